@@ -1,0 +1,87 @@
+//! Criterion benchmarks of the core algorithms on the bundled UR5 and, when the
+//! `example-robot-data` URDFs are found (`ROBODYN_ROBOTS_DIR` or the test virtual environment),
+//! on Panda and Talos.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use rand::{rngs::StdRng, SeedableRng};
+use robodyn::algo::{aba, crba, forward_kinematics, jacobian, rnea, Reference};
+use robodyn::io::{bundled_model, load_urdf_file};
+use robodyn::{Data, Model};
+use std::hint::black_box;
+use std::path::PathBuf;
+
+/// The example-robot-data robots directory, if present.
+fn robots_dir() -> Option<PathBuf> {
+    let dir = std::env::var("ROBODYN_ROBOTS_DIR").map(PathBuf::from).unwrap_or_else(|_| {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../../.venv/lib/python3.11/site-packages/cmeel.prefix/share/example-robot-data/robots")
+    });
+    dir.is_dir().then_some(dir)
+}
+
+fn models() -> Vec<(&'static str, Model)> {
+    let mut models = vec![("ur5", bundled_model("ur5", false).expect("bundled ur5"))];
+    if let Some(dir) = robots_dir() {
+        for (name, path, floating) in [
+            ("panda", "panda_description/urdf/panda.urdf", false),
+            ("talos", "talos_data/robots/talos_full_v2.urdf", true),
+        ] {
+            if let Ok(model) = load_urdf_file(&dir.join(path), floating) {
+                models.push((name, model));
+            }
+        }
+    }
+    models
+}
+
+fn benchmarks(c: &mut Criterion) {
+    for (name, model) in models() {
+        let mut data = Data::new(&model);
+        let mut rng = StdRng::seed_from_u64(7);
+        let q = model.random_configuration(&mut rng);
+        let v = nalgebra::DVector::from_element(model.nv, 0.5);
+        let a = nalgebra::DVector::from_element(model.nv, 0.25);
+        let q = q.as_slice();
+        let frame = model.frames.len() - 1;
+        c.bench_function(&format!("{name}/forward_kinematics"), |b| {
+            b.iter(|| forward_kinematics(&model, &mut data, black_box(q)).map(|x| x.len()))
+        });
+        c.bench_function(&format!("{name}/jacobian"), |b| {
+            b.iter(|| {
+                jacobian(&model, &mut data, black_box(q), frame, Reference::World).map(|j| j[0])
+            })
+        });
+        c.bench_function(&format!("{name}/rnea"), |b| {
+            b.iter(|| {
+                rnea(
+                    &model,
+                    &mut data,
+                    black_box(q),
+                    v.as_slice(),
+                    a.as_slice(),
+                    None,
+                )
+                .map(|t| t[0])
+            })
+        });
+        c.bench_function(&format!("{name}/crba"), |b| {
+            b.iter(|| crba(&model, &mut data, black_box(q)).map(|m| m[0]))
+        });
+        c.bench_function(&format!("{name}/aba"), |b| {
+            b.iter(|| {
+                aba(
+                    &model,
+                    &mut data,
+                    black_box(q),
+                    v.as_slice(),
+                    a.as_slice(),
+                    None,
+                )
+                .map(|t| t[0])
+            })
+        });
+    }
+}
+
+criterion_group!(benches, benchmarks);
+criterion_main!(benches);

@@ -1,0 +1,78 @@
+//! Frame Jacobians: the 6 x nv matrix J with `[v; ω] = J q̇`, rows `[linear; angular]`.
+//!
+//! Reference: seed 001/000's geometric Jacobian (column i of a revolute joint: `[z_i × (p - p_i); z_i]`,
+//! prismatic: `[z_i; 0]`), computed generally as in Featherstone (2008) §8.1: column k of joint j
+//! is the joint's subspace column `S_k` mapped to world coordinates, `X_{j←0}⁻¹ S_k = (ω, v_O)`;
+//! the linear velocity of the frame's origin p is then `v_O + ω × p`.
+//! Input: q (nq), a frame index and a [`Reference`]. Writes `data.x_up`, `data.x_world`,
+//! `data.jacobian`. Cost: O(n) plus one column per ancestor degree of freedom.
+
+use crate::algo::kinematics::{frame_placement, update_body_placements};
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::Data;
+use nalgebra::DMatrix;
+
+/// The coordinates a Jacobian's columns are expressed in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reference {
+    /// Linear velocity of the frame's origin and angular velocity, both in world axes: the lecture
+    /// notes' geometric Jacobian.
+    World,
+    /// The same two vectors in the frame's own axes.
+    Local,
+    /// Featherstone's spatial velocity in world coordinates: the linear velocity of the body point
+    /// passing through the world origin, and the angular velocity (Pinocchio's WORLD).
+    Spatial,
+}
+
+/// J(q) of frame `frame`, written into `data.jacobian` (6 x nv).
+pub fn jacobian<'d>(
+    model: &Model,
+    data: &'d mut Data,
+    q: &[f64],
+    frame: usize,
+    reference: Reference,
+) -> Result<&'d DMatrix<f64>> {
+    model.check_configuration(q)?;
+    if frame >= model.frames.len() {
+        return Err(Error::InvalidValue {
+            argument: "frame".into(),
+            message: format!(
+                "expected a frame index below {}, got {frame}",
+                model.frames.len()
+            ),
+        });
+    }
+    update_body_placements(model, data, q);
+    let pose = frame_placement(model, data, frame);
+    // p: the frame's origin in world coordinates
+    let origin = pose.translation;
+
+    data.jacobian.fill(0.0);
+    let mut j = model.frames[frame].body;
+    while j != 0 {
+        let joint = &model.joints[j];
+        for (k, column) in model.v_range(j).enumerate() {
+            // (ω, v_O) = X_{j←0}⁻¹ S_k
+            let s = data.x_world[j].inverse_apply_motion(&joint.subspace_column(k));
+            let (linear, angular) = match reference {
+                Reference::Spatial => (s.linear, s.angular),
+                // v_p = v_O + ω × p
+                Reference::World => (s.linear + s.angular.cross(&origin), s.angular),
+                Reference::Local => (
+                    pose.rotation * (s.linear + s.angular.cross(&origin)),
+                    pose.rotation * s.angular,
+                ),
+            };
+            data.jacobian
+                .fixed_view_mut::<3, 1>(0, column)
+                .copy_from(&linear);
+            data.jacobian
+                .fixed_view_mut::<3, 1>(3, column)
+                .copy_from(&angular);
+        }
+        j = model.parent[j];
+    }
+    Ok(&data.jacobian)
+}

@@ -1,0 +1,46 @@
+//! Forward kinematics: the placement of every body and frame for a configuration q.
+//!
+//! Reference: Featherstone, *Rigid Body Dynamics Algorithms* (2008), §4.4 (`jcalc`) and the
+//! first lines of Table 5.1: `X_J = jcalc(q_i)`, `X_{i←λ(i)} = X_J X_T(i)`, and the world
+//! transform `X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}`; seed 001 ("forward kinematics": chained `T`).
+//! Cost: one 3x3 rotation product per body.
+
+use crate::error::Result;
+use crate::model::Model;
+use crate::spatial::Transform;
+use crate::Data;
+
+/// Writes `data.x_up` for configuration `q` (assumed already checked).
+pub(crate) fn update_joint_transforms(model: &Model, data: &mut Data, q: &[f64]) {
+    for i in 1..model.nbodies() {
+        // X_{i←λ(i)} = X_J(q_i) X_T(i)
+        data.x_up[i] = model.joints[i].transform(&q[model.q_range(i)]) * model.x_tree[i];
+    }
+}
+
+/// Writes `data.x_up` and `data.x_world` (the pose of every body) for `q` and returns the poses.
+pub(crate) fn update_body_placements(model: &Model, data: &mut Data, q: &[f64]) {
+    update_joint_transforms(model, data, q);
+    for i in 1..model.nbodies() {
+        // X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}
+        data.x_world[i] = data.x_up[i] * data.x_world[model.parent[i]];
+    }
+}
+
+/// Forward kinematics: checks `q`, writes `data.x_up` and `data.x_world`.
+pub fn forward_kinematics<'d>(
+    model: &Model,
+    data: &'d mut Data,
+    q: &[f64],
+) -> Result<&'d [Transform]> {
+    model.check_configuration(q)?;
+    update_body_placements(model, data, q);
+    Ok(&data.x_world)
+}
+
+/// `X_{frame←0}` of frame `frame` from the body placements in `data.x_world` (call
+/// [`forward_kinematics`] first). Its pose in the world is [`Transform::to_homogeneous`].
+pub fn frame_placement(model: &Model, data: &Data, frame: usize) -> Transform {
+    let f = &model.frames[frame];
+    f.placement * data.x_world[f.body]
+}

@@ -1,0 +1,38 @@
+//! The inverse of the joint-space inertia matrix, M(q)⁻¹.
+//!
+//! M from CRBA (Featherstone Table 6.2) is symmetric positive definite, so M⁻¹ comes from its
+//! Cholesky factorisation `M = L Lᵀ` (Featherstone §6.5) solved against the identity.
+//! Input: q (nq). Writes everything `crba` writes, `data.cholesky` and
+//! `data.mass_matrix_inverse`. Cost: O(n d) + O(n³).
+
+use crate::algo::crba::crba;
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::Data;
+use nalgebra::{Cholesky, DMatrix};
+
+/// M(q)⁻¹, written into `data.mass_matrix_inverse`.
+pub fn inverse_mass_matrix<'d>(
+    model: &Model,
+    data: &'d mut Data,
+    q: &[f64],
+) -> Result<&'d DMatrix<f64>> {
+    crba(model, data, q)?;
+    // factor a copy of M in the preallocated workspace: M = L Lᵀ
+    let mut work = std::mem::replace(&mut data.cholesky, DMatrix::zeros(0, 0));
+    work.copy_from(&data.mass_matrix);
+    let Some(factor) = Cholesky::new(work) else {
+        data.cholesky = DMatrix::zeros(model.nv, model.nv);
+        return Err(Error::InvalidValue {
+            argument: "q".into(),
+            message: "the mass matrix is not positive definite at this configuration (a massless \
+                      subtree without armature)"
+                .into(),
+        });
+    };
+    // solve L Lᵀ X = 1
+    data.mass_matrix_inverse.fill_with_identity();
+    factor.solve_mut(&mut data.mass_matrix_inverse);
+    data.cholesky = factor.unpack_dirty();
+    Ok(&data.mass_matrix_inverse)
+}

@@ -1,0 +1,18 @@
+//! One file per algorithm. Each is a free function `f(&Model, &mut Data, inputs) -> Result<..>`
+//! that validates its inputs, writes its results into [`crate::Data`] and allocates nothing.
+
+pub mod aba;
+pub mod crba;
+pub mod energy;
+pub mod jacobian;
+pub mod kinematics;
+pub mod minv;
+pub mod rnea;
+
+pub use aba::aba;
+pub use crba::crba;
+pub use energy::{center_of_mass, kinetic_energy, potential_energy};
+pub use jacobian::{jacobian, Reference};
+pub use kinematics::{forward_kinematics, frame_placement};
+pub use minv::inverse_mass_matrix;
+pub use rnea::{bias_forces, generalized_gravity, rnea};

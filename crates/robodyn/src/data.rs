@@ -1,0 +1,85 @@
+//! The workspace every algorithm writes into, allocated once per model by [`Data::new`].
+//! After that, the algorithms in [`crate::algo`] allocate nothing.
+
+use crate::model::Model;
+use crate::spatial::{Force, Inertia, Mat6, Motion, Transform};
+use nalgebra::{DMatrix, DVector};
+
+/// Results and intermediates of the algorithms, indexed like the model's bodies (0 = world).
+/// Each field says its meaning, shape, frame and which algorithm writes it.
+#[derive(Debug, Clone)]
+pub struct Data {
+    /// `X_{i←λ(i)}`: transform from the parent body's frame to body i's frame; nbodies.
+    /// Written by every algorithm that takes q.
+    pub x_up: Vec<Transform>,
+    /// `X_{i←0}`: transform from the world to body i's frame (its pose in the world); nbodies.
+    /// Written by `forward_kinematics`, `jacobian`, `potential_energy`, `center_of_mass`.
+    pub x_world: Vec<Transform>,
+    /// Spatial velocity of body i in its own frame; nbodies. Written by `rnea`, `aba`,
+    /// `kinetic_energy`.
+    pub v: Vec<Motion>,
+    /// Spatial acceleration of body i in its own frame, gravity included as a fictitious upward
+    /// base acceleration (Featherstone's `a_0 = -g`); nbodies. Written by `rnea`, `aba`.
+    pub a: Vec<Motion>,
+    /// Net spatial force transmitted across joint i, in body i's frame; nbodies. Written by `rnea`.
+    pub f: Vec<Force>,
+    /// Generalized forces; nv. Written by `rnea`.
+    pub tau: DVector<f64>,
+    /// Composite rigid-body inertia of the subtree rooted at body i, in body i's frame; nbodies.
+    /// Written by `crba`.
+    pub i_c: Vec<Inertia>,
+    /// Joint-space inertia matrix M(q), full and symmetric; nv x nv. Written by `crba`.
+    pub mass_matrix: DMatrix<f64>,
+    /// M(q)⁻¹; nv x nv. Written by `inverse_mass_matrix`.
+    pub mass_matrix_inverse: DMatrix<f64>,
+    /// Cholesky factor workspace for `inverse_mass_matrix`; nv x nv.
+    pub cholesky: DMatrix<f64>,
+    /// Velocity-product acceleration `c_i = v_i × v_J` of body i, own frame; nbodies.
+    /// Written by `aba`.
+    pub c: Vec<Motion>,
+    /// Articulated-body inertia `I^A_i` (6x6 on `[angular; linear]`), own frame; nbodies.
+    /// Written by `aba`.
+    pub i_a: Vec<Mat6>,
+    /// Articulated-body bias force `p^A_i`, own frame; nbodies. Written by `aba`.
+    pub p_a: Vec<Force>,
+    /// `U_i = I^A_i S_i`, one force per velocity coordinate of joint i (first nv_i used); nbodies.
+    /// Written by `aba`.
+    pub u: Vec<[Force; 6]>,
+    /// `D_i⁻¹ = (S_iᵀ U_i + armature)⁻¹` in the leading nv_i x nv_i block; nbodies.
+    /// Written by `aba`.
+    pub d_inv: Vec<Mat6>,
+    /// `u_i = τ_i - S_iᵀ p^A_i` (first nv_i used); nbodies. Written by `aba`.
+    pub u_tau: Vec<[f64; 6]>,
+    /// Joint accelerations q̈; nv. Written by `aba`.
+    pub qdd: DVector<f64>,
+    /// Frame Jacobian, 6 x nv, rows `[linear; angular]`. Written by `jacobian`.
+    pub jacobian: DMatrix<f64>,
+}
+
+impl Data {
+    /// Allocates every buffer for `model`.
+    pub fn new(model: &Model) -> Self {
+        let nb = model.nbodies();
+        let nv = model.nv;
+        Data {
+            x_up: vec![Transform::IDENTITY; nb],
+            x_world: vec![Transform::IDENTITY; nb],
+            v: vec![Motion::ZERO; nb],
+            a: vec![Motion::ZERO; nb],
+            f: vec![Force::ZERO; nb],
+            tau: DVector::zeros(nv),
+            i_c: vec![Inertia::ZERO; nb],
+            mass_matrix: DMatrix::zeros(nv, nv),
+            mass_matrix_inverse: DMatrix::zeros(nv, nv),
+            cholesky: DMatrix::zeros(nv, nv),
+            c: vec![Motion::ZERO; nb],
+            i_a: vec![Mat6::zeros(); nb],
+            p_a: vec![Force::ZERO; nb],
+            u: vec![[Force::ZERO; 6]; nb],
+            d_inv: vec![Mat6::zeros(); nb],
+            u_tau: vec![[0.0; 6]; nb],
+            qdd: DVector::zeros(nv),
+            jacobian: DMatrix::zeros(6, nv),
+        }
+    }
+}

@@ -1,0 +1,84 @@
+//! The one error type of the core. Messages name the argument or file element, what was expected
+//! and what was received.
+
+use thiserror::Error;
+
+/// Everything that can go wrong when building a model or calling an algorithm.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum Error {
+    /// A model file does not exist.
+    #[error("model file not found: '{path}'")]
+    FileNotFound { path: String },
+
+    /// A model description is malformed or inconsistent. `location` names the file, element and
+    /// line where known.
+    #[error("{location}: {message}")]
+    InvalidModel { location: String, message: String },
+
+    /// An input array has the wrong length.
+    #[error("argument '{argument}': expected {expected}, got {received}")]
+    Shape {
+        argument: String,
+        expected: String,
+        received: String,
+    },
+
+    /// An input holds NaN or an infinite value.
+    #[error("argument '{argument}': expected finite values, got {value} at index {index}")]
+    NotFinite {
+        argument: String,
+        index: usize,
+        value: f64,
+    },
+
+    /// An input value is finite but outside what the argument accepts (e.g. a non-unit quaternion).
+    #[error("argument '{argument}': {message}")]
+    InvalidValue { argument: String, message: String },
+
+    /// A frame name that the model does not have.
+    #[error("unknown frame '{name}': the model's frames are {available}")]
+    UnknownFrame { name: String, available: String },
+}
+
+/// Result with the core's [`Error`].
+pub type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    /// Shorthand for [`Error::InvalidModel`].
+    pub fn model(location: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::InvalidModel {
+            location: location.into(),
+            message: message.into(),
+        }
+    }
+}
+
+/// Checks that an argument has `expected` entries.
+pub fn check_length(argument: &str, length: usize, expected: usize) -> Result<()> {
+    if length == expected {
+        return Ok(());
+    }
+    Err(Error::Shape {
+        argument: argument.to_string(),
+        expected: format!("length {expected}"),
+        received: format!("length {length}"),
+    })
+}
+
+/// Checks that `values` has `expected` entries, all finite.
+pub fn check_vector(argument: &str, values: &[f64], expected: usize) -> Result<()> {
+    check_length(argument, values.len(), expected)?;
+    check_finite(argument, values)
+}
+
+/// Checks that every entry of `values` is finite.
+pub fn check_finite(argument: &str, values: &[f64]) -> Result<()> {
+    match values.iter().position(|x| !x.is_finite()) {
+        None => Ok(()),
+        Some(index) => Err(Error::NotFinite {
+            argument: argument.to_string(),
+            index,
+            value: values[index],
+        }),
+    }
+}

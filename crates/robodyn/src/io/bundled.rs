@@ -1,0 +1,50 @@
+//! Robot models written by the project from published parameters, compiled into the library so
+//! they need no file at run time. Sources are cited inside each URDF in `models/`.
+
+use crate::error::{Error, Result};
+use crate::io::urdf::load_urdf_str;
+use crate::model::{Model, STANDARD_GRAVITY};
+use crate::spatial::Vec3;
+
+/// (name, URDF text, gravity).
+const BUNDLED: [(&str, &str, [f64; 3]); 3] = [
+    (
+        "ur5",
+        include_str!("../../../../models/ur5.urdf"),
+        [0.0, 0.0, -STANDARD_GRAVITY],
+    ),
+    // the seeds' 2-link arm moves in the x-y plane with gravity along -y
+    (
+        "planar2",
+        include_str!("../../../../models/planar2.urdf"),
+        [0.0, -STANDARD_GRAVITY, 0.0],
+    ),
+    (
+        "pendulum",
+        include_str!("../../../../models/pendulum.urdf"),
+        [0.0, 0.0, -STANDARD_GRAVITY],
+    ),
+];
+
+/// Names of the bundled models.
+pub fn bundled_names() -> Vec<&'static str> {
+    BUNDLED.iter().map(|(name, _, _)| *name).collect()
+}
+
+/// A bundled model by name.
+pub fn bundled_model(name: &str, floating_base: bool) -> Result<Model> {
+    let (_, text, gravity) =
+        BUNDLED
+            .iter()
+            .find(|(n, _, _)| *n == name)
+            .ok_or_else(|| Error::InvalidValue {
+                argument: "name".into(),
+                message: format!(
+                    "expected one of the bundled models {:?}, got '{name}'",
+                    bundled_names()
+                ),
+            })?;
+    let mut model = load_urdf_str(text, &format!("{name}.urdf (bundled)"), floating_base)?;
+    model.gravity = Vec3::from(*gravity);
+    Ok(model)
+}

@@ -1,0 +1,423 @@
+//! URDF loader (ROS's Unified Robot Description Format, <http://wiki.ros.org/urdf/XML>).
+//!
+//! Reads links with their inertials, and joints (`revolute`, `continuous`, `prismatic`, `fixed`,
+//! `floating`, and robodyn's extension `spherical`) with origins, axes, limits, dynamics and mimic
+//! tags. Fixed joints are merged into the parent body and the child link is kept as a frame.
+//! Bodies are numbered depth-first, children in file order. The root link is the world unless
+//! `floating_base` puts a free joint named `root_joint` between the world and the root.
+//! Visual, collision, transmission and gazebo elements are ignored.
+
+use crate::error::{Error, Result};
+use crate::joint::Joint;
+use crate::model::{check_rigid_body, JointProperties, Mimic, Model, ModelBuilder, NewBody};
+use crate::spatial::{rotation_from_rpy, Inertia, Mat3, Transform, Vec3};
+use roxmltree::{Document, Node};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// Loads a URDF file.
+pub fn load_urdf_file(path: &Path, floating_base: bool) -> Result<Model> {
+    let text = std::fs::read_to_string(path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => Error::FileNotFound {
+            path: path.display().to_string(),
+        },
+        _ => Error::model(
+            path.display().to_string(),
+            format!("cannot read the file: {e}"),
+        ),
+    })?;
+    load_urdf_str(&text, &path.display().to_string(), floating_base)
+}
+
+/// Loads a URDF document held in `text`; `source` names it in error messages.
+pub fn load_urdf_str(text: &str, source: &str, floating_base: bool) -> Result<Model> {
+    let document =
+        Document::parse(text).map_err(|e| Error::model(source, format!("malformed XML: {e}")))?;
+    let parser = Parser {
+        source,
+        document: &document,
+    };
+    let robot = document.root_element();
+    if robot.tag_name().name() != "robot" {
+        return Err(parser.error(robot, "expected the root element <robot>"));
+    }
+    let links = parser.links(robot)?;
+    let joints = parser.joints(robot, &links)?;
+    parser.build(robot, &links, &joints, floating_base)
+}
+
+/// A parsed `<link>`.
+struct Link<'a> {
+    name: &'a str,
+    node: Node<'a, 'a>,
+    inertia: Inertia,
+}
+
+/// A parsed `<joint>`; `joint` is `None` for a fixed joint.
+struct UrdfJoint<'a> {
+    name: &'a str,
+    node: Node<'a, 'a>,
+    joint: Option<Joint>,
+    parent: usize,
+    child: usize,
+    origin: Transform,
+    properties: JointProperties,
+    mimic: Option<(&'a str, f64, f64)>,
+}
+
+struct Parser<'a> {
+    source: &'a str,
+    document: &'a Document<'a>,
+}
+
+impl<'a> Parser<'a> {
+    /// An error located at `node`: file, element (with its name attribute) and line.
+    fn error(&self, node: Node, message: impl Into<String>) -> Error {
+        let position = self.document.text_pos_at(node.range().start);
+        let name = node
+            .attribute("name")
+            .map(|n| format!(" name='{n}'"))
+            .unwrap_or_default();
+        Error::model(
+            format!(
+                "{}: <{}{}> (line {})",
+                self.source,
+                node.tag_name().name(),
+                name,
+                position.row
+            ),
+            message,
+        )
+    }
+
+    /// A required attribute.
+    fn attribute(&self, node: Node<'a, 'a>, name: &str) -> Result<&'a str> {
+        node.attribute(name)
+            .ok_or_else(|| self.error(node, format!("missing attribute '{name}'")))
+    }
+
+    /// An attribute of `n` numbers, or `default` when absent.
+    fn numbers<const N: usize>(
+        &self,
+        node: Node,
+        name: &str,
+        default: [f64; N],
+    ) -> Result<[f64; N]> {
+        let Some(text) = node.attribute(name) else {
+            return Ok(default);
+        };
+        let values: Vec<&str> = text.split_whitespace().collect();
+        let mut out = [0.0; N];
+        if values.len() != N {
+            return Err(self.error(
+                node,
+                format!("attribute '{name}': expected {N} numbers, got '{text}'"),
+            ));
+        }
+        for (slot, value) in out.iter_mut().zip(&values) {
+            *slot = value
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| {
+                    self.error(
+                        node,
+                        format!("attribute '{name}': expected finite numbers, got '{text}'"),
+                    )
+                })?;
+        }
+        Ok(out)
+    }
+
+    /// `<origin xyz rpy>` of `node` (identity when absent), as the transform into that frame.
+    fn origin(&self, node: Node) -> Result<Transform> {
+        let Some(origin) = node.children().find(|c| c.has_tag_name("origin")) else {
+            return Ok(Transform::IDENTITY);
+        };
+        let [x, y, z] = self.numbers(origin, "xyz", [0.0; 3])?;
+        let [roll, pitch, yaw] = self.numbers(origin, "rpy", [0.0; 3])?;
+        Ok(Transform::from_pose(
+            &rotation_from_rpy(roll, pitch, yaw),
+            &Vec3::new(x, y, z),
+        ))
+    }
+
+    fn child(node: Node<'a, 'a>, tag: &str) -> Option<Node<'a, 'a>> {
+        node.children().find(|c| c.has_tag_name(tag))
+    }
+
+    /// Every `<link>` with its spatial inertia in the link frame.
+    fn links(&self, robot: Node<'a, 'a>) -> Result<Vec<Link<'a>>> {
+        let mut links: Vec<Link<'a>> = Vec::new();
+        for node in robot.children().filter(|c| c.has_tag_name("link")) {
+            let name = self.attribute(node, "name")?;
+            if links.iter().any(|l| l.name == name) {
+                return Err(self.error(node, "duplicate link name"));
+            }
+            let inertia = match Self::child(node, "inertial") {
+                None => Inertia::ZERO,
+                Some(inertial) => self.inertial(inertial)?,
+            };
+            links.push(Link {
+                name,
+                node,
+                inertia,
+            });
+        }
+        if links.is_empty() {
+            return Err(self.error(robot, "expected at least one <link>"));
+        }
+        Ok(links)
+    }
+
+    /// `<inertial>`: mass, centre of mass and rotational inertia, with their own origin.
+    fn inertial(&self, inertial: Node<'a, 'a>) -> Result<Inertia> {
+        let mass_node =
+            Self::child(inertial, "mass").ok_or_else(|| self.error(inertial, "missing <mass>"))?;
+        let [mass] = self.numbers(mass_node, "value", [f64::NAN])?;
+        if mass.is_nan() {
+            return Err(self.error(mass_node, "missing attribute 'value'"));
+        }
+        let inertia_com = match Self::child(inertial, "inertia") {
+            None => Mat3::zeros(),
+            Some(node) => {
+                let get = |name: &str| self.numbers(node, name, [0.0]).map(|[x]| x);
+                let (ixx, ixy, ixz) = (get("ixx")?, get("ixy")?, get("ixz")?);
+                let (iyy, iyz, izz) = (get("iyy")?, get("iyz")?, get("izz")?);
+                Mat3::new(ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz)
+            }
+        };
+        // the inertial frame: origin at the centre of mass, axes rotated by R = rpy
+        let frame = self.origin(inertial)?;
+        let rotation = frame.rotation.transpose();
+        let inertia_com = rotation * inertia_com * rotation.transpose();
+        check_rigid_body(mass, &inertia_com).map_err(|message| self.error(inertial, message))?;
+        Ok(Inertia::from_com(mass, &frame.translation, &inertia_com))
+    }
+
+    /// Every `<joint>`, with its links resolved to indices into `links`.
+    fn joints(&self, robot: Node<'a, 'a>, links: &[Link<'a>]) -> Result<Vec<UrdfJoint<'a>>> {
+        let index: HashMap<&str, usize> =
+            links.iter().enumerate().map(|(i, l)| (l.name, i)).collect();
+        let mut joints: Vec<UrdfJoint<'a>> = Vec::new();
+        for node in robot.children().filter(|c| c.has_tag_name("joint")) {
+            let name = self.attribute(node, "name")?;
+            if joints.iter().any(|j| j.name == name) {
+                return Err(self.error(node, "duplicate joint name"));
+            }
+            let link_of = |tag: &str| -> Result<usize> {
+                let element = Self::child(node, tag)
+                    .ok_or_else(|| self.error(node, format!("missing <{tag}>")))?;
+                let link = self.attribute(element, "link")?;
+                index.get(link).copied().ok_or_else(|| {
+                    self.error(node, format!("<{tag} link='{link}'>: no link of that name"))
+                })
+            };
+            let (parent, child) = (link_of("parent")?, link_of("child")?);
+            let kind = self.attribute(node, "type")?;
+            let axis = match Self::child(node, "axis") {
+                None => Vec3::x(),
+                Some(a) => Vec3::from(self.numbers(a, "xyz", [1.0, 0.0, 0.0])?),
+            };
+            let unit_axis = || -> Result<Vec3> {
+                let norm = axis.norm();
+                if norm < 1e-12 {
+                    return Err(self.error(node, "<axis>: expected a non-zero vector, got 0 0 0"));
+                }
+                Ok(axis / norm)
+            };
+            let joint = match kind {
+                "revolute" | "continuous" => Some(Joint::Revolute { axis: unit_axis()? }),
+                "prismatic" => Some(Joint::Prismatic { axis: unit_axis()? }),
+                "floating" => Some(Joint::Free),
+                "spherical" => Some(Joint::Spherical),
+                "fixed" => None,
+                other => {
+                    return Err(self.error(
+                        node,
+                        format!(
+                        "unknown joint type '{other}': expected revolute, continuous, prismatic, \
+                             fixed, floating or spherical"
+                    ),
+                    ))
+                }
+            };
+            let mut properties = JointProperties::default();
+            if let Some(limit) = Self::child(node, "limit") {
+                if kind != "continuous" {
+                    [properties.lower] = self.numbers(limit, "lower", [f64::NEG_INFINITY])?;
+                    [properties.upper] = self.numbers(limit, "upper", [f64::INFINITY])?;
+                    // URDF's default for an absent lower/upper pair is 0 0, meaning no limits
+                    if properties.lower == 0.0 && properties.upper == 0.0 {
+                        properties.lower = f64::NEG_INFINITY;
+                        properties.upper = f64::INFINITY;
+                    }
+                }
+                [properties.effort_limit] = self.numbers(limit, "effort", [f64::INFINITY])?;
+                [properties.velocity_limit] = self.numbers(limit, "velocity", [f64::INFINITY])?;
+            }
+            if let Some(dynamics) = Self::child(node, "dynamics") {
+                [properties.damping] = self.numbers(dynamics, "damping", [0.0])?;
+                [properties.friction] = self.numbers(dynamics, "friction", [0.0])?;
+            }
+            let mimic = match Self::child(node, "mimic") {
+                None => None,
+                Some(m) => Some((
+                    self.attribute(m, "joint")?,
+                    self.numbers(m, "multiplier", [1.0])?[0],
+                    self.numbers(m, "offset", [0.0])?[0],
+                )),
+            };
+            joints.push(UrdfJoint {
+                name,
+                node,
+                joint,
+                parent,
+                child,
+                origin: self.origin(node)?,
+                properties,
+                mimic,
+            });
+        }
+        Ok(joints)
+    }
+
+    /// Checks that links and joints form one tree and builds the model depth-first.
+    fn build(
+        &self,
+        robot: Node,
+        links: &[Link<'a>],
+        joints: &[UrdfJoint<'a>],
+        floating_base: bool,
+    ) -> Result<Model> {
+        // the tree: one parent joint per link, exactly one root
+        let mut parent_joint: Vec<Option<usize>> = vec![None; links.len()];
+        for (j, joint) in joints.iter().enumerate() {
+            if let Some(other) = parent_joint[joint.child] {
+                return Err(self.error(
+                    joint.node,
+                    format!(
+                        "link '{}' already has the parent joint '{}': a link may have only one \
+                         (the description must be a tree)",
+                        links[joint.child].name, joints[other].name
+                    ),
+                ));
+            }
+            parent_joint[joint.child] = Some(j);
+        }
+        let roots: Vec<usize> = (0..links.len())
+            .filter(|&l| parent_joint[l].is_none())
+            .collect();
+        let root = match roots.as_slice() {
+            [root] => *root,
+            [] => {
+                return Err(self.error(
+                    robot,
+                    "every link has a parent joint: the joints form a cycle",
+                ))
+            }
+            many => {
+                let names: Vec<&str> = many.iter().map(|&l| links[l].name).collect();
+                return Err(self.error(
+                    robot,
+                    format!(
+                        "expected one root link, got {} not connected to each other: {names:?}",
+                        many.len()
+                    ),
+                ));
+            }
+        };
+
+        let robot_name = robot.attribute("name").unwrap_or("robot");
+        let mut builder = ModelBuilder::new(robot_name, links[root].name);
+        // each link's body and X_{link←body}
+        let mut placement: Vec<Option<(usize, Transform)>> = vec![None; links.len()];
+        if floating_base {
+            let body = builder.add_body(NewBody {
+                parent: 0,
+                joint: Joint::Free,
+                joint_name: "root_joint",
+                x_tree: Transform::IDENTITY,
+                properties: JointProperties::default(),
+                name: links[root].name,
+                inertia: links[root].inertia,
+            })?;
+            placement[root] = Some((body, Transform::IDENTITY));
+        } else {
+            builder.add_frame(links[root].name, 0, Transform::IDENTITY);
+            placement[root] = Some((0, Transform::IDENTITY));
+        }
+
+        // depth-first from the root, children in file order
+        let mut body_of_joint: HashMap<&str, usize> = HashMap::new();
+        let mut stack: Vec<usize> = joints
+            .iter()
+            .enumerate()
+            .rev()
+            .filter(|(_, j)| j.parent == root)
+            .map(|(i, _)| i)
+            .collect();
+        while let Some(j) = stack.pop() {
+            let joint = &joints[j];
+            let (body, link_placement) = placement[joint.parent]
+                .ok_or_else(|| self.error(joint.node, "parent link not reached from the root"))?;
+            // X_T = X_{joint←parent link} X_{parent link←body}
+            let x_tree = joint.origin * link_placement;
+            let child = &links[joint.child];
+            placement[joint.child] = Some(match joint.joint {
+                None => {
+                    builder.add_fixed_link(body, x_tree, child.inertia, child.name);
+                    (body, x_tree)
+                }
+                Some(kind) => {
+                    let index = builder.add_body(NewBody {
+                        parent: body,
+                        joint: kind,
+                        joint_name: joint.name,
+                        x_tree,
+                        properties: joint.properties,
+                        name: child.name,
+                        inertia: child.inertia,
+                    })?;
+                    body_of_joint.insert(joint.name, index);
+                    (index, Transform::IDENTITY)
+                }
+            });
+            stack.extend(
+                joints
+                    .iter()
+                    .enumerate()
+                    .rev()
+                    .filter(|(_, c)| c.parent == joint.child)
+                    .map(|(i, _)| i),
+            );
+        }
+        if let Some(orphan) = placement.iter().position(|p| p.is_none()) {
+            return Err(self.error(
+                links[orphan].node,
+                "link not connected to the root link (the joints form a cycle or a separate tree)",
+            ));
+        }
+
+        // mimic relations, between moving joints
+        for joint in joints {
+            if let Some((mimicked, multiplier, offset)) = joint.mimic {
+                let resolve = |name: &str| {
+                    body_of_joint.get(name).copied().ok_or_else(|| {
+                        self.error(
+                            joint.node,
+                            format!("<mimic joint='{mimicked}'>: '{name}' is not a moving joint"),
+                        )
+                    })
+                };
+                builder.add_mimic(Mimic {
+                    joint: resolve(joint.name)?,
+                    mimicked: resolve(mimicked)?,
+                    multiplier,
+                    offset,
+                });
+            }
+        }
+        Ok(builder.build())
+    }
+}

@@ -1,0 +1,249 @@
+//! Joints: the only place in robodyn that matches on the joint type.
+//!
+//! Each joint answers Featherstone's `jcalc` (*Rigid Body Dynamics Algorithms*, §4.4, Table 4.1):
+//! the joint transform `X_J(q)`, the motion subspace `S` (one [`Motion`] column per velocity
+//! coordinate, in the child body's frame) and the joint velocity `v_J = S q̇`. Every joint here has a
+//! constant `S` in the child frame, so the bias `c_J = Ṡ q̇` is zero. Configuration integration and
+//! differences act on the joint's Lie group (quaternions for the spherical and free joints), so
+//! `difference(q, integrate(q, v)) = v`.
+
+use crate::spatial::{skew, Mat3, Motion, Transform, Vec3};
+use nalgebra::{Quaternion, Rotation3, UnitQuaternion};
+use rand::Rng;
+
+/// Below this rotation angle the SE(3)/SO(3) exponential and logarithm use their Taylor series.
+const SMALL_ANGLE: f64 = 1e-6;
+
+/// A joint between a body and its parent.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Joint {
+    /// No motion: nq = nv = 0. Only the world (body 0) carries it; the loaders merge fixed joints
+    /// into the parent body and keep the child link as a frame.
+    Fixed,
+    /// Rotation about a unit `axis` of the joint frame. q = [angle] (rad), v = [angular rate]
+    /// (rad/s). A URDF `continuous` joint is a revolute joint without position limits.
+    Revolute { axis: Vec3 },
+    /// Translation along a unit `axis` of the joint frame. q = [displacement] (m), v = [rate] (m/s).
+    Prismatic { axis: Vec3 },
+    /// Ball joint. q = [qx, qy, qz, qw], the unit quaternion (scalar last) of the child's rotation
+    /// relative to the joint frame; v = [ωx, ωy, ωz], the child's angular velocity in child axes.
+    Spherical,
+    /// Floating base. q = [x, y, z, qx, qy, qz, qw]: the child's origin in the parent frame and its
+    /// orientation (unit quaternion, scalar last); v = [vx, vy, vz, ωx, ωy, ωz]: the linear
+    /// velocity of the child's origin and its angular velocity, both in the child's own axes.
+    Free,
+}
+
+impl Joint {
+    /// Number of configuration coordinates.
+    pub fn nq(&self) -> usize {
+        match self {
+            Joint::Fixed => 0,
+            Joint::Revolute { .. } | Joint::Prismatic { .. } => 1,
+            Joint::Spherical => 4,
+            Joint::Free => 7,
+        }
+    }
+
+    /// Number of velocity coordinates (degrees of freedom).
+    pub fn nv(&self) -> usize {
+        match self {
+            Joint::Fixed => 0,
+            Joint::Revolute { .. } | Joint::Prismatic { .. } => 1,
+            Joint::Spherical => 3,
+            Joint::Free => 6,
+        }
+    }
+
+    /// A short lowercase name: "revolute", "prismatic", "spherical", "free", "fixed".
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Joint::Fixed => "fixed",
+            Joint::Revolute { .. } => "revolute",
+            Joint::Prismatic { .. } => "prismatic",
+            Joint::Spherical => "spherical",
+            Joint::Free => "free",
+        }
+    }
+
+    /// Where the unit quaternion sits inside this joint's q, if it has one.
+    pub fn quaternion_offset(&self) -> Option<usize> {
+        match self {
+            Joint::Spherical => Some(0),
+            Joint::Free => Some(3),
+            _ => None,
+        }
+    }
+
+    /// The joint transform `X_J(q)` from the joint frame to the child body frame.
+    /// `q` is this joint's slice of the configuration.
+    pub fn transform(&self, q: &[f64]) -> Transform {
+        match self {
+            Joint::Fixed => Transform::IDENTITY,
+            Joint::Revolute { axis } => Transform::from_axis_angle(axis, q[0]),
+            Joint::Prismatic { axis } => Transform::from_translation(&(axis * q[0])),
+            Joint::Spherical => Transform::from_pose(&rotation_of(&q[0..4]), &Vec3::zeros()),
+            Joint::Free => {
+                Transform::from_pose(&rotation_of(&q[3..7]), &Vec3::new(q[0], q[1], q[2]))
+            }
+        }
+    }
+
+    /// Column `k` of the motion subspace `S`, in the child frame.
+    pub fn subspace_column(&self, k: usize) -> Motion {
+        let unit = |i: usize| Vec3::ith(i % 3, 1.0);
+        match self {
+            Joint::Fixed => Motion::ZERO,
+            Joint::Revolute { axis } => Motion::new(*axis, Vec3::zeros()),
+            Joint::Prismatic { axis } => Motion::new(Vec3::zeros(), *axis),
+            Joint::Spherical => Motion::new(unit(k), Vec3::zeros()),
+            Joint::Free if k < 3 => Motion::new(Vec3::zeros(), unit(k)),
+            Joint::Free => Motion::new(unit(k), Vec3::zeros()),
+        }
+    }
+
+    /// The joint velocity `v_J = S q̇` for this joint's slice `v` of the velocity.
+    pub fn motion(&self, v: &[f64]) -> Motion {
+        (0..self.nv()).fold(Motion::ZERO, |sum, k| sum + self.subspace_column(k) * v[k])
+    }
+
+    /// The neutral configuration (zero angles, identity quaternions).
+    pub fn neutral(&self, q: &mut [f64]) {
+        q.fill(0.0);
+        if let Some(offset) = self.quaternion_offset() {
+            q[offset + 3] = 1.0;
+        }
+    }
+
+    /// A random configuration: uniform within finite `lower`/`upper` limits, otherwise within
+    /// [-π, π] for angles and [-1, 1] m for translations; uniformly distributed rotations.
+    pub fn random<R: Rng>(&self, rng: &mut R, lower: &[f64], upper: &[f64], q: &mut [f64]) {
+        for i in 0..self.nq() {
+            let default = match self {
+                Joint::Revolute { .. } => std::f64::consts::PI,
+                _ => 1.0,
+            };
+            let (lo, hi) = if lower[i].is_finite() && upper[i].is_finite() && lower[i] <= upper[i] {
+                (lower[i], upper[i])
+            } else {
+                (-default, default)
+            };
+            q[i] = lo + (hi - lo) * rng.random::<f64>();
+        }
+        if let Some(offset) = self.quaternion_offset() {
+            // Shoemake's uniform random rotation
+            let (u1, u2, u3): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
+            let tau = std::f64::consts::TAU;
+            let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+            q[offset..offset + 4].copy_from_slice(&[
+                a * (tau * u2).sin(),
+                a * (tau * u2).cos(),
+                b * (tau * u3).sin(),
+                b * (tau * u3).cos(),
+            ]);
+        }
+    }
+
+    /// `q ⊕ v`: the configuration reached from `q` by moving with constant velocity `v` for unit
+    /// time, on the joint's Lie group (body-frame velocities, right multiplication).
+    pub fn integrate(&self, q: &[f64], v: &[f64], out: &mut [f64]) {
+        match self {
+            Joint::Fixed => {}
+            Joint::Revolute { .. } | Joint::Prismatic { .. } => out[0] = q[0] + v[0],
+            Joint::Spherical => {
+                let rotation = quaternion_of(&q[0..4]) * exp_so3(&Vec3::new(v[0], v[1], v[2]));
+                write_quaternion(&rotation, &mut out[0..4]);
+            }
+            Joint::Free => {
+                let rotation = quaternion_of(&q[3..7]);
+                let (rotation_step, translation_step) =
+                    exp_se3(&Vec3::new(v[0], v[1], v[2]), &Vec3::new(v[3], v[4], v[5]));
+                let position = Vec3::new(q[0], q[1], q[2]) + rotation * translation_step;
+                out[0..3].copy_from_slice(position.as_slice());
+                write_quaternion(&(rotation * rotation_step), &mut out[3..7]);
+            }
+        }
+    }
+
+    /// `q1 ⊖ q0`: the velocity `v` with `integrate(q0, v) = q1`.
+    pub fn difference(&self, q0: &[f64], q1: &[f64], v: &mut [f64]) {
+        match self {
+            Joint::Fixed => {}
+            Joint::Revolute { .. } | Joint::Prismatic { .. } => v[0] = q1[0] - q0[0],
+            Joint::Spherical => {
+                let relative = quaternion_of(&q0[0..4]).inverse() * quaternion_of(&q1[0..4]);
+                v.copy_from_slice(relative.scaled_axis().as_slice());
+            }
+            Joint::Free => {
+                let r0 = quaternion_of(&q0[3..7]);
+                let relative_rotation = r0.inverse() * quaternion_of(&q1[3..7]);
+                let relative_position = r0.inverse()
+                    * (Vec3::new(q1[0], q1[1], q1[2]) - Vec3::new(q0[0], q0[1], q0[2]));
+                let (linear, angular) = log_se3(&relative_rotation, &relative_position);
+                v[0..3].copy_from_slice(linear.as_slice());
+                v[3..6].copy_from_slice(angular.as_slice());
+            }
+        }
+    }
+}
+
+/// The unit quaternion of `[qx, qy, qz, qw]` (normalised).
+fn quaternion_of(q: &[f64]) -> UnitQuaternion<f64> {
+    UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]))
+}
+
+/// The rotation matrix of `[qx, qy, qz, qw]`.
+fn rotation_of(q: &[f64]) -> Mat3 {
+    *quaternion_of(q).to_rotation_matrix().matrix()
+}
+
+/// Writes `[qx, qy, qz, qw]`, with qw ≥ 0 for a canonical sign.
+fn write_quaternion(rotation: &UnitQuaternion<f64>, out: &mut [f64]) {
+    let sign = if rotation.w < 0.0 { -1.0 } else { 1.0 };
+    out.copy_from_slice(&[
+        sign * rotation.i,
+        sign * rotation.j,
+        sign * rotation.k,
+        sign * rotation.w,
+    ]);
+}
+
+/// `exp(ω×)` on SO(3).
+fn exp_so3(omega: &Vec3) -> UnitQuaternion<f64> {
+    UnitQuaternion::from_scaled_axis(*omega)
+}
+
+/// The left Jacobian of SO(3), `V(ω) = 1 + (1 - cos θ)/θ² ω× + (θ - sin θ)/θ³ ω×²`, which maps a
+/// body twist's linear part to the translation of `exp` on SE(3).
+fn left_jacobian_so3(omega: &Vec3) -> Mat3 {
+    let theta = omega.norm();
+    let w = skew(omega);
+    let (a, b) = if theta < SMALL_ANGLE {
+        (
+            0.5 - theta * theta / 24.0,
+            1.0 / 6.0 - theta * theta / 120.0,
+        )
+    } else {
+        let t2 = theta * theta;
+        (
+            (1.0 - theta.cos()) / t2,
+            (theta - theta.sin()) / (t2 * theta),
+        )
+    };
+    Mat3::identity() + w * a + w * w * b
+}
+
+/// `exp` on SE(3) of the body twist (v, ω): rotation `exp(ω×)`, translation `V(ω) v`.
+fn exp_se3(linear: &Vec3, angular: &Vec3) -> (UnitQuaternion<f64>, Vec3) {
+    (exp_so3(angular), left_jacobian_so3(angular) * linear)
+}
+
+/// `log` on SE(3): the body twist (v, ω) with `exp_se3(v, ω) = (rotation, translation)`.
+fn log_se3(rotation: &UnitQuaternion<f64>, translation: &Vec3) -> (Vec3, Vec3) {
+    let angular = Rotation3::from(*rotation).scaled_axis();
+    let v = left_jacobian_so3(&angular);
+    let linear = v
+        .try_inverse()
+        .map_or(*translation, |inv| inv * translation);
+    (linear, angular)
+}

@@ -1,0 +1,414 @@
+//! The model: topology and constants of a robot. Algorithms never mutate it; everything they
+//! write goes into [`crate::Data`].
+
+use crate::error::{check_length, check_vector, Error, Result};
+use crate::joint::Joint;
+use crate::spatial::{Inertia, Mat3, Transform, Vec3};
+use nalgebra::DVector;
+use rand::Rng;
+
+/// How far a quaternion in q may be from unit norm before it is rejected.
+pub const QUATERNION_NORM_TOLERANCE: f64 = 1e-6;
+/// Slack allowed when checking that a rotational inertia is positive semi-definite, relative to
+/// its largest principal moment.
+pub const INERTIA_EIGENVALUE_TOLERANCE: f64 = 1e-9;
+/// Standard gravity, m/s², used by the default gravity vector `[0, 0, -9.81]`.
+pub const STANDARD_GRAVITY: f64 = 9.81;
+
+/// A named frame rigidly attached to a body: a URDF link (moving or merged through a fixed joint)
+/// or a user frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame {
+    pub name: String,
+    /// The body it is attached to (0 = world).
+    pub body: usize,
+    /// `X_{frame←body}`: the frame's placement relative to its body.
+    pub placement: Transform,
+}
+
+/// A mimic relation from URDF: `q[joint] = multiplier * q[mimicked] + offset`. robodyn keeps both
+/// joints independent and reports the relation; enforcing it is the caller's choice.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mimic {
+    /// Body index of the mimicking joint.
+    pub joint: usize,
+    /// Body index of the mimicked joint.
+    pub mimicked: usize,
+    pub multiplier: f64,
+    pub offset: f64,
+}
+
+/// Per-joint constants other than its kind and placement. Scalars apply to every velocity
+/// coordinate of the joint; limits to every configuration coordinate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointProperties {
+    pub lower: f64,
+    pub upper: f64,
+    pub velocity_limit: f64,
+    pub effort_limit: f64,
+    /// Rotor inertia reflected through the transmission; adds to M's diagonal.
+    pub armature: f64,
+    pub damping: f64,
+    pub friction: f64,
+}
+
+impl Default for JointProperties {
+    fn default() -> Self {
+        JointProperties {
+            lower: f64::NEG_INFINITY,
+            upper: f64::INFINITY,
+            velocity_limit: f64::INFINITY,
+            effort_limit: f64::INFINITY,
+            armature: 0.0,
+            damping: 0.0,
+            friction: 0.0,
+        }
+    }
+}
+
+/// A rigid multibody tree. Bodies are numbered so that `parent[i] < i`; body 0 is the world and
+/// has no joint (`Joint::Fixed`). Body `i ≥ 1` moves relative to its parent through `joints[i]`.
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub name: String,
+    /// Number of configuration coordinates.
+    pub nq: usize,
+    /// Number of velocity coordinates (degrees of freedom).
+    pub nv: usize,
+    /// Parent body of each body (`parent[0] = 0`).
+    pub parent: Vec<usize>,
+    /// Joint of each body (`joints[0] = Joint::Fixed`, the world).
+    pub joints: Vec<Joint>,
+    /// Name of each body's joint (`"universe"` for the world).
+    pub joint_names: Vec<String>,
+    /// Name of each body (its link).
+    pub body_names: Vec<String>,
+    /// `x_tree[i]`: Featherstone's `X_T`, from the parent body frame to body i's joint frame.
+    pub x_tree: Vec<Transform>,
+    /// Spatial inertia of each body about its own origin, in its own axes (fixed links merged).
+    pub inertias: Vec<Inertia>,
+    /// First index of body i's joint in q.
+    pub idx_q: Vec<usize>,
+    /// First index of body i's joint in v.
+    pub idx_v: Vec<usize>,
+    /// Position limits, length nq (±inf where none).
+    pub lower_position_limit: DVector<f64>,
+    pub upper_position_limit: DVector<f64>,
+    /// Velocity and effort limits, length nv (inf where none).
+    pub velocity_limit: DVector<f64>,
+    pub effort_limit: DVector<f64>,
+    /// Rotor inertia per velocity coordinate, added to M's diagonal, RNEA and ABA.
+    pub armature: DVector<f64>,
+    /// Viscous damping and dry friction per velocity coordinate (kept for simulation; the
+    /// dynamics algorithms do not apply them).
+    pub damping: DVector<f64>,
+    pub friction: DVector<f64>,
+    /// Named frames: one per link, moving or merged.
+    pub frames: Vec<Frame>,
+    /// Gravitational acceleration in world axes.
+    pub gravity: Vec3,
+    /// Mimic relations, reported, not enforced.
+    pub mimics: Vec<Mimic>,
+}
+
+impl Model {
+    /// Number of bodies including the world.
+    pub fn nbodies(&self) -> usize {
+        self.parent.len()
+    }
+
+    /// Index of the frame called `name`.
+    pub fn frame_index(&self, name: &str) -> Result<usize> {
+        self.frames
+            .iter()
+            .position(|f| f.name == name)
+            .ok_or_else(|| Error::UnknownFrame {
+                name: name.to_string(),
+                available: format!(
+                    "[{}]",
+                    self.frames
+                        .iter()
+                        .map(|f| format!("'{}'", f.name))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            })
+    }
+
+    /// The range of body i's coordinates in q.
+    pub fn q_range(&self, i: usize) -> std::ops::Range<usize> {
+        self.idx_q[i]..self.idx_q[i] + self.joints[i].nq()
+    }
+
+    /// The range of body i's coordinates in v.
+    pub fn v_range(&self, i: usize) -> std::ops::Range<usize> {
+        self.idx_v[i]..self.idx_v[i] + self.joints[i].nv()
+    }
+
+    /// The neutral configuration: zero angles and displacements, identity quaternions.
+    pub fn neutral(&self) -> DVector<f64> {
+        let mut q = DVector::zeros(self.nq);
+        for i in 1..self.nbodies() {
+            self.joints[i].neutral(&mut q.as_mut_slice()[self.q_range(i)]);
+        }
+        q
+    }
+
+    /// A random configuration within the position limits (see [`Joint::random`]).
+    pub fn random_configuration<R: Rng>(&self, rng: &mut R) -> DVector<f64> {
+        let mut q = DVector::zeros(self.nq);
+        for i in 1..self.nbodies() {
+            let range = self.q_range(i);
+            self.joints[i].random(
+                rng,
+                &self.lower_position_limit.as_slice()[range.clone()],
+                &self.upper_position_limit.as_slice()[range.clone()],
+                &mut q.as_mut_slice()[range],
+            );
+        }
+        q
+    }
+
+    /// Checks a configuration: length nq, finite, unit quaternions.
+    pub fn check_configuration(&self, q: &[f64]) -> Result<()> {
+        check_vector("q", q, self.nq)?;
+        for i in 1..self.nbodies() {
+            if let Some(offset) = self.joints[i].quaternion_offset() {
+                let start = self.idx_q[i] + offset;
+                let norm = q[start..start + 4]
+                    .iter()
+                    .map(|x| x * x)
+                    .sum::<f64>()
+                    .sqrt();
+                if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
+                    return Err(Error::InvalidValue {
+                        argument: "q".into(),
+                        message: format!(
+                            "expected a unit quaternion [qx, qy, qz, qw] at q[{}..{}] (joint '{}'), \
+                             got norm {norm}",
+                            start,
+                            start + 4,
+                            self.joint_names[i]
+                        ),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// `q ⊕ v`: integrates every joint on its Lie group for unit time (scale v for a time step).
+    pub fn integrate(&self, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<()> {
+        self.check_configuration(q)?;
+        check_vector("v", v, self.nv)?;
+        check_length("out", out.len(), self.nq)?;
+        for i in 1..self.nbodies() {
+            self.joints[i].integrate(
+                &q[self.q_range(i)],
+                &v[self.v_range(i)],
+                &mut out[self.q_range(i)],
+            );
+        }
+        Ok(())
+    }
+
+    /// `q1 ⊖ q0`: the velocity that integrates q0 into q1 in unit time.
+    pub fn difference(&self, q0: &[f64], q1: &[f64], v: &mut [f64]) -> Result<()> {
+        self.check_configuration(q0)?;
+        self.check_configuration(q1)?;
+        check_length("out", v.len(), self.nv)?;
+        for i in 1..self.nbodies() {
+            self.joints[i].difference(
+                &q0[self.q_range(i)],
+                &q1[self.q_range(i)],
+                &mut v[self.v_range(i)],
+            );
+        }
+        Ok(())
+    }
+
+    /// Total mass.
+    pub fn total_mass(&self) -> f64 {
+        self.inertias.iter().skip(1).map(|i| i.mass).sum()
+    }
+}
+
+/// Checks that (mass, rotational inertia about the COM) describe a physical rigid body: finite,
+/// mass ≥ 0, symmetric, positive semi-definite. A point mass (zero inertia) is valid.
+pub fn check_rigid_body(mass: f64, inertia_com: &Mat3) -> std::result::Result<(), String> {
+    if !mass.is_finite() || mass < 0.0 {
+        return Err(format!("expected a finite mass >= 0, got {mass}"));
+    }
+    if inertia_com.iter().any(|x| !x.is_finite()) {
+        return Err("expected a finite inertia tensor, got a non-finite entry".into());
+    }
+    let asymmetry = (inertia_com - inertia_com.transpose()).abs().max();
+    let scale = inertia_com.abs().max().max(f64::MIN_POSITIVE);
+    if asymmetry > INERTIA_EIGENVALUE_TOLERANCE * scale {
+        return Err("expected a symmetric inertia tensor".into());
+    }
+    let eigenvalues = inertia_com.symmetric_eigenvalues();
+    let smallest = eigenvalues.min();
+    if smallest < -INERTIA_EIGENVALUE_TOLERANCE * scale {
+        return Err(format!(
+            "expected a positive semi-definite inertia tensor, got principal moments [{:.6e}, {:.6e}, {:.6e}]",
+            eigenvalues[0], eigenvalues[1], eigenvalues[2]
+        ));
+    }
+    Ok(())
+}
+
+/// A moving body for [`ModelBuilder::add_body`].
+#[derive(Debug, Clone)]
+pub struct NewBody<'a> {
+    /// Index of the parent body (0 = world).
+    pub parent: usize,
+    pub joint: Joint,
+    pub joint_name: &'a str,
+    /// Featherstone's `X_T`: from the parent body's frame to the joint frame.
+    pub x_tree: Transform,
+    pub properties: JointProperties,
+    /// The body's (link's) name.
+    pub name: &'a str,
+    /// Spatial inertia in the body's own frame.
+    pub inertia: Inertia,
+}
+
+/// Builds a [`Model`] body by body; every loader ends here.
+#[derive(Debug, Clone)]
+pub struct ModelBuilder {
+    model: Model,
+}
+
+impl ModelBuilder {
+    /// A model holding only the world (body 0), named `world_name`.
+    pub fn new(name: &str, world_name: &str) -> Self {
+        ModelBuilder {
+            model: Model {
+                name: name.to_string(),
+                nq: 0,
+                nv: 0,
+                parent: vec![0],
+                joints: vec![Joint::Fixed],
+                joint_names: vec!["universe".into()],
+                body_names: vec![world_name.to_string()],
+                x_tree: vec![Transform::IDENTITY],
+                inertias: vec![Inertia::ZERO],
+                idx_q: vec![0],
+                idx_v: vec![0],
+                lower_position_limit: DVector::zeros(0),
+                upper_position_limit: DVector::zeros(0),
+                velocity_limit: DVector::zeros(0),
+                effort_limit: DVector::zeros(0),
+                armature: DVector::zeros(0),
+                damping: DVector::zeros(0),
+                friction: DVector::zeros(0),
+                frames: Vec::new(),
+                gravity: Vec3::new(0.0, 0.0, -STANDARD_GRAVITY),
+                mimics: Vec::new(),
+            },
+        }
+    }
+
+    /// Adds a moving body (see [`NewBody`]) and a frame with its name. Returns the body index.
+    pub fn add_body(&mut self, body: NewBody) -> Result<usize> {
+        let NewBody {
+            parent,
+            joint,
+            joint_name,
+            x_tree,
+            properties,
+            name,
+            inertia,
+        } = body;
+        let m = &mut self.model;
+        if parent >= m.parent.len() {
+            return Err(Error::model(
+                format!("joint '{joint_name}'"),
+                format!("parent body {parent} does not exist"),
+            ));
+        }
+        if matches!(joint, Joint::Fixed) {
+            return Err(Error::model(
+                format!("joint '{joint_name}'"),
+                "a fixed joint is merged with add_fixed_link, not added as a body",
+            ));
+        }
+        let index = m.parent.len();
+        m.parent.push(parent);
+        m.joints.push(joint);
+        m.joint_names.push(joint_name.to_string());
+        m.body_names.push(name.to_string());
+        m.x_tree.push(x_tree);
+        m.inertias.push(inertia);
+        m.idx_q.push(m.nq);
+        m.idx_v.push(m.nv);
+        let (nq, nv) = (joint.nq(), joint.nv());
+        m.nq += nq;
+        m.nv += nv;
+        // quaternion coordinates carry no limits
+        let limited = joint.quaternion_offset().is_none();
+        let extend = |v: &mut DVector<f64>, n: usize, value: f64| {
+            *v = DVector::from_iterator(
+                v.len() + n,
+                v.iter().copied().chain(std::iter::repeat_n(value, n)),
+            );
+        };
+        let (lower, upper) = if limited {
+            (properties.lower, properties.upper)
+        } else {
+            (f64::NEG_INFINITY, f64::INFINITY)
+        };
+        extend(&mut m.lower_position_limit, nq, lower);
+        extend(&mut m.upper_position_limit, nq, upper);
+        extend(&mut m.velocity_limit, nv, properties.velocity_limit);
+        extend(&mut m.effort_limit, nv, properties.effort_limit);
+        extend(&mut m.armature, nv, properties.armature);
+        extend(&mut m.damping, nv, properties.damping);
+        extend(&mut m.friction, nv, properties.friction);
+        m.frames.push(Frame {
+            name: name.to_string(),
+            body: index,
+            placement: Transform::IDENTITY,
+        });
+        Ok(index)
+    }
+
+    /// Merges a link attached by a fixed joint into `body`: `placement` is `X_{link←body}`,
+    /// `inertia` the link's spatial inertia in its own frame. The link stays as a frame.
+    pub fn add_fixed_link(
+        &mut self,
+        body: usize,
+        placement: Transform,
+        inertia: Inertia,
+        name: &str,
+    ) {
+        let merged = placement.transpose_apply_inertia(&inertia);
+        self.model.inertias[body] += merged;
+        self.add_frame(name, body, placement);
+    }
+
+    /// Adds a named frame on `body` at `placement` (`X_{frame←body}`).
+    pub fn add_frame(&mut self, name: &str, body: usize, placement: Transform) {
+        self.model.frames.push(Frame {
+            name: name.to_string(),
+            body,
+            placement,
+        });
+    }
+
+    /// Records a mimic relation between two joints (body indices).
+    pub fn add_mimic(&mut self, mimic: Mimic) {
+        self.model.mimics.push(mimic);
+    }
+
+    /// Sets the gravity vector.
+    pub fn gravity(&mut self, gravity: Vec3) {
+        self.model.gravity = gravity;
+    }
+
+    /// The finished model.
+    pub fn build(self) -> Model {
+        self.model
+    }
+}

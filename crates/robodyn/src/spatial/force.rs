@@ -1,0 +1,85 @@
+//! Spatial force vectors (wrenches, momenta).
+
+use super::Vec3;
+use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
+
+/// A spatial force `f = (n_O, f)`: the moment about the frame's origin and the linear force, both
+/// in the frame's axes (Featherstone §2.4).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Force {
+    pub angular: Vec3,
+    pub linear: Vec3,
+}
+
+impl Force {
+    pub const ZERO: Force = Force {
+        angular: Vec3::new(0.0, 0.0, 0.0),
+        linear: Vec3::new(0.0, 0.0, 0.0),
+    };
+
+    pub fn new(angular: Vec3, linear: Vec3) -> Self {
+        Force { angular, linear }
+    }
+
+    /// Flattened `[linear; angular]` (force; moment), robodyn's public order.
+    pub fn to_array(&self) -> [f64; 6] {
+        [
+            self.linear.x,
+            self.linear.y,
+            self.linear.z,
+            self.angular.x,
+            self.angular.y,
+            self.angular.z,
+        ]
+    }
+
+    /// Inverse of [`Force::to_array`].
+    pub fn from_array(values: &[f64; 6]) -> Self {
+        Force {
+            linear: Vec3::new(values[0], values[1], values[2]),
+            angular: Vec3::new(values[3], values[4], values[5]),
+        }
+    }
+}
+
+impl Add for Force {
+    type Output = Force;
+    fn add(self, rhs: Force) -> Force {
+        Force::new(self.angular + rhs.angular, self.linear + rhs.linear)
+    }
+}
+
+impl AddAssign for Force {
+    fn add_assign(&mut self, rhs: Force) {
+        self.angular += rhs.angular;
+        self.linear += rhs.linear;
+    }
+}
+
+impl Sub for Force {
+    type Output = Force;
+    fn sub(self, rhs: Force) -> Force {
+        Force::new(self.angular - rhs.angular, self.linear - rhs.linear)
+    }
+}
+
+impl SubAssign for Force {
+    fn sub_assign(&mut self, rhs: Force) {
+        self.angular -= rhs.angular;
+        self.linear -= rhs.linear;
+    }
+}
+
+impl Neg for Force {
+    type Output = Force;
+    fn neg(self) -> Force {
+        Force::new(-self.angular, -self.linear)
+    }
+}
+
+impl Mul<f64> for Force {
+    type Output = Force;
+    fn mul(self, s: f64) -> Force {
+        Force::new(self.angular * s, self.linear * s)
+    }
+}

@@ -1,0 +1,109 @@
+//! Rigid-body spatial inertia (Featherstone §2.13).
+
+use super::{skew, Force, Mat3, Mat6, Motion, Vec3};
+use std::ops::{Add, AddAssign};
+
+/// The spatial inertia of a rigid body about a frame's origin, stored as the mass `m`, the first
+/// moment `h = m c` (c: centre of mass) and the rotational inertia `Ī_O` about the origin, all in
+/// the frame's axes. As a 6x6 matrix on `[angular; linear]`: `I = [Ī_O  h×; h×ᵀ  m 1]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Inertia {
+    pub mass: f64,
+    /// `h = m c`.
+    pub first_moment: Vec3,
+    /// `Ī_O = I_C + m (c·c 1 - c cᵀ)`, the rotational inertia about the frame's origin.
+    pub rotational: Mat3,
+}
+
+impl Default for Inertia {
+    fn default() -> Self {
+        Inertia::ZERO
+    }
+}
+
+impl Inertia {
+    pub const ZERO: Inertia = Inertia {
+        mass: 0.0,
+        first_moment: Vec3::new(0.0, 0.0, 0.0),
+        rotational: Mat3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+    };
+
+    /// From the mass, the centre of mass `com` and the rotational inertia `inertia_com` about the
+    /// centre of mass (parallel-axis theorem: `Ī_O = I_C + m (c·c 1 - c cᵀ)`).
+    pub fn from_com(mass: f64, com: &Vec3, inertia_com: &Mat3) -> Self {
+        Inertia {
+            mass,
+            first_moment: com * mass,
+            rotational: inertia_com
+                + (Mat3::identity() * com.norm_squared() - com * com.transpose()) * mass,
+        }
+    }
+
+    /// The centre of mass `c = h / m` (the origin for a massless body).
+    pub fn com(&self) -> Vec3 {
+        if self.mass > 0.0 {
+            self.first_moment / self.mass
+        } else {
+            Vec3::zeros()
+        }
+    }
+
+    /// `f = I m`: `n = Ī_O ω + h × v`, `f = m v - h × ω`.
+    pub fn mul_motion(&self, m: &Motion) -> Force {
+        Force {
+            angular: self.rotational * m.angular + self.first_moment.cross(&m.linear),
+            linear: m.linear * self.mass - self.first_moment.cross(&m.angular),
+        }
+    }
+
+    /// The 6x6 matrix on `[angular; linear]`: `[Ī_O  h×; h×ᵀ  m 1]`.
+    pub fn to_matrix(&self) -> Mat6 {
+        let h = skew(&self.first_moment);
+        let mut i = Mat6::zeros();
+        i.fixed_view_mut::<3, 3>(0, 0).copy_from(&self.rotational);
+        i.fixed_view_mut::<3, 3>(0, 3).copy_from(&h);
+        i.fixed_view_mut::<3, 3>(3, 0).copy_from(&h.transpose());
+        i.fixed_view_mut::<3, 3>(3, 3)
+            .copy_from(&(Mat3::identity() * self.mass));
+        i
+    }
+}
+
+impl Add for Inertia {
+    type Output = Inertia;
+    fn add(self, rhs: Inertia) -> Inertia {
+        Inertia {
+            mass: self.mass + rhs.mass,
+            first_moment: self.first_moment + rhs.first_moment,
+            rotational: self.rotational + rhs.rotational,
+        }
+    }
+}
+
+impl AddAssign for Inertia {
+    fn add_assign(&mut self, rhs: Inertia) {
+        *self = *self + rhs;
+    }
+}
+
+/// A 6-vector on `[angular; linear]` from a motion.
+pub(crate) fn motion_vector(m: &Motion) -> nalgebra::Vector6<f64> {
+    nalgebra::Vector6::new(
+        m.angular.x,
+        m.angular.y,
+        m.angular.z,
+        m.linear.x,
+        m.linear.y,
+        m.linear.z,
+    )
+}
+
+/// A force from a 6-vector on `[angular; linear]`.
+pub(crate) fn force_from_vector(f: &nalgebra::Vector6<f64>) -> Force {
+    Force::new(Vec3::new(f[0], f[1], f[2]), Vec3::new(f[3], f[4], f[5]))
+}
+
+/// `f = I m` for a general (articulated-body) 6x6 inertia on `[angular; linear]`.
+pub fn mat6_mul_motion(inertia: &Mat6, m: &Motion) -> Force {
+    force_from_vector(&(inertia * motion_vector(m)))
+}

@@ -1,0 +1,34 @@
+//! Spatial (Plücker) vector algebra, after Featherstone, *Rigid Body Dynamics Algorithms* (2008),
+//! chapter 2.
+//!
+//! Spatial vectors have named `angular` and `linear` parts, so their order exists only at the
+//! boundary, where robodyn flattens them as `[linear; angular]` (see [`Motion::to_array`]).
+//! A [`Transform`] is Featherstone's `X` from frame A to frame B: it maps motion vectors expressed
+//! in A to B coordinates.
+
+mod force;
+mod inertia;
+mod motion;
+mod transform;
+
+pub use force::Force;
+pub use inertia::{mat6_mul_motion, Inertia};
+pub use motion::Motion;
+pub use transform::Transform;
+
+/// 3-vector of f64.
+pub type Vec3 = nalgebra::Vector3<f64>;
+/// 3x3 matrix of f64.
+pub type Mat3 = nalgebra::Matrix3<f64>;
+/// 6x6 matrix of f64 acting on `[angular; linear]` spatial vectors.
+pub type Mat6 = nalgebra::Matrix6<f64>;
+
+/// The skew-symmetric matrix `v×` with `(v×) w = v × w`.
+pub fn skew(v: &Vec3) -> Mat3 {
+    Mat3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
+}
+
+/// Rotation matrix of URDF's roll-pitch-yaw angles: `R = Rz(yaw) Ry(pitch) Rx(roll)`.
+pub fn rotation_from_rpy(roll: f64, pitch: f64, yaw: f64) -> Mat3 {
+    *nalgebra::Rotation3::from_euler_angles(roll, pitch, yaw).matrix()
+}

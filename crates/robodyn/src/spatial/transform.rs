@@ -1,0 +1,145 @@
+//! Plücker coordinate transforms (Featherstone §2.8).
+
+use super::{skew, Force, Inertia, Mat3, Mat6, Motion, Vec3};
+use std::ops::Mul;
+
+/// Featherstone's `X = B_X_A`: the coordinate transform from frame A to frame B, stored as the
+/// rotation `E` (A axes to B axes) and `r`, the position of B's origin in A coordinates.
+/// As a 6x6 matrix on `[angular; linear]` motion vectors, `X = [E 0; -E r× E]`.
+///
+/// The same object describes the pose of B in A: rotation `Eᵀ`, translation `r`
+/// (see [`Transform::from_pose`] and [`Transform::to_homogeneous`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Transform {
+    /// `E`: rotates A coordinates into B coordinates.
+    pub rotation: Mat3,
+    /// `r`: B's origin expressed in A coordinates.
+    pub translation: Vec3,
+}
+
+impl Default for Transform {
+    fn default() -> Self {
+        Transform::IDENTITY
+    }
+}
+
+impl Transform {
+    pub const IDENTITY: Transform = Transform {
+        rotation: Mat3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0),
+        translation: Vec3::new(0.0, 0.0, 0.0),
+    };
+
+    /// The transform into a frame B whose axes are `rotation` (columns = B's axes in A) and whose
+    /// origin is at `position`, both in A coordinates: `E = rotationᵀ`, `r = position`.
+    pub fn from_pose(rotation: &Mat3, position: &Vec3) -> Self {
+        Transform {
+            rotation: rotation.transpose(),
+            translation: *position,
+        }
+    }
+
+    /// Rotation about an arbitrary unit `axis` by `angle` (a frame rotated by `angle`).
+    pub fn from_axis_angle(axis: &Vec3, angle: f64) -> Self {
+        let rotation =
+            nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_unchecked(*axis), angle);
+        Transform::from_pose(rotation.matrix(), &Vec3::zeros())
+    }
+
+    /// Pure translation: B's origin at `position` in A, axes parallel.
+    pub fn from_translation(position: &Vec3) -> Self {
+        Transform {
+            rotation: Mat3::identity(),
+            translation: *position,
+        }
+    }
+
+    /// The pose of B in A as a 4x4 homogeneous matrix `[Eᵀ r; 0 1]` (maps B points to A points).
+    pub fn to_homogeneous(&self) -> nalgebra::Matrix4<f64> {
+        let mut pose = nalgebra::Matrix4::identity();
+        pose.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&self.rotation.transpose());
+        pose.fixed_view_mut::<3, 1>(0, 3)
+            .copy_from(&self.translation);
+        pose
+    }
+
+    /// `X⁻¹ = A_X_B`: `E' = Eᵀ`, `r' = -E r`.
+    pub fn inverse(&self) -> Transform {
+        Transform {
+            rotation: self.rotation.transpose(),
+            translation: -(self.rotation * self.translation),
+        }
+    }
+
+    /// `X m`: `ω' = E ω`, `v' = E (v - r × ω)`.
+    pub fn apply_motion(&self, m: &Motion) -> Motion {
+        Motion {
+            angular: self.rotation * m.angular,
+            linear: self.rotation * (m.linear - self.translation.cross(&m.angular)),
+        }
+    }
+
+    /// `X⁻¹ m`: `ω = Eᵀ ω'`, `v = Eᵀ v' + r × ω`.
+    pub fn inverse_apply_motion(&self, m: &Motion) -> Motion {
+        let angular = self.rotation.tr_mul(&m.angular);
+        Motion {
+            angular,
+            linear: self.rotation.tr_mul(&m.linear) + self.translation.cross(&angular),
+        }
+    }
+
+    /// `X* f`: `n' = E (n - r × f)`, `f' = E f`.
+    pub fn apply_force(&self, f: &Force) -> Force {
+        Force {
+            angular: self.rotation * (f.angular - self.translation.cross(&f.linear)),
+            linear: self.rotation * f.linear,
+        }
+    }
+
+    /// `Xᵀ f` (B forces to A): `f = Eᵀ f'`, `n = Eᵀ n' + r × f`.
+    pub fn transpose_apply_force(&self, f: &Force) -> Force {
+        let linear = self.rotation.tr_mul(&f.linear);
+        Force {
+            angular: self.rotation.tr_mul(&f.angular) + self.translation.cross(&linear),
+            linear,
+        }
+    }
+
+    /// `Xᵀ I X`: a rigid-body inertia given in B coordinates, expressed in A coordinates.
+    pub fn transpose_apply_inertia(&self, inertia: &Inertia) -> Inertia {
+        let r = &self.translation;
+        let m = inertia.mass;
+        // h_A = Eᵀ h_B + m r
+        let h_rotated = self.rotation.tr_mul(&inertia.first_moment);
+        // Ī_A = Eᵀ Ī_B E + (2 r·h' + m|r|²) 1 - (r h'ᵀ + h' rᵀ + m r rᵀ)
+        let i_rotated = self.rotation.transpose() * inertia.rotational * self.rotation;
+        let shift = Mat3::identity() * (2.0 * r.dot(&h_rotated) + m * r.norm_squared())
+            - (r * h_rotated.transpose() + h_rotated * r.transpose() + r * r.transpose() * m);
+        Inertia {
+            mass: m,
+            first_moment: h_rotated + r * m,
+            rotational: i_rotated + shift,
+        }
+    }
+
+    /// `X` as a 6x6 matrix on `[angular; linear]` motion vectors: `[E 0; -E r× E]`.
+    pub fn to_matrix(&self) -> Mat6 {
+        let mut x = Mat6::zeros();
+        x.fixed_view_mut::<3, 3>(0, 0).copy_from(&self.rotation);
+        x.fixed_view_mut::<3, 3>(3, 3).copy_from(&self.rotation);
+        x.fixed_view_mut::<3, 3>(3, 0)
+            .copy_from(&(-self.rotation * skew(&self.translation)));
+        x
+    }
+}
+
+/// Composition `C_X_A = C_X_B * B_X_A`: `E = E_cb E_ba`, `r = r_ba + E_baᵀ r_cb`.
+impl Mul for Transform {
+    type Output = Transform;
+    fn mul(self, rhs: Transform) -> Transform {
+        Transform {
+            rotation: self.rotation * rhs.rotation,
+            translation: rhs.translation + rhs.rotation.tr_mul(&self.translation),
+        }
+    }
+}

@@ -1,0 +1,118 @@
+//! The hot algorithms allocate nothing after `Data::new`: a counting global allocator proves it.
+
+mod common;
+
+use robodyn::algo::*;
+use robodyn::Data;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct CountingAllocator;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: CountingAllocator = CountingAllocator;
+
+/// Allocations made by `f`.
+fn allocations(f: impl FnOnce()) -> usize {
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    f();
+    ALLOCATIONS.load(Ordering::SeqCst) - before
+}
+
+// one test function: the counter is global, and tests in one binary run on several threads
+#[test]
+fn algorithms_allocate_nothing_after_data_new() {
+    // the counter sees allocations
+    assert!(allocations(|| drop(std::hint::black_box(vec![1.0_f64; 8]))) > 0);
+    let mut rng = common::rng();
+    for (name, model) in common::test_models() {
+        let mut data = Data::new(&model);
+        let q = model.random_configuration(&mut rng);
+        let v = common::random_vector(&mut rng, model.nv);
+        let a = common::random_vector(&mut rng, model.nv);
+        let f_ext = vec![robodyn::spatial::Force::ZERO; model.nbodies() - 1];
+        let (q, v, a) = (q.as_slice(), v.as_slice(), a.as_slice());
+        let frame = model.frames.len() - 1;
+        let counts = [
+            (
+                "forward_kinematics",
+                allocations(|| {
+                    forward_kinematics(&model, &mut data, q).unwrap();
+                }),
+            ),
+            (
+                "jacobian",
+                allocations(|| {
+                    jacobian(&model, &mut data, q, frame, Reference::World).unwrap();
+                }),
+            ),
+            (
+                "rnea",
+                allocations(|| {
+                    rnea(&model, &mut data, q, v, a, Some(&f_ext)).unwrap();
+                }),
+            ),
+            (
+                "bias_forces",
+                allocations(|| {
+                    bias_forces(&model, &mut data, q, v).unwrap();
+                }),
+            ),
+            (
+                "generalized_gravity",
+                allocations(|| {
+                    generalized_gravity(&model, &mut data, q).unwrap();
+                }),
+            ),
+            (
+                "crba",
+                allocations(|| {
+                    crba(&model, &mut data, q).unwrap();
+                }),
+            ),
+            (
+                "aba",
+                allocations(|| {
+                    aba(&model, &mut data, q, v, a, Some(&f_ext)).unwrap();
+                }),
+            ),
+            (
+                "inverse_mass_matrix",
+                allocations(|| {
+                    inverse_mass_matrix(&model, &mut data, q).unwrap();
+                }),
+            ),
+            (
+                "kinetic_energy",
+                allocations(|| {
+                    kinetic_energy(&model, &mut data, q, v).unwrap();
+                }),
+            ),
+            (
+                "center_of_mass",
+                allocations(|| {
+                    center_of_mass(&model, &mut data, q).unwrap();
+                }),
+            ),
+        ];
+        for (algorithm, count) in counts {
+            assert_eq!(count, 0, "{name}: {algorithm} allocated {count} times");
+        }
+    }
+}

@@ -1,0 +1,402 @@
+//! Identities between the algorithms, on every test model (DESIGN.md, "How we know it is right" 4).
+
+mod common;
+
+use common::*;
+use nalgebra::{DMatrix, DVector};
+use robodyn::algo::*;
+use robodyn::{Data, Model};
+
+/// Random (q, v, a) for a model.
+fn state(
+    model: &Model,
+    rng: &mut rand::rngs::StdRng,
+) -> (DVector<f64>, DVector<f64>, DVector<f64>) {
+    (
+        model.random_configuration(rng),
+        random_vector(rng, model.nv),
+        random_vector(rng, model.nv),
+    )
+}
+
+#[test]
+fn mass_matrix_columns_are_rnea_with_unit_accelerations() {
+    let mut rng = rng();
+    for (name, mut model) in test_models() {
+        model.gravity.fill(0.0);
+        let mut data = Data::new(&model);
+        let q = model.random_configuration(&mut rng);
+        let m = crba(&model, &mut data, q.as_slice()).unwrap().clone();
+        let zero = DVector::zeros(model.nv);
+        for j in 0..model.nv {
+            // M e_j = rnea(q, 0, e_j) with no gravity
+            let e_j = DVector::from_fn(model.nv, |i, _| if i == j { 1.0 } else { 0.0 });
+            let column = rnea(
+                &model,
+                &mut data,
+                q.as_slice(),
+                zero.as_slice(),
+                e_j.as_slice(),
+                None,
+            )
+            .unwrap();
+            assert_close(
+                &format!("{name}: M column {j}"),
+                m.column(j).as_slice(),
+                column.as_slice(),
+                IDENTITY_TOLERANCE,
+            );
+        }
+    }
+}
+
+#[test]
+fn mass_matrix_is_symmetric_positive_definite() {
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        for _ in 0..5 {
+            let q = model.random_configuration(&mut rng);
+            let m = crba(&model, &mut data, q.as_slice()).unwrap().clone();
+            assert_close(
+                &format!("{name}: M symmetric"),
+                m.as_slice(),
+                m.transpose().as_slice(),
+                0.0,
+            );
+            assert!(
+                m.clone().cholesky().is_some(),
+                "{name}: M not positive definite"
+            );
+        }
+    }
+}
+
+#[test]
+fn aba_inverts_rnea() {
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        for _ in 0..5 {
+            let (q, v, a) = state(&model, &mut rng);
+            let f_ext: Vec<_> = (1..model.nbodies())
+                .map(|_| robodyn::spatial::Force::from_array(&[0.3, -0.2, 0.5, 0.1, 0.05, -0.1]))
+                .collect();
+            let tau = rnea(
+                &model,
+                &mut data,
+                q.as_slice(),
+                v.as_slice(),
+                a.as_slice(),
+                Some(&f_ext),
+            )
+            .unwrap()
+            .clone();
+            let qdd = aba(
+                &model,
+                &mut data,
+                q.as_slice(),
+                v.as_slice(),
+                tau.as_slice(),
+                Some(&f_ext),
+            )
+            .unwrap();
+            assert_close(
+                &format!("{name}: aba(rnea(a))"),
+                qdd.as_slice(),
+                a.as_slice(),
+                IDENTITY_TOLERANCE,
+            );
+        }
+    }
+}
+
+#[test]
+fn forward_dynamics_solves_the_equation_of_motion() {
+    // q̈ = M⁻¹ (τ - b) with b = C q̇ + g
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        let (q, v, tau) = state(&model, &mut rng);
+        let bias = bias_forces(&model, &mut data, q.as_slice(), v.as_slice())
+            .unwrap()
+            .clone();
+        let m_inv = inverse_mass_matrix(&model, &mut data, q.as_slice())
+            .unwrap()
+            .clone();
+        let m = data.mass_matrix.clone();
+        assert_close(
+            &format!("{name}: M⁻¹ M"),
+            (&m_inv * &m).as_slice(),
+            DMatrix::identity(model.nv, model.nv).as_slice(),
+            IDENTITY_TOLERANCE,
+        );
+        let expected = &m_inv * (&tau - &bias);
+        let qdd = aba(
+            &model,
+            &mut data,
+            q.as_slice(),
+            v.as_slice(),
+            tau.as_slice(),
+            None,
+        )
+        .unwrap();
+        assert_close(
+            &format!("{name}: aba"),
+            qdd.as_slice(),
+            expected.as_slice(),
+            IDENTITY_TOLERANCE,
+        );
+    }
+}
+
+#[test]
+fn bias_and_gravity_are_rnea_special_cases() {
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        let (q, v, _) = state(&model, &mut rng);
+        let zero = DVector::zeros(model.nv);
+        let bias = bias_forces(&model, &mut data, q.as_slice(), v.as_slice())
+            .unwrap()
+            .clone();
+        let expected = rnea(
+            &model,
+            &mut data,
+            q.as_slice(),
+            v.as_slice(),
+            zero.as_slice(),
+            None,
+        )
+        .unwrap()
+        .clone();
+        assert_close(
+            &format!("{name}: bias"),
+            bias.as_slice(),
+            expected.as_slice(),
+            0.0,
+        );
+        let gravity = generalized_gravity(&model, &mut data, q.as_slice())
+            .unwrap()
+            .clone();
+        let expected = rnea(
+            &model,
+            &mut data,
+            q.as_slice(),
+            zero.as_slice(),
+            zero.as_slice(),
+            None,
+        )
+        .unwrap();
+        assert_close(
+            &format!("{name}: gravity"),
+            gravity.as_slice(),
+            expected.as_slice(),
+            0.0,
+        );
+    }
+}
+
+#[test]
+fn kinetic_energy_is_half_v_m_v() {
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        let (q, v, _) = state(&model, &mut rng);
+        let energy = kinetic_energy(&model, &mut data, q.as_slice(), v.as_slice()).unwrap();
+        let m = crba(&model, &mut data, q.as_slice()).unwrap();
+        let expected = 0.5 * v.dot(&(m * &v));
+        assert_close(
+            &format!("{name}: KE"),
+            &[energy],
+            &[expected],
+            IDENTITY_TOLERANCE,
+        );
+    }
+}
+
+#[test]
+fn gravity_is_the_gradient_of_potential_energy() {
+    // g(q) = ∂V/∂q, by central differences along each velocity coordinate on the Lie group
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        let q = model.random_configuration(&mut rng);
+        let gravity = generalized_gravity(&model, &mut data, q.as_slice())
+            .unwrap()
+            .clone();
+        for k in 0..model.nv {
+            let energy_at = |h: f64, data: &mut Data| {
+                let step = DVector::from_fn(model.nv, |i, _| if i == k { h } else { 0.0 });
+                let mut moved = DVector::zeros(model.nq);
+                model
+                    .integrate(q.as_slice(), step.as_slice(), moved.as_mut_slice())
+                    .unwrap();
+                potential_energy(&model, data, moved.as_slice()).unwrap()
+            };
+            let derivative =
+                (energy_at(FD_STEP, &mut data) - energy_at(-FD_STEP, &mut data)) / (2.0 * FD_STEP);
+            assert_close(
+                &format!("{name}: dV/dq {k}"),
+                &[gravity[k]],
+                &[derivative],
+                FD_TOLERANCE,
+            );
+        }
+    }
+}
+
+#[test]
+fn jacobian_is_the_derivative_of_forward_kinematics() {
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        let q = model.random_configuration(&mut rng);
+        for frame in 0..model.frames.len() {
+            let world = jacobian(&model, &mut data, q.as_slice(), frame, Reference::World)
+                .unwrap()
+                .clone();
+            let local = jacobian(&model, &mut data, q.as_slice(), frame, Reference::Local)
+                .unwrap()
+                .clone();
+            let spatial = jacobian(&model, &mut data, q.as_slice(), frame, Reference::Spatial)
+                .unwrap()
+                .clone();
+            forward_kinematics(&model, &mut data, q.as_slice()).unwrap();
+            let pose = frame_placement(&model, &data, frame);
+            let rotation = pose.rotation.transpose();
+            for k in 0..model.nv {
+                let pose_at = |h: f64, data: &mut Data| {
+                    let step = DVector::from_fn(model.nv, |i, _| if i == k { h } else { 0.0 });
+                    let mut moved = DVector::zeros(model.nq);
+                    model
+                        .integrate(q.as_slice(), step.as_slice(), moved.as_mut_slice())
+                        .unwrap();
+                    forward_kinematics(&model, data, moved.as_slice()).unwrap();
+                    frame_placement(&model, data, frame)
+                };
+                let (plus, minus) = (pose_at(FD_STEP, &mut data), pose_at(-FD_STEP, &mut data));
+                // linear: ṗ;  angular: from Ṙ Rᵀ = ω×
+                let p_dot = (plus.translation - minus.translation) / (2.0 * FD_STEP);
+                let r_dot =
+                    (plus.rotation.transpose() - minus.rotation.transpose()) / (2.0 * FD_STEP);
+                let omega_hat = r_dot * rotation.transpose();
+                let omega =
+                    nalgebra::Vector3::new(omega_hat[(2, 1)], omega_hat[(0, 2)], omega_hat[(1, 0)]);
+                let label = format!("{name}: frame {} column {k}", model.frames[frame].name);
+                let world_column = [p_dot.as_slice(), omega.as_slice()].concat();
+                assert_close(
+                    &label,
+                    world.column(k).as_slice(),
+                    &world_column,
+                    FD_TOLERANCE,
+                );
+                let local_column = [
+                    (rotation.transpose() * p_dot).as_slice(),
+                    (rotation.transpose() * omega).as_slice(),
+                ]
+                .concat();
+                assert_close(
+                    &label,
+                    local.column(k).as_slice(),
+                    &local_column,
+                    FD_TOLERANCE,
+                );
+                // spatial: velocity of the point at the world origin, v_O = ṗ - ω × p
+                let v_origin = p_dot - omega.cross(&pose.translation);
+                assert_close(
+                    &label,
+                    spatial.column(k).as_slice(),
+                    &[v_origin.as_slice(), omega.as_slice()].concat(),
+                    FD_TOLERANCE,
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn external_force_maps_through_the_jacobian_transpose() {
+    // a wrench on a body adds -Jᵀ f to τ (local Jacobian of the body's frame, f in body axes)
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        let (q, v, a) = state(&model, &mut rng);
+        let body = model.nbodies() - 1;
+        let frame = model
+            .frames
+            .iter()
+            .position(|f| f.body == body && f.placement == robodyn::spatial::Transform::IDENTITY)
+            .unwrap();
+        let wrench = [0.5, -1.0, 2.0, 0.3, 0.2, -0.4];
+        let mut f_ext = vec![robodyn::spatial::Force::ZERO; model.nbodies() - 1];
+        f_ext[body - 1] = robodyn::spatial::Force::from_array(&wrench);
+        let free = rnea(
+            &model,
+            &mut data,
+            q.as_slice(),
+            v.as_slice(),
+            a.as_slice(),
+            None,
+        )
+        .unwrap()
+        .clone();
+        let pushed = rnea(
+            &model,
+            &mut data,
+            q.as_slice(),
+            v.as_slice(),
+            a.as_slice(),
+            Some(&f_ext),
+        )
+        .unwrap()
+        .clone();
+        let j = jacobian(&model, &mut data, q.as_slice(), frame, Reference::Local).unwrap();
+        let expected = &free - j.transpose() * DVector::from_row_slice(&wrench);
+        assert_close(
+            &format!("{name}: f_ext"),
+            pushed.as_slice(),
+            expected.as_slice(),
+            IDENTITY_TOLERANCE,
+        );
+    }
+}
+
+#[test]
+fn center_of_mass_and_potential_energy_agree() {
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        let q = model.random_configuration(&mut rng);
+        let com = center_of_mass(&model, &mut data, q.as_slice()).unwrap();
+        let energy = potential_energy(&model, &mut data, q.as_slice()).unwrap();
+        assert_close(
+            &format!("{name}: V = -M gᵀ c"),
+            &[energy],
+            &[-model.total_mass() * model.gravity.dot(&com)],
+            IDENTITY_TOLERANCE,
+        );
+    }
+}
+
+#[test]
+fn integrate_and_difference_round_trip_on_the_model() {
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let (q, v, _) = state(&model, &mut rng);
+        let mut q1 = DVector::zeros(model.nq);
+        model
+            .integrate(q.as_slice(), v.as_slice(), q1.as_mut_slice())
+            .unwrap();
+        let mut back = DVector::zeros(model.nv);
+        model
+            .difference(q.as_slice(), q1.as_slice(), back.as_mut_slice())
+            .unwrap();
+        assert_close(
+            &format!("{name}: q1 ⊖ q"),
+            back.as_slice(),
+            v.as_slice(),
+            IDENTITY_TOLERANCE,
+        );
+    }
+}

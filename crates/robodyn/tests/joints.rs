@@ -1,0 +1,125 @@
+//! Joints: the motion subspace against a finite difference of the joint transform, and the Lie
+//! group integration against its difference.
+
+mod common;
+
+use common::{rng, FD_STEP, FD_TOLERANCE};
+use robodyn::spatial::{Transform, Vec3};
+use robodyn::Joint;
+
+const ROUND_TRIP_TOLERANCE: f64 = 1e-10;
+
+fn joints() -> Vec<Joint> {
+    vec![
+        Joint::Revolute {
+            axis: Vec3::new(0.6, 0.0, 0.8),
+        },
+        Joint::Prismatic {
+            axis: Vec3::new(0.0, -0.8, 0.6),
+        },
+        Joint::Spherical,
+        Joint::Free,
+    ]
+}
+
+/// The body velocity `(ω, v)` in child axes of the motion X(t): from `Ẋ X⁻¹ = (v×)` on the pose.
+fn body_velocity(before: &Transform, after: &Transform, dt: f64) -> [f64; 6] {
+    // pose of the child in the joint frame: rotation R = Eᵀ, position p = r
+    let (r0, r1) = (before.rotation.transpose(), after.rotation.transpose());
+    let omega_hat = r0.transpose() * (r1 - r0) / dt;
+    let omega = Vec3::new(omega_hat[(2, 1)], omega_hat[(0, 2)], omega_hat[(1, 0)]);
+    let linear = r0.transpose() * (after.translation - before.translation) / dt;
+    [omega.x, omega.y, omega.z, linear.x, linear.y, linear.z]
+}
+
+#[test]
+fn subspace_is_the_derivative_of_the_joint_transform() {
+    let mut rng = rng();
+    for joint in joints() {
+        let mut q = vec![0.0; joint.nq()];
+        joint.random(
+            &mut rng,
+            &vec![-1.0; joint.nq()],
+            &vec![1.0; joint.nq()],
+            &mut q,
+        );
+        for k in 0..joint.nv() {
+            // move along the k-th velocity coordinate for ±h
+            let mut step = vec![0.0; joint.nv()];
+            step[k] = FD_STEP;
+            let (mut q_plus, mut q_minus) = (q.clone(), q.clone());
+            joint.integrate(&q, &step, &mut q_plus);
+            step[k] = -FD_STEP;
+            joint.integrate(&q, &step, &mut q_minus);
+            let velocity = body_velocity(
+                &joint.transform(&q_minus),
+                &joint.transform(&q_plus),
+                2.0 * FD_STEP,
+            );
+            let s = joint.subspace_column(k);
+            let expected = [
+                s.angular.x,
+                s.angular.y,
+                s.angular.z,
+                s.linear.x,
+                s.linear.y,
+                s.linear.z,
+            ];
+            for (a, b) in velocity.iter().zip(expected) {
+                assert!(
+                    (a - b).abs() < FD_TOLERANCE,
+                    "{} column {k}: {velocity:?} vs {expected:?}",
+                    joint.kind()
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn difference_inverts_integrate() {
+    let mut rng = rng();
+    for joint in joints() {
+        for _ in 0..20 {
+            let mut q = vec![0.0; joint.nq()];
+            joint.random(
+                &mut rng,
+                &vec![-1.0; joint.nq()],
+                &vec![1.0; joint.nq()],
+                &mut q,
+            );
+            let v: Vec<f64> = (0..joint.nv())
+                .map(|i| 0.7 * (i as f64 + 1.0).sin())
+                .collect();
+            let mut q1 = vec![0.0; joint.nq()];
+            joint.integrate(&q, &v, &mut q1);
+            let mut back = vec![0.0; joint.nv()];
+            joint.difference(&q, &q1, &mut back);
+            for (a, b) in back.iter().zip(&v) {
+                assert!(
+                    (a - b).abs() < ROUND_TRIP_TOLERANCE,
+                    "{}: {back:?} vs {v:?}",
+                    joint.kind()
+                );
+            }
+            if let Some(offset) = joint.quaternion_offset() {
+                let norm: f64 = q1[offset..offset + 4].iter().map(|x| x * x).sum();
+                assert!((norm - 1.0).abs() < ROUND_TRIP_TOLERANCE);
+            }
+        }
+    }
+}
+
+#[test]
+fn neutral_is_the_identity_transform() {
+    for joint in joints() {
+        let mut q = vec![0.0; joint.nq()];
+        joint.neutral(&mut q);
+        assert_eq!(
+            joint.transform(&q).to_matrix(),
+            Transform::IDENTITY.to_matrix(),
+            "{}",
+            joint.kind()
+        );
+    }
+}

@@ -1,0 +1,93 @@
+//! Spatial algebra identities, as property tests over random transforms and vectors.
+
+use proptest::prelude::*;
+use robodyn::spatial::{rotation_from_rpy, Force, Inertia, Mat3, Motion, Transform, Vec3};
+
+const TOLERANCE: f64 = 1e-12;
+
+fn vec3() -> impl Strategy<Value = Vec3> {
+    (-2.0..2.0, -2.0..2.0, -2.0..2.0).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+
+fn transform() -> impl Strategy<Value = Transform> {
+    (vec3(), vec3())
+        .prop_map(|(rpy, p)| Transform::from_pose(&rotation_from_rpy(rpy.x, rpy.y, rpy.z), &p))
+}
+
+fn inertia() -> impl Strategy<Value = Inertia> {
+    (0.1..5.0, vec3(), vec3(), vec3()).prop_map(|(m, c, d, rpy)| {
+        let r = rotation_from_rpy(rpy.x, rpy.y, rpy.z);
+        let principal = Mat3::from_diagonal(&(d.abs() + Vec3::repeat(0.1)));
+        Inertia::from_com(m, &c, &(r * principal * r.transpose()))
+    })
+}
+
+fn motion_vector(m: &Motion) -> nalgebra::Vector6<f64> {
+    nalgebra::Vector6::new(
+        m.angular.x,
+        m.angular.y,
+        m.angular.z,
+        m.linear.x,
+        m.linear.y,
+        m.linear.z,
+    )
+}
+
+fn force_vector(f: &Force) -> nalgebra::Vector6<f64> {
+    nalgebra::Vector6::new(
+        f.angular.x,
+        f.angular.y,
+        f.angular.z,
+        f.linear.x,
+        f.linear.y,
+        f.linear.z,
+    )
+}
+
+proptest! {
+    #[test]
+    fn transform_times_inverse_is_identity(x in transform(), w in vec3(), v in vec3()) {
+        let m = Motion::new(w, v);
+        let back = x.inverse().apply_motion(&x.apply_motion(&m));
+        prop_assert!((motion_vector(&back) - motion_vector(&m)).norm() < TOLERANCE);
+        let composed = x * x.inverse();
+        prop_assert!((composed.to_matrix() - nalgebra::Matrix6::identity()).norm() < TOLERANCE);
+        prop_assert!((motion_vector(&x.inverse_apply_motion(&m)) - motion_vector(&x.inverse().apply_motion(&m))).norm() < TOLERANCE);
+    }
+
+    #[test]
+    fn force_motion_duality_preserves_power(x in transform(), w in vec3(), v in vec3(), n in vec3(), f in vec3()) {
+        // (X m) · (X* f) = m · f
+        let (m, force) = (Motion::new(w, v), Force::new(n, f));
+        prop_assert!((x.apply_motion(&m).dot(&x.apply_force(&force)) - m.dot(&force)).abs() < TOLERANCE * 100.0);
+        // Xᵀ is the inverse of X*
+        let back = x.transpose_apply_force(&x.apply_force(&force));
+        prop_assert!((force_vector(&back) - force_vector(&force)).norm() < TOLERANCE * 100.0);
+        // X* = X⁻ᵀ as matrices
+        let star = force_vector(&x.apply_force(&force));
+        let expected = x.to_matrix().try_inverse().unwrap().transpose() * force_vector(&force);
+        prop_assert!((star - expected).norm() < 1e-10);
+    }
+
+    #[test]
+    fn composition_matches_matrix_product(a in transform(), b in transform()) {
+        prop_assert!(((a * b).to_matrix() - a.to_matrix() * b.to_matrix()).norm() < 1e-10);
+    }
+
+    #[test]
+    fn inertia_transform_is_congruence_and_symmetric(x in transform(), i in inertia(), w in vec3(), v in vec3()) {
+        let moved = x.transpose_apply_inertia(&i).to_matrix();
+        let expected = x.to_matrix().transpose() * i.to_matrix() * x.to_matrix();
+        prop_assert!((moved - expected).norm() < 1e-9);
+        prop_assert!((moved - moved.transpose()).norm() < 1e-12);
+        let m = Motion::new(w, v);
+        prop_assert!((force_vector(&i.mul_motion(&m)) - i.to_matrix() * motion_vector(&m)).norm() < 1e-12);
+    }
+
+    #[test]
+    fn cross_products_match_their_matrices(w in vec3(), v in vec3(), w2 in vec3(), v2 in vec3(), n in vec3(), f in vec3()) {
+        let (m, other, force) = (Motion::new(w, v), Motion::new(w2, v2), Force::new(n, f));
+        // (m ×* f) · other = -(m × other) · f
+        prop_assert!((other.dot(&m.cross_force(&force)) + m.cross_motion(&other).dot(&force)).abs() < 1e-10);
+    }
+}
