@@ -1,1 +1,786 @@
+//! PyO3 glue for robodyn: argument conversion, batching over all cores with the GIL released, and
+//! errors turned into `ValueError` / `FileNotFoundError`. No physics lives here.
 
+use numpy::ndarray::IxDyn;
+use numpy::{
+    AllowTypeChange, PyArray1, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods,
+};
+use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
+use pyo3::prelude::*;
+use rand::{rngs::StdRng, SeedableRng};
+use rayon::prelude::*;
+use robodyn::algo::{self, Reference};
+use robodyn::spatial::Force;
+use robodyn::{Data, Error, Model};
+use std::borrow::Cow;
+use std::sync::Mutex;
+
+/// A core error as the Python exception the API promises.
+fn to_py_err(error: Error) -> PyErr {
+    match error {
+        Error::FileNotFound { .. } => PyFileNotFoundError::new_err(error.to_string()),
+        _ => PyValueError::new_err(error.to_string()),
+    }
+}
+
+/// What a kernel works in: the algorithm workspace and a buffer for external forces.
+struct Workspace {
+    data: Data,
+    forces: Vec<Force>,
+}
+
+impl Workspace {
+    fn new(model: &Model) -> Self {
+        Workspace {
+            data: Data::new(model),
+            forces: vec![Force::ZERO; model.nbodies() - 1],
+        }
+    }
+}
+
+/// Copies a flat array of `[linear; angular]` rows, one per body, into `forces`.
+fn fill_forces(forces: &mut [Force], flat: &[f64]) {
+    for (force, row) in forces.iter_mut().zip(flat.chunks_exact(6)) {
+        *force = Force::from_array(&[row[0], row[1], row[2], row[3], row[4], row[5]]);
+    }
+}
+
+/// One computation on one sample: inputs (flattened, in argument order) to a flattened output.
+type Kernel<'k> =
+    dyn Fn(&Model, &mut Workspace, &[&[f64]], &mut [f64]) -> robodyn::Result<()> + Sync + 'k;
+
+/// A numeric argument: its name, the array, and the shape of one sample.
+struct Argument<'py> {
+    name: &'static str,
+    array: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+    sample_shape: Vec<usize>,
+}
+
+impl<'py> Argument<'py> {
+    fn new(
+        name: &'static str,
+        value: &Bound<'py, PyAny>,
+        sample_shape: Vec<usize>,
+    ) -> PyResult<Self> {
+        let array = value.extract::<PyArrayLikeDyn<'py, f64, AllowTypeChange>>().map_err(|_| {
+            PyValueError::new_err(format!(
+                "argument '{name}': expected an array of numbers of shape {} or (N, ...), got {}",
+                shape_text(&sample_shape),
+                value.repr().map(|r| r.to_string()).unwrap_or_else(|_| "an unreadable object".into())
+            ))
+        })?;
+        Ok(Argument {
+            name,
+            array,
+            sample_shape,
+        })
+    }
+
+    /// The batch size, `None` for a single sample; errors if the shape fits neither.
+    fn batch(&self) -> PyResult<Option<usize>> {
+        let shape = self.array.shape();
+        if shape == self.sample_shape.as_slice() {
+            Ok(None)
+        } else if shape.len() == self.sample_shape.len() + 1 && shape[1..] == self.sample_shape[..]
+        {
+            Ok(Some(shape[0]))
+        } else {
+            let batch_shape: Vec<String> = std::iter::once("N".to_string())
+                .chain(self.sample_shape.iter().map(|n| n.to_string()))
+                .collect();
+            Err(PyValueError::new_err(format!(
+                "argument '{}': expected shape {} or ({}), got {}",
+                self.name,
+                shape_text(&self.sample_shape),
+                batch_shape.join(", "),
+                shape_text(shape)
+            )))
+        }
+    }
+
+    /// The values in C order, borrowed when the array is contiguous.
+    fn values(&self) -> Cow<'_, [f64]> {
+        match self.array.as_slice() {
+            Ok(slice) => Cow::Borrowed(slice),
+            Err(_) => Cow::Owned(self.array.as_array().iter().copied().collect()),
+        }
+    }
+}
+
+fn shape_text(shape: &[usize]) -> String {
+    match shape {
+        [n] => format!("({n},)"),
+        _ => format!(
+            "({})",
+            shape
+                .iter()
+                .map(|n| n.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+/// A robot model with its preallocated workspace. Every numeric method takes one state (q of
+/// shape (nq,)) or a batch (shape (N, nq)), returning the result or a stack of N results; batches
+/// release the GIL and run on all cores.
+#[pyclass(name = "Model", module = "robodyn._core")]
+struct PyModel {
+    model: Model,
+    workspace: Mutex<Workspace>,
+}
+
+impl PyModel {
+    fn wrap(model: Model) -> Self {
+        let workspace = Mutex::new(Workspace::new(&model));
+        PyModel { model, workspace }
+    }
+
+    /// Runs `kernel` on one sample or a batch of the `arguments`, producing `output_shape` per
+    /// sample.
+    fn evaluate<'py>(
+        &self,
+        py: Python<'py>,
+        arguments: &[Argument<'py>],
+        output_shape: &[usize],
+        kernel: &Kernel,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let batch = arguments[0].batch()?;
+        for argument in &arguments[1..] {
+            if argument.batch()? != batch {
+                return Err(PyValueError::new_err(format!(
+                    "argument '{}': expected {} like argument '{}', got shape {}",
+                    argument.name,
+                    match batch {
+                        None => "a single sample".to_string(),
+                        Some(n) => format!("a batch of {n}"),
+                    },
+                    arguments[0].name,
+                    shape_text(argument.array.shape())
+                )));
+            }
+        }
+        let values: Vec<Cow<[f64]>> = arguments.iter().map(|a| a.values()).collect();
+        let output_size: usize = output_shape.iter().product();
+        let model = &self.model;
+        match batch {
+            None => {
+                let inputs: Vec<&[f64]> = values.iter().map(|v| v.as_ref()).collect();
+                let output = PyArrayDyn::<f64>::zeros(py, IxDyn(output_shape), false);
+                {
+                    let mut guard = output.readwrite();
+                    let out = guard.as_slice_mut().expect("a new array is contiguous");
+                    match self.workspace.try_lock() {
+                        Ok(mut workspace) => kernel(model, &mut workspace, &inputs, out),
+                        Err(_) => kernel(model, &mut Workspace::new(model), &inputs, out),
+                    }
+                    .map_err(to_py_err)?;
+                }
+                if output_shape.is_empty() {
+                    return Ok(output.get_item(())?);
+                }
+                Ok(output.into_any())
+            }
+            Some(n) => {
+                let sizes: Vec<usize> = arguments
+                    .iter()
+                    .map(|a| a.sample_shape.iter().product())
+                    .collect();
+                let mut out = vec![0.0; n * output_size];
+                let result = py.detach(|| {
+                    out.par_chunks_mut(output_size.max(1))
+                        .enumerate()
+                        .try_for_each_init(
+                            || (Workspace::new(model), Vec::with_capacity(values.len())),
+                            |(workspace, inputs), (k, out)| {
+                                inputs.clear();
+                                inputs.extend(
+                                    values
+                                        .iter()
+                                        .zip(&sizes)
+                                        .map(|(v, s)| &v[k * s..(k + 1) * s]),
+                                );
+                                kernel(model, workspace, inputs, out).map_err(|e| (k, e))
+                            },
+                        )
+                });
+                if let Err((k, error)) = result {
+                    let message = format!("batch element {k}: {error}");
+                    return Err(match error {
+                        Error::FileNotFound { .. } => PyFileNotFoundError::new_err(message),
+                        _ => PyValueError::new_err(message),
+                    });
+                }
+                let shape: Vec<usize> = std::iter::once(n)
+                    .chain(output_shape.iter().copied())
+                    .collect();
+                Ok(PyArray1::from_vec(py, out).reshape(shape)?.into_any())
+            }
+        }
+    }
+
+    fn q_arg<'py>(&self, name: &'static str, value: &Bound<'py, PyAny>) -> PyResult<Argument<'py>> {
+        Argument::new(name, value, vec![self.model.nq])
+    }
+
+    fn v_arg<'py>(&self, name: &'static str, value: &Bound<'py, PyAny>) -> PyResult<Argument<'py>> {
+        Argument::new(name, value, vec![self.model.nv])
+    }
+
+    fn frame_index(&self, frame: &Bound<PyAny>) -> PyResult<usize> {
+        if let Ok(name) = frame.extract::<&str>() {
+            return self.model.frame_index(name).map_err(to_py_err);
+        }
+        match frame.extract::<usize>() {
+            Ok(index) if index < self.model.frames.len() => Ok(index),
+            _ => Err(PyValueError::new_err(format!(
+                "argument 'frame': expected a frame name or an index below {}, got {}",
+                self.model.frames.len(),
+                frame.repr()?
+            ))),
+        }
+    }
+
+    /// Dynamics with optional external forces: `algorithm(q, v, x, f_ext)`.
+    fn with_external_forces<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        x: (&'static str, &Bound<'py, PyAny>),
+        f_ext: Option<&Bound<'py, PyAny>>,
+        algorithm: for<'d> fn(
+            &Model,
+            &'d mut Data,
+            &[f64],
+            &[f64],
+            &[f64],
+            Option<&[Force]>,
+        ) -> robodyn::Result<&'d nalgebra::DVector<f64>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let mut arguments = vec![
+            self.q_arg("q", q)?,
+            self.v_arg("v", v)?,
+            self.v_arg(x.0, x.1)?,
+        ];
+        if let Some(f) = f_ext {
+            arguments.push(Argument::new(
+                "f_ext",
+                f,
+                vec![self.model.nbodies() - 1, 6],
+            )?);
+        }
+        self.evaluate(py, &arguments, &[self.model.nv], &|m, w, i, out| {
+            let Workspace { data, forces } = w;
+            let forces = i.get(3).map(|flat| {
+                fill_forces(forces, flat);
+                &forces[..]
+            });
+            out.copy_from_slice(algorithm(m, data, i[0], i[1], i[2], forces)?.as_slice());
+            Ok(())
+        })
+    }
+}
+
+/// Writes a matrix (column-major in nalgebra) into a row-major output.
+fn write_row_major(matrix: &nalgebra::DMatrix<f64>, out: &mut [f64]) {
+    let columns = matrix.ncols();
+    for ((r, c), value) in (0..matrix.nrows())
+        .flat_map(|r| (0..columns).map(move |c| (r, c)))
+        .zip(out.iter_mut())
+    {
+        *value = matrix[(r, c)];
+    }
+}
+
+fn vector_array<'py>(py: Python<'py>, values: &[f64]) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_slice(py, values)
+}
+
+/// Reads a settable per-coordinate property.
+fn read_property(name: &str, value: &Bound<PyAny>, length: usize) -> PyResult<Vec<f64>> {
+    let argument = Argument::new(
+        match name {
+            "gravity" => "gravity",
+            _ => "armature",
+        },
+        value,
+        vec![length],
+    )?;
+    if argument.batch()?.is_some() {
+        return Err(PyValueError::new_err(format!(
+            "argument '{name}': expected shape ({length},), got {}",
+            shape_text(argument.array.shape())
+        )));
+    }
+    let values = argument.values().into_owned();
+    robodyn::error::check_finite(name, &values).map_err(to_py_err)?;
+    Ok(values)
+}
+
+#[pymethods]
+impl PyModel {
+    /// The model's name (URDF `<robot name>`).
+    #[getter]
+    fn name(&self) -> &str {
+        &self.model.name
+    }
+
+    /// Number of configuration coordinates.
+    #[getter]
+    fn nq(&self) -> usize {
+        self.model.nq
+    }
+
+    /// Number of velocity coordinates (degrees of freedom).
+    #[getter]
+    fn nv(&self) -> usize {
+        self.model.nv
+    }
+
+    /// Names of the moving joints, in q/v order (depth-first, file order).
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        self.model.joint_names[1..].to_vec()
+    }
+
+    /// Kind of each moving joint: "revolute", "prismatic", "spherical" or "free".
+    #[getter]
+    fn joint_types(&self) -> Vec<&'static str> {
+        self.model.joints[1..].iter().map(|j| j.kind()).collect()
+    }
+
+    /// First index of each joint in q (aligned with joint_names).
+    #[getter]
+    fn joint_idx_q(&self) -> Vec<usize> {
+        self.model.idx_q[1..].to_vec()
+    }
+
+    /// First index of each joint in v (aligned with joint_names).
+    #[getter]
+    fn joint_idx_v(&self) -> Vec<usize> {
+        self.model.idx_v[1..].to_vec()
+    }
+
+    /// Names of the moving bodies (the child link of each joint, aligned with joint_names); the
+    /// rows of `f_ext`.
+    #[getter]
+    fn body_names(&self) -> Vec<String> {
+        self.model.body_names[1..].to_vec()
+    }
+
+    /// Names of every frame: one per URDF link, moving or merged through a fixed joint.
+    #[getter]
+    fn frame_names(&self) -> Vec<String> {
+        self.model.frames.iter().map(|f| f.name.clone()).collect()
+    }
+
+    /// Gravity vector in world axes (m/s²), settable.
+    #[getter]
+    fn get_gravity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.gravity.as_slice())
+    }
+
+    #[setter]
+    fn set_gravity(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        let values = read_property("gravity", value, 3)?;
+        self.model.gravity = nalgebra::Vector3::from_row_slice(&values);
+        Ok(())
+    }
+
+    /// Rotor inertia per velocity coordinate (kg m² or kg), settable: it adds to M's diagonal and
+    /// to inverse and forward dynamics.
+    #[getter]
+    fn get_armature<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.armature.as_slice())
+    }
+
+    #[setter]
+    fn set_armature(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        let values = read_property("armature", value, self.model.nv)?;
+        if let Some(k) = values.iter().position(|x| *x < 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "argument 'armature': expected values >= 0, got {} at index {k}",
+                values[k]
+            )));
+        }
+        self.model.armature = nalgebra::DVector::from_vec(values);
+        Ok(())
+    }
+
+    /// Lower position limits, shape (nq,), -inf where none.
+    #[getter]
+    fn lower_position_limit<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.lower_position_limit.as_slice())
+    }
+
+    /// Upper position limits, shape (nq,), inf where none.
+    #[getter]
+    fn upper_position_limit<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.upper_position_limit.as_slice())
+    }
+
+    /// Velocity limits, shape (nv,), inf where none.
+    #[getter]
+    fn velocity_limit<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.velocity_limit.as_slice())
+    }
+
+    /// Effort limits, shape (nv,), inf where none.
+    #[getter]
+    fn effort_limit<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.effort_limit.as_slice())
+    }
+
+    /// Viscous damping per velocity coordinate (URDF `<dynamics damping>`), not applied by the
+    /// dynamics calls.
+    #[getter]
+    fn damping<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.damping.as_slice())
+    }
+
+    /// Dry friction per velocity coordinate (URDF `<dynamics friction>`), not applied by the
+    /// dynamics calls.
+    #[getter]
+    fn friction<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.friction.as_slice())
+    }
+
+    /// URDF mimic relations as (joint, mimicked joint, multiplier, offset):
+    /// q[joint] = multiplier * q[mimicked] + offset. Reported, not enforced.
+    #[getter]
+    fn mimic_joints(&self) -> Vec<(String, String, f64, f64)> {
+        self.model
+            .mimics
+            .iter()
+            .map(|m| {
+                (
+                    self.model.joint_names[m.joint].clone(),
+                    self.model.joint_names[m.mimicked].clone(),
+                    m.multiplier,
+                    m.offset,
+                )
+            })
+            .collect()
+    }
+
+    /// Total mass (kg).
+    #[getter]
+    fn total_mass(&self) -> f64 {
+        self.model.total_mass()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "robodyn.Model('{}', nq={}, nv={}, joints={}, frames={})",
+            self.model.name,
+            self.model.nq,
+            self.model.nv,
+            self.model.nbodies() - 1,
+            self.model.frames.len()
+        )
+    }
+
+    /// The neutral configuration: zero angles, identity quaternions. Shape (nq,).
+    fn neutral<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.neutral().as_slice())
+    }
+
+    /// A random configuration within the position limits (angles in [-π, π] and translations in
+    /// [-1, 1] m where a joint has none; uniform rotations). `n` gives a batch (n, nq); `seed`
+    /// makes it reproducible.
+    #[pyo3(signature = (n=None, seed=None))]
+    fn random_configuration<'py>(
+        &self,
+        py: Python<'py>,
+        n: Option<usize>,
+        seed: Option<u64>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let mut rng = match seed {
+            Some(seed) => StdRng::seed_from_u64(seed),
+            None => StdRng::from_os_rng(),
+        };
+        match n {
+            None => Ok(
+                vector_array(py, self.model.random_configuration(&mut rng).as_slice()).into_any(),
+            ),
+            Some(n) => {
+                let mut values = Vec::with_capacity(n * self.model.nq);
+                for _ in 0..n {
+                    values.extend_from_slice(self.model.random_configuration(&mut rng).as_slice());
+                }
+                Ok(PyArray1::from_vec(py, values)
+                    .reshape([n, self.model.nq])?
+                    .into_any())
+            }
+        }
+    }
+
+    /// Inverse dynamics by RNEA: τ = M(q) a + C(q, v) v + g(q) - Σ J_iᵀ f_ext_i.
+    /// `f_ext`: optional (nbodies, 6) wrenches [force; torque] on each body (rows as body_names),
+    /// in the body's frame, at its origin.
+    #[pyo3(signature = (q, v, a, f_ext=None))]
+    fn inverse_dynamics<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        a: &Bound<'py, PyAny>,
+        f_ext: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.with_external_forces(py, q, v, ("a", a), f_ext, algo::rnea)
+    }
+
+    /// Forward dynamics by ABA: a = M(q)⁻¹ (τ - C(q, v) v - g(q) + Σ J_iᵀ f_ext_i).
+    #[pyo3(signature = (q, v, tau, f_ext=None))]
+    fn forward_dynamics<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        tau: &Bound<'py, PyAny>,
+        f_ext: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.with_external_forces(py, q, v, ("tau", tau), f_ext, algo::aba)
+    }
+
+    /// Joint-space inertia matrix M(q) by CRBA, full and symmetric, armature included. (nv, nv).
+    fn mass_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let nv = self.model.nv;
+        self.evaluate(py, &[self.q_arg("q", q)?], &[nv, nv], &|m, w, i, out| {
+            write_row_major(algo::crba(m, &mut w.data, i[0])?, out);
+            Ok(())
+        })
+    }
+
+    /// M(q)⁻¹. (nv, nv).
+    fn inverse_mass_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let nv = self.model.nv;
+        self.evaluate(py, &[self.q_arg("q", q)?], &[nv, nv], &|m, w, i, out| {
+            write_row_major(algo::inverse_mass_matrix(m, &mut w.data, i[0])?, out);
+            Ok(())
+        })
+    }
+
+    /// Bias forces C(q, v) v + g(q) (RNEA with a = 0). (nv,).
+    fn bias_forces<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[self.model.nv],
+            &|m, w, i, out| {
+                out.copy_from_slice(algo::bias_forces(m, &mut w.data, i[0], i[1])?.as_slice());
+                Ok(())
+            },
+        )
+    }
+
+    /// Generalized gravity g(q) (RNEA with v = a = 0). (nv,).
+    fn generalized_gravity<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?],
+            &[self.model.nv],
+            &|m, w, i, out| {
+                out.copy_from_slice(algo::generalized_gravity(m, &mut w.data, i[0])?.as_slice());
+                Ok(())
+            },
+        )
+    }
+
+    /// Pose of a frame (name or index) in the world: 4x4 homogeneous matrix.
+    fn frame_pose<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let frame = self.frame_index(frame)?;
+        self.evaluate(py, &[self.q_arg("q", q)?], &[4, 4], &|m, w, i, out| {
+            algo::forward_kinematics(m, &mut w.data, i[0])?;
+            let pose = algo::frame_placement(m, &w.data, frame).to_homogeneous();
+            for (r, row) in out.chunks_exact_mut(4).enumerate() {
+                for (c, value) in row.iter_mut().enumerate() {
+                    *value = pose[(r, c)];
+                }
+            }
+            Ok(())
+        })
+    }
+
+    /// Jacobian of a frame, (6, nv), rows [linear; angular]. `reference`: "world" (velocity of the
+    /// frame's origin and angular velocity in world axes: the geometric Jacobian), "local" (the
+    /// same in the frame's axes) or "spatial" (spatial velocity in world coordinates).
+    #[pyo3(signature = (q, frame, reference="world"))]
+    fn jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+        reference: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let frame = self.frame_index(frame)?;
+        let reference = match reference {
+            "world" => Reference::World,
+            "local" => Reference::Local,
+            "spatial" => Reference::Spatial,
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "argument 'reference': expected 'world', 'local' or 'spatial', got '{other}'"
+                )))
+            }
+        };
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?],
+            &[6, self.model.nv],
+            &|m, w, i, out| {
+                write_row_major(algo::jacobian(m, &mut w.data, i[0], frame, reference)?, out);
+                Ok(())
+            },
+        )
+    }
+
+    /// Kinetic energy ½ vᵀ M(q) v (J), rotor energy included.
+    fn kinetic_energy<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[],
+            &|m, w, i, out| {
+                out[0] = algo::kinetic_energy(m, &mut w.data, i[0], i[1])?;
+                Ok(())
+            },
+        )
+    }
+
+    /// Potential energy -Σ m_i gᵀ c_i (J), zero at the world origin.
+    fn potential_energy<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(py, &[self.q_arg("q", q)?], &[], &|m, w, i, out| {
+            out[0] = algo::potential_energy(m, &mut w.data, i[0])?;
+            Ok(())
+        })
+    }
+
+    /// Centre of mass of the robot in world coordinates. (3,).
+    fn center_of_mass<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(py, &[self.q_arg("q", q)?], &[3], &|m, w, i, out| {
+            out.copy_from_slice(algo::center_of_mass(m, &mut w.data, i[0])?.as_slice());
+            Ok(())
+        })
+    }
+
+    /// q ⊕ v dt: moves q with constant velocity v for dt seconds on each joint's Lie group.
+    #[pyo3(signature = (q, v, dt=1.0))]
+    fn integrate<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        dt: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        if !dt.is_finite() {
+            return Err(PyValueError::new_err(format!(
+                "argument 'dt': expected a finite number, got {dt}"
+            )));
+        }
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[self.model.nq],
+            &|m, _, i, out| {
+                robodyn::error::check_finite("v", i[1])?;
+                let step: Vec<f64> = i[1].iter().map(|x| x * dt).collect();
+                m.integrate(i[0], &step, out)
+            },
+        )
+    }
+
+    /// q1 ⊖ q0: the velocity that moves q0 to q1 in unit time. (nv,).
+    fn difference<'py>(
+        &self,
+        py: Python<'py>,
+        q0: &Bound<'py, PyAny>,
+        q1: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q0", q0)?, self.q_arg("q1", q1)?],
+            &[self.model.nv],
+            &|m, _, i, out| m.difference(i[0], i[1], out),
+        )
+    }
+}
+
+/// Loads a URDF file; `floating_base` adds a free joint "root_joint" above the root link.
+#[pyfunction]
+#[pyo3(signature = (path, floating_base=false))]
+fn load_urdf(path: std::path::PathBuf, floating_base: bool) -> PyResult<PyModel> {
+    robodyn::io::load_urdf_file(&path, floating_base)
+        .map(PyModel::wrap)
+        .map_err(to_py_err)
+}
+
+/// Loads a URDF document from a string.
+#[pyfunction]
+#[pyo3(signature = (text, floating_base=false, source="<string>"))]
+fn load_urdf_string(text: &str, floating_base: bool, source: &str) -> PyResult<PyModel> {
+    robodyn::io::load_urdf_str(text, source, floating_base)
+        .map(PyModel::wrap)
+        .map_err(to_py_err)
+}
+
+/// A model bundled with robodyn, by name.
+#[pyfunction]
+#[pyo3(signature = (name, floating_base=false))]
+fn load_bundled(name: &str, floating_base: bool) -> PyResult<PyModel> {
+    robodyn::io::bundled_model(name, floating_base)
+        .map(PyModel::wrap)
+        .map_err(to_py_err)
+}
+
+/// Names of the bundled models.
+#[pyfunction]
+fn bundled_names() -> Vec<&'static str> {
+    robodyn::io::bundled_names()
+}
+
+#[pymodule]
+fn _core(module: &Bound<'_, PyModule>) -> PyResult<()> {
+    module.add_class::<PyModel>()?;
+    module.add_function(wrap_pyfunction!(load_urdf, module)?)?;
+    module.add_function(wrap_pyfunction!(load_urdf_string, module)?)?;
+    module.add_function(wrap_pyfunction!(load_bundled, module)?)?;
+    module.add_function(wrap_pyfunction!(bundled_names, module)?)?;
+    Ok(())
+}

@@ -1,0 +1,81 @@
+"""robodyn: rigid-body dynamics for robots.
+
+A Rust core (RNEA, CRBA, ABA, kinematics, Jacobians) behind a NumPy API::
+
+    import numpy as np, robodyn
+    m = robodyn.load("ur5")                 # bundled model, or a path to a .urdf
+    q = m.random_configuration()
+    tau = m.inverse_dynamics(q, np.zeros(m.nv), np.zeros(m.nv))
+
+Every numeric method takes one state (``q`` of shape ``(nq,)``) or a batch (``(N, nq)``);
+batches release the GIL and run on all cores. Conventions: 6-vectors and Jacobian rows are
+``[linear; angular]``; quaternions are ``[qx, qy, qz, qw]``; SI units.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from robodyn._core import Model, bundled_names, load_bundled, load_urdf, load_urdf_string
+
+__all__ = ["Model", "load", "models", "load_urdf", "load_urdf_string", "__version__"]
+__version__ = "0.1.0"
+
+
+def models() -> list[str]:
+    """Names of the robot models bundled with robodyn (``robodyn.load(name)`` loads one)."""
+    return list(bundled_names())
+
+
+def _example_robot_data_dir() -> Path | None:
+    """The robots folder of the ``example-robot-data`` package, when it is installed."""
+    try:
+        import example_robot_data  # noqa: F401  (installs its data under cmeel.prefix)
+    except ImportError:
+        return None
+    import sysconfig
+
+    folder = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
+    return folder if folder.is_dir() else None
+
+
+def _find_file(name: str) -> Path:
+    """``name`` as a path, or else a file of that name in example-robot-data's robots folder."""
+    path = Path(name).expanduser()
+    if path.exists() or path.parent != Path("."):
+        return path
+    robots = _example_robot_data_dir()
+    if robots is not None:
+        matches = sorted(robots.rglob(path.name))
+        if matches:
+            return matches[0]
+    return path
+
+
+def load(name_or_path: str | os.PathLike[str], floating_base: bool = False) -> Model:
+    """Load a robot model.
+
+    ``name_or_path`` is a bundled model's name (see :func:`models`) or a path to a URDF file. A bare
+    file name that does not exist in the working directory is also looked up in the
+    ``example-robot-data`` package when it is installed (``robodyn.load("talos_full_v2.urdf")``).
+    ``floating_base=True`` puts a free joint named ``root_joint`` between the world and the root
+    link (q gains ``[x, y, z, qx, qy, qz, qw]``, v gains ``[v_linear, omega]`` in the base frame).
+
+    Raises ``FileNotFoundError`` for a missing file and ``ValueError`` for an invalid model, naming
+    the file, element and line.
+    """
+    if not isinstance(name_or_path, (str, os.PathLike)):
+        raise ValueError(f"argument 'name_or_path': expected a model name or a path, got {name_or_path!r}")
+    text = os.fspath(name_or_path)
+    if text in bundled_names():
+        return load_bundled(text, floating_base)
+    path = _find_file(text)
+    suffix = path.suffix.lower()
+    if suffix != ".urdf":
+        if not path.exists():
+            raise FileNotFoundError(
+                f"model file not found: '{text}' (and it is not a bundled model: {models()})"
+            )
+        raise ValueError(f"argument 'name_or_path': expected a .urdf file or one of {models()}, got '{text}'")
+    return load_urdf(str(path), floating_base)

@@ -1,0 +1,83 @@
+"""The ``robodyn`` command: ``robodyn demo`` and ``robodyn models``."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+
+import numpy as np
+
+import robodyn
+
+#: forward_dynamics(inverse_dynamics(a)) must return a to this relative accuracy.
+ROUND_TRIP_TOLERANCE = 1e-9
+
+
+def _matrix(rows: np.ndarray, names: list[str]) -> str:
+    width = max(len(n) for n in names)
+    lines = [" " * (width + 2) + "".join(f"{n[:10]:>11}" for n in names)]
+    for name, row in zip(names, np.atleast_2d(rows)):
+        lines.append(f"  {name:<{width}}" + "".join(f"{x:11.4f}" for x in row))
+    return "\n".join(lines)
+
+
+def _table(columns: dict[str, np.ndarray], names: list[str]) -> str:
+    width = max(len(n) for n in names)
+    lines = [f"  {'joint':<{width}}" + "".join(f"{c:>14}" for c in columns)]
+    for k, name in enumerate(names):
+        lines.append(f"  {name:<{width}}" + "".join(f"{values[k]:14.6f}" for values in columns.values()))
+    return "\n".join(lines)
+
+
+def demo(model_name: str = "ur5", batch: int = 10_000) -> int:
+    """Print the dynamics of a bundled robot at a sample state and time a batch."""
+    m = robodyn.load(model_name)
+    names = [n.removesuffix("_joint") for n in m.joint_names]
+    q = m.random_configuration(seed=1)
+    v = np.linspace(-1.0, 1.0, m.nv)
+    a = np.linspace(0.5, -0.5, m.nv)
+
+    mass = m.mass_matrix(q)
+    gravity = m.generalized_gravity(q)
+    coriolis = m.bias_forces(q, v) - gravity
+    tau = m.inverse_dynamics(q, v, a)
+    print(f"robodyn {robodyn.__version__}: {m!r}\n")
+    print("State and the terms of  tau = M(q) a + C(q, v) v + g(q)  (SI units):")
+    print(_table({"q [rad]": q, "v [rad/s]": v, "a [rad/s2]": a, "g(q)": gravity, "C(q,v)v": coriolis, "tau": tau}, names))
+    print("\nMass matrix M(q):")
+    print(_matrix(mass, names))
+
+    qdd = m.forward_dynamics(q, v, tau)
+    error = np.max(np.abs(qdd - a)) / max(1.0, np.max(np.abs(a)))
+    ok = error < ROUND_TRIP_TOLERANCE
+    print(f"\nforward_dynamics(inverse_dynamics(a)) == a: {'yes' if ok else 'NO'} (max error {error:.1e})")
+
+    states = m.random_configuration(n=batch, seed=2)
+    start = time.perf_counter()
+    m.generalized_gravity(states)
+    elapsed = time.perf_counter() - start
+    print(
+        f"generalized_gravity on a batch of {batch} states: {elapsed * 1e3:.2f} ms "
+        f"({elapsed / batch * 1e9:.0f} ns per state, {os.cpu_count()} cores)"
+    )
+    return 0 if ok else 1
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="robodyn", description="Rigid-body dynamics for robots.")
+    commands = parser.add_subparsers(dest="command", required=True)
+    demo_parser = commands.add_parser("demo", help="dynamics of a bundled robot at a sample state")
+    demo_parser.add_argument("model", nargs="?", default="ur5", choices=robodyn.models())
+    demo_parser.add_argument("--batch", type=int, default=10_000, help="batch size to time")
+    commands.add_parser("models", help="list the bundled models")
+    args = parser.parse_args(argv)
+    if args.command == "models":
+        print("\n".join(robodyn.models()))
+        return 0
+    return demo(args.model, args.batch)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
