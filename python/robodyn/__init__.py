@@ -15,12 +15,18 @@ batches release the GIL and run on all cores. Conventions: 6-vectors and Jacobia
 from __future__ import annotations
 
 import os
+import sys
+import warnings
 from pathlib import Path
 
 from robodyn._core import Model, bundled_names, load_bundled, load_urdf, load_urdf_string
 
-__all__ = ["Model", "load", "models", "load_urdf", "load_urdf_string", "__version__"]
+__all__ = ["Model", "ModelWarning", "load", "models", "load_urdf", "load_urdf_string", "__version__"]
 __version__ = "0.1.0"
+
+
+class ModelWarning(UserWarning):
+    """A model loaded, but with something you should know (see ``Model.warnings``)."""
 
 
 def models() -> list[str]:
@@ -29,15 +35,12 @@ def models() -> list[str]:
 
 
 def _example_robot_data_dir() -> Path | None:
-    """The robots folder of the ``example-robot-data`` package, when it is installed."""
-    try:
-        import example_robot_data  # noqa: F401  (installs its data under cmeel.prefix)
-    except ImportError:
-        return None
-    import sysconfig
-
-    folder = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
-    return folder if folder.is_dir() else None
+    """The robots folder of the ``example-robot-data`` package (PyPI), when it is installed."""
+    for entry in sys.path:
+        folder = Path(entry) / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
+        if folder.is_dir():
+            return folder
+    return None
 
 
 def _find_file(name: str) -> Path:
@@ -53,7 +56,7 @@ def _find_file(name: str) -> Path:
     return path
 
 
-def load(name_or_path: str | os.PathLike[str], floating_base: bool = False) -> Model:
+def load(name_or_path: str | os.PathLike[str], floating_base: bool = False, check_inertia: bool = True) -> Model:
     """Load a robot model.
 
     ``name_or_path`` is a bundled model's name (see :func:`models`) or a path to a URDF file. A bare
@@ -61,6 +64,9 @@ def load(name_or_path: str | os.PathLike[str], floating_base: bool = False) -> M
     ``example-robot-data`` package when it is installed (``robodyn.load("talos_full_v2.urdf")``).
     ``floating_base=True`` puts a free joint named ``root_joint`` between the world and the root
     link (q gains ``[x, y, z, qx, qy, qz, qw]``, v gains ``[v_linear, omega]`` in the base frame).
+
+    ``check_inertia=False`` loads a file whose inertia tensors are not positive semi-definite (a few
+    published URDFs have them) and reports each as a :class:`ModelWarning` instead of failing.
 
     Raises ``FileNotFoundError`` for a missing file and ``ValueError`` for an invalid model, naming
     the file, element and line.
@@ -78,4 +84,7 @@ def load(name_or_path: str | os.PathLike[str], floating_base: bool = False) -> M
                 f"model file not found: '{text}' (and it is not a bundled model: {models()})"
             )
         raise ValueError(f"argument 'name_or_path': expected a .urdf file or one of {models()}, got '{text}'")
-    return load_urdf(str(path), floating_base)
+    model = load_urdf(str(path), floating_base, check_inertia)
+    for message in model.warnings:
+        warnings.warn(message, ModelWarning, stacklevel=2)
+    return model

@@ -10,6 +10,7 @@ use pyo3::prelude::*;
 use rand::{rngs::StdRng, SeedableRng};
 use rayon::prelude::*;
 use robodyn::algo::{self, Reference};
+use robodyn::io::LoadOptions;
 use robodyn::spatial::Force;
 use robodyn::{Data, Error, Model};
 use std::borrow::Cow;
@@ -464,6 +465,12 @@ impl PyModel {
             .collect()
     }
 
+    /// What the loader accepted but you should know: ignored mimic tags, unchecked inertias.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.model.warnings.clone()
+    }
+
     /// Total mass (kg).
     #[getter]
     fn total_mass(&self) -> f64 {
@@ -742,20 +749,38 @@ impl PyModel {
     }
 }
 
-/// Loads a URDF file; `floating_base` adds a free joint "root_joint" above the root link.
+/// Loads a URDF file. `floating_base` adds a free joint "root_joint" above the root link;
+/// `check_inertia=False` turns a non-positive-semi-definite inertia from an error into a warning.
 #[pyfunction]
-#[pyo3(signature = (path, floating_base=false))]
-fn load_urdf(path: std::path::PathBuf, floating_base: bool) -> PyResult<PyModel> {
-    robodyn::io::load_urdf_file(&path, floating_base)
+#[pyo3(signature = (path, floating_base=false, check_inertia=true))]
+fn load_urdf(
+    path: std::path::PathBuf,
+    floating_base: bool,
+    check_inertia: bool,
+) -> PyResult<PyModel> {
+    let options = LoadOptions {
+        floating_base,
+        check_inertia,
+    };
+    robodyn::io::load_urdf_file(&path, options)
         .map(PyModel::wrap)
         .map_err(to_py_err)
 }
 
-/// Loads a URDF document from a string.
+/// Loads a URDF document from a string; `source` names it in error messages.
 #[pyfunction]
-#[pyo3(signature = (text, floating_base=false, source="<string>"))]
-fn load_urdf_string(text: &str, floating_base: bool, source: &str) -> PyResult<PyModel> {
-    robodyn::io::load_urdf_str(text, source, floating_base)
+#[pyo3(signature = (text, floating_base=false, check_inertia=true, source="<string>"))]
+fn load_urdf_string(
+    text: &str,
+    floating_base: bool,
+    check_inertia: bool,
+    source: &str,
+) -> PyResult<PyModel> {
+    let options = LoadOptions {
+        floating_base,
+        check_inertia,
+    };
+    robodyn::io::load_urdf_str(text, source, options)
         .map(PyModel::wrap)
         .map_err(to_py_err)
 }

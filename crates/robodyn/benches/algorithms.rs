@@ -5,7 +5,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::{rngs::StdRng, SeedableRng};
 use robodyn::algo::{aba, crba, forward_kinematics, jacobian, rnea, Reference};
-use robodyn::io::{bundled_model, load_urdf_file};
+use robodyn::io::{bundled_model, load_urdf_file, LoadOptions};
 use robodyn::{Data, Model};
 use std::hint::black_box;
 use std::path::PathBuf;
@@ -26,7 +26,7 @@ fn models() -> Vec<(&'static str, Model)> {
             ("panda", "panda_description/urdf/panda.urdf", false),
             ("talos", "talos_data/robots/talos_full_v2.urdf", true),
         ] {
-            if let Ok(model) = load_urdf_file(&dir.join(path), floating) {
+            if let Ok(model) = load_urdf_file(&dir.join(path), LoadOptions::floating(floating)) {
                 models.push((name, model));
             }
         }

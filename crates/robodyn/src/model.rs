@@ -10,8 +10,10 @@ use rand::Rng;
 /// How far a quaternion in q may be from unit norm before it is rejected.
 pub const QUATERNION_NORM_TOLERANCE: f64 = 1e-6;
 /// Slack allowed when checking that a rotational inertia is positive semi-definite, relative to
-/// its largest principal moment.
+/// its largest entry ...
 pub const INERTIA_EIGENVALUE_TOLERANCE: f64 = 1e-9;
+/// ... and in absolute terms (kg m²), so that round-off on a near-zero tensor is accepted.
+pub const INERTIA_ABSOLUTE_TOLERANCE: f64 = 1e-12;
 /// Standard gravity, m/s², used by the default gravity vector `[0, 0, -9.81]`.
 pub const STANDARD_GRAVITY: f64 = 9.81;
 
@@ -109,6 +111,8 @@ pub struct Model {
     pub gravity: Vec3,
     /// Mimic relations, reported, not enforced.
     pub mimics: Vec<Mimic>,
+    /// What the loader accepted but the user should know (ignored tags, unchecked inertias).
+    pub warnings: Vec<String>,
 }
 
 impl Model {
@@ -233,9 +237,9 @@ impl Model {
     }
 }
 
-/// Checks that (mass, rotational inertia about the COM) describe a physical rigid body: finite,
-/// mass ≥ 0, symmetric, positive semi-definite. A point mass (zero inertia) is valid.
-pub fn check_rigid_body(mass: f64, inertia_com: &Mat3) -> std::result::Result<(), String> {
+/// Checks that (mass, rotational inertia about the COM) can be computed with: finite, mass ≥ 0,
+/// symmetric. [`check_positive_semidefinite`] checks that the body is physical.
+pub fn check_mass_and_inertia(mass: f64, inertia_com: &Mat3) -> std::result::Result<(), String> {
     if !mass.is_finite() || mass < 0.0 {
         return Err(format!("expected a finite mass >= 0, got {mass}"));
     }
@@ -247,9 +251,15 @@ pub fn check_rigid_body(mass: f64, inertia_com: &Mat3) -> std::result::Result<()
     if asymmetry > INERTIA_EIGENVALUE_TOLERANCE * scale {
         return Err("expected a symmetric inertia tensor".into());
     }
+    Ok(())
+}
+
+/// Checks that a rotational inertia is positive semi-definite (a point mass, zero, is valid).
+pub fn check_positive_semidefinite(inertia_com: &Mat3) -> std::result::Result<(), String> {
+    let scale = inertia_com.abs().max();
     let eigenvalues = inertia_com.symmetric_eigenvalues();
     let smallest = eigenvalues.min();
-    if smallest < -INERTIA_EIGENVALUE_TOLERANCE * scale {
+    if smallest < -(INERTIA_EIGENVALUE_TOLERANCE * scale).max(INERTIA_ABSOLUTE_TOLERANCE) {
         return Err(format!(
             "expected a positive semi-definite inertia tensor, got principal moments [{:.6e}, {:.6e}, {:.6e}]",
             eigenvalues[0], eigenvalues[1], eigenvalues[2]
@@ -306,6 +316,7 @@ impl ModelBuilder {
                 frames: Vec::new(),
                 gravity: Vec3::new(0.0, 0.0, -STANDARD_GRAVITY),
                 mimics: Vec::new(),
+                warnings: Vec::new(),
             },
         }
     }
@@ -400,6 +411,11 @@ impl ModelBuilder {
     /// Records a mimic relation between two joints (body indices).
     pub fn add_mimic(&mut self, mimic: Mimic) {
         self.model.mimics.push(mimic);
+    }
+
+    /// Records something the user should know about the model.
+    pub fn warn(&mut self, message: String) {
+        self.model.warnings.push(message);
     }
 
     /// Sets the gravity vector.

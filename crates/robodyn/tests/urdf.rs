@@ -1,10 +1,10 @@
 //! URDF loading: structure, conventions, and every kind of bad input giving a clear error.
 
-use robodyn::io::{bundled_model, bundled_names, load_urdf_file, load_urdf_str};
+use robodyn::io::{bundled_model, bundled_names, load_urdf_file, load_urdf_str, LoadOptions};
 use robodyn::{Error, Joint};
 
 fn error_of(text: &str) -> String {
-    load_urdf_str(text, "bad.urdf", false)
+    load_urdf_str(text, "bad.urdf", LoadOptions::default())
         .expect_err("must fail")
         .to_string()
 }
@@ -55,7 +55,7 @@ fn fixed_joints_merge_and_order_is_depth_first() {
            <limit lower='-1' upper='1' effort='1' velocity='1'/></joint>
          <link name='l4'/>",
     );
-    let model = load_urdf_str(&text, "t.urdf", false).unwrap();
+    let model = load_urdf_str(&text, "t.urdf", LoadOptions::default()).unwrap();
     assert_eq!(model.joint_names, vec!["universe", "j1", "j2", "j3", "m"]);
     assert_eq!(model.parent, vec![0, 0, 1, 0, 3]);
     assert_eq!(
@@ -102,7 +102,6 @@ fn errors_name_the_element_and_what_is_wrong() {
         (robot(&format!("{LINK_A}{LINK_B}<joint name='j' type='revolute'><parent link='a'/><child link='b'/><axis xyz='0 0 0'/></joint>")), "non-zero vector"),
         (robot(&format!("{LINK_A}{LINK_B}<joint name='j' type='revolute'><parent link='a'/><child link='b'/><origin xyz='1 2'/></joint>")), "expected 3 numbers"),
         (robot(&format!("{LINK_A}{LINK_B}<joint type='revolute'><parent link='a'/><child link='b'/></joint>")), "missing attribute 'name'"),
-        (robot(&format!("{LINK_A}{LINK_B}<joint name='j' type='revolute'><parent link='a'/><child link='b'/><mimic joint='zz'/></joint>")), "'zz' is not a moving joint"),
         (robot(""), "expected at least one <link>"),
     ];
     for (text, expected) in cases {
@@ -119,11 +118,22 @@ fn errors_name_the_element_and_what_is_wrong() {
     // the element and the line are named
     let message = error_of(&robot(&format!("{LINK_A}{LINK_B}\n<joint name='j' type='screw'><parent link='a'/><child link='b'/></joint>")));
     assert!(message.contains("<joint name='j'> (line 2)"), "{message}");
+    let message = error_of(&robot(
+        "<link name='a'>\n<inertial><mass value='-1'/></inertial></link>",
+    ));
+    assert!(
+        message.contains("<link name='a'>/<inertial> (line 2)"),
+        "{message}"
+    );
 }
 
 #[test]
 fn missing_file_is_its_own_error() {
-    let error = load_urdf_file(std::path::Path::new("/no/such/robot.urdf"), false).unwrap_err();
+    let error = load_urdf_file(
+        std::path::Path::new("/no/such/robot.urdf"),
+        LoadOptions::default(),
+    )
+    .unwrap_err();
     assert_eq!(
         error,
         Error::FileNotFound {
@@ -160,4 +170,27 @@ fn bad_states_are_rejected_with_the_argument_named() {
         .unwrap_err()
         .to_string()
         .contains("unknown frame 'nope'"));
+}
+
+#[test]
+fn questionable_input_loads_with_a_warning() {
+    // a mimic naming a joint that does not exist, and a non-physical inertia with the check off
+    let text = robot(&format!(
+        "<link name='a'><inertial><mass value='1'/><inertia ixx='1' iyy='1' izz='-1' ixy='0' ixz='0' iyz='0'/></inertial></link>{LINK_B}
+         <joint name='j' type='revolute'><parent link='a'/><child link='b'/><mimic joint='zz'/></joint>"
+    ));
+    let options = LoadOptions {
+        check_inertia: false,
+        ..LoadOptions::default()
+    };
+    let model = load_urdf_str(&text, "odd.urdf", options).unwrap();
+    assert!(model.mimics.is_empty());
+    assert_eq!(model.warnings.len(), 2, "{:?}", model.warnings);
+    assert!(
+        model.warnings[0].contains("positive semi-definite")
+            && model.warnings[0].contains("check_inertia is off")
+    );
+    assert!(model.warnings[1].contains("<mimic joint='zz'> ignored"));
+    // with the check on (the default) the inertia is an error
+    assert!(load_urdf_str(&text, "odd.urdf", LoadOptions::default()).is_err());
 }

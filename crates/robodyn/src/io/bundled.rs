@@ -2,7 +2,7 @@
 //! they need no file at run time. Sources are cited inside each URDF in `models/`.
 
 use crate::error::{Error, Result};
-use crate::io::urdf::load_urdf_str;
+use crate::io::{urdf::load_urdf_str, LoadOptions};
 use crate::model::{Model, STANDARD_GRAVITY};
 use crate::spatial::Vec3;
 
@@ -44,7 +44,11 @@ pub fn bundled_model(name: &str, floating_base: bool) -> Result<Model> {
                     bundled_names()
                 ),
             })?;
-    let mut model = load_urdf_str(text, &format!("{name}.urdf (bundled)"), floating_base)?;
+    let mut model = load_urdf_str(
+        text,
+        &format!("{name}.urdf (bundled)"),
+        LoadOptions::floating(floating_base),
+    )?;
     model.gravity = Vec3::from(*gravity);
     Ok(model)
 }

@@ -6,3 +6,31 @@ pub mod urdf;
 
 pub use bundled::{bundled_model, bundled_names};
 pub use urdf::{load_urdf_file, load_urdf_str};
+
+/// How a model file is turned into a model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Put a free joint named `root_joint` between the world and the root link.
+    pub floating_base: bool,
+    /// Reject inertias that are not positive semi-definite (otherwise: a warning on the model).
+    pub check_inertia: bool,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        LoadOptions {
+            floating_base: false,
+            check_inertia: true,
+        }
+    }
+}
+
+impl LoadOptions {
+    /// The defaults, with or without a floating base.
+    pub fn floating(floating_base: bool) -> Self {
+        LoadOptions {
+            floating_base,
+            ..LoadOptions::default()
+        }
+    }
+}

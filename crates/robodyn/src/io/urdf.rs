@@ -5,18 +5,25 @@
 //! tags. Fixed joints are merged into the parent body and the child link is kept as a frame.
 //! Bodies are numbered depth-first, children in file order. The root link is the world unless
 //! `floating_base` puts a free joint named `root_joint` between the world and the root.
+//! An inertia that is not positive semi-definite is an error unless `check_inertia` is off, when
+//! it becomes a warning on the model. A mimic tag on a fixed joint, or naming a joint that does not
+//! move, is ignored with a warning.
 //! Visual, collision, transmission and gazebo elements are ignored.
 
 use crate::error::{Error, Result};
+use crate::io::LoadOptions;
 use crate::joint::Joint;
-use crate::model::{check_rigid_body, JointProperties, Mimic, Model, ModelBuilder, NewBody};
+use crate::model::{
+    check_mass_and_inertia, check_positive_semidefinite, JointProperties, Mimic, Model,
+    ModelBuilder, NewBody,
+};
 use crate::spatial::{rotation_from_rpy, Inertia, Mat3, Transform, Vec3};
 use roxmltree::{Document, Node};
 use std::collections::HashMap;
 use std::path::Path;
 
 /// Loads a URDF file.
-pub fn load_urdf_file(path: &Path, floating_base: bool) -> Result<Model> {
+pub fn load_urdf_file(path: &Path, options: LoadOptions) -> Result<Model> {
     let text = std::fs::read_to_string(path).map_err(|e| match e.kind() {
         std::io::ErrorKind::NotFound => Error::FileNotFound {
             path: path.display().to_string(),
@@ -26,16 +33,18 @@ pub fn load_urdf_file(path: &Path, floating_base: bool) -> Result<Model> {
             format!("cannot read the file: {e}"),
         ),
     })?;
-    load_urdf_str(&text, &path.display().to_string(), floating_base)
+    load_urdf_str(&text, &path.display().to_string(), options)
 }
 
 /// Loads a URDF document held in `text`; `source` names it in error messages.
-pub fn load_urdf_str(text: &str, source: &str, floating_base: bool) -> Result<Model> {
+pub fn load_urdf_str(text: &str, source: &str, options: LoadOptions) -> Result<Model> {
     let document =
         Document::parse(text).map_err(|e| Error::model(source, format!("malformed XML: {e}")))?;
-    let parser = Parser {
+    let mut parser = Parser {
         source,
         document: &document,
+        options,
+        warnings: Vec::new(),
     };
     let robot = document.root_element();
     if robot.tag_name().name() != "robot" {
@@ -43,7 +52,7 @@ pub fn load_urdf_str(text: &str, source: &str, floating_base: bool) -> Result<Mo
     }
     let links = parser.links(robot)?;
     let joints = parser.joints(robot, &links)?;
-    parser.build(robot, &links, &joints, floating_base)
+    parser.build(robot, &links, &joints)
 }
 
 /// A parsed `<link>`.
@@ -68,26 +77,35 @@ struct UrdfJoint<'a> {
 struct Parser<'a> {
     source: &'a str,
     document: &'a Document<'a>,
+    options: LoadOptions,
+    warnings: Vec<String>,
 }
 
 impl<'a> Parser<'a> {
     /// An error located at `node`: file, element (with its name attribute) and line.
     fn error(&self, node: Node, message: impl Into<String>) -> Error {
+        Error::model(self.location(node), message)
+    }
+
+    /// "file: <element name='...'> (line n)"; an element without a name is shown under its
+    /// nearest named ancestor, e.g. "<link name='arm'>/<inertial>".
+    fn location(&self, node: Node) -> String {
         let position = self.document.text_pos_at(node.range().start);
-        let name = node
-            .attribute("name")
-            .map(|n| format!(" name='{n}'"))
-            .unwrap_or_default();
-        Error::model(
-            format!(
-                "{}: <{}{}> (line {})",
-                self.source,
-                node.tag_name().name(),
-                name,
-                position.row
-            ),
-            message,
-        )
+        let tag = |n: Node| match n.attribute("name") {
+            Some(name) => format!("<{} name='{name}'>", n.tag_name().name()),
+            None => format!("<{}>", n.tag_name().name()),
+        };
+        let named_ancestor = node
+            .ancestors()
+            .skip(1)
+            .find(|a| a.is_element() && a.has_attribute("name") && !a.has_tag_name("robot"));
+        let path = match named_ancestor {
+            Some(ancestor) if !node.has_attribute("name") => {
+                format!("{}/{}", tag(ancestor), tag(node))
+            }
+            _ => tag(node),
+        };
+        format!("{}: {path} (line {})", self.source, position.row)
     }
 
     /// A required attribute.
@@ -147,7 +165,7 @@ impl<'a> Parser<'a> {
     }
 
     /// Every `<link>` with its spatial inertia in the link frame.
-    fn links(&self, robot: Node<'a, 'a>) -> Result<Vec<Link<'a>>> {
+    fn links(&mut self, robot: Node<'a, 'a>) -> Result<Vec<Link<'a>>> {
         let mut links: Vec<Link<'a>> = Vec::new();
         for node in robot.children().filter(|c| c.has_tag_name("link")) {
             let name = self.attribute(node, "name")?;
@@ -171,7 +189,7 @@ impl<'a> Parser<'a> {
     }
 
     /// `<inertial>`: mass, centre of mass and rotational inertia, with their own origin.
-    fn inertial(&self, inertial: Node<'a, 'a>) -> Result<Inertia> {
+    fn inertial(&mut self, inertial: Node<'a, 'a>) -> Result<Inertia> {
         let mass_node =
             Self::child(inertial, "mass").ok_or_else(|| self.error(inertial, "missing <mass>"))?;
         let [mass] = self.numbers(mass_node, "value", [f64::NAN])?;
@@ -191,7 +209,16 @@ impl<'a> Parser<'a> {
         let frame = self.origin(inertial)?;
         let rotation = frame.rotation.transpose();
         let inertia_com = rotation * inertia_com * rotation.transpose();
-        check_rigid_body(mass, &inertia_com).map_err(|message| self.error(inertial, message))?;
+        check_mass_and_inertia(mass, &inertia_com)
+            .map_err(|message| self.error(inertial, message))?;
+        if let Err(message) = check_positive_semidefinite(&inertia_com) {
+            let error = self.error(inertial, message);
+            if self.options.check_inertia {
+                return Err(error);
+            }
+            self.warnings
+                .push(format!("{error} (loaded anyway: check_inertia is off)"));
+        }
         Ok(Inertia::from_com(mass, &frame.translation, &inertia_com))
     }
 
@@ -283,13 +310,7 @@ impl<'a> Parser<'a> {
     }
 
     /// Checks that links and joints form one tree and builds the model depth-first.
-    fn build(
-        &self,
-        robot: Node,
-        links: &[Link<'a>],
-        joints: &[UrdfJoint<'a>],
-        floating_base: bool,
-    ) -> Result<Model> {
+    fn build(&self, robot: Node, links: &[Link<'a>], joints: &[UrdfJoint<'a>]) -> Result<Model> {
         // the tree: one parent joint per link, exactly one root
         let mut parent_joint: Vec<Option<usize>> = vec![None; links.len()];
         for (j, joint) in joints.iter().enumerate() {
@@ -332,7 +353,10 @@ impl<'a> Parser<'a> {
         let mut builder = ModelBuilder::new(robot_name, links[root].name);
         // each link's body and X_{link←body}
         let mut placement: Vec<Option<(usize, Transform)>> = vec![None; links.len()];
-        if floating_base {
+        for warning in &self.warnings {
+            builder.warn(warning.clone());
+        }
+        if self.options.floating_base {
             let body = builder.add_body(NewBody {
                 parent: 0,
                 joint: Joint::Free,
@@ -402,20 +426,20 @@ impl<'a> Parser<'a> {
         // mimic relations, between moving joints
         for joint in joints {
             if let Some((mimicked, multiplier, offset)) = joint.mimic {
-                let resolve = |name: &str| {
-                    body_of_joint.get(name).copied().ok_or_else(|| {
-                        self.error(
-                            joint.node,
-                            format!("<mimic joint='{mimicked}'>: '{name}' is not a moving joint"),
-                        )
-                    })
-                };
-                builder.add_mimic(Mimic {
-                    joint: resolve(joint.name)?,
-                    mimicked: resolve(mimicked)?,
-                    multiplier,
-                    offset,
-                });
+                match (body_of_joint.get(joint.name), body_of_joint.get(mimicked)) {
+                    (Some(&joint_body), Some(&mimicked_body)) => builder.add_mimic(Mimic {
+                        joint: joint_body,
+                        mimicked: mimicked_body,
+                        multiplier,
+                        offset,
+                    }),
+                    _ => builder.warn(format!(
+                        "{}: <mimic joint='{mimicked}'> ignored: both '{}' and '{mimicked}' must be \
+                         moving joints of the model",
+                        self.location(joint.node),
+                        joint.name
+                    )),
+                }
             }
         }
         Ok(builder.build())

@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use rand::{rngs::StdRng, Rng, SeedableRng};
-use robodyn::io::{bundled_model, load_urdf_str};
+use robodyn::io::{bundled_model, load_urdf_str, LoadOptions};
 use robodyn::Model;
 
 /// Identities between exact algorithms (M from RNEA, ABA∘RNEA, ...), relative to the magnitude.
@@ -46,7 +46,8 @@ pub const TREE_URDF: &str = r#"<robot name="tree">
 
 /// The models every identity runs on: the bundled ones (fixed and floating base) and the tree.
 pub fn test_models() -> Vec<(&'static str, Model)> {
-    let mut tree = load_urdf_str(TREE_URDF, "tree.urdf", true).expect("tree loads");
+    let mut tree =
+        load_urdf_str(TREE_URDF, "tree.urdf", LoadOptions::floating(true)).expect("tree loads");
     // rotor inertia on a few joints, so armature is checked everywhere
     tree.armature[6] = 0.05;
     tree.armature[9] = 0.02;
