@@ -102,8 +102,8 @@ impl<'py> Argument<'py> {
     /// The values in C order, borrowed when the array is contiguous.
     fn values(&self) -> Cow<'_, [f64]> {
         match self.array.as_slice() {
-            Ok(slice) => Cow::Borrowed(slice),
-            Err(_) => Cow::Owned(self.array.as_array().iter().copied().collect()),
+            Ok(slice) if self.array.is_c_contiguous() => Cow::Borrowed(slice),
+            _ => Cow::Owned(self.array.as_array().iter().copied().collect()),
         }
     }
 }

@@ -1,0 +1,48 @@
+"""Shared fixtures: the robots the cross-checks use and the tolerances."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import robodyn
+
+#: Field-by-field agreement with Pinocchio, relative to the field's largest magnitude (or 1).
+CROSS_CHECK_TOLERANCE = 1e-9
+#: Identities between robodyn's own algorithms.
+IDENTITY_TOLERANCE = 1e-10
+
+REPOSITORY = Path(__file__).resolve().parents[2]
+REFERENCE_DIR = REPOSITORY / "testdata" / "reference"
+
+#: Robots from example-robot-data cross-checked against Pinocchio: name -> (path under robots/, floating base)
+ROBOTS = {
+    "ur5": ("ur_description/urdf/ur5_robot.urdf", False),
+    "panda": ("panda_description/urdf/panda.urdf", False),
+    "talos": ("talos_data/robots/talos_full_v2.urdf", True),
+    "solo12": ("solo_description/robots/solo12.urdf", True),
+}
+
+
+def assert_close(actual, expected, tolerance, label=""):
+    """|actual - expected| <= tolerance * max(1, max|expected|), entry by entry."""
+    actual, expected = np.asarray(actual, dtype=float), np.asarray(expected, dtype=float)
+    assert actual.shape == expected.shape, f"{label}: shape {actual.shape} vs {expected.shape}"
+    scale = max(1.0, float(np.max(np.abs(expected))) if expected.size else 1.0)
+    error = float(np.max(np.abs(actual - expected))) if expected.size else 0.0
+    assert error <= tolerance * scale, f"{label}: max error {error:.3e} > {tolerance * scale:.3e}"
+
+
+@pytest.fixture(scope="session")
+def robots_dir() -> Path:
+    """example-robot-data's robots folder (a test dependency)."""
+    folder = robodyn._example_robot_data_dir()
+    assert folder is not None, "example-robot-data is a test dependency: pip install '.[test]'"
+    return folder
+
+
+def load_reference(name: str) -> dict:
+    return json.loads((REFERENCE_DIR / f"{name}.json").read_text())

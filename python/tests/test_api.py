@@ -1,0 +1,200 @@
+"""The Python API contract: names, shapes, batching, array-likes, the bundled models and the CLI."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import threading
+
+import numpy as np
+import pytest
+from conftest import IDENTITY_TOLERANCE, assert_close
+
+import robodyn
+
+
+@pytest.fixture(scope="module")
+def ur5():
+    return robodyn.load("ur5")
+
+
+@pytest.fixture(scope="module")
+def floating(robots_dir):
+    """Solo12, a quadruped with a floating base (the UR5's massless base link makes a floating UR5
+    singular)."""
+    return robodyn.load(robots_dir / "solo_description/robots/solo12.urdf", floating_base=True)
+
+
+def test_bundled_models():
+    assert robodyn.models() == ["ur5", "planar2", "pendulum"]
+    for name in robodyn.models():
+        model = robodyn.load(name)
+        assert model.nq == model.nv == len(model.joint_names)
+    assert list(robodyn.load("planar2").gravity) == [0.0, -9.81, 0.0]
+    assert list(robodyn.load("ur5").gravity) == [0.0, 0.0, -9.81]
+
+
+def test_model_description(ur5):
+    floating = robodyn.load("ur5", floating_base=True)
+    assert (ur5.nq, ur5.nv) == (6, 6)
+    assert ur5.joint_names[0] == "shoulder_pan_joint"
+    assert ur5.joint_idx_q == ur5.joint_idx_v == list(range(6))
+    assert ur5.joint_types == ["revolute"] * 6
+    assert "tool0" in ur5.frame_names and "base_link" in ur5.frame_names
+    assert ur5.body_names[0] == "shoulder_link"
+    assert ur5.total_mass == pytest.approx(3.7 + 8.393 + 2.275 + 1.219 + 1.219 + 0.1879)
+    assert ur5.lower_position_limit.shape == (6,) and ur5.effort_limit[0] == 150.0
+    assert (floating.nq, floating.nv) == (13, 12)
+    assert floating.joint_names[0] == "root_joint" and floating.joint_types[0] == "free"
+    assert floating.joint_idx_q[:2] == [0, 7] and floating.joint_idx_v[:2] == [0, 6]
+    assert "nq=6" in repr(ur5)
+    np.testing.assert_array_equal(floating.neutral()[:7], [0, 0, 0, 0, 0, 0, 1])
+
+
+def test_issue_example(ur5, robots_dir):
+    talos = robodyn.load("talos_full_v2.urdf", floating_base=True)
+    assert talos.nv == 50
+    for m in (ur5, talos):
+        q, v, a = m.random_configuration(), np.ones(m.nv), np.zeros(m.nv)
+        tau = m.inverse_dynamics(q, v, a)
+        mass = m.mass_matrix(q)
+        assert mass.shape == (m.nv, m.nv)
+        assert_close(m.forward_dynamics(q, v, tau), a, IDENTITY_TOLERANCE)
+        states = np.stack([m.random_configuration() for _ in range(200)])
+        assert m.generalized_gravity(states).shape == (200, m.nv)
+
+
+def test_shapes_and_dtypes(floating):
+    m = floating
+    q = m.random_configuration(seed=1)
+    v = np.linspace(-1, 1, m.nv)
+    frame = m.frame_names[-1]
+    expected = {
+        "inverse_dynamics": ((q, v, v), (m.nv,)),
+        "forward_dynamics": ((q, v, v), (m.nv,)),
+        "bias_forces": ((q, v), (m.nv,)),
+        "generalized_gravity": ((q,), (m.nv,)),
+        "mass_matrix": ((q,), (m.nv, m.nv)),
+        "inverse_mass_matrix": ((q,), (m.nv, m.nv)),
+        "center_of_mass": ((q,), (3,)),
+        "frame_pose": ((q, frame), (4, 4)),
+        "jacobian": ((q, frame), (6, m.nv)),
+        "integrate": ((q, v), (m.nq,)),
+        "difference": ((q, q), (m.nv,)),
+    }
+    for name, (args, shape) in expected.items():
+        result = getattr(m, name)(*args)
+        assert result.shape == shape and result.dtype == np.float64, name
+    assert isinstance(m.kinetic_energy(q, v), float)
+    assert isinstance(m.potential_energy(q), float)
+
+
+def test_batches_equal_the_loop_bit_for_bit(floating):
+    m = floating
+    n = 64
+    q = m.random_configuration(n=n, seed=3)
+    rng = np.random.default_rng(0)
+    v, a = rng.uniform(-1, 1, (n, m.nv)), rng.uniform(-1, 1, (n, m.nv))
+    f_ext = rng.uniform(-1, 1, (n, len(m.body_names), 6))
+    frame = m.frame_names[-1]
+    calls = {
+        "inverse_dynamics": (q, v, a),
+        "forward_dynamics": (q, v, a),
+        "bias_forces": (q, v),
+        "generalized_gravity": (q,),
+        "mass_matrix": (q,),
+        "inverse_mass_matrix": (q,),
+        "kinetic_energy": (q, v),
+        "potential_energy": (q,),
+        "center_of_mass": (q,),
+        "integrate": (q, v),
+    }
+    for name, args in calls.items():
+        batch = getattr(m, name)(*args)
+        loop = np.stack([np.asarray(getattr(m, name)(*(x[k] for x in args))) for k in range(n)])
+        assert batch.shape == loop.shape, name
+        np.testing.assert_array_equal(batch, loop, err_msg=name)
+    batch = m.jacobian(q, frame, "local")
+    np.testing.assert_array_equal(batch, np.stack([m.jacobian(x, frame, "local") for x in q]))
+    batch = m.frame_pose(q, frame)
+    np.testing.assert_array_equal(batch, np.stack([m.frame_pose(x, frame) for x in q]))
+    batch = m.inverse_dynamics(q, v, a, f_ext=f_ext)
+    np.testing.assert_array_equal(batch, np.stack([m.inverse_dynamics(q[k], v[k], a[k], f_ext=f_ext[k]) for k in range(n)]))
+
+
+def test_any_array_like_is_accepted(ur5):
+    q = [0.1, -0.5, 1, 0, 2, 3]  # a list with ints
+    expected = ur5.generalized_gravity(np.array(q, dtype=float))
+    np.testing.assert_array_equal(ur5.generalized_gravity(q), expected)
+    np.testing.assert_array_equal(ur5.generalized_gravity(tuple(q)), expected)
+    np.testing.assert_array_equal(ur5.generalized_gravity(np.array(q, dtype=np.float32).astype(np.int64)), ur5.generalized_gravity(np.trunc(q)))
+    # non-contiguous views
+    wide = np.zeros((6, 2))
+    wide[:, 0] = q
+    np.testing.assert_array_equal(ur5.generalized_gravity(wide[:, 0]), expected)
+    batch = np.asfortranarray(np.stack([q, q]))
+    np.testing.assert_array_equal(ur5.generalized_gravity(batch), np.stack([expected, expected]))
+
+
+def test_random_configuration_respects_limits_and_seed(ur5, floating):
+    q = ur5.random_configuration(n=500, seed=4)
+    assert np.all(q >= ur5.lower_position_limit) and np.all(q <= ur5.upper_position_limit)
+    np.testing.assert_array_equal(q, ur5.random_configuration(n=500, seed=4))
+    quaternions = floating.random_configuration(n=100)[:, 3:7]
+    np.testing.assert_allclose(np.linalg.norm(quaternions, axis=1), 1.0, atol=1e-12)
+
+
+def test_integrate_and_difference(floating):
+    q = floating.random_configuration(seed=9)
+    v = np.linspace(-1, 1, floating.nv)
+    q1 = floating.integrate(q, v, 0.1)
+    assert_close(floating.difference(q, q1), 0.1 * v, IDENTITY_TOLERANCE)
+
+
+def test_gravity_and_armature_are_settable():
+    m = robodyn.load("pendulum")
+    m.gravity = [0.0, 0.0, -1.62]  # the Moon
+    assert m.generalized_gravity([np.pi / 2])[0] == pytest.approx(1.62)
+    m.armature = [0.5]
+    assert m.mass_matrix([0.0])[0, 0] == pytest.approx(1.5)
+    assert m.inverse_dynamics([0.0], [0.0], [2.0])[0] == pytest.approx(3.0)
+    assert m.forward_dynamics([0.0], [0.0], [3.0])[0] == pytest.approx(2.0)
+    assert m.kinetic_energy([0.0], [2.0]) == pytest.approx(0.5 * 1.5 * 4)
+
+
+def test_mimic_joints_are_reported():
+    urdf = """<robot name="gripper"><link name="base"/><link name="left"/><link name="right"/>
+      <joint name="l" type="prismatic"><parent link="base"/><child link="left"/><limit lower="0" upper="0.04" effort="1" velocity="1"/></joint>
+      <joint name="r" type="prismatic"><parent link="base"/><child link="right"/><limit lower="-0.04" upper="0" effort="1" velocity="1"/>
+        <mimic joint="l" multiplier="-1" offset="0"/></joint></robot>"""
+    m = robodyn.load_urdf_string(urdf)
+    assert m.nv == 2
+    assert m.mimic_joints == [("r", "l", -1.0, 0.0)]
+
+
+def test_batches_release_the_gil(floating):
+    """A batch in one thread lets another Python thread run meanwhile."""
+    states = floating.random_configuration(n=200_000, seed=1)
+    ticks = []
+    done = threading.Event()
+
+    def count():
+        while not done.is_set():
+            ticks.append(1)
+
+    counter = threading.Thread(target=count)
+    counter.start()
+    try:
+        before = len(ticks)
+        floating.mass_matrix(states)
+        during = len(ticks) - before
+    finally:
+        done.set()
+        counter.join()
+    assert during > 10, "the other thread did not run while the batch computed"
+
+
+def test_demo_command_runs():
+    result = subprocess.run([sys.executable, "-m", "robodyn.cli", "demo", "--batch", "1000"], capture_output=True, text=True, check=True)
+    assert "M(q)" in result.stdout and "yes" in result.stdout
+    assert "batch of 1000 states" in result.stdout

@@ -1,0 +1,162 @@
+"""Cross-checks against Pinocchio, field by field, on example-robot-data robots and the bundled
+models; the same comparisons against the frozen references in testdata/reference/."""
+
+from __future__ import annotations
+
+import hashlib
+import warnings
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import CROSS_CHECK_TOLERANCE, REPOSITORY, ROBOTS, assert_close, load_reference
+from conventions import PinocchioMap
+
+import robodyn
+
+
+def pinocchio_model(path, floating_base):
+    if floating_base:
+        return pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    return pin.buildModelFromUrdf(str(path))
+
+
+@pytest.fixture(scope="module", params=sorted(ROBOTS))
+def robot(request, robots_dir):
+    path, floating_base = ROBOTS[request.param]
+    model = robodyn.load(robots_dir / path, floating_base=floating_base)
+    pin_model = pinocchio_model(robots_dir / path, floating_base)
+    return request.param, model, pin_model, PinocchioMap(model, pin_model)
+
+
+def test_dynamics_agree_with_pinocchio(robot):
+    name, model, pin_model, mapping = robot
+    data = pin_model.createData()
+    rng = np.random.default_rng(7)
+    for seed in range(5):
+        q = model.random_configuration(seed=seed)
+        v, a = rng.uniform(-2, 2, model.nv), rng.uniform(-2, 2, model.nv)
+        pq, pv, pa = mapping.q(q), mapping.v(v), mapping.v(a)
+        tau = model.inverse_dynamics(q, v, a)
+        assert_close(tau, mapping.v_back(pin.rnea(pin_model, data, pq, pv, pa)), CROSS_CHECK_TOLERANCE, f"{name} tau")
+        mass = pin.crba(pin_model, data, pq)
+        mass = np.triu(mass) + np.triu(mass, 1).T
+        assert_close(model.mass_matrix(q), mapping.matrix_back(mass), CROSS_CHECK_TOLERANCE, f"{name} M")
+        assert_close(
+            model.generalized_gravity(q),
+            mapping.v_back(pin.computeGeneralizedGravity(pin_model, data, pq)),
+            CROSS_CHECK_TOLERANCE,
+            f"{name} g",
+        )
+        assert_close(model.bias_forces(q, v), mapping.v_back(pin.nle(pin_model, data, pq, pv)), CROSS_CHECK_TOLERANCE, f"{name} bias")
+        assert_close(
+            model.forward_dynamics(q, v, tau),
+            mapping.v_back(pin.aba(pin_model, data, pq, pv, mapping.v(tau))),
+            CROSS_CHECK_TOLERANCE,
+            f"{name} aba",
+        )
+        assert_close(
+            model.inverse_mass_matrix(q),
+            mapping.matrix_back(np.linalg.inv(mass)),
+            CROSS_CHECK_TOLERANCE,
+            f"{name} M^-1",
+        )
+        assert_close(model.kinetic_energy(q, v), pin.computeKineticEnergy(pin_model, data, pq, pv), CROSS_CHECK_TOLERANCE, f"{name} KE")
+        assert_close(model.potential_energy(q), pin.computePotentialEnergy(pin_model, data, pq), CROSS_CHECK_TOLERANCE, f"{name} PE")
+        assert_close(model.center_of_mass(q), pin.centerOfMass(pin_model, data, pq), CROSS_CHECK_TOLERANCE, f"{name} com")
+
+
+def test_external_forces_agree_with_pinocchio(robot):
+    name, model, pin_model, mapping = robot
+    data = pin_model.createData()
+    rng = np.random.default_rng(8)
+    q = model.random_configuration(seed=11)
+    v, a = rng.uniform(-1, 1, model.nv), rng.uniform(-1, 1, model.nv)
+    f_ext = rng.uniform(-5, 5, (len(model.body_names), 6))
+    pin_forces = [pin.Force.Zero() for _ in range(pin_model.njoints)]
+    for joint_name, wrench in zip(model.joint_names, f_ext):
+        pin_forces[pin_model.getJointId(joint_name)] = pin.Force(wrench[:3], wrench[3:])
+    expected = mapping.v_back(pin.rnea(pin_model, data, mapping.q(q), mapping.v(v), mapping.v(a), pin_forces))
+    tau = model.inverse_dynamics(q, v, a, f_ext=f_ext)
+    assert_close(tau, expected, CROSS_CHECK_TOLERANCE, f"{name} tau with f_ext")
+    assert_close(model.forward_dynamics(q, v, tau, f_ext=f_ext), a, CROSS_CHECK_TOLERANCE, f"{name} aba with f_ext")
+
+
+def test_kinematics_agree_with_pinocchio(robot):
+    name, model, pin_model, mapping = robot
+    data = pin_model.createData()
+    for seed in range(3):
+        q = model.random_configuration(seed=20 + seed)
+        pq = mapping.q(q)
+        pin.framesForwardKinematics(pin_model, data, pq)
+        pin.computeJointJacobians(pin_model, data, pq)
+        for frame in model.frame_names:
+            frame_id = pin_model.getFrameId(frame)
+            assert_close(model.frame_pose(q, frame), data.oMf[frame_id].homogeneous, CROSS_CHECK_TOLERANCE, f"{name} pose {frame}")
+            for reference, pin_reference in [("world", pin.LOCAL_WORLD_ALIGNED), ("local", pin.LOCAL), ("spatial", pin.WORLD)]:
+                expected = mapping.columns_back(pin.getFrameJacobian(pin_model, data, frame_id, pin_reference))
+                assert_close(model.jacobian(q, frame, reference), expected, CROSS_CHECK_TOLERANCE, f"{name} J {reference} {frame}")
+
+
+def test_bundled_models_agree_with_pinocchio():
+    for name in robodyn.models():
+        model = robodyn.load(name)
+        pin_model = pinocchio_model(REPOSITORY / "models" / f"{name}.urdf", False)
+        pin_model.gravity.linear = model.gravity
+        mapping = PinocchioMap(model, pin_model)
+        data = pin_model.createData()
+        q = model.random_configuration(seed=5)
+        v, a = np.linspace(-1, 1, model.nv), np.linspace(1, -1, model.nv)
+        expected = mapping.v_back(pin.rnea(pin_model, data, mapping.q(q), mapping.v(v), mapping.v(a)))
+        assert_close(model.inverse_dynamics(q, v, a), expected, CROSS_CHECK_TOLERANCE, f"{name} tau")
+
+
+@pytest.mark.parametrize("name", sorted(ROBOTS) + [f"bundled_{n}" for n in ("ur5", "planar2", "pendulum")])
+def test_frozen_references(name, robots_dir):
+    reference = load_reference(f"pinocchio_{name}")
+    provenance = reference["provenance"]
+    if name.startswith("bundled_"):
+        urdf = REPOSITORY / provenance["urdf"]
+        model = robodyn.load(name.removeprefix("bundled_"))
+    else:
+        urdf = robots_dir / provenance["urdf"].removeprefix("example-robot-data robots/")
+        model = robodyn.load(urdf, floating_base=provenance["floating_base"])
+    digest = hashlib.sha256(urdf.read_bytes()).hexdigest()
+    assert digest == provenance["urdf_sha256"], f"{urdf} changed since the reference was frozen: run make_reference.py"
+    assert model.joint_names == reference["joint_names"]
+    for k, state in enumerate(reference["states"]):
+        q, v, a, tau = (np.array(state[key]) for key in ("q", "v", "a", "tau"))
+        label = f"{name} state {k}"
+        assert_close(model.inverse_dynamics(q, v, a), state["rnea"], CROSS_CHECK_TOLERANCE, f"{label} rnea")
+        assert_close(model.mass_matrix(q), state["mass_matrix"], CROSS_CHECK_TOLERANCE, f"{label} M")
+        assert_close(model.generalized_gravity(q), state["gravity"], CROSS_CHECK_TOLERANCE, f"{label} g")
+        assert_close(model.bias_forces(q, v), state["bias"], CROSS_CHECK_TOLERANCE, f"{label} bias")
+        assert_close(model.forward_dynamics(q, v, tau), state["aba"], CROSS_CHECK_TOLERANCE, f"{label} aba")
+        for frame, pose in state["frame_poses"].items():
+            assert_close(model.frame_pose(q, frame), pose, CROSS_CHECK_TOLERANCE, f"{label} pose {frame}")
+        for frame, jacobian in state["world_jacobians"].items():
+            assert_close(model.jacobian(q, frame), jacobian, CROSS_CHECK_TOLERANCE, f"{label} J {frame}")
+
+
+def test_loads_every_urdf_pinocchio_loads(robots_dir):
+    """Every example-robot-data URDF that Pinocchio loads, robodyn loads with the same dimensions.
+    A file whose inertias are not positive semi-definite is refused by default, naming the link,
+    and loads with check_inertia=False, which reports each such inertia as a warning."""
+    loaded = 0
+    for path in sorted(robots_dir.rglob("*.urdf")):
+        try:
+            pin_model = pin.buildModelFromUrdf(str(path))
+        except Exception:  # noqa: BLE001  (a file Pinocchio itself cannot load is out of scope)
+            continue
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", robodyn.ModelWarning)
+            try:
+                model = robodyn.load(path)
+            except ValueError as error:
+                assert "positive semi-definite" in str(error), f"{path}: {error}"
+                model = robodyn.load(path, check_inertia=False)
+                assert any("positive semi-definite" in w for w in model.warnings)
+        continuous = sum(1 for j in pin_model.joints[1:] if j.nq == 2 and j.nv == 1)
+        assert (model.nq + continuous, model.nv) == (pin_model.nq, pin_model.nv), path
+        loaded += 1
+    assert loaded >= 50, f"only {loaded} URDFs found in {robots_dir}"
