@@ -46,6 +46,16 @@ fn fill_forces(forces: &mut [Force], flat: &[f64]) {
     }
 }
 
+/// A core algorithm taking (q, v, a or τ, external forces) and returning a vector in `Data`.
+type DynamicsAlgorithm = for<'d> fn(
+    &Model,
+    &'d mut Data,
+    &[f64],
+    &[f64],
+    &[f64],
+    Option<&[Force]>,
+) -> robodyn::Result<&'d nalgebra::DVector<f64>>;
+
 /// One computation on one sample: inputs (flattened, in argument order) to a flattened output.
 type Kernel<'k> =
     dyn Fn(&Model, &mut Workspace, &[&[f64]], &mut [f64]) -> robodyn::Result<()> + Sync + 'k;
@@ -53,7 +63,7 @@ type Kernel<'k> =
 /// A numeric argument: its name, the array, and the shape of one sample.
 struct Argument<'py> {
     name: &'static str,
-    array: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+    array: Bound<'py, PyArrayDyn<f64>>,
     sample_shape: Vec<usize>,
 }
 
@@ -63,7 +73,15 @@ impl<'py> Argument<'py> {
         value: &Bound<'py, PyAny>,
         sample_shape: Vec<usize>,
     ) -> PyResult<Self> {
-        let array = value.extract::<PyArrayLikeDyn<'py, f64, AllowTypeChange>>().map_err(|_| {
+        // a float64 ndarray is used as it is; anything else goes through numpy.asarray
+        if let Ok(array) = value.cast::<PyArrayDyn<f64>>() {
+            return Ok(Argument {
+                name,
+                array: array.clone(),
+                sample_shape,
+            });
+        }
+        let converted = value.extract::<PyArrayLikeDyn<'py, f64, AllowTypeChange>>().map_err(|_| {
             PyValueError::new_err(format!(
                 "argument '{name}': expected an array of numbers of shape {} or (N, ...), got {}",
                 shape_text(&sample_shape),
@@ -72,7 +90,7 @@ impl<'py> Argument<'py> {
         })?;
         Ok(Argument {
             name,
-            array,
+            array: (**converted).clone(),
             sample_shape,
         })
     }
@@ -101,10 +119,14 @@ impl<'py> Argument<'py> {
 
     /// The values in C order, borrowed when the array is contiguous.
     fn values(&self) -> Cow<'_, [f64]> {
-        match self.array.as_slice() {
-            Ok(slice) if self.array.is_c_contiguous() => Cow::Borrowed(slice),
-            _ => Cow::Owned(self.array.as_array().iter().copied().collect()),
+        if self.array.is_c_contiguous() {
+            // SAFETY: no Rust code holds a mutable view of an input: the only array robodyn writes
+            // is the output, which each call creates itself.
+            if let Ok(slice) = unsafe { self.array.as_slice() } {
+                return Cow::Borrowed(slice);
+            }
         }
+        Cow::Owned(self.array.to_owned_array().iter().copied().collect())
     }
 }
 
@@ -168,17 +190,16 @@ impl PyModel {
             None => {
                 let inputs: Vec<&[f64]> = values.iter().map(|v| v.as_ref()).collect();
                 let output = PyArrayDyn::<f64>::zeros(py, IxDyn(output_shape), false);
-                {
-                    let mut guard = output.readwrite();
-                    let out = guard.as_slice_mut().expect("a new array is contiguous");
-                    match self.workspace.try_lock() {
-                        Ok(mut workspace) => kernel(model, &mut workspace, &inputs, out),
-                        Err(_) => kernel(model, &mut Workspace::new(model), &inputs, out),
-                    }
-                    .map_err(to_py_err)?;
+                // SAFETY: the array was created just above and nothing else refers to it yet.
+                let out = unsafe { output.as_slice_mut() }
+                    .map_err(|e| PyValueError::new_err(e.to_string()))?;
+                match self.workspace.try_lock() {
+                    Ok(mut workspace) => kernel(model, &mut workspace, &inputs, out),
+                    Err(_) => kernel(model, &mut Workspace::new(model), &inputs, out),
                 }
+                .map_err(to_py_err)?;
                 if output_shape.is_empty() {
-                    return Ok(output.get_item(())?);
+                    return output.get_item(());
                 }
                 Ok(output.into_any())
             }
@@ -250,14 +271,7 @@ impl PyModel {
         v: &Bound<'py, PyAny>,
         x: (&'static str, &Bound<'py, PyAny>),
         f_ext: Option<&Bound<'py, PyAny>>,
-        algorithm: for<'d> fn(
-            &Model,
-            &'d mut Data,
-            &[f64],
-            &[f64],
-            &[f64],
-            Option<&[Force]>,
-        ) -> robodyn::Result<&'d nalgebra::DVector<f64>>,
+        algorithm: DynamicsAlgorithm,
     ) -> PyResult<Bound<'py, PyAny>> {
         let mut arguments = vec![
             self.q_arg("q", q)?,

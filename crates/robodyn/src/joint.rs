@@ -36,6 +36,7 @@ pub enum Joint {
 
 impl Joint {
     /// Number of configuration coordinates.
+    #[inline]
     pub fn nq(&self) -> usize {
         match self {
             Joint::Fixed => 0,
@@ -46,6 +47,7 @@ impl Joint {
     }
 
     /// Number of velocity coordinates (degrees of freedom).
+    #[inline]
     pub fn nv(&self) -> usize {
         match self {
             Joint::Fixed => 0,
@@ -67,6 +69,7 @@ impl Joint {
     }
 
     /// Where the unit quaternion sits inside this joint's q, if it has one.
+    #[inline]
     pub fn quaternion_offset(&self) -> Option<usize> {
         match self {
             Joint::Spherical => Some(0),
@@ -77,6 +80,7 @@ impl Joint {
 
     /// The joint transform `X_J(q)` from the joint frame to the child body frame.
     /// `q` is this joint's slice of the configuration.
+    #[inline]
     pub fn transform(&self, q: &[f64]) -> Transform {
         match self {
             Joint::Fixed => Transform::IDENTITY,
@@ -90,6 +94,7 @@ impl Joint {
     }
 
     /// Column `k` of the motion subspace `S`, in the child frame.
+    #[inline]
     pub fn subspace_column(&self, k: usize) -> Motion {
         let unit = |i: usize| Vec3::ith(i % 3, 1.0);
         match self {
@@ -103,6 +108,7 @@ impl Joint {
     }
 
     /// The joint velocity `v_J = S q̇` for this joint's slice `v` of the velocity.
+    #[inline]
     pub fn motion(&self, v: &[f64]) -> Motion {
         (0..self.nv()).fold(Motion::ZERO, |sum, k| sum + self.subspace_column(k) * v[k])
     }

@@ -49,7 +49,7 @@ pub fn jacobian<'d>(
     // p: the frame's origin in world coordinates
     let origin = pose.translation;
 
-    data.jacobian.fill(0.0);
+    data.jacobian.as_mut_slice().fill(0.0);
     let mut j = model.frames[frame].body;
     while j != 0 {
         let joint = &model.joints[j];

@@ -22,6 +22,7 @@ impl Force {
     }
 
     /// Flattened `[linear; angular]` (force; moment), robodyn's public order.
+    #[inline]
     pub fn to_array(&self) -> [f64; 6] {
         [
             self.linear.x,
@@ -34,6 +35,7 @@ impl Force {
     }
 
     /// Inverse of [`Force::to_array`].
+    #[inline]
     pub fn from_array(values: &[f64; 6]) -> Self {
         Force {
             linear: Vec3::new(values[0], values[1], values[2]),
@@ -44,12 +46,14 @@ impl Force {
 
 impl Add for Force {
     type Output = Force;
+    #[inline]
     fn add(self, rhs: Force) -> Force {
         Force::new(self.angular + rhs.angular, self.linear + rhs.linear)
     }
 }
 
 impl AddAssign for Force {
+    #[inline]
     fn add_assign(&mut self, rhs: Force) {
         self.angular += rhs.angular;
         self.linear += rhs.linear;
@@ -58,12 +62,14 @@ impl AddAssign for Force {
 
 impl Sub for Force {
     type Output = Force;
+    #[inline]
     fn sub(self, rhs: Force) -> Force {
         Force::new(self.angular - rhs.angular, self.linear - rhs.linear)
     }
 }
 
 impl SubAssign for Force {
+    #[inline]
     fn sub_assign(&mut self, rhs: Force) {
         self.angular -= rhs.angular;
         self.linear -= rhs.linear;
@@ -72,6 +78,7 @@ impl SubAssign for Force {
 
 impl Neg for Force {
     type Output = Force;
+    #[inline]
     fn neg(self) -> Force {
         Force::new(-self.angular, -self.linear)
     }
@@ -79,6 +86,7 @@ impl Neg for Force {
 
 impl Mul<f64> for Force {
     type Output = Force;
+    #[inline]
     fn mul(self, s: f64) -> Force {
         Force::new(self.angular * s, self.linear * s)
     }

@@ -16,6 +16,7 @@ pub struct Inertia {
 }
 
 impl Default for Inertia {
+    #[inline]
     fn default() -> Self {
         Inertia::ZERO
     }
@@ -30,6 +31,7 @@ impl Inertia {
 
     /// From the mass, the centre of mass `com` and the rotational inertia `inertia_com` about the
     /// centre of mass (parallel-axis theorem: `Ī_O = I_C + m (c·c 1 - c cᵀ)`).
+    #[inline]
     pub fn from_com(mass: f64, com: &Vec3, inertia_com: &Mat3) -> Self {
         Inertia {
             mass,
@@ -40,6 +42,7 @@ impl Inertia {
     }
 
     /// The centre of mass `c = h / m` (the origin for a massless body).
+    #[inline]
     pub fn com(&self) -> Vec3 {
         if self.mass > 0.0 {
             self.first_moment / self.mass
@@ -49,6 +52,7 @@ impl Inertia {
     }
 
     /// `f = I m`: `n = Ī_O ω + h × v`, `f = m v - h × ω`.
+    #[inline]
     pub fn mul_motion(&self, m: &Motion) -> Force {
         Force {
             angular: self.rotational * m.angular + self.first_moment.cross(&m.linear),
@@ -57,6 +61,7 @@ impl Inertia {
     }
 
     /// The 6x6 matrix on `[angular; linear]`: `[Ī_O  h×; h×ᵀ  m 1]`.
+    #[inline]
     pub fn to_matrix(&self) -> Mat6 {
         let h = skew(&self.first_moment);
         let mut i = Mat6::zeros();
@@ -71,6 +76,7 @@ impl Inertia {
 
 impl Add for Inertia {
     type Output = Inertia;
+    #[inline]
     fn add(self, rhs: Inertia) -> Inertia {
         Inertia {
             mass: self.mass + rhs.mass,
@@ -81,6 +87,7 @@ impl Add for Inertia {
 }
 
 impl AddAssign for Inertia {
+    #[inline]
     fn add_assign(&mut self, rhs: Inertia) {
         *self = *self + rhs;
     }

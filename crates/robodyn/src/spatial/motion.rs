@@ -22,6 +22,7 @@ impl Motion {
     }
 
     /// `m × n`: the motion cross product (Featherstone eq. 2.31).
+    #[inline]
     pub fn cross_motion(&self, other: &Motion) -> Motion {
         Motion {
             angular: self.angular.cross(&other.angular),
@@ -30,6 +31,7 @@ impl Motion {
     }
 
     /// `m ×* f`: the force cross product (Featherstone eq. 2.32).
+    #[inline]
     pub fn cross_force(&self, f: &Force) -> Force {
         Force {
             angular: self.angular.cross(&f.angular) + self.linear.cross(&f.linear),
@@ -38,11 +40,13 @@ impl Motion {
     }
 
     /// The scalar product `m · f` (power).
+    #[inline]
     pub fn dot(&self, f: &Force) -> f64 {
         self.angular.dot(&f.angular) + self.linear.dot(&f.linear)
     }
 
     /// Flattened `[linear; angular]`, robodyn's public order.
+    #[inline]
     pub fn to_array(&self) -> [f64; 6] {
         [
             self.linear.x,
@@ -55,6 +59,7 @@ impl Motion {
     }
 
     /// Inverse of [`Motion::to_array`].
+    #[inline]
     pub fn from_array(values: &[f64; 6]) -> Self {
         Motion {
             linear: Vec3::new(values[0], values[1], values[2]),
@@ -65,12 +70,14 @@ impl Motion {
 
 impl Add for Motion {
     type Output = Motion;
+    #[inline]
     fn add(self, rhs: Motion) -> Motion {
         Motion::new(self.angular + rhs.angular, self.linear + rhs.linear)
     }
 }
 
 impl AddAssign for Motion {
+    #[inline]
     fn add_assign(&mut self, rhs: Motion) {
         self.angular += rhs.angular;
         self.linear += rhs.linear;
@@ -79,6 +86,7 @@ impl AddAssign for Motion {
 
 impl Sub for Motion {
     type Output = Motion;
+    #[inline]
     fn sub(self, rhs: Motion) -> Motion {
         Motion::new(self.angular - rhs.angular, self.linear - rhs.linear)
     }
@@ -86,6 +94,7 @@ impl Sub for Motion {
 
 impl Neg for Motion {
     type Output = Motion;
+    #[inline]
     fn neg(self) -> Motion {
         Motion::new(-self.angular, -self.linear)
     }
@@ -93,6 +102,7 @@ impl Neg for Motion {
 
 impl Mul<f64> for Motion {
     type Output = Motion;
+    #[inline]
     fn mul(self, s: f64) -> Motion {
         Motion::new(self.angular * s, self.linear * s)
     }

@@ -18,6 +18,7 @@ pub struct Transform {
 }
 
 impl Default for Transform {
+    #[inline]
     fn default() -> Self {
         Transform::IDENTITY
     }
@@ -31,6 +32,7 @@ impl Transform {
 
     /// The transform into a frame B whose axes are `rotation` (columns = B's axes in A) and whose
     /// origin is at `position`, both in A coordinates: `E = rotationᵀ`, `r = position`.
+    #[inline]
     pub fn from_pose(rotation: &Mat3, position: &Vec3) -> Self {
         Transform {
             rotation: rotation.transpose(),
@@ -38,14 +40,33 @@ impl Transform {
         }
     }
 
-    /// Rotation about an arbitrary unit `axis` by `angle` (a frame rotated by `angle`).
+    /// Rotation about a unit `axis` by `angle` (a frame rotated by `angle`): by Rodrigues' formula
+    /// `R = c 1 + s a× + (1 - c) a aᵀ`, and `E = Rᵀ`.
+    #[inline]
     pub fn from_axis_angle(axis: &Vec3, angle: f64) -> Self {
-        let rotation =
-            nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_unchecked(*axis), angle);
-        Transform::from_pose(rotation.matrix(), &Vec3::zeros())
+        let (s, c) = angle.sin_cos();
+        let t = 1.0 - c;
+        let a = axis;
+        // E = c 1 - s a× + (1 - c) a aᵀ
+        let rotation = Mat3::new(
+            c + t * a.x * a.x,
+            t * a.x * a.y + s * a.z,
+            t * a.x * a.z - s * a.y,
+            t * a.x * a.y - s * a.z,
+            c + t * a.y * a.y,
+            t * a.y * a.z + s * a.x,
+            t * a.x * a.z + s * a.y,
+            t * a.y * a.z - s * a.x,
+            c + t * a.z * a.z,
+        );
+        Transform {
+            rotation,
+            translation: Vec3::zeros(),
+        }
     }
 
     /// Pure translation: B's origin at `position` in A, axes parallel.
+    #[inline]
     pub fn from_translation(position: &Vec3) -> Self {
         Transform {
             rotation: Mat3::identity(),
@@ -54,6 +75,7 @@ impl Transform {
     }
 
     /// The pose of B in A as a 4x4 homogeneous matrix `[Eᵀ r; 0 1]` (maps B points to A points).
+    #[inline]
     pub fn to_homogeneous(&self) -> nalgebra::Matrix4<f64> {
         let mut pose = nalgebra::Matrix4::identity();
         pose.fixed_view_mut::<3, 3>(0, 0)
@@ -64,6 +86,7 @@ impl Transform {
     }
 
     /// `X⁻¹ = A_X_B`: `E' = Eᵀ`, `r' = -E r`.
+    #[inline]
     pub fn inverse(&self) -> Transform {
         Transform {
             rotation: self.rotation.transpose(),
@@ -72,6 +95,7 @@ impl Transform {
     }
 
     /// `X m`: `ω' = E ω`, `v' = E (v - r × ω)`.
+    #[inline]
     pub fn apply_motion(&self, m: &Motion) -> Motion {
         Motion {
             angular: self.rotation * m.angular,
@@ -80,6 +104,7 @@ impl Transform {
     }
 
     /// `X⁻¹ m`: `ω = Eᵀ ω'`, `v = Eᵀ v' + r × ω`.
+    #[inline]
     pub fn inverse_apply_motion(&self, m: &Motion) -> Motion {
         let angular = self.rotation.tr_mul(&m.angular);
         Motion {
@@ -89,6 +114,7 @@ impl Transform {
     }
 
     /// `X* f`: `n' = E (n - r × f)`, `f' = E f`.
+    #[inline]
     pub fn apply_force(&self, f: &Force) -> Force {
         Force {
             angular: self.rotation * (f.angular - self.translation.cross(&f.linear)),
@@ -97,6 +123,7 @@ impl Transform {
     }
 
     /// `Xᵀ f` (B forces to A): `f = Eᵀ f'`, `n = Eᵀ n' + r × f`.
+    #[inline]
     pub fn transpose_apply_force(&self, f: &Force) -> Force {
         let linear = self.rotation.tr_mul(&f.linear);
         Force {
@@ -106,6 +133,7 @@ impl Transform {
     }
 
     /// `Xᵀ I X`: a rigid-body inertia given in B coordinates, expressed in A coordinates.
+    #[inline]
     pub fn transpose_apply_inertia(&self, inertia: &Inertia) -> Inertia {
         let r = &self.translation;
         let m = inertia.mass;
@@ -123,6 +151,7 @@ impl Transform {
     }
 
     /// `X` as a 6x6 matrix on `[angular; linear]` motion vectors: `[E 0; -E r× E]`.
+    #[inline]
     pub fn to_matrix(&self) -> Mat6 {
         let mut x = Mat6::zeros();
         x.fixed_view_mut::<3, 3>(0, 0).copy_from(&self.rotation);
@@ -136,6 +165,7 @@ impl Transform {
 /// Composition `C_X_A = C_X_B * B_X_A`: `E = E_cb E_ba`, `r = r_ba + E_baᵀ r_cb`.
 impl Mul for Transform {
     type Output = Transform;
+    #[inline]
     fn mul(self, rhs: Transform) -> Transform {
         Transform {
             rotation: self.rotation * rhs.rotation,
