@@ -128,3 +128,9 @@ def test_singular_dynamics_is_an_error_not_nan():
         model.forward_dynamics(q, v, v)
     with pytest.raises(ValueError, match="not positive definite"):
         model.inverse_mass_matrix(q)
+
+
+def test_overflow_is_an_error_not_inf():
+    model = robodyn.load("pendulum")
+    with pytest.raises(ValueError, match="the result is not finite"):
+        model.kinetic_energy([0.0], [1e200])

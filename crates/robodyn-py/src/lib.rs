@@ -60,18 +60,67 @@ type DynamicsAlgorithm = for<'d> fn(
 type Kernel<'k> =
     dyn Fn(&Model, &mut Workspace, &[&[f64]], &mut [f64]) -> robodyn::Result<()> + Sync + 'k;
 
+/// The most numeric arguments a method takes (q, v, a, f_ext).
+const MAX_ARGUMENTS: usize = 4;
+
+/// The shape of one sample of an argument: one or two dimensions, stored without allocating.
+#[derive(Clone, Copy)]
+struct SampleShape {
+    dims: [usize; 2],
+    ndim: usize,
+}
+
+impl SampleShape {
+    fn vector(n: usize) -> Self {
+        SampleShape {
+            dims: [n, 0],
+            ndim: 1,
+        }
+    }
+
+    fn matrix(rows: usize, columns: usize) -> Self {
+        SampleShape {
+            dims: [rows, columns],
+            ndim: 2,
+        }
+    }
+
+    fn as_slice(&self) -> &[usize] {
+        &self.dims[..self.ndim]
+    }
+}
+
+/// Runs `kernel` and rejects a result that is not finite (finite inputs so large that the
+/// arithmetic overflowed), so that no NaN or infinity reaches the caller.
+fn run_kernel(
+    kernel: &Kernel,
+    model: &Model,
+    workspace: &mut Workspace,
+    inputs: &[&[f64]],
+    out: &mut [f64],
+) -> robodyn::Result<()> {
+    kernel(model, workspace, inputs, out)?;
+    match out.iter().position(|x| !x.is_finite()) {
+        None => Ok(()),
+        Some(index) => Err(Error::Overflow {
+            index,
+            value: out[index],
+        }),
+    }
+}
+
 /// A numeric argument: its name, the array, and the shape of one sample.
 struct Argument<'py> {
     name: &'static str,
     array: Bound<'py, PyArrayDyn<f64>>,
-    sample_shape: Vec<usize>,
+    sample_shape: SampleShape,
 }
 
 impl<'py> Argument<'py> {
     fn new(
         name: &'static str,
         value: &Bound<'py, PyAny>,
-        sample_shape: Vec<usize>,
+        sample_shape: SampleShape,
     ) -> PyResult<Self> {
         // a float64 ndarray is used as it is; anything else goes through numpy.asarray
         if let Ok(array) = value.cast::<PyArrayDyn<f64>>() {
@@ -84,7 +133,7 @@ impl<'py> Argument<'py> {
         let converted = value.extract::<PyArrayLikeDyn<'py, f64, AllowTypeChange>>().map_err(|_| {
             PyValueError::new_err(format!(
                 "argument '{name}': expected an array of numbers of shape {} or (N, ...), got {}",
-                shape_text(&sample_shape),
+                shape_text(sample_shape.as_slice()),
                 value.repr().map(|r| r.to_string()).unwrap_or_else(|_| "an unreadable object".into())
             ))
         })?;
@@ -98,19 +147,19 @@ impl<'py> Argument<'py> {
     /// The batch size, `None` for a single sample; errors if the shape fits neither.
     fn batch(&self) -> PyResult<Option<usize>> {
         let shape = self.array.shape();
-        if shape == self.sample_shape.as_slice() {
+        let sample = self.sample_shape.as_slice();
+        if shape == sample {
             Ok(None)
-        } else if shape.len() == self.sample_shape.len() + 1 && shape[1..] == self.sample_shape[..]
-        {
+        } else if shape.len() == sample.len() + 1 && shape[1..] == *sample {
             Ok(Some(shape[0]))
         } else {
             let batch_shape: Vec<String> = std::iter::once("N".to_string())
-                .chain(self.sample_shape.iter().map(|n| n.to_string()))
+                .chain(sample.iter().map(|n| n.to_string()))
                 .collect();
             Err(PyValueError::new_err(format!(
                 "argument '{}': expected shape {} or ({}), got {}",
                 self.name,
-                shape_text(&self.sample_shape),
+                shape_text(sample),
                 batch_shape.join(", "),
                 shape_text(shape)
             )))
@@ -183,19 +232,28 @@ impl PyModel {
                 )));
             }
         }
-        let values: Vec<Cow<[f64]>> = arguments.iter().map(|a| a.values()).collect();
+        let values: [Cow<[f64]>; MAX_ARGUMENTS] = std::array::from_fn(|k| {
+            arguments
+                .get(k)
+                .map_or(Cow::Borrowed(&[][..]), |a| a.values())
+        });
+        let values = &values[..arguments.len()];
         let output_size: usize = output_shape.iter().product();
         let model = &self.model;
         match batch {
             None => {
-                let inputs: Vec<&[f64]> = values.iter().map(|v| v.as_ref()).collect();
+                let mut inputs: [&[f64]; MAX_ARGUMENTS] = [&[]; MAX_ARGUMENTS];
+                for (input, value) in inputs.iter_mut().zip(values) {
+                    *input = value.as_ref();
+                }
+                let inputs = &inputs[..values.len()];
                 let output = PyArrayDyn::<f64>::zeros(py, IxDyn(output_shape), false);
                 // SAFETY: the array was created just above and nothing else refers to it yet.
                 let out = unsafe { output.as_slice_mut() }
                     .map_err(|e| PyValueError::new_err(e.to_string()))?;
                 match self.workspace.try_lock() {
-                    Ok(mut workspace) => kernel(model, &mut workspace, &inputs, out),
-                    Err(_) => kernel(model, &mut Workspace::new(model), &inputs, out),
+                    Ok(mut workspace) => run_kernel(kernel, model, &mut workspace, inputs, out),
+                    Err(_) => run_kernel(kernel, model, &mut Workspace::new(model), inputs, out),
                 }
                 .map_err(to_py_err)?;
                 if output_shape.is_empty() {
@@ -206,7 +264,7 @@ impl PyModel {
             Some(n) => {
                 let sizes: Vec<usize> = arguments
                     .iter()
-                    .map(|a| a.sample_shape.iter().product())
+                    .map(|a| a.sample_shape.as_slice().iter().product())
                     .collect();
                 let mut out = vec![0.0; n * output_size];
                 let result = py.detach(|| {
@@ -222,7 +280,8 @@ impl PyModel {
                                         .zip(&sizes)
                                         .map(|(v, s)| &v[k * s..(k + 1) * s]),
                                 );
-                                kernel(model, workspace, inputs, out).map_err(|e| (k, e))
+                                run_kernel(kernel, model, workspace, inputs, out)
+                                    .map_err(|e| (k, e))
                             },
                         )
                 });
@@ -242,11 +301,11 @@ impl PyModel {
     }
 
     fn q_arg<'py>(&self, name: &'static str, value: &Bound<'py, PyAny>) -> PyResult<Argument<'py>> {
-        Argument::new(name, value, vec![self.model.nq])
+        Argument::new(name, value, SampleShape::vector(self.model.nq))
     }
 
     fn v_arg<'py>(&self, name: &'static str, value: &Bound<'py, PyAny>) -> PyResult<Argument<'py>> {
-        Argument::new(name, value, vec![self.model.nv])
+        Argument::new(name, value, SampleShape::vector(self.model.nv))
     }
 
     fn frame_index(&self, frame: &Bound<PyAny>) -> PyResult<usize> {
@@ -282,7 +341,7 @@ impl PyModel {
             arguments.push(Argument::new(
                 "f_ext",
                 f,
-                vec![self.model.nbodies() - 1, 6],
+                SampleShape::matrix(self.model.nbodies() - 1, 6),
             )?);
         }
         self.evaluate(py, &arguments, &[self.model.nv], &|m, w, i, out| {
@@ -320,7 +379,7 @@ fn read_property(name: &str, value: &Bound<PyAny>, length: usize) -> PyResult<Ve
             _ => "armature",
         },
         value,
-        vec![length],
+        SampleShape::vector(length),
     )?;
     if argument.batch()?.is_some() {
         return Err(PyValueError::new_err(format!(
@@ -635,8 +694,7 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let frame = self.frame_index(frame)?;
         self.evaluate(py, &[self.q_arg("q", q)?], &[4, 4], &|m, w, i, out| {
-            algo::forward_kinematics(m, &mut w.data, i[0])?;
-            let pose = algo::frame_placement(m, &w.data, frame).to_homogeneous();
+            let pose = algo::frame_pose(m, &mut w.data, i[0], frame)?.to_homogeneous();
             for (r, row) in out.chunks_exact_mut(4).enumerate() {
                 for (c, value) in row.iter_mut().enumerate() {
                     *value = pose[(r, c)];

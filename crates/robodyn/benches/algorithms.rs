@@ -4,7 +4,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::{rngs::StdRng, SeedableRng};
-use robodyn::algo::{aba, crba, forward_kinematics, jacobian, rnea, Reference};
+use robodyn::algo::{aba, crba, forward_kinematics, frame_pose, jacobian, rnea, Reference};
 use robodyn::io::{bundled_model, load_urdf_file, LoadOptions};
 use robodyn::{Data, Model};
 use std::hint::black_box;
@@ -45,6 +45,9 @@ fn benchmarks(c: &mut Criterion) {
         let frame = model.frames.len() - 1;
         c.bench_function(&format!("{name}/forward_kinematics"), |b| {
             b.iter(|| forward_kinematics(&model, &mut data, black_box(q)).map(|x| x.len()))
+        });
+        c.bench_function(&format!("{name}/frame_pose"), |b| {
+            b.iter(|| frame_pose(&model, &mut data, black_box(q), frame).map(|x| x.translation.x))
         });
         c.bench_function(&format!("{name}/jacobian"), |b| {
             b.iter(|| {

@@ -35,6 +35,10 @@ pub enum Error {
     #[error("argument '{argument}': {message}")]
     InvalidValue { argument: String, message: String },
 
+    /// Finite inputs so large that a result overflowed.
+    #[error("the result is not finite (entry {index} is {value}): the inputs are too large for float64 arithmetic")]
+    Overflow { index: usize, value: f64 },
+
     /// A frame name that the model does not have.
     #[error("unknown frame '{name}': the model's frames are {available}")]
     UnknownFrame { name: String, available: String },

@@ -7,7 +7,7 @@
 //! differences act on the joint's Lie group (quaternions for the spherical and free joints), so
 //! `difference(q, integrate(q, v)) = v`.
 
-use crate::spatial::{skew, Mat3, Motion, Transform, Vec3};
+use crate::spatial::{skew, Force, Mat3, Motion, Transform, Vec3};
 use nalgebra::{Quaternion, Rotation3, UnitQuaternion};
 use rand::Rng;
 
@@ -104,6 +104,19 @@ impl Joint {
             Joint::Spherical => Motion::new(unit(k), Vec3::zeros()),
             Joint::Free if k < 3 => Motion::new(Vec3::zeros(), unit(k)),
             Joint::Free => Motion::new(unit(k), Vec3::zeros()),
+        }
+    }
+
+    /// `S_kᵀ f`: the component of force `f` (child frame) along velocity coordinate `k`.
+    #[inline]
+    pub fn project_force(&self, k: usize, f: &Force) -> f64 {
+        match self {
+            Joint::Fixed => 0.0,
+            Joint::Revolute { axis } => axis.dot(&f.angular),
+            Joint::Prismatic { axis } => axis.dot(&f.linear),
+            Joint::Spherical => f.angular[k % 3],
+            Joint::Free if k < 3 => f.linear[k],
+            Joint::Free => f.angular[k % 3],
         }
     }
 

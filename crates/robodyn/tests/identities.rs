@@ -264,6 +264,14 @@ fn jacobian_is_the_derivative_of_forward_kinematics() {
                 .clone();
             forward_kinematics(&model, &mut data, q.as_slice()).unwrap();
             let pose = frame_placement(&model, &data, frame);
+            // the support-only pose equals the one from full forward kinematics
+            let direct = frame_pose(&model, &mut Data::new(&model), q.as_slice(), frame).unwrap();
+            assert_close(
+                &format!("{name}: frame_pose"),
+                direct.to_homogeneous().as_slice(),
+                pose.to_homogeneous().as_slice(),
+                0.0,
+            );
             let rotation = pose.rotation.transpose();
             for k in 0..model.nv {
                 let pose_at = |h: f64, data: &mut Data| {

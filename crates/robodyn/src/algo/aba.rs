@@ -56,13 +56,13 @@ pub fn aba<'d>(
         for k in 0..nv_i {
             // U_i = I^A_i S_i;  u_i = τ_i - S_iᵀ p^A_i
             data.u[i][k] = mat6_mul_motion(&data.i_a[i], &joint.subspace_column(k));
-            data.u_tau[i][k] = tau[dofs.start + k] - joint.subspace_column(k).dot(&data.p_a[i]);
+            data.u_tau[i][k] = tau[dofs.start + k] - joint.project_force(k, &data.p_a[i]);
         }
         // D_i = S_iᵀ U_i + armature
         let mut d = Mat6::identity();
         for r in 0..nv_i {
             for c in 0..nv_i {
-                d[(r, c)] = joint.subspace_column(r).dot(&data.u[i][c]);
+                d[(r, c)] = joint.project_force(r, &data.u[i][c]);
             }
             d[(r, r)] += model.armature[dofs.start + r];
         }

@@ -28,14 +28,14 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMat
 
     // one column block per joint: F = I^c_i S_i, walked up to the root; entries between
     // different branches stay zero
-    data.mass_matrix.fill(0.0);
+    data.mass_matrix.as_mut_slice().fill(0.0);
     for i in 1..model.nbodies() {
         let joint = &model.joints[i];
         for (k, row) in model.v_range(i).enumerate() {
             let mut f = data.i_c[i].mul_motion(&joint.subspace_column(k));
             // H_ii = S_iᵀ F (the block's upper triangle, mirrored)
             for (l, col) in model.v_range(i).enumerate().skip(k) {
-                let h = joint.subspace_column(l).dot(&f);
+                let h = joint.project_force(l, &f);
                 data.mass_matrix[(row, col)] = h;
                 data.mass_matrix[(col, row)] = h;
             }
@@ -46,7 +46,7 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMat
                 f = data.x_up[j].transpose_apply_force(&f);
                 j = model.parent[j];
                 for (l, col) in model.v_range(j).enumerate() {
-                    let h = model.joints[j].subspace_column(l).dot(&f);
+                    let h = model.joints[j].project_force(l, &f);
                     data.mass_matrix[(row, col)] = h;
                     data.mass_matrix[(col, row)] = h;
                 }

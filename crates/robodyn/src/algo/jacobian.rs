@@ -4,11 +4,12 @@
 //! prismatic: `[z_i; 0]`), computed generally as in Featherstone (2008) §8.1: column k of joint j
 //! is the joint's subspace column `S_k` mapped to world coordinates, `X_{j←0}⁻¹ S_k = (ω, v_O)`;
 //! the linear velocity of the frame's origin p is then `v_O + ω × p`.
-//! Input: q (nq), a frame index and a [`Reference`]. Writes `data.x_up`, `data.x_world`,
-//! `data.jacobian`. Cost: O(n) plus one column per ancestor degree of freedom.
+//! Input: q (nq), a frame index and a [`Reference`]. Writes `data.support`, and `data.x_up`,
+//! `data.x_world` along it, and `data.jacobian`. Cost: O(depth) plus one column per ancestor
+//! degree of freedom.
 
-use crate::algo::kinematics::{frame_placement, update_body_placements};
-use crate::error::{Error, Result};
+use crate::algo::kinematics::{check_frame, frame_placement, update_support_placements};
+use crate::error::Result;
 use crate::model::Model;
 use crate::Data;
 use nalgebra::DMatrix;
@@ -35,23 +36,14 @@ pub fn jacobian<'d>(
     reference: Reference,
 ) -> Result<&'d DMatrix<f64>> {
     model.check_configuration(q)?;
-    if frame >= model.frames.len() {
-        return Err(Error::InvalidValue {
-            argument: "frame".into(),
-            message: format!(
-                "expected a frame index below {}, got {frame}",
-                model.frames.len()
-            ),
-        });
-    }
-    update_body_placements(model, data, q);
+    check_frame(model, frame)?;
+    update_support_placements(model, data, q, model.frames[frame].body);
     let pose = frame_placement(model, data, frame);
     // p: the frame's origin in world coordinates
     let origin = pose.translation;
 
     data.jacobian.as_mut_slice().fill(0.0);
-    let mut j = model.frames[frame].body;
-    while j != 0 {
+    for &j in &data.support {
         let joint = &model.joints[j];
         for (k, column) in model.v_range(j).enumerate() {
             // (ω, v_O) = X_{j←0}⁻¹ S_k
@@ -72,7 +64,6 @@ pub fn jacobian<'d>(
                 .fixed_view_mut::<3, 1>(3, column)
                 .copy_from(&angular);
         }
-        j = model.parent[j];
     }
     Ok(&data.jacobian)
 }

@@ -5,7 +5,7 @@
 //! transform `X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}`; seed 001 ("forward kinematics": chained `T`).
 //! Cost: one 3x3 rotation product per body.
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::spatial::Transform;
 use crate::Data;
@@ -36,6 +36,45 @@ pub fn forward_kinematics<'d>(
     model.check_configuration(q)?;
     update_body_placements(model, data, q);
     Ok(&data.x_world)
+}
+
+/// Writes `data.support` (the bodies from `body` to the world) and `data.x_up`, `data.x_world`
+/// along it only: what a single frame needs.
+pub(crate) fn update_support_placements(model: &Model, data: &mut Data, q: &[f64], body: usize) {
+    data.support.clear();
+    let mut j = body;
+    while j != 0 {
+        data.support.push(j);
+        j = model.parent[j];
+    }
+    for &i in data.support.iter().rev() {
+        // X_{i←λ(i)} = X_J(q_i) X_T(i);  X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}
+        data.x_up[i] = model.joints[i].transform(&q[model.q_range(i)]) * model.x_tree[i];
+        data.x_world[i] = data.x_up[i] * data.x_world[model.parent[i]];
+    }
+}
+
+/// The placement `X_{frame←0}` of one frame for configuration `q`, computing only the bodies
+/// between it and the world. Writes `data.support`, and `data.x_up`, `data.x_world` on it.
+pub fn frame_pose(model: &Model, data: &mut Data, q: &[f64], frame: usize) -> Result<Transform> {
+    model.check_configuration(q)?;
+    check_frame(model, frame)?;
+    update_support_placements(model, data, q, model.frames[frame].body);
+    Ok(frame_placement(model, data, frame))
+}
+
+/// Checks a frame index.
+pub(crate) fn check_frame(model: &Model, frame: usize) -> Result<()> {
+    if frame < model.frames.len() {
+        return Ok(());
+    }
+    Err(Error::InvalidValue {
+        argument: "frame".into(),
+        message: format!(
+            "expected a frame index below {}, got {frame}",
+            model.frames.len()
+        ),
+    })
 }
 
 /// `X_{frame←0}` of frame `frame` from the body placements in `data.x_world` (call

@@ -13,6 +13,6 @@ pub use aba::aba;
 pub use crba::crba;
 pub use energy::{center_of_mass, kinetic_energy, potential_energy};
 pub use jacobian::{jacobian, Reference};
-pub use kinematics::{forward_kinematics, frame_placement};
+pub use kinematics::{forward_kinematics, frame_placement, frame_pose};
 pub use minv::inverse_mass_matrix;
 pub use rnea::{bias_forces, generalized_gravity, rnea};

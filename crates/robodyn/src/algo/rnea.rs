@@ -94,7 +94,7 @@ fn newton_euler<'d>(
         for (k, dof) in model.v_range(i).enumerate() {
             // τ_i = S_iᵀ f_i + armature q̈_i
             let rotor = a.map_or(0.0, |a| model.armature[dof] * a[dof]);
-            data.tau[dof] = joint.subspace_column(k).dot(&data.f[i]) + rotor;
+            data.tau[dof] = joint.project_force(k, &data.f[i]) + rotor;
         }
         let parent = model.parent[i];
         if parent != 0 {
