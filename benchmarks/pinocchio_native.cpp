@@ -1,7 +1,7 @@
 // Native timing of Pinocchio's C++ algorithms, to set robodyn's criterion figures beside.
 // Built and run by benchmarks/pinocchio_native.sh against the headers and libraries of the `pin`
 // wheel. Prints nanoseconds per call (best of 5 rounds) for each robot given on the command line
-// as `name path floating(0|1)`.
+// as `name path floating(0|1) frame`; the Jacobian is that frame's.
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/frames.hpp>
@@ -29,7 +29,7 @@ template <typename F> double best_ns(F&& call, int calls) {
 }
 
 int main(int argc, char** argv) {
-  for (int arg = 1; arg + 2 < argc; arg += 3) {
+  for (int arg = 1; arg + 3 < argc; arg += 4) {
     const std::string name = argv[arg];
     pinocchio::Model model;
     if (std::atoi(argv[arg + 2]))
@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
     Eigen::VectorXd q = pinocchio::randomConfiguration(model);
     Eigen::VectorXd v = Eigen::VectorXd::Constant(model.nv, 0.5);
     Eigen::VectorXd a = Eigen::VectorXd::Constant(model.nv, 0.25);
-    const auto frame = static_cast<pinocchio::FrameIndex>(model.nframes - 1);
+    const auto frame = model.getFrameId(argv[arg + 3]);
     pinocchio::Data::Matrix6x jacobian = pinocchio::Data::Matrix6x::Zero(6, model.nv);
     const int calls = 20000;
     std::printf("%s forward_kinematics %.1f\n", name.c_str(),

@@ -17,6 +17,6 @@ g++ -O3 -DNDEBUG -std=c++17 -w -DBOOST_MPL_LIMIT_LIST_SIZE=30 -DBOOST_MPL_LIMIT_
     -I"$prefix/include" -I"$prefix/include/eigen3" -I"$prefix/include/urdfdom_headers" -I"$prefix/include/urdfdom" -L"$prefix/lib" -Wl,-rpath,"$prefix/lib" \
     -lpinocchio_default -lpinocchio_parsers -lboost_filesystem
 "$binary" \
-    ur5 "$robots/ur_description/urdf/ur5_robot.urdf" 0 \
-    panda "$robots/panda_description/urdf/panda.urdf" 0 \
-    talos "$robots/talos_data/robots/talos_full_v2.urdf" 1
+    ur5 "$robots/ur_description/urdf/ur5_robot.urdf" 0 tool0 \
+    panda "$robots/panda_description/urdf/panda.urdf" 0 panda_hand_tcp \
+    talos "$robots/talos_data/robots/talos_full_v2.urdf" 1 gripper_left_fingertip_1_link

@@ -372,15 +372,8 @@ fn vector_array<'py>(py: Python<'py>, values: &[f64]) -> Bound<'py, PyArray1<f64
 }
 
 /// Reads a settable per-coordinate property.
-fn read_property(name: &str, value: &Bound<PyAny>, length: usize) -> PyResult<Vec<f64>> {
-    let argument = Argument::new(
-        match name {
-            "gravity" => "gravity",
-            _ => "armature",
-        },
-        value,
-        SampleShape::vector(length),
-    )?;
+fn read_property(name: &'static str, value: &Bound<PyAny>, length: usize) -> PyResult<Vec<f64>> {
+    let argument = Argument::new(name, value, SampleShape::vector(length))?;
     if argument.batch()?.is_some() {
         return Err(PyValueError::new_err(format!(
             "argument '{name}': expected shape ({length},), got {}",

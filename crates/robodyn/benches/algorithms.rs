@@ -1,6 +1,6 @@
 //! Criterion benchmarks of the core algorithms on the bundled UR5 and, when the
 //! `example-robot-data` URDFs are found (`ROBODYN_ROBOTS_DIR` or the test virtual environment),
-//! on Panda and Talos.
+//! on its UR5, Panda and Talos, the robots `benchmarks/pinocchio_native.sh` times with Pinocchio.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::{rngs::StdRng, SeedableRng};
@@ -19,15 +19,32 @@ fn robots_dir() -> Option<PathBuf> {
     dir.is_dir().then_some(dir)
 }
 
-fn models() -> Vec<(&'static str, Model)> {
-    let mut models = vec![("ur5", bundled_model("ur5", false).expect("bundled ur5"))];
+/// (name, model, the frame whose Jacobian and pose are timed): the bundled UR5, and the
+/// example-robot-data robots that benchmarks/pinocchio_native.sh times with Pinocchio.
+fn models() -> Vec<(&'static str, Model, &'static str)> {
+    let mut models = vec![(
+        "ur5 (bundled)",
+        bundled_model("ur5", false).expect("bundled ur5"),
+        "tool0",
+    )];
     if let Some(dir) = robots_dir() {
-        for (name, path, floating) in [
-            ("panda", "panda_description/urdf/panda.urdf", false),
-            ("talos", "talos_data/robots/talos_full_v2.urdf", true),
+        for (name, path, floating, frame) in [
+            ("ur5", "ur_description/urdf/ur5_robot.urdf", false, "tool0"),
+            (
+                "panda",
+                "panda_description/urdf/panda.urdf",
+                false,
+                "panda_hand_tcp",
+            ),
+            (
+                "talos",
+                "talos_data/robots/talos_full_v2.urdf",
+                true,
+                "gripper_left_fingertip_1_link",
+            ),
         ] {
             if let Ok(model) = load_urdf_file(&dir.join(path), LoadOptions::floating(floating)) {
-                models.push((name, model));
+                models.push((name, model, frame));
             }
         }
     }
@@ -35,14 +52,14 @@ fn models() -> Vec<(&'static str, Model)> {
 }
 
 fn benchmarks(c: &mut Criterion) {
-    for (name, model) in models() {
+    for (name, model, frame) in models() {
         let mut data = Data::new(&model);
         let mut rng = StdRng::seed_from_u64(7);
         let q = model.random_configuration(&mut rng);
         let v = nalgebra::DVector::from_element(model.nv, 0.5);
         let a = nalgebra::DVector::from_element(model.nv, 0.25);
         let q = q.as_slice();
-        let frame = model.frames.len() - 1;
+        let frame = model.frame_index(frame).expect("benchmark frame");
         c.bench_function(&format!("{name}/forward_kinematics"), |b| {
             b.iter(|| forward_kinematics(&model, &mut data, black_box(q)).map(|x| x.len()))
         });

@@ -25,9 +25,12 @@ pub struct Data {
     pub f: Vec<Force>,
     /// Generalized forces; nv. Written by `rnea`.
     pub tau: DVector<f64>,
-    /// Composite rigid-body inertia of the subtree rooted at body i, in body i's frame; nbodies.
-    /// Written by `crba`.
+    /// Composite rigid-body inertia of the subtree rooted at body i, in world coordinates;
+    /// nbodies. Written by `crba`.
     pub i_c: Vec<Inertia>,
+    /// Motion subspace column of each velocity coordinate in world coordinates (the spatial
+    /// Jacobian's columns); nv. Written by `crba`.
+    pub s_world: Vec<Motion>,
     /// Joint-space inertia matrix M(q), full and symmetric; nv x nv. Written by `crba`.
     pub mass_matrix: DMatrix<f64>,
     /// M(q)⁻¹; nv x nv. Written by `inverse_mass_matrix`.
@@ -72,6 +75,7 @@ impl Data {
             f: vec![Force::ZERO; nb],
             tau: DVector::zeros(nv),
             i_c: vec![Inertia::ZERO; nb],
+            s_world: vec![Motion::ZERO; nv],
             mass_matrix: DMatrix::zeros(nv, nv),
             mass_matrix_inverse: DMatrix::zeros(nv, nv),
             cholesky: DMatrix::zeros(nv, nv),

@@ -1,11 +1,16 @@
 //! Composite-rigid-body algorithm: the joint-space inertia matrix M(q).
 //!
-//! Reference: Featherstone, *Rigid Body Dynamics Algorithms* (2008), Table 6.2. Seeds 000/003 give
-//! the same matrix as Σ mᵢ J_vᵢᵀ J_vᵢ + J_ωᵢᵀ Iᵢ J_ωᵢ and as n RNEA calls; the tests check both.
-//! Input: q (nq). Writes `data.x_up`, `data.i_c`, `data.mass_matrix` (full, symmetric, armature on
-//! the diagonal). Cost: O(n d), d the depth of the tree.
+//! Reference: Featherstone, *Rigid Body Dynamics Algorithms* (2008), §6.2 and Table 6.2:
+//! `H_ij = S_iᵀ I^c_i S_j` for j an ancestor of i (or i itself), with `I^c_i` the composite inertia
+//! of the subtree rooted at body i. Table 6.2 evaluates it in body coordinates, carrying the force
+//! `F = I^c_i S_i` up the tree; here every quantity is expressed once in world coordinates, where
+//! composite inertias add without transforms and each `H_ij` is a single dot product (the form
+//! Pinocchio uses). Seed 003 obtains the same M from n RNEA calls; the tests check it.
+//! Input: q (nq). Writes `data.x_up`, `data.x_world`, `data.s_world`, `data.i_c` (world
+//! coordinates), `data.mass_matrix` (full, symmetric, armature on the diagonal).
+//! Cost: O(n) transforms plus one 6-vector dot product per pair (joint, ancestor joint).
 
-use crate::algo::kinematics::update_joint_transforms;
+use crate::algo::kinematics::update_body_placements;
 use crate::error::Result;
 use crate::model::Model;
 use crate::Data;
@@ -14,45 +19,46 @@ use nalgebra::DMatrix;
 /// M(q), written into `data.mass_matrix`.
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMatrix<f64>> {
     model.check_configuration(q)?;
-    update_joint_transforms(model, data, q);
+    update_body_placements(model, data, q);
 
-    // composite inertias, leaves to root: I^c_λ(i) += X_iᵀ I^c_i X_i
-    data.i_c.copy_from_slice(&model.inertias);
+    // world-frame inertias and motion subspaces: ⁰I_i = X_{i←0}ᵀ I_i X_{i←0}, ⁰S_i = X_{i←0}⁻¹ S_i
+    for i in 1..model.nbodies() {
+        data.i_c[i] = data.x_world[i].transpose_apply_inertia(&model.inertias[i]);
+        for (k, dof) in model.v_range(i).enumerate() {
+            data.s_world[dof] =
+                data.x_world[i].inverse_apply_motion(&model.joints[i].subspace_column(k));
+        }
+    }
+
+    // composite inertias, leaves to root: I^c_λ(i) += I^c_i (same coordinates, no transform)
     for i in (1..model.nbodies()).rev() {
         let parent = model.parent[i];
         if parent != 0 {
-            let inertia = data.x_up[i].transpose_apply_inertia(&data.i_c[i]);
-            data.i_c[parent] += inertia;
+            let subtree = data.i_c[i];
+            data.i_c[parent] += subtree;
         }
     }
 
-    // one column block per joint: F = I^c_i S_i, walked up to the root; entries between
-    // different branches stay zero
-    data.mass_matrix.as_mut_slice().fill(0.0);
+    // H_ij = ⁰S_jᵀ (I^c_i ⁰S_i) for j on the path from i to the root; other entries are zero
+    let nv = model.nv;
+    let mass_matrix = data.mass_matrix.as_mut_slice();
+    mass_matrix.fill(0.0);
     for i in 1..model.nbodies() {
-        let joint = &model.joints[i];
-        for (k, row) in model.v_range(i).enumerate() {
-            let mut f = data.i_c[i].mul_motion(&joint.subspace_column(k));
-            // H_ii = S_iᵀ F (the block's upper triangle, mirrored)
-            for (l, col) in model.v_range(i).enumerate().skip(k) {
-                let h = joint.project_force(l, &f);
-                data.mass_matrix[(row, col)] = h;
-                data.mass_matrix[(col, row)] = h;
-            }
-            data.mass_matrix[(row, row)] += model.armature[row];
+        for row in model.v_range(i) {
+            // F = I^c_i S_i
+            let f = data.i_c[i].mul_motion(&data.s_world[row]);
             let mut j = i;
-            while model.parent[j] != 0 {
-                // F = X_jᵀ F;  j = λ(j);  H_ij = Fᵀ S_j = H_ji
-                f = data.x_up[j].transpose_apply_force(&f);
-                j = model.parent[j];
-                for (l, col) in model.v_range(j).enumerate() {
-                    let h = model.joints[j].project_force(l, &f);
-                    data.mass_matrix[(row, col)] = h;
-                    data.mass_matrix[(col, row)] = h;
+            while j != 0 {
+                for col in model.v_range(j).filter(|&col| j != i || col >= row) {
+                    // column-major storage: H[row, col] at row + col nv
+                    let h = data.s_world[col].dot(&f);
+                    mass_matrix[row + col * nv] = h;
+                    mass_matrix[col + row * nv] = h;
                 }
+                j = model.parent[j];
             }
+            mass_matrix[row + row * nv] += model.armature[row];
         }
     }
-
     Ok(&data.mass_matrix)
 }

@@ -3,7 +3,7 @@
 //! M from CRBA (Featherstone Table 6.2) is symmetric positive definite, so M⁻¹ comes from its
 //! Cholesky factorisation `M = L Lᵀ` (Featherstone §6.5) solved against the identity.
 //! Input: q (nq). Writes everything `crba` writes, `data.cholesky` and
-//! `data.mass_matrix_inverse`. Cost: O(n d) + O(n³).
+//! `data.mass_matrix_inverse`. Cost: that of `crba` plus O(n³).
 
 use crate::algo::crba::crba;
 use crate::error::{Error, Result};

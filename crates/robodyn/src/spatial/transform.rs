@@ -137,16 +137,25 @@ impl Transform {
     pub fn transpose_apply_inertia(&self, inertia: &Inertia) -> Inertia {
         let r = &self.translation;
         let m = inertia.mass;
-        // h_A = Eᵀ h_B + m r
-        let h_rotated = self.rotation.tr_mul(&inertia.first_moment);
-        // Ī_A = Eᵀ Ī_B E + (2 r·h' + m|r|²) 1 - (r h'ᵀ + h' rᵀ + m r rᵀ)
-        let i_rotated = self.rotation.transpose() * inertia.rotational * self.rotation;
-        let shift = Mat3::identity() * (2.0 * r.dot(&h_rotated) + m * r.norm_squared())
-            - (r * h_rotated.transpose() + h_rotated * r.transpose() + r * r.transpose() * m);
+        // h' = Eᵀ h_B (the first moment in A's axes, about B's origin)
+        let h = self.rotation.tr_mul(&inertia.first_moment);
+        // Ī_A = Eᵀ Ī_B E + (2 r·h' + m|r|²) 1 - (r h'ᵀ + h' rᵀ + m r rᵀ), symmetric: the upper
+        // triangle is computed and mirrored
+        let rotated = self.rotation.tr_mul(&(inertia.rotational * self.rotation));
+        let diagonal = 2.0 * r.dot(&h) + m * r.norm_squared();
+        let mut rotational = Mat3::zeros();
+        for row in 0..3 {
+            for col in row..3 {
+                let shift = r[row] * h[col] + h[row] * r[col] + m * r[row] * r[col];
+                let value = rotated[(row, col)] - shift + if row == col { diagonal } else { 0.0 };
+                rotational[(row, col)] = value;
+                rotational[(col, row)] = value;
+            }
+        }
         Inertia {
             mass: m,
-            first_moment: h_rotated + r * m,
-            rotational: i_rotated + shift,
+            first_moment: h + r * m,
+            rotational,
         }
     }
 
