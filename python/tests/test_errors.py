@@ -126,7 +126,7 @@ def test_singular_dynamics_is_an_error_not_nan():
     q, v = model.neutral(), np.zeros(model.nv)
     with pytest.raises(ValueError, match="singular"):
         model.forward_dynamics(q, v, v)
-    with pytest.raises(ValueError, match="not positive definite"):
+    with pytest.raises(ValueError, match="mass matrix is singular"):
         model.inverse_mass_matrix(q)
 
 

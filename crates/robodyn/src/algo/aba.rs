@@ -8,6 +8,7 @@
 
 use crate::algo::kinematics::update_joint_transforms;
 use crate::algo::rnea::check_external_forces;
+use crate::algo::SINGULARITY_TOLERANCE;
 use crate::error::{check_vector, Error, Result};
 use crate::model::Model;
 use crate::spatial::{mat6_mul_motion, Force, Mat6, Motion, Vec3};
@@ -140,11 +141,12 @@ fn force_vector(f: &Force) -> nalgebra::Vector6<f64> {
 
 /// Inverts the leading `n` x `n` block of `m` in place by Gauss–Jordan elimination without
 /// pivoting (the block, `D_i`, is symmetric positive definite). Returns false if a pivot is not
-/// positive.
+/// positive relative to the block's largest diagonal entry ([`SINGULARITY_TOLERANCE`]).
 fn invert_leading_block(m: &mut Mat6, n: usize) -> bool {
+    let scale = (0..n).map(|k| m[(k, k)]).fold(0.0, f64::max);
     for k in 0..n {
         let pivot = m[(k, k)];
-        if pivot.is_nan() || pivot <= 0.0 {
+        if pivot.is_nan() || pivot <= SINGULARITY_TOLERANCE * scale || pivot <= 0.0 {
             return false;
         }
         m[(k, k)] = 1.0;

@@ -6,6 +6,7 @@
 //! `data.mass_matrix_inverse`. Cost: that of `crba` plus O(n³).
 
 use crate::algo::crba::crba;
+use crate::algo::SINGULARITY_TOLERANCE;
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::Data;
@@ -21,14 +22,27 @@ pub fn inverse_mass_matrix<'d>(
     // factor a copy of M in the preallocated workspace: M = L Lᵀ
     let mut work = std::mem::replace(&mut data.cholesky, DMatrix::zeros(0, 0));
     work.copy_from(&data.mass_matrix);
-    let Some(factor) = Cholesky::new(work) else {
-        data.cholesky = DMatrix::zeros(model.nv, model.nv);
-        return Err(Error::InvalidValue {
-            argument: "q".into(),
-            message: "the mass matrix is not positive definite at this configuration (a massless \
-                      subtree without armature)"
-                .into(),
-        });
+    let nv = model.nv;
+    let scale = (0..nv)
+        .map(|k| data.mass_matrix[(k, k)])
+        .fold(0.0, f64::max);
+    let factor = match Cholesky::new(work) {
+        // L_kk² is the k-th pivot
+        Some(factor)
+            if (0..nv)
+                .all(|k| factor.l_dirty()[(k, k)].powi(2) > SINGULARITY_TOLERANCE * scale) =>
+        {
+            factor
+        }
+        other => {
+            data.cholesky = other.map_or_else(|| DMatrix::zeros(nv, nv), |f| f.unpack_dirty());
+            return Err(Error::InvalidValue {
+                argument: "q".into(),
+                message: "the mass matrix is singular at this configuration (a massless subtree \
+                          without armature)"
+                    .into(),
+            });
+        }
     };
     // solve L Lᵀ X = 1
     data.mass_matrix_inverse.fill_with_identity();
