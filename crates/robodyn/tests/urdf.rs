@@ -194,3 +194,17 @@ fn questionable_input_loads_with_a_warning() {
     // with the check on (the default) the inertia is an error
     assert!(load_urdf_str(&text, "odd.urdf", LoadOptions::default()).is_err());
 }
+
+#[test]
+fn singular_dynamics_is_refused() {
+    // floating, the UR5's massless base link can spin without moving the arm: M is singular
+    let model = bundled_model("ur5", true).unwrap();
+    let mut data = robodyn::Data::new(&model);
+    let q = model.neutral();
+    let zero = vec![0.0; model.nv];
+    let error =
+        robodyn::algo::aba(&model, &mut data, q.as_slice(), &zero, &zero, None).unwrap_err();
+    assert!(error.to_string().contains("singular"), "{error}");
+    let error = robodyn::algo::inverse_mass_matrix(&model, &mut data, q.as_slice()).unwrap_err();
+    assert!(error.to_string().contains("singular"), "{error}");
+}
