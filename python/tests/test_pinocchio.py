@@ -160,3 +160,47 @@ def test_loads_every_urdf_pinocchio_loads(robots_dir):
         assert (model.nq + continuous, model.nv) == (pin_model.nq, pin_model.nv), path
         loaded += 1
     assert loaded >= 50, f"only {loaded} URDFs found in {robots_dir}"
+
+
+ROTATED_INERTIALS = """<robot name="tree">
+  <link name="base"><inertial><origin xyz="0.1 0 0.05" rpy="0.1 0.2 0.3"/><mass value="4"/>
+    <inertia ixx="0.3" ixy="0.01" ixz="0.02" iyy="0.25" iyz="0.03" izz="0.2"/></inertial></link>
+  <joint name="a" type="revolute"><parent link="base"/><child link="arm"/><origin xyz="0.2 0.1 0.3" rpy="0.3 -0.2 0.5"/>
+    <axis xyz="1 1 0"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+  <link name="arm"><inertial><origin xyz="0 0 0.2" rpy="0 0.4 0.2"/><mass value="1.5"/>
+    <inertia ixx="0.05" ixy="0.002" ixz="0" iyy="0.04" iyz="0.001" izz="0.01"/></inertial></link>
+  <joint name="b" type="prismatic"><parent link="arm"/><child link="slider"/><origin xyz="0.1 0.2 0" rpy="0.5 0 0"/>
+    <axis xyz="0 0.6 0.8"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <link name="slider"><inertial><origin xyz="0 0.05 0" rpy="1 0 0"/><mass value="0.3"/>
+    <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.001"/></inertial></link>
+  <joint name="fixed" type="fixed"><parent link="slider"/><child link="tip"/><origin xyz="0 0.1 0.02" rpy="0 0 1"/></joint>
+  <link name="tip"><inertial><origin xyz="0.01 0 0" rpy="0.3 0.2 0.1"/><mass value="0.1"/>
+    <inertia ixx="0.0001" ixy="0" ixz="0" iyy="0.0002" iyz="0" izz="0.0003"/></inertial></link>
+  <joint name="c" type="continuous"><parent link="base"/><child link="leg"/><origin xyz="-0.2 0 -0.1" rpy="0 0.3 0"/>
+    <axis xyz="0 1 0"/></joint>
+  <link name="leg"><inertial><origin xyz="0 0 -0.2"/><mass value="2"/>
+    <inertia ixx="0.03" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="0.004"/></inertial></link>
+</robot>"""
+
+
+@pytest.mark.parametrize("floating_base", [False, True])
+def test_oblique_axes_rotated_inertials_and_merged_links_agree_with_pinocchio(floating_base):
+    model = robodyn.load_urdf_string(ROTATED_INERTIALS, floating_base=floating_base)
+    pin_model = (
+        pin.buildModelFromXML(ROTATED_INERTIALS, pin.JointModelFreeFlyer())
+        if floating_base
+        else pin.buildModelFromXML(ROTATED_INERTIALS)
+    )
+    mapping = PinocchioMap(model, pin_model)
+    data = pin_model.createData()
+    rng = np.random.default_rng(3)
+    for seed in range(3):
+        q = model.random_configuration(seed=seed)
+        v, a = rng.uniform(-1, 1, model.nv), rng.uniform(-1, 1, model.nv)
+        pq = mapping.q(q)
+        expected = mapping.v_back(pin.rnea(pin_model, data, pq, mapping.v(v), mapping.v(a)))
+        assert_close(model.inverse_dynamics(q, v, a), expected, CROSS_CHECK_TOLERANCE, "tau")
+        mass = pin.crba(pin_model, data, pq)
+        assert_close(model.mass_matrix(q), mapping.matrix_back(np.triu(mass) + np.triu(mass, 1).T), CROSS_CHECK_TOLERANCE, "M")
+        pin.framesForwardKinematics(pin_model, data, pq)
+        assert_close(model.frame_pose(q, "tip"), data.oMf[pin_model.getFrameId("tip")].homogeneous, CROSS_CHECK_TOLERANCE, "tip")

@@ -208,3 +208,18 @@ fn singular_dynamics_is_refused() {
     let error = robodyn::algo::inverse_mass_matrix(&model, &mut data, q.as_slice()).unwrap_err();
     assert!(error.to_string().contains("singular"), "{error}");
 }
+
+#[test]
+fn floating_joint_becomes_free() {
+    let text = robot(
+        "<link name='world'/><link name='box'><inertial><mass value='1'/><inertia ixx='1' iyy='1' izz='1' ixy='0' ixz='0' iyz='0'/></inertial></link>
+         <joint name='float' type='floating'><parent link='world'/><child link='box'/><origin xyz='0 0 1'/></joint>",
+    );
+    let model = load_urdf_str(&text, "f.urdf", LoadOptions::default()).unwrap();
+    assert_eq!((model.nq, model.nv), (7, 6));
+    assert_eq!(model.joints[1], Joint::Free);
+    assert_eq!(
+        model.neutral().as_slice(),
+        &[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+    );
+}
