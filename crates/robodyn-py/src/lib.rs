@@ -14,6 +14,7 @@ use robodyn::io::LoadOptions;
 use robodyn::spatial::Force;
 use robodyn::{Data, Error, Model};
 use std::borrow::Cow;
+use std::collections::HashMap;
 use std::sync::Mutex;
 
 /// A core error as the Python exception the API promises.
@@ -200,12 +201,23 @@ fn shape_text(shape: &[usize]) -> String {
 struct PyModel {
     model: Model,
     workspace: Mutex<Workspace>,
+    /// Frame name to index, for the calls that take a frame by name.
+    frame_indices: HashMap<String, usize>,
 }
 
 impl PyModel {
     fn wrap(model: Model) -> Self {
         let workspace = Mutex::new(Workspace::new(&model));
-        PyModel { model, workspace }
+        let mut frame_indices = HashMap::new();
+        for (index, frame) in model.frames.iter().enumerate() {
+            // the first frame of a name wins, as in Model::frame_index
+            frame_indices.entry(frame.name.clone()).or_insert(index);
+        }
+        PyModel {
+            model,
+            workspace,
+            frame_indices,
+        }
     }
 
     /// Runs `kernel` on one sample or a batch of the `arguments`, producing `output_shape` per
@@ -310,7 +322,10 @@ impl PyModel {
 
     fn frame_index(&self, frame: &Bound<PyAny>) -> PyResult<usize> {
         if let Ok(name) = frame.extract::<&str>() {
-            return self.model.frame_index(name).map_err(to_py_err);
+            return match self.frame_indices.get(name) {
+                Some(&index) => Ok(index),
+                None => self.model.frame_index(name).map_err(to_py_err),
+            };
         }
         match frame.extract::<usize>() {
             Ok(index) if index < self.model.frames.len() => Ok(index),
@@ -358,12 +373,11 @@ impl PyModel {
 
 /// Writes a matrix (column-major in nalgebra) into a row-major output.
 fn write_row_major(matrix: &nalgebra::DMatrix<f64>, out: &mut [f64]) {
-    let columns = matrix.ncols();
-    for ((r, c), value) in (0..matrix.nrows())
-        .flat_map(|r| (0..columns).map(move |c| (r, c)))
-        .zip(out.iter_mut())
-    {
-        *value = matrix[(r, c)];
+    let (rows, columns) = matrix.shape();
+    for (c, column) in matrix.as_slice().chunks_exact(rows.max(1)).enumerate() {
+        for (r, value) in column.iter().enumerate() {
+            out[r * columns + c] = *value;
+        }
     }
 }
 
@@ -625,7 +639,8 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let nv = self.model.nv;
         self.evaluate(py, &[self.q_arg("q", q)?], &[nv, nv], &|m, w, i, out| {
-            write_row_major(algo::crba(m, &mut w.data, i[0])?, out);
+            // M is exactly symmetric: its column-major storage is its row-major layout
+            out.copy_from_slice(algo::crba(m, &mut w.data, i[0])?.as_slice());
             Ok(())
         })
     }
