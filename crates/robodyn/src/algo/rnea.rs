@@ -69,21 +69,31 @@ fn newton_euler<'d>(
     for i in 1..model.nbodies() {
         let joint = &model.joints[i];
         let parent = model.parent[i];
-        let v_j = v.map_or(Motion::ZERO, |v| joint.motion(&v[model.v_range(i)]));
-        // v_i = X_i v_λ(i) + v_J
-        let v_i = data.x_up[i].apply_motion(&data.v[parent]) + v_j;
+        let inertia = &model.inertias[i];
         // a_i = X_i a_λ(i) + S q̈_i + v_i × v_J   (c_J = 0)
-        let mut a_i = data.x_up[i].apply_motion(&data.a[parent]) + v_i.cross_motion(&v_j);
+        let mut a_i = data.x_up[i].apply_motion(&data.a[parent]);
         if let Some(a) = a {
             a_i += joint.motion(&a[model.v_range(i)]);
         }
-        let inertia = &model.inertias[i];
         // f_i = I_i a_i + v_i ×* I_i v_i - f_ext_i
-        let mut f_i = inertia.mul_motion(&a_i) + v_i.cross_force(&inertia.mul_motion(&v_i));
+        let mut f_i = match v {
+            Some(v) => {
+                // v_i = X_i v_λ(i) + v_J
+                let v_j = joint.motion(&v[model.v_range(i)]);
+                let v_i = data.x_up[i].apply_motion(&data.v[parent]) + v_j;
+                a_i += v_i.cross_motion(&v_j);
+                data.v[i] = v_i;
+                inertia.mul_motion(&a_i) + v_i.cross_force(&inertia.mul_motion(&v_i))
+            }
+            None => {
+                // at rest every velocity product vanishes
+                data.v[i] = Motion::ZERO;
+                inertia.mul_motion(&a_i)
+            }
+        };
         if let Some(forces) = f_ext {
             f_i -= forces[i - 1];
         }
-        data.v[i] = v_i;
         data.a[i] = a_i;
         data.f[i] = f_i;
     }
