@@ -1,8 +1,12 @@
-"""robodyn against Pinocchio from Python, in one run: per-call time of each algorithm and a
-10 000-state batch against a Pinocchio loop, printed as ratios (< 1 means robodyn is faster).
+"""robodyn against Pinocchio and MuJoCo from Python, in one run: per-call time of each algorithm
+and a 10 000-state batch against a Python loop, printed as ratios (< 1 means robodyn is faster).
 
 Run: .venv/bin/python benchmarks/compare.py [--batch 10000] [--robots ur5 panda talos]
 Needs the bench extras (pip install '.[bench]'). Times are the best of several repeats.
+
+MuJoCo loads the same URDFs (visual and collision elements removed) with a fixed base, so its
+table uses fixed-base robodyn models. MuJoCo has no separate RNEA/CRBA entry points that start
+from q, so each MuJoCo case is the pipeline of mj_* calls a Python user would make for it.
 """
 
 from __future__ import annotations
@@ -10,10 +14,12 @@ from __future__ import annotations
 import argparse
 import os
 import platform
+import re
 import sys
 import timeit
 from pathlib import Path
 
+import mujoco
 import numpy as np
 import pinocchio as pin
 
@@ -93,18 +99,87 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
     return rows
 
 
+def mujoco_model(urdf: Path) -> mujoco.MjModel:
+    """MuJoCo's import of a URDF without its meshes (they are not needed for dynamics)."""
+    text = re.sub(r"<(visual|collision|gazebo|transmission)\b.*?</\1>", "", urdf.read_text(), flags=re.S)
+    return mujoco.MjModel.from_xml_string(text)
+
+
+def compare_mujoco(name: str, batch: int) -> list[tuple[str, float, float]]:
+    path, _ = ROBOTS[name]
+    urdf = robodyn._example_robot_data_dir() / path
+    m = robodyn.load(urdf)
+    mj = mujoco_model(urdf)
+    d = mujoco.MjData(mj)
+    assert mj.nv == m.nv, f"{name}: MuJoCo has nv = {mj.nv}, robodyn {m.nv}"
+    rng = np.random.default_rng(0)
+    q = m.random_configuration(seed=1)
+    v, a = rng.uniform(-1, 1, m.nv), rng.uniform(-1, 1, m.nv)
+    tau = np.zeros(m.nv)
+    dense = np.zeros((m.nv, m.nv))
+    d.qpos[:], d.qvel[:], d.qacc[:] = q, v, a
+
+    def mj_rnea():
+        mujoco.mj_kinematics(mj, d)
+        mujoco.mj_comPos(mj, d)
+        mujoco.mj_comVel(mj, d)
+        mujoco.mj_rne(mj, d, 1, tau)
+
+    def mj_crba():
+        mujoco.mj_kinematics(mj, d)
+        mujoco.mj_comPos(mj, d)
+        mujoco.mj_crb(mj, d)
+        mujoco.mj_fullM(mj, d, dense)
+
+    def mj_gravity():
+        mujoco.mj_kinematics(mj, d)
+        mujoco.mj_comPos(mj, d)
+        mujoco.mj_rne(mj, d, 0, tau)
+
+    zero = np.zeros(m.nv)
+    single = {
+        "rnea": (lambda: m.inverse_dynamics(q, v, a), mj_rnea),
+        "crba": (lambda: m.mass_matrix(q), mj_crba),
+        "forward dynamics": (lambda: m.forward_dynamics(q, v, a), lambda: mujoco.mj_forward(mj, d)),
+        "gravity": (lambda: m.inverse_dynamics(q, zero, zero), mj_gravity),
+    }
+    rows = [(f"{name} {k} (one call)", best_time(ours, 2000), best_time(theirs, 2000)) for k, (ours, theirs) in single.items()]
+
+    states = m.random_configuration(n=batch, seed=2)
+
+    def mj_gravity_loop():
+        d.qvel[:] = 0.0
+        for x in states:
+            d.qpos[:] = x
+            mj_gravity()
+
+    def mj_crba_loop():
+        for x in states:
+            d.qpos[:] = x
+            mj_crba()
+
+    rows.append((f"{name} gravity ({batch} states)", best_time(lambda: m.generalized_gravity(states), 1), best_time(mj_gravity_loop, 1)))
+    rows.append((f"{name} crba ({batch} states)", best_time(lambda: m.mass_matrix(states), 1), best_time(mj_crba_loop, 1)))
+    return rows
+
+
+def print_table(title: str, other: str, rows) -> None:
+    print(f"\n{title}")
+    print(f"{'case':<40}{'robodyn':>14}{other:>14}{'ratio':>9}")
+    for case, ours, theirs in rows:
+        unit, scale = ("us", 1e6) if theirs < 1e-3 else ("ms", 1e3)
+        print(f"{case:<40}{ours * scale:>11.2f} {unit}{theirs * scale:>11.2f} {unit}{ours / theirs:>9.3f}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--batch", type=int, default=10_000)
     parser.add_argument("--robots", nargs="+", default=list(ROBOTS), choices=list(ROBOTS))
     args = parser.parse_args()
-    print(f"robodyn {robodyn.__version__} vs Pinocchio {pin.__version__}; Python {platform.python_version()}, "
-          f"{platform.machine()}, {os.cpu_count()} cores ({platform.processor() or 'unknown CPU'})")
-    print(f"{'case':<36}{'robodyn':>14}{'pinocchio':>14}{'ratio':>9}")
-    for name in args.robots:
-        for case, ours, theirs in compare_robot(name, args.batch):
-            unit, scale = ("us", 1e6) if theirs < 1e-3 else ("ms", 1e3)
-            print(f"{case:<36}{ours * scale:>11.2f} {unit}{theirs * scale:>11.2f} {unit}{ours / theirs:>9.3f}")
+    print(f"robodyn {robodyn.__version__}, Pinocchio {pin.__version__}, MuJoCo {mujoco.__version__}; "
+          f"Python {platform.python_version()}, {platform.machine()}, {os.cpu_count()} cores")
+    print_table("robodyn vs Pinocchio", "pinocchio", [row for name in args.robots for row in compare_robot(name, args.batch)])
+    print_table("robodyn vs MuJoCo (fixed base)", "mujoco", [row for name in args.robots for row in compare_mujoco(name, args.batch)])
 
 
 if __name__ == "__main__":
