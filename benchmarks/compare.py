@@ -34,9 +34,14 @@ ROBOTS = {
 }
 
 
-def best_time(function, number: int) -> float:
-    """Best per-call time in seconds over 5 repeats of `number` calls."""
-    return min(timeit.repeat(function, number=number, repeat=5)) / number
+def best_times(ours, theirs, number: int, repeat: int = 7) -> tuple[float, float]:
+    """Best per-call times in seconds of two functions over `repeat` rounds of `number` calls,
+    the rounds interleaved so that a drift in the machine's speed affects both alike."""
+    best_ours = best_theirs = float("inf")
+    for _ in range(repeat):
+        best_ours = min(best_ours, timeit.timeit(ours, number=number))
+        best_theirs = min(best_theirs, timeit.timeit(theirs, number=number))
+    return best_ours / number, best_theirs / number
 
 
 def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
@@ -68,9 +73,7 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
         "frame_pose": (lambda: m.frame_pose(q, frame), pin_frame_pose),
         "jacobian": (lambda: m.jacobian(q, frame), pin_jacobian),
     }
-    rows = []
-    for algorithm, (ours, theirs) in single.items():
-        rows.append((f"{name} {algorithm} (one call)", best_time(ours, 2000), best_time(theirs, 2000)))
+    rows = [(f"{name} {algorithm} (one call)", *best_times(ours, theirs, 2000)) for algorithm, (ours, theirs) in single.items()]
 
     states = m.random_configuration(n=batch, seed=2)
     pin_states = [mapping.q(x) for x in states]
@@ -94,8 +97,7 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
         "rnea": (lambda: m.inverse_dynamics(states, velocities, velocities), pin_rnea_loop),
         "crba": (lambda: m.mass_matrix(states), pin_crba_loop),
     }
-    for algorithm, (ours, theirs) in batches.items():
-        rows.append((f"{name} {algorithm} ({batch} states)", best_time(ours, 1), best_time(theirs, 1)))
+    rows += [(f"{name} {algorithm} ({batch} states)", *best_times(ours, theirs, 1, 5)) for algorithm, (ours, theirs) in batches.items()]
     return rows
 
 
@@ -136,14 +138,13 @@ def compare_mujoco(name: str, batch: int) -> list[tuple[str, float, float]]:
         mujoco.mj_comPos(mj, d)
         mujoco.mj_rne(mj, d, 0, tau)
 
-    zero = np.zeros(m.nv)
     single = {
         "rnea": (lambda: m.inverse_dynamics(q, v, a), mj_rnea),
         "crba": (lambda: m.mass_matrix(q), mj_crba),
         "forward dynamics": (lambda: m.forward_dynamics(q, v, a), lambda: mujoco.mj_forward(mj, d)),
-        "gravity": (lambda: m.inverse_dynamics(q, zero, zero), mj_gravity),
+        "gravity": (lambda: m.generalized_gravity(q), mj_gravity),
     }
-    rows = [(f"{name} {k} (one call)", best_time(ours, 2000), best_time(theirs, 2000)) for k, (ours, theirs) in single.items()]
+    rows = [(f"{name} {k} (one call)", *best_times(ours, theirs, 2000)) for k, (ours, theirs) in single.items()]
 
     states = m.random_configuration(n=batch, seed=2)
 
@@ -158,8 +159,8 @@ def compare_mujoco(name: str, batch: int) -> list[tuple[str, float, float]]:
             d.qpos[:] = x
             mj_crba()
 
-    rows.append((f"{name} gravity ({batch} states)", best_time(lambda: m.generalized_gravity(states), 1), best_time(mj_gravity_loop, 1)))
-    rows.append((f"{name} crba ({batch} states)", best_time(lambda: m.mass_matrix(states), 1), best_time(mj_crba_loop, 1)))
+    rows.append((f"{name} gravity ({batch} states)", *best_times(lambda: m.generalized_gravity(states), mj_gravity_loop, 1, 5)))
+    rows.append((f"{name} crba ({batch} states)", *best_times(lambda: m.mass_matrix(states), mj_crba_loop, 1, 5)))
     return rows
 
 
