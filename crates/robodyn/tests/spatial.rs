@@ -22,37 +22,15 @@ fn inertia() -> impl Strategy<Value = Inertia> {
     })
 }
 
-fn motion_vector(m: &Motion) -> nalgebra::Vector6<f64> {
-    nalgebra::Vector6::new(
-        m.angular.x,
-        m.angular.y,
-        m.angular.z,
-        m.linear.x,
-        m.linear.y,
-        m.linear.z,
-    )
-}
-
-fn force_vector(f: &Force) -> nalgebra::Vector6<f64> {
-    nalgebra::Vector6::new(
-        f.angular.x,
-        f.angular.y,
-        f.angular.z,
-        f.linear.x,
-        f.linear.y,
-        f.linear.z,
-    )
-}
-
 proptest! {
     #[test]
     fn transform_times_inverse_is_identity(x in transform(), w in vec3(), v in vec3()) {
         let m = Motion::new(w, v);
         let back = x.inverse().apply_motion(&x.apply_motion(&m));
-        prop_assert!((motion_vector(&back) - motion_vector(&m)).norm() < TOLERANCE);
+        prop_assert!((back.to_vector() - m.to_vector()).norm() < TOLERANCE);
         let composed = x * x.inverse();
         prop_assert!((composed.to_matrix() - nalgebra::Matrix6::identity()).norm() < TOLERANCE);
-        prop_assert!((motion_vector(&x.inverse_apply_motion(&m)) - motion_vector(&x.inverse().apply_motion(&m))).norm() < TOLERANCE);
+        prop_assert!((x.inverse_apply_motion(&m).to_vector() - x.inverse().apply_motion(&m).to_vector()).norm() < TOLERANCE);
     }
 
     #[test]
@@ -62,10 +40,10 @@ proptest! {
         prop_assert!((x.apply_motion(&m).dot(&x.apply_force(&force)) - m.dot(&force)).abs() < TOLERANCE * 100.0);
         // Xᵀ is the inverse of X*
         let back = x.transpose_apply_force(&x.apply_force(&force));
-        prop_assert!((force_vector(&back) - force_vector(&force)).norm() < TOLERANCE * 100.0);
+        prop_assert!((back.to_vector() - force.to_vector()).norm() < TOLERANCE * 100.0);
         // X* = X⁻ᵀ as matrices
-        let star = force_vector(&x.apply_force(&force));
-        let expected = x.to_matrix().try_inverse().unwrap().transpose() * force_vector(&force);
+        let star = x.apply_force(&force).to_vector();
+        let expected = x.to_matrix().try_inverse().unwrap().transpose() * force.to_vector();
         prop_assert!((star - expected).norm() < 1e-10);
     }
 
@@ -81,7 +59,7 @@ proptest! {
         prop_assert!((moved - expected).norm() < 1e-9);
         prop_assert!((moved - moved.transpose()).norm() < 1e-12);
         let m = Motion::new(w, v);
-        prop_assert!((force_vector(&i.mul_motion(&m)) - i.to_matrix() * motion_vector(&m)).norm() < 1e-12);
+        prop_assert!((i.mul_motion(&m).to_vector() - i.to_matrix() * m.to_vector()).norm() < 1e-12);
     }
 
     #[test]

@@ -84,10 +84,10 @@ pub fn aba<'d>(
             let mut i_a = data.i_a[i];
             let mut p_a = data.p_a[i];
             for r in 0..nv_i {
-                let u_r = force_vector(&data.u[i][r]);
+                let u_r = data.u[i][r].to_vector();
                 let mut d_inv_u = 0.0;
                 for c in 0..nv_i {
-                    let u_c = force_vector(&data.u[i][c]);
+                    let u_c = data.u[i][c].to_vector();
                     i_a -= u_r * u_c.transpose() * d[(r, c)];
                     d_inv_u += d[(r, c)] * data.u_tau[i][c];
                 }
@@ -125,18 +125,6 @@ pub fn aba<'d>(
         data.a[i] = a_i;
     }
     Ok(&data.qdd)
-}
-
-/// A force as a 6-vector on `[angular; linear]`.
-fn force_vector(f: &Force) -> nalgebra::Vector6<f64> {
-    nalgebra::Vector6::new(
-        f.angular.x,
-        f.angular.y,
-        f.angular.z,
-        f.linear.x,
-        f.linear.y,
-        f.linear.z,
-    )
 }
 
 /// Inverts the leading `n` x `n` block of `m` in place by Gauss–Jordan elimination without

@@ -21,6 +21,25 @@ impl Force {
         Force { angular, linear }
     }
 
+    /// The Plücker 6-vector `[angular; linear]` (moment; force).
+    #[inline]
+    pub fn to_vector(&self) -> nalgebra::Vector6<f64> {
+        nalgebra::Vector6::new(
+            self.angular.x,
+            self.angular.y,
+            self.angular.z,
+            self.linear.x,
+            self.linear.y,
+            self.linear.z,
+        )
+    }
+
+    /// Inverse of [`Force::to_vector`].
+    #[inline]
+    pub fn from_vector(f: &nalgebra::Vector6<f64>) -> Self {
+        Force::new(Vec3::new(f[0], f[1], f[2]), Vec3::new(f[3], f[4], f[5]))
+    }
+
     /// Flattened `[linear; angular]` (force; moment), robodyn's public order.
     #[inline]
     pub fn to_array(&self) -> [f64; 6] {

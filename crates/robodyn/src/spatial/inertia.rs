@@ -93,24 +93,7 @@ impl AddAssign for Inertia {
     }
 }
 
-/// A 6-vector on `[angular; linear]` from a motion.
-pub(crate) fn motion_vector(m: &Motion) -> nalgebra::Vector6<f64> {
-    nalgebra::Vector6::new(
-        m.angular.x,
-        m.angular.y,
-        m.angular.z,
-        m.linear.x,
-        m.linear.y,
-        m.linear.z,
-    )
-}
-
-/// A force from a 6-vector on `[angular; linear]`.
-pub(crate) fn force_from_vector(f: &nalgebra::Vector6<f64>) -> Force {
-    Force::new(Vec3::new(f[0], f[1], f[2]), Vec3::new(f[3], f[4], f[5]))
-}
-
 /// `f = I m` for a general (articulated-body) 6x6 inertia on `[angular; linear]`.
 pub fn mat6_mul_motion(inertia: &Mat6, m: &Motion) -> Force {
-    force_from_vector(&(inertia * motion_vector(m)))
+    Force::from_vector(&(inertia * m.to_vector()))
 }

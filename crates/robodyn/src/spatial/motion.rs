@@ -45,6 +45,20 @@ impl Motion {
         self.angular.dot(&f.angular) + self.linear.dot(&f.linear)
     }
 
+    /// The Plücker 6-vector `[angular; linear]` that [`super::Transform::to_matrix`] and
+    /// [`super::Inertia::to_matrix`] act on.
+    #[inline]
+    pub fn to_vector(&self) -> nalgebra::Vector6<f64> {
+        nalgebra::Vector6::new(
+            self.angular.x,
+            self.angular.y,
+            self.angular.z,
+            self.linear.x,
+            self.linear.y,
+            self.linear.z,
+        )
+    }
+
     /// Flattened `[linear; angular]`, robodyn's public order.
     #[inline]
     pub fn to_array(&self) -> [f64; 6] {
