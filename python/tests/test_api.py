@@ -198,3 +198,16 @@ def test_demo_command_runs():
     result = subprocess.run([sys.executable, "-m", "robodyn.cli", "demo", "--batch", "1000"], capture_output=True, text=True, check=True)
     assert "M(q)" in result.stdout and "yes" in result.stdout
     assert "batch of 1000 states" in result.stdout
+
+
+def test_single_calls_from_many_threads(floating):
+    """Threads sharing one model get the same results as sequential calls (each call that finds the
+    shared workspace busy uses its own)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    states = floating.random_configuration(n=400, seed=8)
+    expected = [floating.mass_matrix(q) for q in states]
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        results = list(pool.map(floating.mass_matrix, states))
+    for got, want in zip(results, expected):
+        np.testing.assert_array_equal(got, want)
