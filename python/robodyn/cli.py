@@ -17,9 +17,10 @@ ROUND_TRIP_TOLERANCE = 1e-9
 
 def _matrix(rows: np.ndarray, names: list[str]) -> str:
     width = max(len(n) for n in names)
-    lines = [" " * (width + 2) + "".join(f"{n[:10]:>11}" for n in names)]
+    column = max(10, width + 2)
+    lines = [" " * (width + 2) + "".join(f"{n:>{column}}" for n in names)]
     for name, row in zip(names, np.atleast_2d(rows)):
-        lines.append(f"  {name:<{width}}" + "".join(f"{x:11.4f}" for x in row))
+        lines.append(f"  {name:<{width}}" + "".join(f"{x:{column}.4f}" for x in row))
     return "\n".join(lines)
 
 
