@@ -2,9 +2,13 @@
 //! format reaches the algorithms.
 
 pub mod bundled;
+pub mod dh;
 pub mod urdf;
 
 pub use bundled::{bundled_model, bundled_names};
+pub use dh::{
+    build_dh, load_dh_document, load_dh_file, load_dh_str, DhConvention, DhJoint, DhRow, DhTable,
+};
 pub use urdf::{load_urdf_file, load_urdf_str};
 
 /// How a model file is turned into a model.
