@@ -19,9 +19,9 @@ import sys
 import warnings
 from pathlib import Path
 
-from robodyn._core import Model, bundled_names, load_bundled, load_urdf, load_urdf_string
+from robodyn._core import Model, bundled_names, load_bundled, load_dh, load_dh_dict, load_urdf, load_urdf_string
 
-__all__ = ["Model", "ModelWarning", "load", "models", "load_urdf", "load_urdf_string", "__version__"]
+__all__ = ["Model", "ModelWarning", "from_dh", "load", "models", "load_urdf", "load_urdf_string", "__version__"]
 __version__ = "0.1.0"
 
 
@@ -59,7 +59,8 @@ def _find_file(name: str) -> Path:
 def load(name_or_path: str | os.PathLike[str], floating_base: bool = False, check_inertia: bool = True) -> Model:
     """Load a robot model.
 
-    ``name_or_path`` is a bundled model's name (see :func:`models`) or a path to a URDF file. A bare
+    ``name_or_path`` is a bundled model's name (see :func:`models`), a path to a URDF file, or a
+    path to a DH table in TOML (``.toml``, the format :func:`from_dh` documents). A bare
     file name that does not exist in the working directory is also looked up in the
     ``example-robot-data`` package when it is installed (``robodyn.load("talos_full_v2.urdf")``).
     ``floating_base=True`` puts a free joint named ``root_joint`` between the world and the root
@@ -78,13 +79,51 @@ def load(name_or_path: str | os.PathLike[str], floating_base: bool = False, chec
         return load_bundled(text, floating_base)
     path = _find_file(text)
     suffix = path.suffix.lower()
+    if suffix == ".toml":
+        return load_dh(str(path))
     if suffix != ".urdf":
         if not path.exists():
             raise FileNotFoundError(
                 f"model file not found: '{text}' (and it is not a bundled model: {models()})"
             )
-        raise ValueError(f"argument 'name_or_path': expected a .urdf file or one of {models()}, got '{text}'")
+        raise ValueError(
+            f"argument 'name_or_path': expected a .urdf or .toml (DH table) file or one of {models()}, got '{text}'"
+        )
     model = load_urdf(str(path), floating_base, check_inertia)
     for message in model.warnings:
         warnings.warn(message, ModelWarning, stacklevel=2)
     return model
+
+
+def from_dh(
+    rows: list[dict],
+    convention: str = "modified",
+    *,
+    name: str = "dh_robot",
+    base: dict | None = None,
+    tool: dict | None = None,
+    gravity=None,
+    angle_unit: str = "radian",
+) -> Model:
+    """Build a robot from a Denavit-Hartenberg table.
+
+    ``convention``: ``"modified"`` (Craig: row i holds α_{i-1}, a_{i-1}, θ_i, d_i and
+    ``ⁱ⁻¹T_i = Rx(α) Tx(a) Rz(θ) Tz(d)``) or ``"standard"`` (row i holds θ_i, d_i, a_i, α_i and
+    ``ⁱ⁻¹T_i = Rz(θ) Tz(d) Tx(a) Rx(α)``). Each row is a dict::
+
+        {"type": "revolute" | "prismatic", "a": ..., "alpha": ..., "d": ..., "theta": ...,
+         "name": "joint1", "mass": 0.0, "com": [x, y, z], "inertia": [ixx, iyy, izz, ixy, ixz, iyz],
+         "lower": -inf, "upper": inf}
+
+    The joint variable adds to θ (revolute) or d (prismatic), so the table's θ or d is the joint
+    offset. Mass, centre of mass and inertia (about the centre of mass) are in DH frame i.
+    ``base`` and ``tool`` are ``{"xyz": [...], "rpy": [...]}``: DH frame 0 in the world and the tool
+    frame in the last DH frame. Frames: ``"base"``, one per row (DH frame i, named after the row) and
+    ``"tool"``. ``angle_unit="degree"`` reads α, θ, revolute limits and rpy in degrees. A ``.toml``
+    file with the same keys (``[[joint]]`` rows) loads with :func:`load`.
+    """
+    document = {"name": name, "convention": convention, "angle_unit": angle_unit, "joint": list(rows)}
+    for key, value in (("base", base), ("tool", tool), ("gravity", gravity)):
+        if value is not None:
+            document[key] = value
+    return load_dh_dict(document)

@@ -7,6 +7,7 @@ use numpy::{
 };
 use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use rand::{rngs::StdRng, SeedableRng};
 use rayon::prelude::*;
 use robodyn::algo::{self, Reference};
@@ -865,6 +866,62 @@ fn load_urdf_string(
         .map_err(to_py_err)
 }
 
+/// Loads a DH table file (TOML).
+#[pyfunction]
+fn load_dh(path: std::path::PathBuf) -> PyResult<PyModel> {
+    robodyn::io::load_dh_file(&path)
+        .map(PyModel::wrap)
+        .map_err(to_py_err)
+}
+
+/// Builds a model from a DH table given as a dict with the keys of the TOML format.
+#[pyfunction]
+#[pyo3(signature = (document, source="from_dh"))]
+fn load_dh_dict(document: &Bound<PyDict>, source: &str) -> PyResult<PyModel> {
+    let toml::Value::Table(table) = toml_value(document.as_any(), "table")? else {
+        return Err(PyValueError::new_err(
+            "argument 'document': expected a dict",
+        ));
+    };
+    robodyn::io::load_dh_document(&table, source)
+        .map(PyModel::wrap)
+        .map_err(to_py_err)
+}
+
+/// A Python value (dict, list, str, bool, int, float, NumPy array) as a TOML value.
+fn toml_value(value: &Bound<PyAny>, key: &str) -> PyResult<toml::Value> {
+    if let Ok(dict) = value.cast::<PyDict>() {
+        let mut table = toml::Table::new();
+        for (k, v) in dict.iter() {
+            let k: String = k
+                .extract()
+                .map_err(|_| PyValueError::new_err(format!("'{key}': expected string keys")))?;
+            let item = toml_value(&v, &k)?;
+            table.insert(k, item);
+        }
+        return Ok(toml::Value::Table(table));
+    }
+    if let Ok(text) = value.extract::<String>() {
+        return Ok(toml::Value::String(text));
+    }
+    if let Ok(flag) = value.extract::<bool>() {
+        return Ok(toml::Value::Boolean(flag));
+    }
+    if let Ok(number) = value.extract::<f64>() {
+        return Ok(toml::Value::Float(number));
+    }
+    if let Ok(items) = value.try_iter() {
+        return items
+            .map(|item| toml_value(&item?, key))
+            .collect::<PyResult<Vec<_>>>()
+            .map(toml::Value::Array);
+    }
+    Err(PyValueError::new_err(format!(
+        "'{key}': expected a number, a string, a list or a dict, got {}",
+        value.repr()?
+    )))
+}
+
 /// A model bundled with robodyn, by name.
 #[pyfunction]
 #[pyo3(signature = (name, floating_base=false))]
@@ -886,6 +943,8 @@ fn _core(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(load_urdf, module)?)?;
     module.add_function(wrap_pyfunction!(load_urdf_string, module)?)?;
     module.add_function(wrap_pyfunction!(load_bundled, module)?)?;
+    module.add_function(wrap_pyfunction!(load_dh, module)?)?;
+    module.add_function(wrap_pyfunction!(load_dh_dict, module)?)?;
     module.add_function(wrap_pyfunction!(bundled_names, module)?)?;
     Ok(())
 }
