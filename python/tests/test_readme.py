@@ -12,10 +12,12 @@ README = (REPOSITORY / "README.md").read_text()
 
 
 def test_python_examples_run():
+    """In order, in one session, as a reader would run them."""
     blocks = re.findall(r"```python\n(.*?)```", README, re.S)
     assert len(blocks) >= 2
+    session: dict = {}
     for block in blocks:
-        exec(compile(block, "README.md", "exec"), {})
+        exec(compile(block, "README.md", "exec"), session)
 
 
 def test_toml_example_loads(tmp_path):
