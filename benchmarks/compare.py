@@ -15,7 +15,6 @@ import argparse
 import os
 import platform
 import re
-import sys
 import timeit
 from pathlib import Path
 
@@ -23,9 +22,8 @@ import mujoco
 import numpy as np
 import pinocchio as pin
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "python" / "tests"))
-import robodyn  # noqa: E402
-from conventions import PinocchioMap  # noqa: E402
+import robodyn
+from robodyn.convert import PinocchioLayout
 
 ROBOTS = {
     "ur5": ("ur_description/urdf/ur5_robot.urdf", False),
@@ -50,11 +48,11 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
     m = robodyn.load(urdf, floating_base=floating)
     pm = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer()) if floating else pin.buildModelFromUrdf(str(urdf))
     pd = pm.createData()
-    mapping = PinocchioMap(m, pm)
+    mapping = PinocchioLayout(m, pm)
     rng = np.random.default_rng(0)
     q = m.random_configuration(seed=1)
     v, a = rng.uniform(-1, 1, m.nv), rng.uniform(-1, 1, m.nv)
-    pq, pv, pa = mapping.q(q), mapping.v(v), mapping.v(a)
+    pq, pv, pa = mapping.q_to_pinocchio(q), mapping.v_to_pinocchio(v), mapping.v_to_pinocchio(a)
     frame = m.frame_names[-1]
     frame_id = pm.getFrameId(frame)
 
@@ -76,9 +74,9 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
     rows = [(f"{name} {algorithm} (one call)", *best_times(ours, theirs, 2000)) for algorithm, (ours, theirs) in single.items()]
 
     states = m.random_configuration(n=batch, seed=2)
-    pin_states = [mapping.q(x) for x in states]
+    pin_states = [mapping.q_to_pinocchio(x) for x in states]
     velocities = rng.uniform(-1, 1, (batch, m.nv))
-    pin_velocities = [mapping.v(x) for x in velocities]
+    pin_velocities = [mapping.v_to_pinocchio(x) for x in velocities]
 
     def pin_gravity_loop():
         for x in pin_states:

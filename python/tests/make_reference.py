@@ -19,8 +19,8 @@ import pinocchio as pin
 
 sys.path.insert(0, str(Path(__file__).parent))
 import robodyn  # noqa: E402
+from robodyn.convert import PinocchioLayout  # noqa: E402
 from conftest import REFERENCE_DIR, REPOSITORY, ROBOTS  # noqa: E402
-from conventions import PinocchioMap  # noqa: E402
 
 STATES = 3
 JACOBIAN_FRAMES = 4
@@ -34,7 +34,7 @@ def reference(name: str, urdf: Path, floating_base: bool, model, source: str) ->
     )
     pin_model.gravity.linear = np.asarray(model.gravity)
     data = pin_model.createData()
-    mapping = PinocchioMap(model, pin_model)
+    mapping = PinocchioLayout(model, pin_model)
     rng = np.random.default_rng(2026)
     frames = model.frame_names
     jacobian_frames = sorted({frames[int(k)] for k in np.linspace(0, len(frames) - 1, JACOBIAN_FRAMES)})
@@ -42,14 +42,14 @@ def reference(name: str, urdf: Path, floating_base: bool, model, source: str) ->
     for k in range(STATES):
         q = model.random_configuration(seed=100 + k)
         v, a, tau = (rng.uniform(-1, 1, model.nv) for _ in range(3))
-        pq, pv = mapping.q(q), mapping.v(v)
+        pq, pv = mapping.q_to_pinocchio(q), mapping.v_to_pinocchio(v)
         mass = pin.crba(pin_model, data, pq)
         mass = np.triu(mass) + np.triu(mass, 1).T
         pin.framesForwardKinematics(pin_model, data, pq)
         poses = {f: data.oMf[pin_model.getFrameId(f)].homogeneous.tolist() for f in frames}
         pin.computeJointJacobians(pin_model, data, pq)
         jacobians = {
-            f: mapping.columns_back(
+            f: mapping.jacobian_from_pinocchio(
                 pin.getFrameJacobian(pin_model, data, pin_model.getFrameId(f), pin.LOCAL_WORLD_ALIGNED)
             ).tolist()
             for f in jacobian_frames
@@ -60,11 +60,11 @@ def reference(name: str, urdf: Path, floating_base: bool, model, source: str) ->
                 "v": v.tolist(),
                 "a": a.tolist(),
                 "tau": tau.tolist(),
-                "rnea": mapping.v_back(pin.rnea(pin_model, data, pq, pv, mapping.v(a))).tolist(),
-                "mass_matrix": mapping.matrix_back(mass).tolist(),
-                "gravity": mapping.v_back(pin.computeGeneralizedGravity(pin_model, data, pq)).tolist(),
-                "bias": mapping.v_back(pin.nle(pin_model, data, pq, pv)).tolist(),
-                "aba": mapping.v_back(pin.aba(pin_model, data, pq, pv, mapping.v(tau))).tolist(),
+                "rnea": mapping.v_from_pinocchio(pin.rnea(pin_model, data, pq, pv, mapping.v_to_pinocchio(a))).tolist(),
+                "mass_matrix": mapping.matrix_from_pinocchio(mass).tolist(),
+                "gravity": mapping.v_from_pinocchio(pin.computeGeneralizedGravity(pin_model, data, pq)).tolist(),
+                "bias": mapping.v_from_pinocchio(pin.nle(pin_model, data, pq, pv)).tolist(),
+                "aba": mapping.v_from_pinocchio(pin.aba(pin_model, data, pq, pv, mapping.v_to_pinocchio(tau))).tolist(),
                 "frame_poses": poses,
                 "world_jacobians": jacobians,
             }

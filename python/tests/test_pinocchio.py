@@ -10,9 +10,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from conftest import CROSS_CHECK_TOLERANCE, REPOSITORY, ROBOTS, assert_close, load_reference
-from conventions import PinocchioMap
 
 import robodyn
+from robodyn.convert import PinocchioLayout
 
 
 def pinocchio_model(path, floating_base):
@@ -26,7 +26,7 @@ def robot(request, robots_dir):
     path, floating_base = ROBOTS[request.param]
     model = robodyn.load(robots_dir / path, floating_base=floating_base)
     pin_model = pinocchio_model(robots_dir / path, floating_base)
-    return request.param, model, pin_model, PinocchioMap(model, pin_model)
+    return request.param, model, pin_model, PinocchioLayout(model, pin_model)
 
 
 def test_dynamics_agree_with_pinocchio(robot):
@@ -36,28 +36,28 @@ def test_dynamics_agree_with_pinocchio(robot):
     for seed in range(5):
         q = model.random_configuration(seed=seed)
         v, a = rng.uniform(-2, 2, model.nv), rng.uniform(-2, 2, model.nv)
-        pq, pv, pa = mapping.q(q), mapping.v(v), mapping.v(a)
+        pq, pv, pa = mapping.q_to_pinocchio(q), mapping.v_to_pinocchio(v), mapping.v_to_pinocchio(a)
         tau = model.inverse_dynamics(q, v, a)
-        assert_close(tau, mapping.v_back(pin.rnea(pin_model, data, pq, pv, pa)), CROSS_CHECK_TOLERANCE, f"{name} tau")
+        assert_close(tau, mapping.v_from_pinocchio(pin.rnea(pin_model, data, pq, pv, pa)), CROSS_CHECK_TOLERANCE, f"{name} tau")
         mass = pin.crba(pin_model, data, pq)
         mass = np.triu(mass) + np.triu(mass, 1).T
-        assert_close(model.mass_matrix(q), mapping.matrix_back(mass), CROSS_CHECK_TOLERANCE, f"{name} M")
+        assert_close(model.mass_matrix(q), mapping.matrix_from_pinocchio(mass), CROSS_CHECK_TOLERANCE, f"{name} M")
         assert_close(
             model.generalized_gravity(q),
-            mapping.v_back(pin.computeGeneralizedGravity(pin_model, data, pq)),
+            mapping.v_from_pinocchio(pin.computeGeneralizedGravity(pin_model, data, pq)),
             CROSS_CHECK_TOLERANCE,
             f"{name} g",
         )
-        assert_close(model.bias_forces(q, v), mapping.v_back(pin.nle(pin_model, data, pq, pv)), CROSS_CHECK_TOLERANCE, f"{name} bias")
+        assert_close(model.bias_forces(q, v), mapping.v_from_pinocchio(pin.nle(pin_model, data, pq, pv)), CROSS_CHECK_TOLERANCE, f"{name} bias")
         assert_close(
             model.forward_dynamics(q, v, tau),
-            mapping.v_back(pin.aba(pin_model, data, pq, pv, mapping.v(tau))),
+            mapping.v_from_pinocchio(pin.aba(pin_model, data, pq, pv, mapping.v_to_pinocchio(tau))),
             CROSS_CHECK_TOLERANCE,
             f"{name} aba",
         )
         assert_close(
             model.inverse_mass_matrix(q),
-            mapping.matrix_back(np.linalg.inv(mass)),
+            mapping.matrix_from_pinocchio(np.linalg.inv(mass)),
             CROSS_CHECK_TOLERANCE,
             f"{name} M^-1",
         )
@@ -76,7 +76,7 @@ def test_external_forces_agree_with_pinocchio(robot):
     pin_forces = [pin.Force.Zero() for _ in range(pin_model.njoints)]
     for joint_name, wrench in zip(model.joint_names, f_ext):
         pin_forces[pin_model.getJointId(joint_name)] = pin.Force(wrench[:3], wrench[3:])
-    expected = mapping.v_back(pin.rnea(pin_model, data, mapping.q(q), mapping.v(v), mapping.v(a), pin_forces))
+    expected = mapping.v_from_pinocchio(pin.rnea(pin_model, data, mapping.q_to_pinocchio(q), mapping.v_to_pinocchio(v), mapping.v_to_pinocchio(a), pin_forces))
     tau = model.inverse_dynamics(q, v, a, f_ext=f_ext)
     assert_close(tau, expected, CROSS_CHECK_TOLERANCE, f"{name} tau with f_ext")
     assert_close(model.forward_dynamics(q, v, tau, f_ext=f_ext), a, CROSS_CHECK_TOLERANCE, f"{name} aba with f_ext")
@@ -87,14 +87,14 @@ def test_kinematics_agree_with_pinocchio(robot):
     data = pin_model.createData()
     for seed in range(3):
         q = model.random_configuration(seed=20 + seed)
-        pq = mapping.q(q)
+        pq = mapping.q_to_pinocchio(q)
         pin.framesForwardKinematics(pin_model, data, pq)
         pin.computeJointJacobians(pin_model, data, pq)
         for frame in model.frame_names:
             frame_id = pin_model.getFrameId(frame)
             assert_close(model.frame_pose(q, frame), data.oMf[frame_id].homogeneous, CROSS_CHECK_TOLERANCE, f"{name} pose {frame}")
             for reference, pin_reference in [("world", pin.LOCAL_WORLD_ALIGNED), ("local", pin.LOCAL), ("spatial", pin.WORLD)]:
-                expected = mapping.columns_back(pin.getFrameJacobian(pin_model, data, frame_id, pin_reference))
+                expected = mapping.jacobian_from_pinocchio(pin.getFrameJacobian(pin_model, data, frame_id, pin_reference))
                 assert_close(model.jacobian(q, frame, reference), expected, CROSS_CHECK_TOLERANCE, f"{name} J {reference} {frame}")
 
 
@@ -103,11 +103,11 @@ def test_bundled_models_agree_with_pinocchio():
         model = robodyn.load(name)
         pin_model = pinocchio_model(REPOSITORY / "models" / f"{name}.urdf", False)
         pin_model.gravity.linear = model.gravity
-        mapping = PinocchioMap(model, pin_model)
+        mapping = PinocchioLayout(model, pin_model)
         data = pin_model.createData()
         q = model.random_configuration(seed=5)
         v, a = np.linspace(-1, 1, model.nv), np.linspace(1, -1, model.nv)
-        expected = mapping.v_back(pin.rnea(pin_model, data, mapping.q(q), mapping.v(v), mapping.v(a)))
+        expected = mapping.v_from_pinocchio(pin.rnea(pin_model, data, mapping.q_to_pinocchio(q), mapping.v_to_pinocchio(v), mapping.v_to_pinocchio(a)))
         assert_close(model.inverse_dynamics(q, v, a), expected, CROSS_CHECK_TOLERANCE, f"{name} tau")
 
 
@@ -191,16 +191,16 @@ def test_oblique_axes_rotated_inertials_and_merged_links_agree_with_pinocchio(fl
         if floating_base
         else pin.buildModelFromXML(ROTATED_INERTIALS)
     )
-    mapping = PinocchioMap(model, pin_model)
+    mapping = PinocchioLayout(model, pin_model)
     data = pin_model.createData()
     rng = np.random.default_rng(3)
     for seed in range(3):
         q = model.random_configuration(seed=seed)
         v, a = rng.uniform(-1, 1, model.nv), rng.uniform(-1, 1, model.nv)
-        pq = mapping.q(q)
-        expected = mapping.v_back(pin.rnea(pin_model, data, pq, mapping.v(v), mapping.v(a)))
+        pq = mapping.q_to_pinocchio(q)
+        expected = mapping.v_from_pinocchio(pin.rnea(pin_model, data, pq, mapping.v_to_pinocchio(v), mapping.v_to_pinocchio(a)))
         assert_close(model.inverse_dynamics(q, v, a), expected, CROSS_CHECK_TOLERANCE, "tau")
         mass = pin.crba(pin_model, data, pq)
-        assert_close(model.mass_matrix(q), mapping.matrix_back(np.triu(mass) + np.triu(mass, 1).T), CROSS_CHECK_TOLERANCE, "M")
+        assert_close(model.mass_matrix(q), mapping.matrix_from_pinocchio(np.triu(mass) + np.triu(mass, 1).T), CROSS_CHECK_TOLERANCE, "M")
         pin.framesForwardKinematics(pin_model, data, pq)
         assert_close(model.frame_pose(q, "tip"), data.oMf[pin_model.getFrameId("tip")].homogeneous, CROSS_CHECK_TOLERANCE, "tip")
