@@ -79,6 +79,8 @@ def test_shapes_and_dtypes(floating):
         "center_of_mass": ((q,), (3,)),
         "frame_pose": ((q, frame), (4, 4)),
         "jacobian": ((q, frame), (6, m.nv)),
+        "frame_velocity": ((q, v, frame), (6,)),
+        "frame_acceleration": ((q, v, v, frame), (6,)),
         "integrate": ((q, v), (m.nq,)),
         "difference": ((q, q), (m.nv,)),
     }
@@ -118,6 +120,10 @@ def test_batches_equal_the_loop_bit_for_bit(floating):
     np.testing.assert_array_equal(batch, np.stack([m.jacobian(x, frame, "local") for x in q]))
     batch = m.frame_pose(q, frame)
     np.testing.assert_array_equal(batch, np.stack([m.frame_pose(x, frame) for x in q]))
+    batch = m.frame_acceleration(q, v, a, frame)
+    np.testing.assert_array_equal(batch, np.stack([m.frame_acceleration(q[k], v[k], a[k], frame) for k in range(n)]))
+    batch = m.frame_velocity(q, v, frame, "spatial")
+    np.testing.assert_array_equal(batch, np.stack([m.frame_velocity(q[k], v[k], frame, "spatial") for k in range(n)]))
     batch = m.inverse_dynamics(q, v, a, f_ext=f_ext)
     np.testing.assert_array_equal(batch, np.stack([m.inverse_dynamics(q[k], v[k], a[k], f_ext=f_ext[k]) for k in range(n)]))
 

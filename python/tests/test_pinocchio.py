@@ -98,6 +98,27 @@ def test_kinematics_agree_with_pinocchio(robot):
                 assert_close(model.jacobian(q, frame, reference), expected, CROSS_CHECK_TOLERANCE, f"{name} J {reference} {frame}")
 
 
+def test_frame_velocity_and_acceleration_agree_with_pinocchio(robot):
+    """Frame velocity, classical acceleration (J a + J̇ v) and spatial acceleration."""
+    name, model, pin_model, mapping = robot
+    data = pin_model.createData()
+    rng = np.random.default_rng(12)
+    for seed in range(3):
+        q = model.random_configuration(seed=30 + seed)
+        v, a = rng.uniform(-1, 1, model.nv), rng.uniform(-1, 1, model.nv)
+        pin.forwardKinematics(pin_model, data, mapping.q_to_pinocchio(q), mapping.v_to_pinocchio(v), mapping.v_to_pinocchio(a))
+        pin.updateFramePlacements(pin_model, data)
+        for frame in model.frame_names[:: max(1, len(model.frame_names) // 8)]:
+            frame_id = pin_model.getFrameId(frame)
+            for reference, pin_reference in [("world", pin.LOCAL_WORLD_ALIGNED), ("local", pin.LOCAL)]:
+                velocity = pin.getFrameVelocity(pin_model, data, frame_id, pin_reference).vector
+                assert_close(model.frame_velocity(q, v, frame, reference), velocity, CROSS_CHECK_TOLERANCE, f"{name} v {frame}")
+                classical = pin.getFrameClassicalAcceleration(pin_model, data, frame_id, pin_reference).vector
+                assert_close(model.frame_acceleration(q, v, a, frame, reference), classical, CROSS_CHECK_TOLERANCE, f"{name} a {frame}")
+            spatial = pin.getFrameAcceleration(pin_model, data, frame_id, pin.WORLD).vector
+            assert_close(model.frame_acceleration(q, v, a, frame, "spatial"), spatial, CROSS_CHECK_TOLERANCE, f"{name} spatial a {frame}")
+
+
 def test_bundled_models_agree_with_pinocchio():
     for name in robodyn.models():
         model = robodyn.load(name)

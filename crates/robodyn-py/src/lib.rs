@@ -386,6 +386,18 @@ fn vector_array<'py>(py: Python<'py>, values: &[f64]) -> Bound<'py, PyArray1<f64
     PyArray1::from_slice(py, values)
 }
 
+/// The Jacobian/velocity reference named by the user.
+fn parse_reference(reference: &str) -> PyResult<Reference> {
+    match reference {
+        "world" => Ok(Reference::World),
+        "local" => Ok(Reference::Local),
+        "spatial" => Ok(Reference::Spatial),
+        other => Err(PyValueError::new_err(format!(
+            "argument 'reference': expected 'world', 'local' or 'spatial', got '{other}'"
+        ))),
+    }
+}
+
 /// Reads a settable per-coordinate property.
 fn read_property(name: &'static str, value: &Bound<PyAny>, length: usize) -> PyResult<Vec<f64>> {
     let argument = Argument::new(name, value, SampleShape::vector(length))?;
@@ -725,16 +737,7 @@ impl PyModel {
         reference: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
         let frame = self.frame_index(frame)?;
-        let reference = match reference {
-            "world" => Reference::World,
-            "local" => Reference::Local,
-            "spatial" => Reference::Spatial,
-            other => {
-                return Err(PyValueError::new_err(format!(
-                    "argument 'reference': expected 'world', 'local' or 'spatial', got '{other}'"
-                )))
-            }
-        };
+        let reference = parse_reference(reference)?;
         self.evaluate(
             py,
             &[self.q_arg("q", q)?],
@@ -744,6 +747,70 @@ impl PyModel {
                 Ok(())
             },
         )
+    }
+
+    /// Velocity of a frame, (6,) [linear; angular] = J(q) v: "world" (its origin's velocity and
+    /// angular velocity in world axes), "local" (the same in its axes) or "spatial".
+    #[pyo3(signature = (q, v, frame, reference="world"))]
+    fn frame_velocity<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+        reference: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (frame, reference) = (self.frame_index(frame)?, parse_reference(reference)?);
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[6],
+            &|m, w, i, out| {
+                out.copy_from_slice(&algo::frame_velocity(
+                    m,
+                    &mut w.data,
+                    i[0],
+                    i[1],
+                    frame,
+                    reference,
+                )?);
+                Ok(())
+            },
+        )
+    }
+
+    /// Acceleration of a frame, (6,) [linear; angular] = J(q) a + J̇(q, v) v: "world" (the
+    /// classical acceleration of its origin and its angular acceleration, world axes), "local"
+    /// (the same in its axes) or "spatial" (Featherstone's spatial acceleration, world
+    /// coordinates). With a = 0 it is J̇ v.
+    #[pyo3(signature = (q, v, a, frame, reference="world"))]
+    fn frame_acceleration<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        a: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+        reference: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (frame, reference) = (self.frame_index(frame)?, parse_reference(reference)?);
+        let arguments = [
+            self.q_arg("q", q)?,
+            self.v_arg("v", v)?,
+            self.v_arg("a", a)?,
+        ];
+        self.evaluate(py, &arguments, &[6], &|m, w, i, out| {
+            out.copy_from_slice(&algo::frame_acceleration(
+                m,
+                &mut w.data,
+                i[0],
+                i[1],
+                i[2],
+                frame,
+                reference,
+            )?);
+            Ok(())
+        })
     }
 
     /// Kinetic energy ½ vᵀ M(q) v (J), rotor energy included.

@@ -408,3 +408,101 @@ fn integrate_and_difference_round_trip_on_the_model() {
         );
     }
 }
+
+#[test]
+fn frame_velocity_and_acceleration_are_j_v_and_j_a_plus_jdot_v() {
+    // J̇ q̇ by a central difference of J along q(t) = q ⊕ t q̇
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        let (q, v, a) = state(&model, &mut rng);
+        let frame = model.frames.len() - 1;
+        for reference in [Reference::World, Reference::Spatial, Reference::Local] {
+            let jacobian_at = |h: f64, data: &mut Data| {
+                let mut moved = DVector::zeros(model.nq);
+                model
+                    .integrate(q.as_slice(), (&v * h).as_slice(), moved.as_mut_slice())
+                    .unwrap();
+                jacobian(&model, data, moved.as_slice(), frame, reference)
+                    .unwrap()
+                    .clone()
+            };
+            let j = jacobian_at(0.0, &mut data);
+            let velocity = frame_velocity(
+                &model,
+                &mut data,
+                q.as_slice(),
+                v.as_slice(),
+                frame,
+                reference,
+            )
+            .unwrap();
+            assert_close(
+                &format!("{name} {reference:?}: J v"),
+                &velocity,
+                (&j * &v).as_slice(),
+                IDENTITY_TOLERANCE,
+            );
+            if reference == Reference::Local {
+                // local: the world quantities in the frame's axes
+                let world = frame_acceleration(
+                    &model,
+                    &mut data,
+                    q.as_slice(),
+                    v.as_slice(),
+                    a.as_slice(),
+                    frame,
+                    Reference::World,
+                )
+                .unwrap();
+                forward_kinematics(&model, &mut data, q.as_slice()).unwrap();
+                let rotation = frame_placement(&model, &data, frame).rotation;
+                let local = frame_acceleration(
+                    &model,
+                    &mut data,
+                    q.as_slice(),
+                    v.as_slice(),
+                    a.as_slice(),
+                    frame,
+                    reference,
+                )
+                .unwrap();
+                let expected: Vec<f64> = [&world[0..3], &world[3..6]]
+                    .iter()
+                    .flat_map(|part| {
+                        (rotation * nalgebra::Vector3::from_row_slice(part))
+                            .iter()
+                            .copied()
+                            .collect::<Vec<_>>()
+                    })
+                    .collect();
+                assert_close(
+                    &format!("{name}: local acceleration"),
+                    &local,
+                    &expected,
+                    IDENTITY_TOLERANCE,
+                );
+                continue;
+            }
+            let j_dot_v = (jacobian_at(FD_STEP, &mut data) - jacobian_at(-FD_STEP, &mut data)) * &v
+                / (2.0 * FD_STEP);
+            let acceleration = frame_acceleration(
+                &model,
+                &mut data,
+                q.as_slice(),
+                v.as_slice(),
+                a.as_slice(),
+                frame,
+                reference,
+            )
+            .unwrap();
+            let expected = &j * &a + j_dot_v;
+            assert_close(
+                &format!("{name} {reference:?}: J a + J̇ v"),
+                &acceleration,
+                expected.as_slice(),
+                FD_TOLERANCE,
+            );
+        }
+    }
+}

@@ -1,0 +1,121 @@
+//! Velocity and acceleration of a frame, and with them J̇ q̇.
+//!
+//! Reference: Featherstone, *Rigid Body Dynamics Algorithms* (2008), §2.10-2.11 and the outward
+//! pass of Table 5.1 without gravity: `v_i = X_i v_λ(i) + S_i q̇_i`,
+//! `a_i = X_i a_λ(i) + S_i q̈_i + v_i × S_i q̇_i`, here only along the frame's support. The classical
+//! (textbook) acceleration of the frame's origin is the spatial one plus `ω × v` (seed 001,
+//! "Recap: Acceleration"): `p̈ = a_O + ω × ṗ`. With q̈ = 0 it is `J̇ q̇`, the bias acceleration.
+//! Inputs: q (nq), v (nv), a (nv), a frame and a [`Reference`]. Writes `data.support`,
+//! `data.x_up`, `data.x_world`, `data.v`, `data.a` along the support. Cost: O(depth).
+
+use crate::algo::kinematics::{check_frame, frame_placement, update_support_placements};
+use crate::algo::Reference;
+use crate::error::{check_vector, Result};
+use crate::model::Model;
+use crate::spatial::Motion;
+use crate::Data;
+
+/// The frame's velocity `[linear; angular]`: with [`Reference::World`] the velocity of its origin
+/// and its angular velocity in world axes, [`Reference::Local`] the same in its own axes,
+/// [`Reference::Spatial`] the spatial velocity in world coordinates. Equals `J(q) q̇`.
+pub fn frame_velocity(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    v: &[f64],
+    frame: usize,
+    reference: Reference,
+) -> Result<[f64; 6]> {
+    let (velocity, _) = frame_motion(model, data, q, v, None, frame, reference)?;
+    Ok(velocity)
+}
+
+/// The frame's acceleration `[linear; angular]`: with [`Reference::World`] the classical
+/// acceleration of its origin (`p̈`) and its angular acceleration, in world axes;
+/// [`Reference::Local`] the same two vectors in the frame's axes; [`Reference::Spatial`]
+/// Featherstone's spatial acceleration in world coordinates. Equals `J(q) q̈ + J̇(q, q̇) q̇`; with
+/// `a = 0` it is `J̇ q̇`.
+pub fn frame_acceleration(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    v: &[f64],
+    a: &[f64],
+    frame: usize,
+    reference: Reference,
+) -> Result<[f64; 6]> {
+    check_vector("a", a, model.nv)?;
+    let (_, acceleration) = frame_motion(model, data, q, v, Some(a), frame, reference)?;
+    Ok(acceleration)
+}
+
+/// Velocity and acceleration of a frame in the requested coordinates.
+fn frame_motion(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    v: &[f64],
+    a: Option<&[f64]>,
+    frame: usize,
+    reference: Reference,
+) -> Result<([f64; 6], [f64; 6])> {
+    model.check_configuration(q)?;
+    check_vector("v", v, model.nv)?;
+    check_frame(model, frame)?;
+    let body = model.frames[frame].body;
+    update_support_placements(model, data, q, body);
+
+    // outward along the support: v_i = X_i v_λ(i) + v_J;  a_i = X_i a_λ(i) + S q̈ + v_i × v_J
+    data.v[0] = Motion::ZERO;
+    data.a[0] = Motion::ZERO;
+    for k in (0..data.support.len()).rev() {
+        let i = data.support[k];
+        let joint = &model.joints[i];
+        let parent = model.parent[i];
+        let v_j = joint.motion(&v[model.v_range(i)]);
+        let v_i = data.x_up[i].apply_motion(&data.v[parent]) + v_j;
+        let mut a_i = data.x_up[i].apply_motion(&data.a[parent]) + v_i.cross_motion(&v_j);
+        if let Some(a) = a {
+            a_i += joint.motion(&a[model.v_range(i)]);
+        }
+        data.v[i] = v_i;
+        data.a[i] = a_i;
+    }
+
+    // in the frame's coordinates: (ω, v_O) and (ω̇, a_O) of its origin
+    let to_frame = model.frames[frame].placement;
+    let velocity = to_frame.apply_motion(&data.v[body]);
+    let acceleration = to_frame.apply_motion(&data.a[body]);
+    let pose = frame_placement(model, data, frame);
+    let world_axes = |m: &Motion| {
+        Motion::new(
+            pose.rotation.tr_mul(&m.angular),
+            pose.rotation.tr_mul(&m.linear),
+        )
+    };
+    Ok(match reference {
+        Reference::Spatial => (
+            data.x_world[body]
+                .inverse_apply_motion(&data.v[body])
+                .to_array(),
+            data.x_world[body]
+                .inverse_apply_motion(&data.a[body])
+                .to_array(),
+        ),
+        Reference::Local | Reference::World => {
+            // classical acceleration of the origin: p̈ = a_O + ω × v_O
+            let classical = Motion::new(
+                acceleration.angular,
+                acceleration.linear + velocity.angular.cross(&velocity.linear),
+            );
+            if reference == Reference::Local {
+                (velocity.to_array(), classical.to_array())
+            } else {
+                (
+                    world_axes(&velocity).to_array(),
+                    world_axes(&classical).to_array(),
+                )
+            }
+        }
+    })
+}
