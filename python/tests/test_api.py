@@ -77,6 +77,7 @@ def test_shapes_and_dtypes(floating):
         "mass_matrix": ((q,), (m.nv, m.nv)),
         "inverse_mass_matrix": ((q,), (m.nv, m.nv)),
         "center_of_mass": ((q,), (3,)),
+        "center_of_mass_jacobian": ((q,), (3, m.nv)),
         "frame_pose": ((q, frame), (4, 4)),
         "jacobian": ((q, frame), (6, m.nv)),
         "frame_velocity": ((q, v, frame), (6,)),
@@ -109,6 +110,7 @@ def test_batches_equal_the_loop_bit_for_bit(floating):
         "kinetic_energy": (q, v),
         "potential_energy": (q,),
         "center_of_mass": (q,),
+        "center_of_mass_jacobian": (q,),
         "integrate": (q, v),
     }
     for name, args in calls.items():

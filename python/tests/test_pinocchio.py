@@ -64,6 +64,12 @@ def test_dynamics_agree_with_pinocchio(robot):
         assert_close(model.kinetic_energy(q, v), pin.computeKineticEnergy(pin_model, data, pq, pv), CROSS_CHECK_TOLERANCE, f"{name} KE")
         assert_close(model.potential_energy(q), pin.computePotentialEnergy(pin_model, data, pq), CROSS_CHECK_TOLERANCE, f"{name} PE")
         assert_close(model.center_of_mass(q), pin.centerOfMass(pin_model, data, pq), CROSS_CHECK_TOLERANCE, f"{name} com")
+        assert_close(
+            model.center_of_mass_jacobian(q),
+            mapping.jacobian_from_pinocchio(pin.jacobianCenterOfMass(pin_model, data, pq)),
+            CROSS_CHECK_TOLERANCE,
+            f"{name} J_com",
+        )
 
 
 def test_external_forces_agree_with_pinocchio(robot):

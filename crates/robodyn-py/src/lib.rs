@@ -372,11 +372,15 @@ impl PyModel {
     }
 }
 
-/// Writes a matrix (column-major in nalgebra) into a row-major output.
-fn write_row_major(matrix: &nalgebra::DMatrix<f64>, out: &mut [f64]) {
-    let (rows, columns) = matrix.shape();
-    for (c, column) in matrix.as_slice().chunks_exact(rows.max(1)).enumerate() {
-        for (r, value) in column.iter().enumerate() {
+/// Writes the first `rows` rows of a matrix (column-major in nalgebra) into a row-major output.
+fn write_row_major(matrix: &nalgebra::DMatrix<f64>, rows: usize, out: &mut [f64]) {
+    let columns = matrix.ncols();
+    for (c, column) in matrix
+        .as_slice()
+        .chunks_exact(matrix.nrows().max(1))
+        .enumerate()
+    {
+        for (r, value) in column.iter().take(rows).enumerate() {
             out[r * columns + c] = *value;
         }
     }
@@ -666,7 +670,7 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let nv = self.model.nv;
         self.evaluate(py, &[self.q_arg("q", q)?], &[nv, nv], &|m, w, i, out| {
-            write_row_major(algo::inverse_mass_matrix(m, &mut w.data, i[0])?, out);
+            write_row_major(algo::inverse_mass_matrix(m, &mut w.data, i[0])?, m.nv, out);
             Ok(())
         })
     }
@@ -743,7 +747,11 @@ impl PyModel {
             &[self.q_arg("q", q)?],
             &[6, self.model.nv],
             &|m, w, i, out| {
-                write_row_major(algo::jacobian(m, &mut w.data, i[0], frame, reference)?, out);
+                write_row_major(
+                    algo::jacobian(m, &mut w.data, i[0], frame, reference)?,
+                    6,
+                    out,
+                );
                 Ok(())
             },
         )
@@ -853,6 +861,23 @@ impl PyModel {
             out.copy_from_slice(algo::center_of_mass(m, &mut w.data, i[0])?.as_slice());
             Ok(())
         })
+    }
+
+    /// Jacobian of the centre of mass, (3, nv) in world axes: ċ = J_com v.
+    fn center_of_mass_jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?],
+            &[3, self.model.nv],
+            &|m, w, i, out| {
+                write_row_major(algo::center_of_mass_jacobian(m, &mut w.data, i[0])?, 3, out);
+                Ok(())
+            },
+        )
     }
 
     /// q ⊕ v dt: moves q with constant velocity v for dt seconds on each joint's Lie group.

@@ -26,7 +26,7 @@ pub struct Data {
     /// Generalized forces; nv. Written by `rnea`.
     pub tau: DVector<f64>,
     /// Composite rigid-body inertia of the subtree rooted at body i, in world coordinates;
-    /// nbodies. Written by `crba`.
+    /// nbodies. Written by `crba`; `center_of_mass_jacobian` writes only its mass and first moment.
     pub i_c: Vec<Inertia>,
     /// Motion subspace column of each velocity coordinate in world coordinates (the spatial
     /// Jacobian's columns); nv. Written by `crba`.

@@ -506,3 +506,33 @@ fn frame_velocity_and_acceleration_are_j_v_and_j_a_plus_jdot_v() {
         }
     }
 }
+
+#[test]
+fn center_of_mass_jacobian_is_the_derivative_of_the_center_of_mass() {
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        let q = model.random_configuration(&mut rng);
+        let j = center_of_mass_jacobian(&model, &mut data, q.as_slice())
+            .unwrap()
+            .clone();
+        for k in 0..model.nv {
+            let com_at = |h: f64, data: &mut Data| {
+                let step = DVector::from_fn(model.nv, |i, _| if i == k { h } else { 0.0 });
+                let mut moved = DVector::zeros(model.nq);
+                model
+                    .integrate(q.as_slice(), step.as_slice(), moved.as_mut_slice())
+                    .unwrap();
+                center_of_mass(&model, data, moved.as_slice()).unwrap()
+            };
+            let derivative =
+                (com_at(FD_STEP, &mut data) - com_at(-FD_STEP, &mut data)) / (2.0 * FD_STEP);
+            assert_close(
+                &format!("{name}: J_com column {k}"),
+                &j.column(k).as_slice()[..3],
+                derivative.as_slice(),
+                FD_TOLERANCE,
+            );
+        }
+    }
+}
