@@ -219,3 +219,17 @@ def test_single_calls_from_many_threads(floating):
         results = list(pool.map(floating.mass_matrix, states))
     for got, want in zip(results, expected):
         np.testing.assert_array_equal(got, want)
+
+
+def test_manipulability_matches_singular_values(ur5):
+    for seed in range(5):
+        q = ur5.random_configuration(seed=seed)
+        jacobian = ur5.jacobian(q, "tool0")
+        for task, rows in (("full", slice(0, 6)), ("position", slice(0, 3)), ([3, 4, 5], slice(3, 6))):
+            sigma = np.linalg.svd(jacobian[rows], compute_uv=False)
+            assert_close(ur5.manipulability(q, "tool0", task), np.prod(sigma), IDENTITY_TOLERANCE)
+            assert_close(ur5.inverse_condition_number(q, "tool0", task), sigma[-1] / sigma[0], 1e-8)
+    with pytest.raises(ValueError, match="argument 'task'"):
+        ur5.manipulability(q, "tool0", "elbow")
+    # batched like every call
+    assert ur5.manipulability(ur5.random_configuration(n=4), "tool0").shape == (4,)

@@ -321,6 +321,23 @@ impl PyModel {
         Argument::new(name, value, SampleShape::vector(self.model.nv))
     }
 
+    /// One of the two measures of `algo::manipulability`, per state.
+    fn manipulability_measure<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+        task: Option<&Bound<'py, PyAny>>,
+        measure: fn((f64, f64)) -> f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let frame = self.frame_index(frame)?;
+        let rows = task.map_or_else(|| Ok((0..6).collect()), parse_task)?;
+        self.evaluate(py, &[self.q_arg("q", q)?], &[], &|m, w, i, out| {
+            out[0] = measure(algo::manipulability(m, &mut w.data, i[0], frame, &rows)?);
+            Ok(())
+        })
+    }
+
     fn frame_index(&self, frame: &Bound<PyAny>) -> PyResult<usize> {
         if let Ok(name) = frame.extract::<&str>() {
             return match self.frame_indices.get(name) {
@@ -399,6 +416,24 @@ fn parse_reference(reference: &str) -> PyResult<Reference> {
         other => Err(PyValueError::new_err(format!(
             "argument 'reference': expected 'world', 'local' or 'spatial', got '{other}'"
         ))),
+    }
+}
+
+/// The Jacobian rows of a task: "full", "position", "orientation" or a list of row indices.
+fn parse_task(task: &Bound<PyAny>) -> PyResult<Vec<usize>> {
+    match task.extract::<String>().as_deref() {
+        Ok("full") => Ok((0..6).collect()),
+        Ok("position") => Ok((0..3).collect()),
+        Ok("orientation") => Ok((3..6).collect()),
+        Ok(other) => Err(PyValueError::new_err(format!(
+            "argument 'task': expected 'full', 'position', 'orientation' or a list of rows 0..5, got '{other}'"
+        ))),
+        Err(_) => task.extract::<Vec<usize>>().map_err(|_| {
+            PyValueError::new_err(format!(
+                "argument 'task': expected 'full', 'position', 'orientation' or a list of rows 0..5, got {}",
+                task.repr().map(|r| r.to_string()).unwrap_or_default()
+            ))
+        }),
     }
 }
 
@@ -860,6 +895,34 @@ impl PyModel {
         self.evaluate(py, &[self.q_arg("q", q)?], &[3], &|m, w, i, out| {
             out.copy_from_slice(algo::center_of_mass(m, &mut w.data, i[0])?.as_slice());
             Ok(())
+        })
+    }
+
+    /// Yoshikawa's manipulability √det(J Jᵀ) of a frame for a task: "full" (6 rows), "position",
+    /// "orientation" or a list of rows of [vx, vy, vz, ωx, ωy, ωz]. Zero at a singularity.
+    #[pyo3(signature = (q, frame, task=None))]
+    fn manipulability<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+        task: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.manipulability_measure(py, q, frame, task, |(w, _)| w)
+    }
+
+    /// σ_min / σ_max of a frame's task Jacobian (see `manipulability`): 1 when isotropic, 0 at a
+    /// singularity.
+    #[pyo3(signature = (q, frame, task=None))]
+    fn inverse_condition_number<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+        task: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.manipulability_measure(py, q, frame, task, |(_, inverse_condition)| {
+            inverse_condition
         })
     }
 

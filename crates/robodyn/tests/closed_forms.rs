@@ -202,3 +202,33 @@ fn gravity_torques_from_com_jacobians() {
         CLOSED_FORM_TOLERANCE,
     );
 }
+
+/// Seed 001, "Manipulability": for the 2-link arm's planar position task, √det(J Jᵀ) = l1 l2 |s2|,
+/// zero at the stretched-out singularity.
+#[test]
+fn planar_two_link_arm_manipulability() {
+    let model = bundled_model("planar2", false).unwrap();
+    let mut data = Data::new(&model);
+    let tool = model.frame_index("tool").unwrap();
+    let (l1, l2) = (1.0, 0.5);
+    for q in [[0.3_f64, -0.7], [1.2, 2.1], [-2.5, 0.4], [0.7, 0.0]] {
+        let (w, inverse_condition) = manipulability(&model, &mut data, &q, tool, &[0, 1]).unwrap();
+        assert_close(
+            "w",
+            &[w],
+            &[l1 * l2 * q[1].sin().abs()],
+            CLOSED_FORM_TOLERANCE,
+        );
+        assert!((0.0..=1.0).contains(&inverse_condition));
+        assert_eq!(inverse_condition == 0.0, q[1] == 0.0);
+    }
+    // the full 6-row task of a 2-joint arm has no volume
+    assert_eq!(
+        manipulability(&model, &mut data, &[0.3, 0.4], tool, &[0, 1, 2, 3, 4, 5])
+            .unwrap()
+            .0,
+        0.0
+    );
+    let error = manipulability(&model, &mut data, &[0.3, 0.4], tool, &[0, 0]).unwrap_err();
+    assert!(error.to_string().contains("argument 'task'"), "{error}");
+}

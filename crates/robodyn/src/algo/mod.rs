@@ -12,6 +12,7 @@ pub mod energy;
 pub mod frame_motion;
 pub mod jacobian;
 pub mod kinematics;
+pub mod manipulability;
 pub mod minv;
 pub mod rnea;
 
@@ -21,5 +22,6 @@ pub use energy::{center_of_mass, center_of_mass_jacobian, kinetic_energy, potent
 pub use frame_motion::{frame_acceleration, frame_velocity};
 pub use jacobian::{jacobian, Reference};
 pub use kinematics::{forward_kinematics, frame_placement, frame_pose};
+pub use manipulability::manipulability;
 pub use minv::inverse_mass_matrix;
 pub use rnea::{bias_forces, generalized_gravity, rnea};
