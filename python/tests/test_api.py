@@ -233,3 +233,12 @@ def test_manipulability_matches_singular_values(ur5):
         ur5.manipulability(q, "tool0", "elbow")
     # batched like every call
     assert ur5.manipulability(ur5.random_configuration(n=4), "tool0").shape == (4,)
+
+
+def test_workspace_samples_frame_positions(ur5):
+    points = ur5.workspace("tool0", n=500, seed=3)
+    assert points.shape == (500, 3) and points.flags.c_contiguous
+    states = ur5.random_configuration(n=500, seed=3)
+    np.testing.assert_array_equal(points, ur5.frame_pose(states, "tool0")[:, :3, 3])
+    # the UR5's reach: shoulder offset plus the two arm links plus the wrist
+    assert np.max(np.linalg.norm(points - [0, 0, 0.089159], axis=1)) < 0.425 + 0.39225 + 0.2

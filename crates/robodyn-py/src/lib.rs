@@ -926,6 +926,27 @@ impl PyModel {
         })
     }
 
+    /// Workspace sampling: the world positions (n, 3) of a frame's origin over n random
+    /// configurations (see `random_configuration`), computed on all cores.
+    #[pyo3(signature = (frame, n=10_000, seed=None))]
+    fn workspace<'py>(
+        &self,
+        py: Python<'py>,
+        frame: &Bound<'py, PyAny>,
+        n: usize,
+        seed: Option<u64>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let states = self.random_configuration(py, Some(n), seed)?;
+        let poses = self.frame_pose(py, &states, frame)?;
+        // the translation column of each pose
+        let slicing = (
+            pyo3::types::PySlice::full(py),
+            pyo3::types::PySlice::new(py, 0, 3, 1),
+            3,
+        );
+        Ok(poses.get_item(slicing)?.call_method0("copy")?)
+    }
+
     /// Jacobian of the centre of mass, (3, nv) in world axes: ċ = J_com v.
     fn center_of_mass_jacobian<'py>(
         &self,
