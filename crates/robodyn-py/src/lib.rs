@@ -944,7 +944,7 @@ impl PyModel {
             pyo3::types::PySlice::new(py, 0, 3, 1),
             3,
         );
-        Ok(poses.get_item(slicing)?.call_method0("copy")?)
+        poses.get_item(slicing)?.call_method0("copy")
     }
 
     /// Jacobian of the centre of mass, (3, nv) in world axes: ċ = J_com v.
