@@ -7,8 +7,8 @@
 //! differences act on the joint's Lie group (quaternions for the spherical and free joints), so
 //! `difference(q, integrate(q, v)) = v`.
 
-use crate::spatial::{skew, Force, Mat3, Motion, Transform, Vec3};
-use nalgebra::{Quaternion, Rotation3, UnitQuaternion};
+use crate::spatial::{log_rotation, skew, Force, Mat3, Motion, Transform, Vec3};
+use nalgebra::{Quaternion, UnitQuaternion};
 use rand::Rng;
 
 /// Below this rotation angle the SE(3)/SO(3) exponential and logarithm use their Taylor series.
@@ -191,7 +191,7 @@ impl Joint {
             Joint::Revolute { .. } | Joint::Prismatic { .. } => v[0] = q1[0] - q0[0],
             Joint::Spherical => {
                 let relative = quaternion_of(&q0[0..4]).inverse() * quaternion_of(&q1[0..4]);
-                v.copy_from_slice(relative.scaled_axis().as_slice());
+                v.copy_from_slice(log_rotation(&relative).as_slice());
             }
             Joint::Free => {
                 let r0 = quaternion_of(&q0[3..7]);
@@ -259,7 +259,7 @@ fn exp_se3(linear: &Vec3, angular: &Vec3) -> (UnitQuaternion<f64>, Vec3) {
 
 /// `log` on SE(3): the body twist (v, ω) with `exp_se3(v, ω) = (rotation, translation)`.
 fn log_se3(rotation: &UnitQuaternion<f64>, translation: &Vec3) -> (Vec3, Vec3) {
-    let angular = Rotation3::from(*rotation).scaled_axis();
+    let angular = log_rotation(rotation);
     let v = left_jacobian_so3(&angular);
     let linear = v
         .try_inverse()

@@ -69,3 +69,20 @@ proptest! {
         prop_assert!((other.dot(&m.cross_force(&force)) + m.cross_motion(&other).dot(&force)).abs() < 1e-10);
     }
 }
+
+#[test]
+fn rotation_log_is_accurate_from_tiny_angles_to_pi() {
+    use robodyn::spatial::log_rotation;
+    let axis = nalgebra::Unit::new_normalize(Vec3::new(0.3, -0.5, 0.8));
+    for angle in [1e-14, 1e-9, 1e-5, 0.3, 2.0, std::f64::consts::PI - 1e-9] {
+        let rotation = nalgebra::UnitQuaternion::from_axis_angle(&axis, angle);
+        let log = log_rotation(&rotation);
+        assert!(
+            (log - axis.into_inner() * angle).norm() <= 1e-15 + 1e-12 * angle,
+            "angle {angle}: {log:?}"
+        );
+        // the negated quaternion is the same rotation
+        let flipped = nalgebra::UnitQuaternion::new_unchecked(-rotation.into_inner());
+        assert!((log_rotation(&flipped) - log).norm() <= 1e-15 + 1e-12 * angle);
+    }
+}

@@ -32,3 +32,17 @@ pub fn skew(v: &Vec3) -> Mat3 {
 pub fn rotation_from_rpy(roll: f64, pitch: f64, yaw: f64) -> Mat3 {
     *nalgebra::Rotation3::from_euler_angles(roll, pitch, yaw).matrix()
 }
+
+/// `log` on SO(3): the rotation vector θ·axis of a unit quaternion, accurate for tiny angles
+/// (where acos of the scalar part loses half the digits) and up to θ = π.
+pub fn log_rotation(rotation: &nalgebra::UnitQuaternion<f64>) -> Vec3 {
+    // q and -q are the same rotation: take w ≥ 0, so θ = 2 atan2(|v|, w) ∈ [0, π]
+    let sign = if rotation.w < 0.0 { -1.0 } else { 1.0 };
+    let (w, v) = (rotation.w * sign, rotation.vector() * sign);
+    let sine = v.norm();
+    if sine < 1e-12 {
+        // θ → 0: θ axis = 2 v / w
+        return v * (2.0 / w);
+    }
+    v * (2.0 * sine.atan2(w) / sine)
+}
