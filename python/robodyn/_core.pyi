@@ -72,6 +72,18 @@ class Model:
     def center_of_mass(self, q: ArrayLike) -> FloatArray: ...
     def center_of_mass_jacobian(self, q: ArrayLike) -> FloatArray: ...
     def workspace(self, frame: str | int, n: int = 10000, seed: int | None = None) -> FloatArray: ...
+    def inverse_kinematics(
+        self,
+        frame: str | int,
+        target: ArrayLike,
+        q0: ArrayLike | None = None,
+        position_only: bool = False,
+        tolerance: float = 1e-10,
+        max_iterations: int = 200,
+        restarts: int = 20,
+        damping: float = 1e-6,
+        seed: int = 0,
+    ) -> dict[str, NDArray]: ...
     def manipulability(self, q: ArrayLike, frame: str | int, task: str | list[int] | None = None) -> float | FloatArray: ...
     def inverse_condition_number(
         self, q: ArrayLike, frame: str | int, task: str | list[int] | None = None

@@ -947,6 +947,116 @@ impl PyModel {
         poses.get_item(slicing)?.call_method0("copy")
     }
 
+    /// Inverse kinematics: a configuration placing `frame` at `target`, a 4x4 pose (or N poses,
+    /// solved in parallel), by damped least squares from `q0` (default: neutral) and then from up
+    /// to `restarts` random configurations. `position_only` matches only the target's position.
+    /// Returns a dict: "q" (nq,), "success" (bool), "iterations" (int), "residual" (the error
+    /// norm, m and rad), with a leading N for a batch. Results do not depend on batch position.
+    #[pyo3(signature = (frame, target, q0=None, position_only=false, tolerance=1e-10, max_iterations=200, restarts=20, damping=1e-6, seed=0))]
+    #[allow(clippy::too_many_arguments)]
+    fn inverse_kinematics<'py>(
+        &self,
+        py: Python<'py>,
+        frame: &Bound<'py, PyAny>,
+        target: &Bound<'py, PyAny>,
+        q0: Option<&Bound<'py, PyAny>>,
+        position_only: bool,
+        tolerance: f64,
+        max_iterations: usize,
+        restarts: usize,
+        damping: f64,
+        seed: u64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let frame = self.frame_index(frame)?;
+        let options = algo::IkOptions {
+            position_only,
+            tolerance,
+            max_iterations,
+            restarts,
+            damping,
+        };
+        let target = Argument::new("target", target, SampleShape::matrix(4, 4))?;
+        let q0 = match q0 {
+            Some(q0) => self.q_arg("q0", q0)?,
+            None => {
+                // the neutral configuration, once per target
+                let neutral = self.model.neutral();
+                let starts = match target.batch()? {
+                    None => PyArray1::from_slice(py, neutral.as_slice()).into_any(),
+                    Some(n) => {
+                        let repeated: Vec<f64> =
+                            (0..n).flat_map(|_| neutral.iter().copied()).collect();
+                        PyArray1::from_vec(py, repeated)
+                            .reshape([n, self.model.nq])?
+                            .into_any()
+                    }
+                };
+                self.q_arg("q0", &starts)?
+            }
+        };
+        let nq = self.model.nq;
+        let packed = self.evaluate(py, &[target, q0], &[nq + 3], &|m, w, i, out| {
+            let pose = i[0];
+            let rotation = nalgebra::Matrix3::new(
+                pose[0], pose[1], pose[2], pose[4], pose[5], pose[6], pose[8], pose[9], pose[10],
+            );
+            let orthonormal =
+                (rotation.transpose() * rotation - nalgebra::Matrix3::identity()).norm() < 1e-6
+                    && rotation.determinant() > 0.0
+                    && pose[12..16] == [0.0, 0.0, 0.0, 1.0];
+            if !orthonormal {
+                return Err(Error::InvalidValue {
+                    argument: "target".into(),
+                    message: "expected a 4x4 homogeneous pose [R p; 0 0 0 1] with R a rotation"
+                        .into(),
+                });
+            }
+            let position = nalgebra::Vector3::new(pose[3], pose[7], pose[11]);
+            let target = robodyn::spatial::Transform::from_pose(&rotation, &position);
+            // the restarts' random states depend on the sample, never on its place in a batch
+            let mut hasher = std::collections::hash_map::DefaultHasher::new();
+            std::hash::Hash::hash(&seed, &mut hasher);
+            for value in pose.iter().chain(i[1]) {
+                std::hash::Hash::hash(&value.to_bits(), &mut hasher);
+            }
+            let mut rng = StdRng::seed_from_u64(std::hash::Hasher::finish(&hasher));
+            let solution =
+                algo::inverse_kinematics(m, &mut w.data, frame, &target, i[1], &options, &mut rng)?;
+            out[..m.nq].copy_from_slice(solution.q.as_slice());
+            out[m.nq] = f64::from(u8::from(solution.success));
+            out[m.nq + 1] = solution.iterations as f64;
+            out[m.nq + 2] = solution.residual;
+            Ok(())
+        })?;
+        // unpack [q, success, iterations, residual] along the last axis
+        let result = PyDict::new(py);
+        let ellipsis = py.Ellipsis().into_bound(py);
+        let column = |k: usize| (ellipsis.clone(), k);
+        result.set_item(
+            "q",
+            packed
+                .get_item((
+                    ellipsis.clone(),
+                    pyo3::types::PySlice::new(py, 0, nq as isize, 1),
+                ))?
+                .call_method0("copy")?,
+        )?;
+        result.set_item(
+            "success",
+            packed
+                .get_item(column(nq))?
+                .call_method1("astype", ("bool",))?,
+        )?;
+        result.set_item(
+            "iterations",
+            packed
+                .get_item(column(nq + 1))?
+                .call_method1("astype", ("int64",))?,
+        )?;
+        result.set_item("residual", packed.get_item(column(nq + 2))?)?;
+        Ok(result)
+    }
+
     /// Jacobian of the centre of mass, (3, nv) in world axes: ċ = J_com v.
     fn center_of_mass_jacobian<'py>(
         &self,
