@@ -81,6 +81,7 @@ def test_shapes_and_dtypes(floating):
         "frame_pose": ((q, frame), (4, 4)),
         "jacobian": ((q, frame), (6, m.nv)),
         "frame_velocity": ((q, v, frame), (6,)),
+        "jacobian_time_variation": ((q, v, frame), (6, m.nv)),
         "frame_acceleration": ((q, v, v, frame), (6,)),
         "integrate": ((q, v), (m.nq,)),
         "difference": ((q, q), (m.nv,)),

@@ -121,6 +121,10 @@ def test_frame_velocity_and_acceleration_agree_with_pinocchio(robot):
                 assert_close(model.frame_velocity(q, v, frame, reference), velocity, CROSS_CHECK_TOLERANCE, f"{name} v {frame}")
                 classical = pin.getFrameClassicalAcceleration(pin_model, data, frame_id, pin_reference).vector
                 assert_close(model.frame_acceleration(q, v, a, frame, reference), classical, CROSS_CHECK_TOLERANCE, f"{name} a {frame}")
+            pin.computeJointJacobiansTimeVariation(pin_model, data, mapping.q_to_pinocchio(q), mapping.v_to_pinocchio(v))
+            for reference, pin_reference in [("world", pin.LOCAL_WORLD_ALIGNED), ("local", pin.LOCAL), ("spatial", pin.WORLD)]:
+                expected = mapping.jacobian_from_pinocchio(pin.getFrameJacobianTimeVariation(pin_model, data, frame_id, pin_reference))
+                assert_close(model.jacobian_time_variation(q, v, frame, reference), expected, CROSS_CHECK_TOLERANCE, f"{name} J̇ {reference} {frame}")
             spatial = pin.getFrameAcceleration(pin_model, data, frame_id, pin.WORLD).vector
             assert_close(model.frame_acceleration(q, v, a, frame, "spatial"), spatial, CROSS_CHECK_TOLERANCE, f"{name} spatial a {frame}")
 

@@ -792,6 +792,33 @@ impl PyModel {
         )
     }
 
+    /// Time derivative J̇(q, v) of a frame's Jacobian, (6, nv), same references as `jacobian`;
+    /// J̇ v equals `frame_acceleration(q, v, 0, frame, reference)`.
+    #[pyo3(signature = (q, v, frame, reference="world"))]
+    fn jacobian_time_variation<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+        reference: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (frame, reference) = (self.frame_index(frame)?, parse_reference(reference)?);
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[6, self.model.nv],
+            &|m, w, i, out| {
+                write_row_major(
+                    algo::jacobian_time_variation(m, &mut w.data, i[0], i[1], frame, reference)?,
+                    6,
+                    out,
+                );
+                Ok(())
+            },
+        )
+    }
+
     /// Velocity of a frame, (6,) [linear; angular] = J(q) v: "world" (its origin's velocity and
     /// angular velocity in world axes), "local" (the same in its axes) or "spatial".
     #[pyo3(signature = (q, v, frame, reference="world"))]

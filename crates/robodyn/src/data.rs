@@ -57,6 +57,9 @@ pub struct Data {
     pub qdd: DVector<f64>,
     /// Frame Jacobian, 6 x nv, rows `[linear; angular]`. Written by `jacobian`.
     pub jacobian: DMatrix<f64>,
+    /// Time derivative J̇ of a frame Jacobian, 6 x nv, rows `[linear; angular]`. Written by
+    /// `jacobian_time_variation`.
+    pub jacobian_dot: DMatrix<f64>,
     /// The bodies from a frame's body down to the world's child (its support), in that order.
     /// Written by `jacobian` and `frame_pose`.
     pub support: Vec<usize>,
@@ -87,6 +90,7 @@ impl Data {
             u_tau: vec![[0.0; 6]; nb],
             qdd: DVector::zeros(nv),
             jacobian: DMatrix::zeros(6, nv),
+            jacobian_dot: DMatrix::zeros(6, nv),
             support: Vec::with_capacity(nb),
         }
     }

@@ -536,3 +536,42 @@ fn center_of_mass_jacobian_is_the_derivative_of_the_center_of_mass() {
         }
     }
 }
+
+#[test]
+fn jacobian_time_variation_is_the_derivative_of_the_jacobian() {
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        let (q, v, _) = state(&model, &mut rng);
+        for frame in [0, model.frames.len() / 2, model.frames.len() - 1] {
+            for reference in [Reference::World, Reference::Local, Reference::Spatial] {
+                let jacobian_at = |h: f64, data: &mut Data| {
+                    let mut moved = DVector::zeros(model.nq);
+                    model
+                        .integrate(q.as_slice(), (&v * h).as_slice(), moved.as_mut_slice())
+                        .unwrap();
+                    jacobian(&model, data, moved.as_slice(), frame, reference)
+                        .unwrap()
+                        .clone()
+                };
+                let expected = (jacobian_at(FD_STEP, &mut data) - jacobian_at(-FD_STEP, &mut data))
+                    / (2.0 * FD_STEP);
+                let j_dot = jacobian_time_variation(
+                    &model,
+                    &mut data,
+                    q.as_slice(),
+                    v.as_slice(),
+                    frame,
+                    reference,
+                )
+                .unwrap();
+                assert_close(
+                    &format!("{name} frame {frame} {reference:?}: J̇"),
+                    j_dot.as_slice(),
+                    expected.as_slice(),
+                    FD_TOLERANCE,
+                );
+            }
+        }
+    }
+}

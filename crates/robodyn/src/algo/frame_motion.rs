@@ -5,15 +5,21 @@
 //! `a_i = X_i a_λ(i) + S_i q̈_i + v_i × S_i q̇_i`, here only along the frame's support. The classical
 //! (textbook) acceleration of the frame's origin is the spatial one plus `ω × v` (seed 001,
 //! "Recap: Acceleration"): `p̈ = a_O + ω × ṗ`. With q̈ = 0 it is `J̇ q̇`, the bias acceleration.
+//! The time derivative of the Jacobian follows from `S` being constant in its body: in world
+//! coordinates each column `s = X⁻¹ S_k` changes as `ṡ = v_j × s` (Featherstone §2.9), `v_j` the
+//! spatial velocity of the joint's body; the world and local references add the motion of the
+//! frame's origin and axes.
 //! Inputs: q (nq), v (nv), a (nv), a frame and a [`Reference`]. Writes `data.support`,
-//! `data.x_up`, `data.x_world`, `data.v`, `data.a` along the support. Cost: O(depth).
+//! `data.x_up`, `data.x_world`, `data.v`, `data.a` along the support (and `data.jacobian_dot`).
+//! Cost: O(depth).
 
 use crate::algo::kinematics::{check_frame, frame_placement, update_support_placements};
 use crate::algo::Reference;
 use crate::error::{check_vector, Result};
 use crate::model::Model;
-use crate::spatial::Motion;
+use crate::spatial::{Motion, Vec3};
 use crate::Data;
+use nalgebra::DMatrix;
 
 /// The frame's velocity `[linear; angular]`: with [`Reference::World`] the velocity of its origin
 /// and its angular velocity in world axes, [`Reference::Local`] the same in its own axes,
@@ -118,4 +124,63 @@ fn frame_motion(
             }
         }
     })
+}
+
+/// J̇(q, q̇) of frame `frame` (6 x nv, rows `[linear; angular]`, the same [`Reference`] as
+/// [`crate::algo::jacobian`]), written into `data.jacobian_dot`. `J̇ q̇` equals
+/// [`frame_acceleration`] with q̈ = 0.
+pub fn jacobian_time_variation<'d>(
+    model: &Model,
+    data: &'d mut Data,
+    q: &[f64],
+    v: &[f64],
+    frame: usize,
+    reference: Reference,
+) -> Result<&'d DMatrix<f64>> {
+    // body velocities along the support (data.v), in body coordinates
+    frame_motion(model, data, q, v, None, frame, reference)?;
+    let body = model.frames[frame].body;
+    let pose = frame_placement(model, data, frame);
+    // the frame's origin p, its velocity ṗ and angular velocity ω_f, in world coordinates
+    let origin = pose.translation;
+    let frame_velocity = data.x_world[body].inverse_apply_motion(&data.v[body]);
+    let origin_velocity = frame_velocity.linear + frame_velocity.angular.cross(&origin);
+    let frame_rotation_rate = frame_velocity.angular;
+
+    data.jacobian_dot.as_mut_slice().fill(0.0);
+    for &j in &data.support {
+        let joint = &model.joints[j];
+        let body_velocity = data.x_world[j].inverse_apply_motion(&data.v[j]);
+        for (k, column) in model.v_range(j).enumerate() {
+            // s = X_{j←0}⁻¹ S_k;  ṡ = v_j × s
+            let s = data.x_world[j].inverse_apply_motion(&joint.subspace_column(k));
+            let s_dot = body_velocity.cross_motion(&s);
+            let (linear, angular): (Vec3, Vec3) = match reference {
+                Reference::Spatial => (s_dot.linear, s_dot.angular),
+                Reference::World | Reference::Local => {
+                    // d/dt (v_O + ω × p) = v̇_O + ω̇ × p + ω × ṗ
+                    let linear = s_dot.linear
+                        + s_dot.angular.cross(&origin)
+                        + s.angular.cross(&origin_velocity);
+                    if reference == Reference::World {
+                        (linear, s_dot.angular)
+                    } else {
+                        // d/dt (Rᵀ x) = Rᵀ (ẋ - ω_f × x)
+                        let world_linear = s.linear + s.angular.cross(&origin);
+                        (
+                            pose.rotation * (linear - frame_rotation_rate.cross(&world_linear)),
+                            pose.rotation * (s_dot.angular - frame_rotation_rate.cross(&s.angular)),
+                        )
+                    }
+                }
+            };
+            data.jacobian_dot
+                .fixed_view_mut::<3, 1>(0, column)
+                .copy_from(&linear);
+            data.jacobian_dot
+                .fixed_view_mut::<3, 1>(3, column)
+                .copy_from(&angular);
+        }
+    }
+    Ok(&data.jacobian_dot)
 }

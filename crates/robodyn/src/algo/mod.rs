@@ -20,7 +20,7 @@ pub mod rnea;
 pub use aba::aba;
 pub use crba::crba;
 pub use energy::{center_of_mass, center_of_mass_jacobian, kinetic_energy, potential_energy};
-pub use frame_motion::{frame_acceleration, frame_velocity};
+pub use frame_motion::{frame_acceleration, frame_velocity, jacobian_time_variation};
 pub use inverse_kinematics::{inverse_kinematics, IkOptions, IkSolution};
 pub use jacobian::{jacobian, Reference};
 pub use kinematics::{forward_kinematics, frame_placement, frame_pose};
