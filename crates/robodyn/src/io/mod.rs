@@ -4,6 +4,7 @@
 pub mod bundled;
 pub mod dh;
 pub mod urdf;
+mod xml;
 
 pub use bundled::{bundled_model, bundled_names};
 pub use dh::{

@@ -11,6 +11,7 @@
 //! Visual, collision, transmission and gazebo elements are ignored.
 
 use crate::error::{Error, Result};
+use crate::io::xml::{location, parse_numbers};
 use crate::io::LoadOptions;
 use crate::joint::Joint;
 use crate::model::{
@@ -87,25 +88,8 @@ impl<'a> Parser<'a> {
         Error::model(self.location(node), message)
     }
 
-    /// "file: <element name='...'> (line n)"; an element without a name is shown under its
-    /// nearest named ancestor, e.g. "<link name='arm'>/<inertial>".
     fn location(&self, node: Node) -> String {
-        let position = self.document.text_pos_at(node.range().start);
-        let tag = |n: Node| match n.attribute("name") {
-            Some(name) => format!("<{} name='{name}'>", n.tag_name().name()),
-            None => format!("<{}>", n.tag_name().name()),
-        };
-        let named_ancestor = node
-            .ancestors()
-            .skip(1)
-            .find(|a| a.is_element() && a.has_attribute("name") && !a.has_tag_name("robot"));
-        let path = match named_ancestor {
-            Some(ancestor) if !node.has_attribute("name") => {
-                format!("{}/{}", tag(ancestor), tag(node))
-            }
-            _ => tag(node),
-        };
-        format!("{}: {path} (line {})", self.source, position.row)
+        location(self.source, self.document, node)
     }
 
     /// A required attribute.
@@ -121,30 +105,10 @@ impl<'a> Parser<'a> {
         name: &str,
         default: [f64; N],
     ) -> Result<[f64; N]> {
-        let Some(text) = node.attribute(name) else {
-            return Ok(default);
-        };
-        let values: Vec<&str> = text.split_whitespace().collect();
-        let mut out = [0.0; N];
-        if values.len() != N {
-            return Err(self.error(
-                node,
-                format!("attribute '{name}': expected {N} numbers, got '{text}'"),
-            ));
+        match node.attribute(name) {
+            None => Ok(default),
+            Some(text) => parse_numbers(text, name).map_err(|message| self.error(node, message)),
         }
-        for (slot, value) in out.iter_mut().zip(&values) {
-            *slot = value
-                .parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| {
-                    self.error(
-                        node,
-                        format!("attribute '{name}': expected finite numbers, got '{text}'"),
-                    )
-                })?;
-        }
-        Ok(out)
     }
 
     /// `<origin xyz rpy>` of `node` (identity when absent), as the transform into that frame.
