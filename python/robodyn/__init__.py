@@ -19,9 +19,30 @@ import sys
 import warnings
 from pathlib import Path
 
-from robodyn._core import Model, bundled_names, load_bundled, load_dh, load_dh_dict, load_urdf, load_urdf_string
+from robodyn._core import (
+    Model,
+    bundled_names,
+    load_bundled,
+    load_dh,
+    load_dh_dict,
+    load_mjcf,
+    load_mjcf_string,
+    load_urdf,
+    load_urdf_string,
+)
 
-__all__ = ["Model", "ModelWarning", "from_dh", "load", "models", "load_urdf", "load_urdf_string", "__version__"]
+__all__ = [
+    "Model",
+    "ModelWarning",
+    "from_dh",
+    "load",
+    "models",
+    "load_mjcf",
+    "load_mjcf_string",
+    "load_urdf",
+    "load_urdf_string",
+    "__version__",
+]
 __version__ = "0.1.0"
 
 
@@ -59,8 +80,9 @@ def _find_file(name: str) -> Path:
 def load(name_or_path: str | os.PathLike[str], floating_base: bool = False, check_inertia: bool = True) -> Model:
     """Load a robot model.
 
-    ``name_or_path`` is a bundled model's name (see :func:`models`), a path to a URDF file, or a
-    path to a DH table in TOML (``.toml``, the format :func:`from_dh` documents). A bare
+    ``name_or_path`` is a bundled model's name (see :func:`models`), a path to a URDF file, an MJCF
+    file (``.xml``, MuJoCo's format), or a DH table in TOML (``.toml``, the format :func:`from_dh`
+    documents). A bare
     file name that does not exist in the working directory is also looked up in the
     ``example-robot-data`` package when it is installed (``robodyn.load("talos_full_v2.urdf")``).
     ``floating_base=True`` puts a free joint named ``root_joint`` between the world and the root
@@ -81,13 +103,19 @@ def load(name_or_path: str | os.PathLike[str], floating_base: bool = False, chec
     suffix = path.suffix.lower()
     if suffix == ".toml":
         return load_dh(str(path))
+    if suffix == ".xml":
+        model = load_mjcf(str(path))
+        for message in model.warnings:
+            warnings.warn(message, ModelWarning, stacklevel=2)
+        return model
     if suffix != ".urdf":
         if not path.exists():
             raise FileNotFoundError(
                 f"model file not found: '{text}' (and it is not a bundled model: {models()})"
             )
         raise ValueError(
-            f"argument 'name_or_path': expected a .urdf or .toml (DH table) file or one of {models()}, got '{text}'"
+            f"argument 'name_or_path': expected a .urdf, MJCF .xml or .toml (DH table) file or one of {models()}, "
+            f"got '{text}'"
         )
     model = load_urdf(str(path), floating_base, check_inertia)
     for message in model.warnings:

@@ -106,3 +106,17 @@ def test_layouts_reject_a_different_robot():
     model = robodyn.load("planar2")
     with pytest.raises(ValueError, match="expected a joint named 'joint1'"):
         MujocoLayout(model, mujoco.MjModel.from_xml_string(MJCF))
+
+
+def test_mjcf_loader_reads_the_same_robot(floating):
+    """robodyn's MJCF loader and its URDF loader give the same model of the floating robot."""
+    model, _, _ = floating
+    from_mjcf = robodyn.load_mjcf_string(MJCF)
+    assert from_mjcf.joint_names == model.joint_names
+    rng = np.random.default_rng(9)
+    for seed in range(3):
+        q = model.random_configuration(seed=seed)
+        v = rng.uniform(-1, 1, model.nv)
+        assert_close(from_mjcf.mass_matrix(q), model.mass_matrix(q), CROSS_CHECK_TOLERANCE, "M")
+        assert_close(from_mjcf.bias_forces(q, v), model.bias_forces(q, v), CROSS_CHECK_TOLERANCE, "bias")
+        assert_close(from_mjcf.frame_pose(q, "tip"), model.frame_pose(q, "tip"), CROSS_CHECK_TOLERANCE, "tip")

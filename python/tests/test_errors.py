@@ -24,7 +24,7 @@ def test_missing_file():
 def test_unsupported_file_type(tmp_path):
     path = tmp_path / "robot.sdf"
     path.write_text("<sdf/>")
-    with pytest.raises(ValueError, match=r"expected a \.urdf or \.toml \(DH table\) file"):
+    with pytest.raises(ValueError, match=r"expected a \.urdf, MJCF \.xml or \.toml \(DH table\) file"):
         robodyn.load(path)
     with pytest.raises(ValueError, match="name_or_path"):
         robodyn.load(42)

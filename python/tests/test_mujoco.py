@@ -8,7 +8,7 @@ import re
 import mujoco
 import numpy as np
 import pytest
-from conftest import CROSS_CHECK_TOLERANCE, ROBOTS, assert_close
+from conftest import CROSS_CHECK_TOLERANCE, REPOSITORY, ROBOTS, assert_close
 
 import robodyn
 
@@ -69,3 +69,130 @@ def test_body_poses_and_jacobians_agree_with_mujoco(robot):
         assert_close(pose[:3, :3], data.xmat[body].reshape(3, 3), CROSS_CHECK_TOLERANCE, f"{name} {link} rotation")
         mujoco.mj_jacBody(mj, data, jacp, jacr, body)
         assert_close(model.jacobian(q, link), np.vstack([jacp, jacr]), CROSS_CHECK_TOLERANCE, f"{name} {link} J")
+
+
+SHARED_MJCF = REPOSITORY.parent / "shared" / "mjcf"
+
+
+@pytest.mark.parametrize("name", ["ur5e_nomesh.xml", "panda_nomesh.xml"])
+def test_mjcf_models_agree_with_mujoco(name):
+    """MuJoCo Menagerie's UR5e and Panda (meshes removed), loaded by robodyn's MJCF loader."""
+    path = SHARED_MJCF / name
+    with pytest.warns(robodyn.ModelWarning, match="not read"):
+        model = robodyn.load(path)
+    mj = mujoco.MjModel.from_xml_path(str(path))
+    # rigid-body dynamics with armature: no damping, friction, limit or actuator forces
+    mj.dof_damping[:] = 0.0
+    mj.dof_frictionloss[:] = 0.0
+    mj.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT | mujoco.mjtDisableBit.mjDSBL_ACTUATION
+    assert model.joint_names == [mj.joint(j).name for j in range(mj.njnt)]
+    np.testing.assert_array_equal(model.armature, mj.dof_armature)
+    data = mujoco.MjData(mj)
+    rng = np.random.default_rng(6)
+    jacp, jacr = np.zeros((3, mj.nv)), np.zeros((3, mj.nv))
+    for seed in range(3):
+        q = model.random_configuration(seed=seed)
+        v, a, tau = (rng.uniform(-1, 1, model.nv) for _ in range(3))
+        data.qpos[:], data.qvel[:], data.qfrc_applied[:] = q, v, tau
+        mujoco.mj_forward(mj, data)
+        mass = np.zeros((mj.nv, mj.nv))
+        mujoco.mj_fullM(mj, data, mass)
+        assert_close(model.mass_matrix(q), mass, CROSS_CHECK_TOLERANCE, f"{name} M")
+        assert_close(model.bias_forces(q, v), data.qfrc_bias, CROSS_CHECK_TOLERANCE, f"{name} bias")
+        assert_close(model.forward_dynamics(q, v, tau), data.qacc, CROSS_CHECK_TOLERANCE, f"{name} qacc")
+        for body in range(1, mj.nbody):
+            link = mj.body(body).name
+            pose = model.frame_pose(q, link)
+            assert_close(pose[:3, 3], data.xpos[body], CROSS_CHECK_TOLERANCE, f"{name} {link}")
+            assert_close(pose[:3, :3], data.xmat[body].reshape(3, 3), CROSS_CHECK_TOLERANCE, f"{name} {link}")
+            mujoco.mj_jacBody(mj, data, jacp, jacr, body)
+            assert_close(model.jacobian(q, link), np.vstack([jacp, jacr]), CROSS_CHECK_TOLERANCE, f"{name} {link} J")
+        for site in range(mj.nsite):
+            pose = model.frame_pose(q, mj.site(site).name)
+            assert_close(pose[:3, 3], data.site_xpos[site], CROSS_CHECK_TOLERANCE, f"{name} site")
+            assert_close(pose[:3, :3], data.site_xmat[site].reshape(3, 3), CROSS_CHECK_TOLERANCE, f"{name} site")
+        result = np.zeros(mj.nv)
+        data.qacc[:] = a
+        mujoco.mj_rne(mj, data, 1, result)
+        # mj_rne leaves armature out of M qacc
+        assert_close(model.inverse_dynamics(q, v, a) - model.armature * a, result, CROSS_CHECK_TOLERANCE, f"{name} rne")
+
+
+MJCF_FEATURES = """<mujoco model="features">
+  <compiler angle="degree" eulerseq="zyx"/>
+  <option gravity="0 -9.81 -3"/>
+  <default>
+    <joint armature="0.01" axis="1 0 0"/>
+    <default class="heavy">
+      <joint armature="0.2" damping="3"/>
+    </default>
+  </default>
+  <worldbody>
+    <site name="world_site" pos="0.1 0 0"/>
+    <body name="a" pos="0 0 0.5" euler="10 20 30" childclass="heavy">
+      <inertial pos="0.1 0 0" mass="2" diaginertia="0.1 0.2 0.3" axisangle="1 1 0 30"/>
+      <joint name="a1" type="hinge" pos="0.1 0.2 0" axis="0 0 1"/>
+      <joint name="a2" type="hinge" pos="-0.1 0 0.3" axis="0 1 0"/>
+      <joint name="a3" type="slide" axis="1 0 1" range="-0.2 0.2"/>
+      <body name="b" pos="0.3 0 0" xyaxes="0 1 0 -1 0 0">
+        <inertial pos="0 0 0.1" mass="1" fullinertia="0.05 0.04 0.03 0.001 0.002 0.003"/>
+        <joint name="b1" class="main"/>
+        <site name="b_tip" pos="0 0 0.2" zaxis="1 1 1"/>
+        <body name="c" pos="0 0.1 0.2">
+          <inertial pos="0 0 0" mass="0.5" diaginertia="0.01 0.01 0.01"/>
+          <joint name="c1" type="ball" pos="0 0 0.05"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>"""
+
+
+def test_mjcf_orientations_defaults_and_joint_chains_agree_with_mujoco():
+    """Every orientation form, degrees, eulerseq, classes and childclass, several joints in one
+    body with their own pos, a ball joint off the body origin, sites."""
+    model = robodyn.load_mjcf_string(MJCF_FEATURES)
+    mj = mujoco.MjModel.from_xml_string(MJCF_FEATURES)
+    mj.dof_damping[:] = 0.0
+    mj.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+    assert model.joint_names == ["a1", "a2", "a3", "b1", "c1"]
+    np.testing.assert_allclose(model.armature, mj.dof_armature)
+    np.testing.assert_allclose(model.gravity, mj.opt.gravity)
+    data = mujoco.MjData(mj)
+    rng = np.random.default_rng(2)
+    for seed in range(3):
+        q = model.random_configuration(seed=seed)
+        v, tau = rng.uniform(-1, 1, model.nv), rng.uniform(-1, 1, model.nv)
+        qpos = np.concatenate([q[:4], np.roll(q[4:8], 1)])  # the ball's quaternion, w first
+        data.qpos[:], data.qvel[:], data.qfrc_applied[:] = qpos, v, tau
+        mujoco.mj_forward(mj, data)
+        mass = np.zeros((mj.nv, mj.nv))
+        mujoco.mj_fullM(mj, data, mass)
+        assert_close(model.mass_matrix(q), mass, CROSS_CHECK_TOLERANCE, "M")
+        assert_close(model.bias_forces(q, v), data.qfrc_bias, CROSS_CHECK_TOLERANCE, "bias")
+        assert_close(model.forward_dynamics(q, v, tau), data.qacc, CROSS_CHECK_TOLERANCE, "qacc")
+        for body in range(1, mj.nbody):
+            pose = model.frame_pose(q, mj.body(body).name)
+            assert_close(pose[:3, 3], data.xpos[body], CROSS_CHECK_TOLERANCE, mj.body(body).name)
+            assert_close(pose[:3, :3], data.xmat[body].reshape(3, 3), CROSS_CHECK_TOLERANCE, mj.body(body).name)
+        for site in range(mj.nsite):
+            pose = model.frame_pose(q, mj.site(site).name)
+            assert_close(pose[:3, 3], data.site_xpos[site], CROSS_CHECK_TOLERANCE, mj.site(site).name)
+            assert_close(pose[:3, :3], data.site_xmat[site].reshape(3, 3), CROSS_CHECK_TOLERANCE, mj.site(site).name)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("<mujoco><worldbody><body name='x'><geom size='0.1'/><joint/></body></worldbody></mujoco>", "<body name='x'>.*inertia from geoms"),
+        ("<mujoco><worldbody><body name='x'><inertial mass='1' diaginertia='1 1 1'/><joint type='screw'/></body></worldbody></mujoco>", "unknown joint type 'screw'"),
+        ("<mujoco><default><default><joint/></default></default></mujoco>", "needs a 'class'"),
+        ("<mujoco><worldbody><body name='x' quat='0 0 0 0'/></worldbody></mujoco>", "non-zero quaternion"),
+        ("<mujoco><worldbody><body name='x' pos='1 2'/></worldbody></mujoco>", "attribute 'pos': expected 3 numbers"),
+        ("<robot/>", "expected the root element <mujoco>"),
+        ("<mujoco><worldbody><body name='x'><inertial mass='1' diaginertia='1 1 1'/><joint class='nope'/></body></worldbody></mujoco>", "unknown class 'nope'"),
+    ],
+)
+def test_mjcf_errors_name_the_element(text, message):
+    with pytest.raises(ValueError, match=message):
+        robodyn.load_mjcf_string(text, source="bad.xml")

@@ -1179,6 +1179,23 @@ fn load_urdf_string(
         .map_err(to_py_err)
 }
 
+/// Loads an MJCF (MuJoCo XML) file.
+#[pyfunction]
+fn load_mjcf(path: std::path::PathBuf) -> PyResult<PyModel> {
+    robodyn::io::load_mjcf_file(&path)
+        .map(PyModel::wrap)
+        .map_err(to_py_err)
+}
+
+/// Loads an MJCF document from a string; `source` names it in error messages.
+#[pyfunction]
+#[pyo3(signature = (text, source="<string>"))]
+fn load_mjcf_string(text: &str, source: &str) -> PyResult<PyModel> {
+    robodyn::io::load_mjcf_str(text, source)
+        .map(PyModel::wrap)
+        .map_err(to_py_err)
+}
+
 /// Loads a DH table file (TOML).
 #[pyfunction]
 fn load_dh(path: std::path::PathBuf) -> PyResult<PyModel> {
@@ -1257,6 +1274,8 @@ fn _core(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(load_urdf_string, module)?)?;
     module.add_function(wrap_pyfunction!(load_bundled, module)?)?;
     module.add_function(wrap_pyfunction!(load_dh, module)?)?;
+    module.add_function(wrap_pyfunction!(load_mjcf, module)?)?;
+    module.add_function(wrap_pyfunction!(load_mjcf_string, module)?)?;
     module.add_function(wrap_pyfunction!(load_dh_dict, module)?)?;
     module.add_function(wrap_pyfunction!(bundled_names, module)?)?;
     Ok(())

@@ -3,6 +3,7 @@
 
 pub mod bundled;
 pub mod dh;
+pub mod mjcf;
 pub mod urdf;
 mod xml;
 
@@ -10,6 +11,7 @@ pub use bundled::{bundled_model, bundled_names};
 pub use dh::{
     build_dh, load_dh_document, load_dh_file, load_dh_str, DhConvention, DhJoint, DhRow, DhTable,
 };
+pub use mjcf::{load_mjcf_file, load_mjcf_str};
 pub use urdf::{load_urdf_file, load_urdf_str};
 
 /// How a model file is turned into a model.

@@ -1,0 +1,102 @@
+//! MJCF: the tree, orientations in MuJoCo's default degrees, classes, errors with element and line.
+
+use robodyn::algo::frame_pose;
+use robodyn::io::load_mjcf_str;
+use robodyn::{Data, Joint};
+
+const ARM: &str = r#"<mujoco model="arm">
+  <default>
+    <joint axis="0 1 0" armature="0.5"/>
+    <default class="slider"><joint type="slide" axis="1 0 0"/></default>
+  </default>
+  <worldbody>
+    <body name="upper" pos="0 0 1" axisangle="0 0 1 90">
+      <inertial pos="0 0 -0.2" mass="1" diaginertia="0.01 0.01 0.001"/>
+      <joint name="shoulder"/>
+      <body name="lower" pos="0 0 -0.4">
+        <inertial pos="0 0 0" mass="0.5" diaginertia="0.001 0.001 0.001"/>
+        <joint name="slide" class="slider" range="-0.1 0.1"/>
+        <site name="tip" pos="0 0 -0.3"/>
+      </body>
+    </body>
+    <body name="free_box" pos="1 0 0"><freejoint/><inertial mass="1" diaginertia="1 1 1"/></body>
+  </worldbody>
+  <actuator><motor joint="shoulder"/></actuator>
+</mujoco>"#;
+
+#[test]
+fn tree_classes_and_degrees() {
+    let model = load_mjcf_str(ARM, "arm.xml").unwrap();
+    assert_eq!(
+        model.joint_names[1..],
+        ["shoulder", "slide", "free_box_joint0"]
+    );
+    assert_eq!(
+        model.joints[1],
+        Joint::Revolute {
+            axis: nalgebra::Vector3::y()
+        }
+    );
+    assert_eq!(
+        model.joints[2],
+        Joint::Prismatic {
+            axis: nalgebra::Vector3::x()
+        }
+    );
+    assert_eq!(model.joints[3], Joint::Free);
+    assert_eq!(model.armature.as_slice()[..2], [0.5, 0.5]);
+    assert_eq!(
+        (model.lower_position_limit[1], model.upper_position_limit[1]),
+        (-0.1, 0.1)
+    );
+    // "90" is degrees by default: the upper arm's x axis points along world y
+    let mut data = Data::new(&model);
+    let q = model.neutral();
+    let upper = frame_pose(
+        &model,
+        &mut data,
+        q.as_slice(),
+        model.frame_index("upper").unwrap(),
+    )
+    .unwrap();
+    let pose = upper.to_homogeneous();
+    assert!(
+        (pose[(1, 0)] - 1.0).abs() < 1e-12 && (pose[(2, 3)] - 1.0).abs() < 1e-12,
+        "{pose}"
+    );
+    let tip = frame_pose(
+        &model,
+        &mut data,
+        q.as_slice(),
+        model.frame_index("tip").unwrap(),
+    )
+    .unwrap();
+    assert!((tip.translation - nalgebra::Vector3::new(0.0, 0.0, 0.3)).norm() < 1e-12);
+    // the actuator section is reported, not read
+    assert!(
+        model
+            .warnings
+            .iter()
+            .any(|w| w.contains("<actuator>") && w.contains("not read")),
+        "{:?}",
+        model.warnings
+    );
+}
+
+#[test]
+fn errors_name_element_and_line() {
+    let cases = [
+        ("<mujoco><worldbody>\n<body name='x'><geom size='1'/></body></worldbody></mujoco>", "<body name='x'> (line 2): no <inertial>"),
+        ("<mujoco><compiler angle='grad'/></mujoco>", "attribute 'angle'"),
+        ("<mujoco><worldbody><body name='x'><body name='y'><freejoint/><inertial mass='1' diaginertia='1 1 1'/></body></body></worldbody></mujoco>", "a free joint must be"),
+        ("<mujoco><worldbody><body name='x'><inertial mass='-1' diaginertia='1 1 1'/></body></worldbody></mujoco>", "mass >= 0"),
+        ("<mujoco><worldbody><body", "malformed XML"),
+    ];
+    for (text, expected) in cases {
+        let message = load_mjcf_str(text, "bad.xml").unwrap_err().to_string();
+        assert!(
+            message.contains(expected) && message.starts_with("bad.xml"),
+            "got: {message}\nexpected: {expected}"
+        );
+    }
+}
