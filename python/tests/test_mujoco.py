@@ -78,6 +78,7 @@ SHARED_MJCF = REPOSITORY.parent / "shared" / "mjcf"
 def test_mjcf_models_agree_with_mujoco(name):
     """MuJoCo Menagerie's UR5e and Panda (meshes removed), loaded by robodyn's MJCF loader."""
     path = SHARED_MJCF / name
+    assert path.exists(), f"{path}: the MJCF test models live in shared/mjcf beside the repository"
     with pytest.warns(robodyn.ModelWarning, match="not read"):
         model = robodyn.load(path)
     mj = mujoco.MjModel.from_xml_path(str(path))
