@@ -7,6 +7,25 @@ use nalgebra::{DMatrix, DVector};
 use robodyn::algo::*;
 use robodyn::{Data, Model};
 
+/// J at q ⊕ h q̇, for finite differences along a motion.
+fn jacobian_along(
+    model: &Model,
+    data: &mut Data,
+    q: &DVector<f64>,
+    v: &DVector<f64>,
+    h: f64,
+    frame: usize,
+    reference: Reference,
+) -> DMatrix<f64> {
+    let mut moved = DVector::zeros(model.nq);
+    model
+        .integrate(q.as_slice(), (v * h).as_slice(), moved.as_mut_slice())
+        .unwrap();
+    jacobian(model, data, moved.as_slice(), frame, reference)
+        .unwrap()
+        .clone()
+}
+
 /// Random (q, v, a) for a model.
 fn state(
     model: &Model,
@@ -418,15 +437,8 @@ fn frame_velocity_and_acceleration_are_j_v_and_j_a_plus_jdot_v() {
         let (q, v, a) = state(&model, &mut rng);
         let frame = model.frames.len() - 1;
         for reference in [Reference::World, Reference::Spatial, Reference::Local] {
-            let jacobian_at = |h: f64, data: &mut Data| {
-                let mut moved = DVector::zeros(model.nq);
-                model
-                    .integrate(q.as_slice(), (&v * h).as_slice(), moved.as_mut_slice())
-                    .unwrap();
-                jacobian(&model, data, moved.as_slice(), frame, reference)
-                    .unwrap()
-                    .clone()
-            };
+            let jacobian_at =
+                |h: f64, data: &mut Data| jacobian_along(&model, data, &q, &v, h, frame, reference);
             let j = jacobian_at(0.0, &mut data);
             let velocity = frame_velocity(
                 &model,
@@ -546,13 +558,7 @@ fn jacobian_time_variation_is_the_derivative_of_the_jacobian() {
         for frame in [0, model.frames.len() / 2, model.frames.len() - 1] {
             for reference in [Reference::World, Reference::Local, Reference::Spatial] {
                 let jacobian_at = |h: f64, data: &mut Data| {
-                    let mut moved = DVector::zeros(model.nq);
-                    model
-                        .integrate(q.as_slice(), (&v * h).as_slice(), moved.as_mut_slice())
-                        .unwrap();
-                    jacobian(&model, data, moved.as_slice(), frame, reference)
-                        .unwrap()
-                        .clone()
+                    jacobian_along(&model, data, &q, &v, h, frame, reference)
                 };
                 let expected = (jacobian_at(FD_STEP, &mut data) - jacobian_at(-FD_STEP, &mut data))
                     / (2.0 * FD_STEP);

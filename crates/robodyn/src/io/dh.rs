@@ -13,6 +13,7 @@
 //! loader; the joints are named after the rows.
 
 use crate::error::{Error, Result};
+use crate::io::read_model_file;
 use crate::joint::Joint;
 use crate::model::{
     check_mass_and_inertia, check_positive_semidefinite, JointProperties, Model, ModelBuilder,
@@ -190,15 +191,7 @@ pub fn build_dh(table: &DhTable) -> Result<Model> {
 
 /// Loads a DH table file (TOML; the format is in the README).
 pub fn load_dh_file(path: &std::path::Path) -> Result<Model> {
-    let text = std::fs::read_to_string(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => Error::FileNotFound {
-            path: path.display().to_string(),
-        },
-        _ => Error::model(
-            path.display().to_string(),
-            format!("cannot read the file: {e}"),
-        ),
-    })?;
+    let text = read_model_file(path)?;
     load_dh_str(&text, &path.display().to_string())
 }
 

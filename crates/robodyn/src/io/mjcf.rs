@@ -14,6 +14,7 @@
 //! (inertia from geoms is not implemented yet).
 
 use crate::error::{Error, Result};
+use crate::io::read_model_file;
 use crate::io::xml::{location, parse_numbers};
 use crate::joint::Joint;
 use crate::model::{
@@ -41,15 +42,7 @@ const IGNORED_SECTIONS: [&str; 9] = [
 
 /// Loads an MJCF file.
 pub fn load_mjcf_file(path: &Path) -> Result<Model> {
-    let text = std::fs::read_to_string(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => Error::FileNotFound {
-            path: path.display().to_string(),
-        },
-        _ => Error::model(
-            path.display().to_string(),
-            format!("cannot read the file: {e}"),
-        ),
-    })?;
+    let text = read_model_file(path)?;
     load_mjcf_str(&text, &path.display().to_string())
 }
 

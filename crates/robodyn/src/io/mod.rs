@@ -41,3 +41,16 @@ impl LoadOptions {
         }
     }
 }
+
+/// The text of a model file; a missing file is [`Error::FileNotFound`].
+pub(crate) fn read_model_file(path: &std::path::Path) -> crate::Result<String> {
+    std::fs::read_to_string(path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => crate::Error::FileNotFound {
+            path: path.display().to_string(),
+        },
+        _ => crate::Error::model(
+            path.display().to_string(),
+            format!("cannot read the file: {e}"),
+        ),
+    })
+}

@@ -12,7 +12,7 @@
 
 use crate::error::{Error, Result};
 use crate::io::xml::{location, parse_numbers};
-use crate::io::LoadOptions;
+use crate::io::{read_model_file, LoadOptions};
 use crate::joint::Joint;
 use crate::model::{
     check_mass_and_inertia, check_positive_semidefinite, JointProperties, Mimic, Model,
@@ -25,15 +25,7 @@ use std::path::Path;
 
 /// Loads a URDF file.
 pub fn load_urdf_file(path: &Path, options: LoadOptions) -> Result<Model> {
-    let text = std::fs::read_to_string(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => Error::FileNotFound {
-            path: path.display().to_string(),
-        },
-        _ => Error::model(
-            path.display().to_string(),
-            format!("cannot read the file: {e}"),
-        ),
-    })?;
+    let text = read_model_file(path)?;
     load_urdf_str(&text, &path.display().to_string(), options)
 }
 
