@@ -13,15 +13,54 @@ from conftest import CROSS_CHECK_TOLERANCE, REPOSITORY, ROBOTS, assert_close
 import robodyn
 
 
+def rigid_body_only(mj):
+    """No passive joint forces, limit constraints or actuators: MuJoCo's rigid-body dynamics
+    (armature stays: robodyn models it too)."""
+    mj.dof_damping[:] = 0.0
+    mj.dof_frictionloss[:] = 0.0
+    mj.jnt_stiffness[:] = 0.0
+    mj.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT | mujoco.mjtDisableBit.mjDSBL_ACTUATION
+    return mj
+
+
 def mujoco_model(urdf):
     text = re.sub(r"<(visual|collision|gazebo|transmission)\b.*?</\1>", "", urdf.read_text(), flags=re.S)
-    model = mujoco.MjModel.from_xml_string(text)
-    # rigid-body dynamics only: no passive joint forces, no limit constraints
-    model.dof_damping[:] = 0.0
-    model.dof_frictionloss[:] = 0.0
-    model.jnt_stiffness[:] = 0.0
-    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
-    return model
+    return rigid_body_only(mujoco.MjModel.from_xml_string(text))
+
+
+def check_dynamics(model, mj, data, q, qpos, v, a, tau, label):
+    """M, bias, q̈ and mj_rne at one state (v, a, τ mean the same in both: no free joints)."""
+    data.qpos[:], data.qvel[:], data.qfrc_applied[:] = qpos, v, tau
+    mujoco.mj_forward(mj, data)
+    mass = np.zeros((mj.nv, mj.nv))
+    mujoco.mj_fullM(mj, data, mass)
+    assert_close(model.mass_matrix(q), mass, CROSS_CHECK_TOLERANCE, f"{label} M")
+    assert_close(model.bias_forces(q, v), data.qfrc_bias, CROSS_CHECK_TOLERANCE, f"{label} bias")
+    assert_close(model.forward_dynamics(q, v, tau), data.qacc, CROSS_CHECK_TOLERANCE, f"{label} qacc")
+    result = np.zeros(mj.nv)
+    data.qacc[:] = a
+    mujoco.mj_rne(mj, data, 1, result)
+    # mj_rne leaves armature out of M qacc
+    assert_close(model.inverse_dynamics(q, v, a) - model.armature * a, result, CROSS_CHECK_TOLERANCE, f"{label} rne")
+
+
+def check_frames(model, mj, data, q, qpos, label):
+    """Every body's pose and Jacobian (mj_jacBody) and every site's pose."""
+    data.qpos[:] = qpos
+    mujoco.mj_forward(mj, data)
+    jacp, jacr = np.zeros((3, mj.nv)), np.zeros((3, mj.nv))
+    for body in range(1, mj.nbody):
+        link = mj.body(body).name
+        pose = model.frame_pose(q, link)
+        assert_close(pose[:3, 3], data.xpos[body], CROSS_CHECK_TOLERANCE, f"{label} {link} position")
+        assert_close(pose[:3, :3], data.xmat[body].reshape(3, 3), CROSS_CHECK_TOLERANCE, f"{label} {link} rotation")
+        mujoco.mj_jacBody(mj, data, jacp, jacr, body)
+        assert_close(model.jacobian(q, link), np.vstack([jacp, jacr]), CROSS_CHECK_TOLERANCE, f"{label} {link} J")
+    for site in range(mj.nsite):
+        name = mj.site(site).name
+        pose = model.frame_pose(q, name)
+        assert_close(pose[:3, 3], data.site_xpos[site], CROSS_CHECK_TOLERANCE, f"{label} {name}")
+        assert_close(pose[:3, :3], data.site_xmat[site].reshape(3, 3), CROSS_CHECK_TOLERANCE, f"{label} {name}")
 
 
 @pytest.fixture(scope="module", params=sorted(ROBOTS))
@@ -42,33 +81,13 @@ def test_dynamics_agree_with_mujoco(robot):
     for seed in range(3):
         q = model.random_configuration(seed=seed)
         v, a, tau = (rng.uniform(-1, 1, model.nv) for _ in range(3))
-        data.qpos[:], data.qvel[:], data.qfrc_applied[:] = q, v, tau
-        mujoco.mj_forward(mj, data)
-        mass = np.zeros((mj.nv, mj.nv))
-        mujoco.mj_fullM(mj, data, mass)
-        assert_close(model.mass_matrix(q), mass, CROSS_CHECK_TOLERANCE, f"{name} M")
-        assert_close(model.bias_forces(q, v), data.qfrc_bias, CROSS_CHECK_TOLERANCE, f"{name} bias")
-        assert_close(model.forward_dynamics(q, v, tau), data.qacc, CROSS_CHECK_TOLERANCE, f"{name} qacc")
-        result = np.zeros(mj.nv)
-        data.qacc[:] = a
-        mujoco.mj_rne(mj, data, 1, result)
-        assert_close(model.inverse_dynamics(q, v, a), result, CROSS_CHECK_TOLERANCE, f"{name} rne")
+        check_dynamics(model, mj, data, q, q, v, a, tau, name)
 
 
 def test_body_poses_and_jacobians_agree_with_mujoco(robot):
     name, model, mj = robot
-    data = mujoco.MjData(mj)
     q = model.random_configuration(seed=9)
-    data.qpos[:] = q
-    mujoco.mj_forward(mj, data)
-    jacp, jacr = np.zeros((3, mj.nv)), np.zeros((3, mj.nv))
-    for body in range(1, mj.nbody):
-        link = mj.body(body).name
-        pose = model.frame_pose(q, link)
-        assert_close(pose[:3, 3], data.xpos[body], CROSS_CHECK_TOLERANCE, f"{name} {link} position")
-        assert_close(pose[:3, :3], data.xmat[body].reshape(3, 3), CROSS_CHECK_TOLERANCE, f"{name} {link} rotation")
-        mujoco.mj_jacBody(mj, data, jacp, jacr, body)
-        assert_close(model.jacobian(q, link), np.vstack([jacp, jacr]), CROSS_CHECK_TOLERANCE, f"{name} {link} J")
+    check_frames(model, mj, mujoco.MjData(mj), q, q, name)
 
 
 SHARED_MJCF = REPOSITORY.parent / "shared" / "mjcf"
@@ -81,42 +100,16 @@ def test_mjcf_models_agree_with_mujoco(name):
     assert path.exists(), f"{path}: the MJCF test models live in shared/mjcf beside the repository"
     with pytest.warns(robodyn.ModelWarning, match="not read"):
         model = robodyn.load(path)
-    mj = mujoco.MjModel.from_xml_path(str(path))
-    # rigid-body dynamics with armature: no damping, friction, limit or actuator forces
-    mj.dof_damping[:] = 0.0
-    mj.dof_frictionloss[:] = 0.0
-    mj.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT | mujoco.mjtDisableBit.mjDSBL_ACTUATION
+    mj = rigid_body_only(mujoco.MjModel.from_xml_path(str(path)))
     assert model.joint_names == [mj.joint(j).name for j in range(mj.njnt)]
     np.testing.assert_array_equal(model.armature, mj.dof_armature)
     data = mujoco.MjData(mj)
     rng = np.random.default_rng(6)
-    jacp, jacr = np.zeros((3, mj.nv)), np.zeros((3, mj.nv))
     for seed in range(3):
         q = model.random_configuration(seed=seed)
         v, a, tau = (rng.uniform(-1, 1, model.nv) for _ in range(3))
-        data.qpos[:], data.qvel[:], data.qfrc_applied[:] = q, v, tau
-        mujoco.mj_forward(mj, data)
-        mass = np.zeros((mj.nv, mj.nv))
-        mujoco.mj_fullM(mj, data, mass)
-        assert_close(model.mass_matrix(q), mass, CROSS_CHECK_TOLERANCE, f"{name} M")
-        assert_close(model.bias_forces(q, v), data.qfrc_bias, CROSS_CHECK_TOLERANCE, f"{name} bias")
-        assert_close(model.forward_dynamics(q, v, tau), data.qacc, CROSS_CHECK_TOLERANCE, f"{name} qacc")
-        for body in range(1, mj.nbody):
-            link = mj.body(body).name
-            pose = model.frame_pose(q, link)
-            assert_close(pose[:3, 3], data.xpos[body], CROSS_CHECK_TOLERANCE, f"{name} {link}")
-            assert_close(pose[:3, :3], data.xmat[body].reshape(3, 3), CROSS_CHECK_TOLERANCE, f"{name} {link}")
-            mujoco.mj_jacBody(mj, data, jacp, jacr, body)
-            assert_close(model.jacobian(q, link), np.vstack([jacp, jacr]), CROSS_CHECK_TOLERANCE, f"{name} {link} J")
-        for site in range(mj.nsite):
-            pose = model.frame_pose(q, mj.site(site).name)
-            assert_close(pose[:3, 3], data.site_xpos[site], CROSS_CHECK_TOLERANCE, f"{name} site")
-            assert_close(pose[:3, :3], data.site_xmat[site].reshape(3, 3), CROSS_CHECK_TOLERANCE, f"{name} site")
-        result = np.zeros(mj.nv)
-        data.qacc[:] = a
-        mujoco.mj_rne(mj, data, 1, result)
-        # mj_rne leaves armature out of M qacc
-        assert_close(model.inverse_dynamics(q, v, a) - model.armature * a, result, CROSS_CHECK_TOLERANCE, f"{name} rne")
+        check_dynamics(model, mj, data, q, q, v, a, tau, name)
+        check_frames(model, mj, data, q, q, name)
 
 
 MJCF_FEATURES = """<mujoco model="features">
@@ -153,9 +146,7 @@ def test_mjcf_orientations_defaults_and_joint_chains_agree_with_mujoco():
     """Every orientation form, degrees, eulerseq, classes and childclass, several joints in one
     body with their own pos, a ball joint off the body origin, sites."""
     model = robodyn.load_mjcf_string(MJCF_FEATURES)
-    mj = mujoco.MjModel.from_xml_string(MJCF_FEATURES)
-    mj.dof_damping[:] = 0.0
-    mj.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+    mj = rigid_body_only(mujoco.MjModel.from_xml_string(MJCF_FEATURES))
     assert model.joint_names == ["a1", "a2", "a3", "b1", "c1"]
     np.testing.assert_allclose(model.armature, mj.dof_armature)
     np.testing.assert_allclose(model.gravity, mj.opt.gravity)
@@ -163,23 +154,10 @@ def test_mjcf_orientations_defaults_and_joint_chains_agree_with_mujoco():
     rng = np.random.default_rng(2)
     for seed in range(3):
         q = model.random_configuration(seed=seed)
-        v, tau = rng.uniform(-1, 1, model.nv), rng.uniform(-1, 1, model.nv)
+        v, a, tau = (rng.uniform(-1, 1, model.nv) for _ in range(3))
         qpos = np.concatenate([q[:4], np.roll(q[4:8], 1)])  # the ball's quaternion, w first
-        data.qpos[:], data.qvel[:], data.qfrc_applied[:] = qpos, v, tau
-        mujoco.mj_forward(mj, data)
-        mass = np.zeros((mj.nv, mj.nv))
-        mujoco.mj_fullM(mj, data, mass)
-        assert_close(model.mass_matrix(q), mass, CROSS_CHECK_TOLERANCE, "M")
-        assert_close(model.bias_forces(q, v), data.qfrc_bias, CROSS_CHECK_TOLERANCE, "bias")
-        assert_close(model.forward_dynamics(q, v, tau), data.qacc, CROSS_CHECK_TOLERANCE, "qacc")
-        for body in range(1, mj.nbody):
-            pose = model.frame_pose(q, mj.body(body).name)
-            assert_close(pose[:3, 3], data.xpos[body], CROSS_CHECK_TOLERANCE, mj.body(body).name)
-            assert_close(pose[:3, :3], data.xmat[body].reshape(3, 3), CROSS_CHECK_TOLERANCE, mj.body(body).name)
-        for site in range(mj.nsite):
-            pose = model.frame_pose(q, mj.site(site).name)
-            assert_close(pose[:3, 3], data.site_xpos[site], CROSS_CHECK_TOLERANCE, mj.site(site).name)
-            assert_close(pose[:3, :3], data.site_xmat[site].reshape(3, 3), CROSS_CHECK_TOLERANCE, mj.site(site).name)
+        check_dynamics(model, mj, data, q, qpos, v, a, tau, "features")
+        check_frames(model, mj, data, q, qpos, "features")
 
 
 @pytest.mark.parametrize(

@@ -17,13 +17,24 @@ fn jacobian_along(
     frame: usize,
     reference: Reference,
 ) -> DMatrix<f64> {
-    let mut moved = DVector::zeros(model.nq);
-    model
-        .integrate(q.as_slice(), (v * h).as_slice(), moved.as_mut_slice())
-        .unwrap();
+    let moved = displaced(model, q, &(v * h));
     jacobian(model, data, moved.as_slice(), frame, reference)
         .unwrap()
         .clone()
+}
+
+/// q ⊕ step, on the joints' Lie groups.
+fn displaced(model: &Model, q: &DVector<f64>, step: &DVector<f64>) -> DVector<f64> {
+    let mut moved = DVector::zeros(model.nq);
+    model
+        .integrate(q.as_slice(), step.as_slice(), moved.as_mut_slice())
+        .unwrap();
+    moved
+}
+
+/// h times the k-th unit vector of length n.
+fn unit_step(n: usize, k: usize, h: f64) -> DVector<f64> {
+    DVector::from_fn(n, |i, _| if i == k { h } else { 0.0 })
 }
 
 /// Random (q, v, a) for a model.
@@ -246,11 +257,7 @@ fn gravity_is_the_gradient_of_potential_energy() {
             .clone();
         for k in 0..model.nv {
             let energy_at = |h: f64, data: &mut Data| {
-                let step = DVector::from_fn(model.nv, |i, _| if i == k { h } else { 0.0 });
-                let mut moved = DVector::zeros(model.nq);
-                model
-                    .integrate(q.as_slice(), step.as_slice(), moved.as_mut_slice())
-                    .unwrap();
+                let moved = displaced(&model, &q, &unit_step(model.nv, k, h));
                 potential_energy(&model, data, moved.as_slice()).unwrap()
             };
             let derivative =
@@ -294,11 +301,7 @@ fn jacobian_is_the_derivative_of_forward_kinematics() {
             let rotation = pose.rotation.transpose();
             for k in 0..model.nv {
                 let pose_at = |h: f64, data: &mut Data| {
-                    let step = DVector::from_fn(model.nv, |i, _| if i == k { h } else { 0.0 });
-                    let mut moved = DVector::zeros(model.nq);
-                    model
-                        .integrate(q.as_slice(), step.as_slice(), moved.as_mut_slice())
-                        .unwrap();
+                    let moved = displaced(&model, &q, &unit_step(model.nv, k, h));
                     forward_kinematics(&model, data, moved.as_slice()).unwrap();
                     frame_placement(&model, data, frame)
                 };
@@ -530,11 +533,7 @@ fn center_of_mass_jacobian_is_the_derivative_of_the_center_of_mass() {
             .clone();
         for k in 0..model.nv {
             let com_at = |h: f64, data: &mut Data| {
-                let step = DVector::from_fn(model.nv, |i, _| if i == k { h } else { 0.0 });
-                let mut moved = DVector::zeros(model.nq);
-                model
-                    .integrate(q.as_slice(), step.as_slice(), moved.as_mut_slice())
-                    .unwrap();
+                let moved = displaced(&model, &q, &unit_step(model.nv, k, h));
                 center_of_mass(&model, data, moved.as_slice()).unwrap()
             };
             let derivative =
