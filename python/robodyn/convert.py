@@ -108,6 +108,8 @@ class MujocoLayout:
     def __init__(self, model, mj_model):
         self.model, self.mj_model = model, mj_model
         names = [mj_model.joint(j).name for j in range(mj_model.njnt)]
+        if mj_model.nv != model.nv:
+            raise ValueError(f"argument 'mj_model': expected {model.nv} velocity coordinates as the robodyn model has, got {mj_model.nv}")
         self.v_index = np.zeros(model.nv, dtype=int)
         self._joints = []
         for name, kind, iq, iv in zip(model.joint_names, model.joint_types, model.joint_idx_q, model.joint_idx_v):

@@ -11,6 +11,7 @@ import pytest
 from conftest import CROSS_CHECK_TOLERANCE, REPOSITORY, ROBOTS, assert_close
 
 import robodyn
+from robodyn.convert import MujocoLayout
 
 
 def rigid_body_only(mj):
@@ -28,39 +29,69 @@ def mujoco_model(urdf):
     return rigid_body_only(mujoco.MjModel.from_xml_string(text))
 
 
-def check_dynamics(model, mj, data, q, qpos, v, a, tau, label):
-    """M, bias, q̈ and mj_rne at one state (v, a, τ mean the same in both: no free joints)."""
-    data.qpos[:], data.qvel[:], data.qfrc_applied[:] = qpos, v, tau
+def check_dynamics(model, mj, data, q, v, a, tau, label):
+    """M, bias, q̈ and mj_rne at one state, through robodyn.convert's MuJoCo layout."""
+    layout = MujocoLayout(model, mj)
+    data.qpos[:], data.qvel[:] = layout.q_to_mujoco(q), layout.v_to_mujoco(q, v)
+    data.qfrc_applied[:] = layout.force_to_mujoco(q, tau)
     mujoco.mj_forward(mj, data)
     mass = np.zeros((mj.nv, mj.nv))
     mujoco.mj_fullM(mj, data, mass)
-    assert_close(model.mass_matrix(q), mass, CROSS_CHECK_TOLERANCE, f"{label} M")
-    assert_close(model.bias_forces(q, v), data.qfrc_bias, CROSS_CHECK_TOLERANCE, f"{label} bias")
-    assert_close(model.forward_dynamics(q, v, tau), data.qacc, CROSS_CHECK_TOLERANCE, f"{label} qacc")
+    assert_close(model.mass_matrix(q), layout.matrix_from_mujoco(q, mass), CROSS_CHECK_TOLERANCE, f"{label} M")
+    bias = layout.bias_from_mujoco(q, v, data.qfrc_bias, mass)
+    assert_close(model.bias_forces(q, v), bias, CROSS_CHECK_TOLERANCE, f"{label} bias")
+    qacc = layout.a_from_mujoco(q, v, data.qacc)
+    assert_close(model.forward_dynamics(q, v, tau), qacc, CROSS_CHECK_TOLERANCE, f"{label} qacc")
     result = np.zeros(mj.nv)
-    data.qacc[:] = a
+    data.qacc[:] = layout.a_to_mujoco(q, v, a)
     mujoco.mj_rne(mj, data, 1, result)
     # mj_rne leaves armature out of M qacc
-    assert_close(model.inverse_dynamics(q, v, a) - model.armature * a, result, CROSS_CHECK_TOLERANCE, f"{label} rne")
+    expected = layout.force_from_mujoco(q, result)
+    assert_close(model.inverse_dynamics(q, v, a) - model.armature * a, expected, CROSS_CHECK_TOLERANCE, f"{label} rne")
 
 
-def check_frames(model, mj, data, q, qpos, label):
-    """Every body's pose and Jacobian (mj_jacBody) and every site's pose."""
-    data.qpos[:] = qpos
+def check_frames(model, mj, data, q, v, label):
+    """Every body's pose, Jacobian (mj_jacBody) and J̇v (mj_jacDot), and every site's pose."""
+    layout = MujocoLayout(model, mj)
+    v_mj = layout.v_to_mujoco(q, v)
+    data.qpos[:], data.qvel[:] = layout.q_to_mujoco(q), v_mj
     mujoco.mj_forward(mj, data)
+    # the point's acceleration at zero robodyn q̈ is J̇v = J_mj a_mj(q̈ = 0) + J̇_mj v_mj
+    a_mj = layout.a_to_mujoco(q, v, np.zeros(model.nv))
+    has_free_joint = "free" in model.joint_types
     jacp, jacr = np.zeros((3, mj.nv)), np.zeros((3, mj.nv))
+    jacp_dot, jacr_dot = np.zeros((3, mj.nv)), np.zeros((3, mj.nv))
     for body in range(1, mj.nbody):
         link = mj.body(body).name
         pose = model.frame_pose(q, link)
         assert_close(pose[:3, 3], data.xpos[body], CROSS_CHECK_TOLERANCE, f"{label} {link} position")
         assert_close(pose[:3, :3], data.xmat[body].reshape(3, 3), CROSS_CHECK_TOLERANCE, f"{label} {link} rotation")
         mujoco.mj_jacBody(mj, data, jacp, jacr, body)
-        assert_close(model.jacobian(q, link), np.vstack([jacp, jacr]), CROSS_CHECK_TOLERANCE, f"{label} {link} J")
+        jacobian = np.vstack([jacp, jacr])
+        assert_close(model.jacobian(q, link), layout.jacobian_from_mujoco(q, jacobian), CROSS_CHECK_TOLERANCE, f"{label} {link} J")
+        mujoco.mj_jacDot(mj, data, jacp_dot, jacr_dot, data.xpos[body], body)
+        jacobian_dot = np.vstack([jacp_dot, jacr_dot])
+        time_variation = model.jacobian_time_variation(q, v, link)
+        expected = jacobian @ a_mj + jacobian_dot @ v_mj
+        assert_close(time_variation @ v, expected, CROSS_CHECK_TOLERANCE, f"{label} {link} J̇v")
+        if not has_free_joint:
+            assert_close(time_variation, jacobian_dot[:, layout.v_index], CROSS_CHECK_TOLERANCE, f"{label} {link} J̇")
     for site in range(mj.nsite):
         name = mj.site(site).name
         pose = model.frame_pose(q, name)
         assert_close(pose[:3, 3], data.site_xpos[site], CROSS_CHECK_TOLERANCE, f"{label} {name}")
         assert_close(pose[:3, :3], data.site_xmat[site].reshape(3, 3), CROSS_CHECK_TOLERANCE, f"{label} {name}")
+
+
+def check_against_mujoco(model, mj, seed, label, states=3):
+    """check_dynamics and check_frames at a few random states."""
+    data = mujoco.MjData(mj)
+    rng = np.random.default_rng(seed)
+    for k in range(states):
+        q = model.random_configuration(seed=seed + k)
+        v, a, tau = (rng.uniform(-1, 1, model.nv) for _ in range(3))
+        check_dynamics(model, mj, data, q, v, a, tau, label)
+        check_frames(model, mj, data, q, v, label)
 
 
 @pytest.fixture(scope="module", params=sorted(ROBOTS))
@@ -74,42 +105,55 @@ def robot(request, robots_dir):
     return request.param, model, mj
 
 
-def test_dynamics_agree_with_mujoco(robot):
+def test_urdf_robots_agree_with_mujoco(robot):
     name, model, mj = robot
-    data = mujoco.MjData(mj)
-    rng = np.random.default_rng(5)
-    for seed in range(3):
-        q = model.random_configuration(seed=seed)
-        v, a, tau = (rng.uniform(-1, 1, model.nv) for _ in range(3))
-        check_dynamics(model, mj, data, q, q, v, a, tau, name)
-
-
-def test_body_poses_and_jacobians_agree_with_mujoco(robot):
-    name, model, mj = robot
-    q = model.random_configuration(seed=9)
-    check_frames(model, mj, mujoco.MjData(mj), q, q, name)
+    check_against_mujoco(model, mj, 5, name)
 
 
 SHARED_MJCF = REPOSITORY.parent / "shared" / "mjcf"
+TEST_MJCF = REPOSITORY / "testdata" / "mjcf"
+
+#: MJCF models read by robodyn's loader and by MuJoCo: Menagerie's UR5e and Panda (meshes removed,
+#: in shared/mjcf beside the repository) and the iiwa 14 written from Menagerie's inertial data,
+#: through a scene that <include>s it.
+MJCF_MODELS = {
+    "ur5e": SHARED_MJCF / "ur5e_nomesh.xml",
+    "panda": SHARED_MJCF / "panda_nomesh.xml",
+    "iiwa14": TEST_MJCF / "iiwa14_scene.xml",
+}
 
 
-@pytest.mark.parametrize("name", ["ur5e_nomesh.xml", "panda_nomesh.xml"])
+@pytest.mark.parametrize("name", sorted(MJCF_MODELS))
 def test_mjcf_models_agree_with_mujoco(name):
-    """MuJoCo Menagerie's UR5e and Panda (meshes removed), loaded by robodyn's MJCF loader."""
-    path = SHARED_MJCF / name
+    path = MJCF_MODELS[name]
     assert path.exists(), f"{path}: the MJCF test models live in shared/mjcf beside the repository"
-    with pytest.warns(robodyn.ModelWarning, match="not read"):
-        model = robodyn.load(path)
+    model = robodyn.load(path, check_inertia=True)
     mj = rigid_body_only(mujoco.MjModel.from_xml_path(str(path)))
     assert model.joint_names == [mj.joint(j).name for j in range(mj.njnt)]
     np.testing.assert_array_equal(model.armature, mj.dof_armature)
-    data = mujoco.MjData(mj)
-    rng = np.random.default_rng(6)
-    for seed in range(3):
-        q = model.random_configuration(seed=seed)
-        v, a, tau = (rng.uniform(-1, 1, model.nv) for _ in range(3))
-        check_dynamics(model, mj, data, q, q, v, a, tau, name)
-        check_frames(model, mj, data, q, q, name)
+    np.testing.assert_allclose(model.lower_position_limit, np.where(mj.jnt_limited, mj.jnt_range[:, 0], -np.inf))
+    check_against_mujoco(model, mj, 6, name)
+
+
+def floating_mjcf(urdf):
+    """An MJCF file written by MuJoCo from an example-robot-data URDF, its root body on a free
+    joint: a floating-base robot as MuJoCo itself writes one."""
+    text = re.sub(r"<(visual|collision|gazebo|transmission)\b.*?</\1>", "", urdf.read_text(), flags=re.S)
+    spec = mujoco.MjSpec.from_string(text)
+    spec.worldbody.first_body().add_freejoint(name="root_joint")
+    spec.compile()
+    return spec.to_xml()
+
+
+@pytest.mark.parametrize("name", ["solo12", "talos"])
+def test_floating_base_mjcf_agrees_with_mujoco(name, robots_dir):
+    """A quadruped and a humanoid on free joints: MuJoCo's quaternion order and world-frame linear
+    velocity, converted by robodyn.convert.MujocoLayout."""
+    xml = floating_mjcf(robots_dir / ROBOTS[name][0])
+    model = robodyn.load_mjcf_string(xml, source=f"{name}.xml")
+    mj = rigid_body_only(mujoco.MjModel.from_xml_string(xml))
+    assert model.joint_types[0] == "free"
+    check_against_mujoco(model, mj, 8, name, states=2)
 
 
 MJCF_FEATURES = """<mujoco model="features">
@@ -126,8 +170,8 @@ MJCF_FEATURES = """<mujoco model="features">
     <body name="a" pos="0 0 0.5" euler="10 20 30" childclass="heavy">
       <inertial pos="0.1 0 0" mass="2" diaginertia="0.1 0.2 0.3" axisangle="1 1 0 30"/>
       <joint name="a1" type="hinge" pos="0.1 0.2 0" axis="0 0 1"/>
-      <joint name="a2" type="hinge" pos="-0.1 0 0.3" axis="0 1 0"/>
-      <joint name="a3" type="slide" axis="1 0 1" range="-0.2 0.2"/>
+      <joint name="a2" type="hinge" pos="-0.1 0 0.3" axis="0 1 0" ref="20" stiffness="4" springref="-10"/>
+      <joint name="a3" type="slide" axis="1 0 1" range="-0.2 0.2" ref="0.05" stiffness="7" springref="0.1"/>
       <body name="b" pos="0.3 0 0" xyaxes="0 1 0 -1 0 0">
         <inertial pos="0 0 0.1" mass="1" fullinertia="0.05 0.04 0.03 0.001 0.002 0.003"/>
         <joint name="b1" class="main"/>
@@ -144,26 +188,117 @@ MJCF_FEATURES = """<mujoco model="features">
 
 def test_mjcf_orientations_defaults_and_joint_chains_agree_with_mujoco():
     """Every orientation form, degrees, eulerseq, classes and childclass, several joints in one
-    body with their own pos, a ball joint off the body origin, sites."""
+    body with their own pos and ref, a ball joint off the body origin, sites, springs."""
     model = robodyn.load_mjcf_string(MJCF_FEATURES)
-    mj = rigid_body_only(mujoco.MjModel.from_xml_string(MJCF_FEATURES))
+    mj = mujoco.MjModel.from_xml_string(MJCF_FEATURES)
     assert model.joint_names == ["a1", "a2", "a3", "b1", "c1"]
+    np.testing.assert_allclose(model.stiffness, np.repeat(mj.jnt_stiffness, [1, 1, 1, 1, 3]))
+    mj = rigid_body_only(mj)
     np.testing.assert_allclose(model.armature, mj.dof_armature)
     np.testing.assert_allclose(model.gravity, mj.opt.gravity)
-    data = mujoco.MjData(mj)
-    rng = np.random.default_rng(2)
-    for seed in range(3):
-        q = model.random_configuration(seed=seed)
-        v, a, tau = (rng.uniform(-1, 1, model.nv) for _ in range(3))
-        qpos = np.concatenate([q[:4], np.roll(q[4:8], 1)])  # the ball's quaternion, w first
-        check_dynamics(model, mj, data, q, qpos, v, a, tau, "features")
-        check_frames(model, mj, data, q, qpos, "features")
+    layout = MujocoLayout(model, mj)
+    np.testing.assert_allclose(layout.q_to_mujoco(model.spring_reference), mj.qpos_spring, atol=1e-15)
+    check_against_mujoco(model, mj, 2, "features")
+
+
+MJCF_GEOMS = """<mujoco model="geoms">
+  <compiler angle="radian" inertiagrouprange="0 3"/>
+  <default>
+    <geom density="500"/>
+    <default class="light"><geom density="100"/></default>
+    <default class="visual"><geom group="4" type="box" size="1 1 1"/></default>
+  </default>
+  <worldbody>
+    <geom name="floor" type="plane" size="0 0 1"/>
+    <body name="a" pos="0 0 1">
+      <joint name="a1" axis="0 1 0"/>
+      <geom type="sphere" size="0.1" pos="0.2 0 0"/>
+      <geom type="capsule" size="0.05" fromto="0 0 0 0.3 0.1 -0.2" class="light"/>
+      <geom class="visual"/>
+      <frame pos="0 0.1 0" euler="0.3 0 0.2">
+        <geom type="box" size="0.1 0.05 0.02" pos="0.1 0 0" euler="0.1 0.2 0.3" mass="2"/>
+        <site name="in_frame" pos="0.1 0.1 0"/>
+      </frame>
+      <body name="b" pos="0.3 0.1 -0.2">
+        <joint name="b1" axis="1 0 0" ref="0.4"/>
+        <geom type="ellipsoid" size="0.1 0.05 0.03" quat="1 0.2 0.3 0.1"/>
+        <geom type="cylinder" size="0.04 0.1" pos="0 0 -0.1" axisangle="1 0 0 0.5"/>
+        <geom type="box" fromto="0 0 0 0 0.2 0" size="0.02 0.03"/>
+        <frame pos="0 0 -0.2" xyaxes="0 1 0 -1 0 0">
+          <body name="c">
+            <joint name="c1" type="slide" axis="0 0 1"/>
+            <geom type="cylinder" fromto="0 0 0 0.1 0 0.1" size="0.03"/>
+          </body>
+        </frame>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>"""
+
+
+def test_mjcf_inertia_from_geoms_agrees_with_mujoco():
+    """Bodies without <inertial> get MuJoCo's inertia from their primitive geoms: every type,
+    `fromto`, density from classes, an explicit mass, geoms inside a <frame>, a group outside
+    inertiagrouprange; joints with `ref`; bodies and sites inside frames."""
+    model = robodyn.load_mjcf_string(MJCF_GEOMS)
+    mj = rigid_body_only(mujoco.MjModel.from_xml_string(MJCF_GEOMS))
+    assert model.joint_names == ["a1", "b1", "c1"]
+    check_against_mujoco(model, mj, 3, "geoms")
+
+
+def test_mjcf_inertiafromgeom_true_and_false():
+    """`inertiafromgeom="true"` ignores <inertial>; "false" ignores geoms."""
+    body = "<body name='a'><joint name='a1'/><inertial mass='1' diaginertia='0.1 0.1 0.1' pos='0.5 0 0'/><geom size='0.1 0.2 0.3' type='box'/></body>"
+    for setting in ["true", "false"]:
+        text = f"<mujoco><compiler inertiafromgeom='{setting}'/><worldbody>{body}</worldbody></mujoco>"
+        model = robodyn.load_mjcf_string(text)
+        mj = rigid_body_only(mujoco.MjModel.from_xml_string(text))
+        check_against_mujoco(model, mj, 1, f"inertiafromgeom={setting}", states=1)
+
+
+def test_mjcf_include(tmp_path):
+    """<include> splices the included file's <mujoco> children in place, in the main file's
+    sections and inside a body; errors name the included file."""
+    (tmp_path / "parts").mkdir()
+    (tmp_path / "parts" / "defaults.xml").write_text("<mujoco><default><joint damping='2' axis='0 1 0'/></default></mujoco>")
+    (tmp_path / "arm.xml").write_text(
+        "<mujoco><body name='forearm' pos='0.3 0 0'><joint name='elbow'/>"
+        "<inertial mass='1' pos='0.15 0 0' diaginertia='0.01 0.01 0.001'/><site name='tip' pos='0.3 0 0'/></body></mujoco>"
+    )
+    main = tmp_path / "robot.xml"
+    main.write_text(
+        "<mujoco model='included'><include file='parts/defaults.xml'/><worldbody>"
+        "<body name='upper' pos='0 0 1'><joint name='shoulder'/><inertial mass='2' pos='0.15 0 0' diaginertia='0.02 0.02 0.002'/>"
+        "<include file='arm.xml'/></body></worldbody></mujoco>"
+    )
+    model = robodyn.load(main)
+    mj = rigid_body_only(mujoco.MjModel.from_xml_path(str(main)))
+    assert model.joint_names == ["shoulder", "elbow"]
+    np.testing.assert_array_equal(model.damping, [2.0, 2.0])
+    check_against_mujoco(model, mj, 4, "include")
+    (tmp_path / "arm.xml").write_text("<mujoco><body name='forearm'><joint type='screw'/></body></mujoco>")
+    with pytest.raises(ValueError, match=r"arm\.xml: <body name='forearm'>/<joint>.*unknown joint type 'screw'"):
+        robodyn.load(main)
+    (tmp_path / "twice.xml").write_text("<mujoco><include file='parts/defaults.xml'/><include file='parts/defaults.xml'/></mujoco>")
+    with pytest.raises(ValueError, match="included more than once"):
+        robodyn.load(tmp_path / "twice.xml")
+    (tmp_path / "missing.xml").write_text("<mujoco><include file='nowhere.xml'/></mujoco>")
+    with pytest.raises(FileNotFoundError, match="nowhere.xml"):
+        robodyn.load(tmp_path / "missing.xml")
 
 
 @pytest.mark.parametrize(
     ("text", "message"),
     [
-        ("<mujoco><worldbody><body name='x'><geom size='0.1'/><joint/></body></worldbody></mujoco>", "<body name='x'>.*inertia from geoms"),
+        ("<mujoco><worldbody><body name='x'><geom type='mesh' mesh='m'/><joint/></body></worldbody></mujoco>", "<body name='x'>/<geom>.*mesh geom needs its file.*<inertial>"),
+        ("<mujoco><worldbody><body name='x'><geom type='plane' size='1 1 1'/><joint/></body></worldbody></mujoco>", "'plane' geom has no volume"),
+        ("<mujoco><worldbody><body name='x'><geom type='box' size='0.1 0.1'/><joint/></body></worldbody></mujoco>", "a box needs 3 positive numbers"),
+        ("<mujoco><worldbody><body name='x'><geom type='sphere' fromto='0 0 0 1 0 0' size='0.1'/><joint/></body></worldbody></mujoco>", "'fromto'"),
+        ("<mujoco><include file='robot.xml'/></mujoco>", "<include>.*load the model from its file"),
+        ("<mujoco><compiler settotalmass='3'/></mujoco>", "'settotalmass' is not supported"),
+        ("<mujoco><worldbody><replicate count='2'/></worldbody></mujoco>", "<replicate> is not supported"),
+        ("<mujoco><worldbody><frame><joint/></frame></worldbody></mujoco>", "not in a <frame>"),
+        ("<mujoco><worldbody><body name='x'><inertial mass='1' diaginertia='1 1 1'/><joint type='ball' ref='1'/></body></worldbody></mujoco>", "'ref': only hinge and slide"),
         ("<mujoco><worldbody><body name='x'><inertial mass='1' diaginertia='1 1 1'/><joint type='screw'/></body></worldbody></mujoco>", "unknown joint type 'screw'"),
         ("<mujoco><default><default><joint/></default></default></mujoco>", "needs a 'class'"),
         ("<mujoco><worldbody><body name='x' quat='0 0 0 0'/></worldbody></mujoco>", "non-zero quaternion"),

@@ -579,6 +579,20 @@ impl PyModel {
         vector_array(py, self.model.friction.as_slice())
     }
 
+    /// Joint spring stiffness per velocity coordinate (MJCF `stiffness`), not applied by the
+    /// dynamics calls.
+    #[getter]
+    fn stiffness<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.stiffness.as_slice())
+    }
+
+    /// The configuration at which the joint springs are relaxed, shape (nq,) (MJCF `springref`;
+    /// neutral for spherical and free joints).
+    #[getter]
+    fn spring_reference<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.spring_reference.as_slice())
+    }
+
     /// URDF mimic relations as (joint, mimicked joint, multiplier, offset):
     /// q[joint] = multiplier * q[mimicked] + offset. Reported, not enforced.
     #[getter]

@@ -52,6 +52,10 @@ pub struct JointProperties {
     pub armature: f64,
     pub damping: f64,
     pub friction: f64,
+    /// Joint spring stiffness (MJCF `stiffness`), pulling q towards `spring_reference`.
+    pub stiffness: f64,
+    /// The position at which the spring is relaxed (MJCF `springref`); one-coordinate joints only.
+    pub spring_reference: f64,
 }
 
 impl Default for JointProperties {
@@ -64,6 +68,8 @@ impl Default for JointProperties {
             armature: 0.0,
             damping: 0.0,
             friction: 0.0,
+            stiffness: 0.0,
+            spring_reference: 0.0,
         }
     }
 }
@@ -105,6 +111,11 @@ pub struct Model {
     /// dynamics algorithms do not apply them).
     pub damping: DVector<f64>,
     pub friction: DVector<f64>,
+    /// Joint springs: stiffness per velocity coordinate and the configuration where they are
+    /// relaxed, length nq (the neutral configuration for spherical and free joints). Kept for
+    /// simulation, like damping and friction.
+    pub stiffness: DVector<f64>,
+    pub spring_reference: DVector<f64>,
     /// Named frames: one per link, moving or merged.
     pub frames: Vec<Frame>,
     /// Gravitational acceleration in world axes.
@@ -313,6 +324,8 @@ impl ModelBuilder {
                 armature: DVector::zeros(0),
                 damping: DVector::zeros(0),
                 friction: DVector::zeros(0),
+                stiffness: DVector::zeros(0),
+                spring_reference: DVector::zeros(0),
                 frames: Vec::new(),
                 gravity: Vec3::new(0.0, 0.0, -STANDARD_GRAVITY),
                 mimics: Vec::new(),
@@ -377,6 +390,11 @@ impl ModelBuilder {
         extend(&mut m.armature, nv, properties.armature);
         extend(&mut m.damping, nv, properties.damping);
         extend(&mut m.friction, nv, properties.friction);
+        extend(&mut m.stiffness, nv, properties.stiffness);
+        extend(&mut m.spring_reference, nq, properties.spring_reference);
+        if nq > 1 {
+            joint.neutral(&mut m.spring_reference.as_mut_slice()[m.nq - nq..]);
+        }
         m.frames.push(Frame {
             name: name.to_string(),
             body: index,

@@ -86,7 +86,7 @@ fn tree_classes_and_degrees() {
 #[test]
 fn errors_name_element_and_line() {
     let cases = [
-        ("<mujoco><worldbody>\n<body name='x'><geom size='1'/></body></worldbody></mujoco>", "<body name='x'> (line 2): no <inertial>"),
+        ("<mujoco><worldbody>\n<body name='x'><geom type='mesh' mesh='m'/></body></worldbody></mujoco>", "<body name='x'>/<geom> (line 2): the inertia of a mesh geom needs its file"),
         ("<mujoco><compiler angle='grad'/></mujoco>", "attribute 'angle'"),
         ("<mujoco><worldbody><body name='x'><body name='y'><freejoint/><inertial mass='1' diaginertia='1 1 1'/></body></body></worldbody></mujoco>", "a free joint must be"),
         ("<mujoco><worldbody><body name='x'><inertial mass='-1' diaginertia='1 1 1'/></body></worldbody></mujoco>", "mass >= 0"),
@@ -99,4 +99,25 @@ fn errors_name_element_and_line() {
             "got: {message}\nexpected: {expected}"
         );
     }
+}
+
+#[test]
+fn inertia_from_a_sphere_and_a_box_geom() {
+    // a sphere of radius r and a box of half-sides a, b, c at density ρ:
+    // m = ρ 4/3 π r³, I = 2/5 m r²; m = 8 ρ abc, I_xx = m (b² + c²) / 3
+    let text = "<mujoco><worldbody>
+        <body name='ball'><joint/><geom type='sphere' size='0.1' density='2000'/></body>
+        <body name='brick'><joint/><geom type='box' size='0.1 0.2 0.3' pos='1 0 0'/></body>
+      </worldbody></mujoco>";
+    let model = load_mjcf_str(text, "geoms.xml").unwrap();
+    let ball = &model.inertias[1];
+    let mass = 2000.0 * 4.0 / 3.0 * std::f64::consts::PI * 0.1f64.powi(3);
+    assert!((ball.mass - mass).abs() < 1e-12);
+    assert!((ball.rotational[(0, 0)] - 0.4 * mass * 0.01).abs() < 1e-14);
+    let brick = &model.inertias[2];
+    let mass = 8.0 * 1000.0 * 0.1 * 0.2 * 0.3;
+    assert!((brick.mass - mass).abs() < 1e-12);
+    assert!((brick.com() - nalgebra::Vector3::new(1.0, 0.0, 0.0)).norm() < 1e-14);
+    // about the body origin: I_xx is unchanged by a shift along x
+    assert!((brick.rotational[(0, 0)] - mass * (0.04 + 0.09) / 3.0).abs() < 1e-12);
 }

@@ -1,21 +1,35 @@
 //! MJCF loader (MuJoCo's XML, <https://mujoco.readthedocs.io/en/stable/XMLreference.html>), the
 //! part that describes a robot's rigid-body tree.
 //!
-//! Reads `<compiler angle eulerseq>`, `<option gravity>`, `<default>` classes (nested, with
-//! `class` and `childclass`), and in `<worldbody>` nested `<body>`s with `pos` and any orientation
-//! (`quat` w-first, `axisangle`, `euler`, `xyaxes`, `zaxis`), `<inertial>` (`mass`, `pos`,
-//! orientation, `diaginertia` or `fullinertia`), `<joint>` (`hinge`, `slide`, `ball`, `free`; `pos`,
-//! `axis`, `range`, `armature`, `damping`, `frictionloss`), `<freejoint>` and `<site>`s. Bodies and
-//! sites become frames; a body without joints is merged into its parent; several joints in one
-//! body become a chain of massless bodies, applied in order as MuJoCo does. A free joint's q is
-//! the body's pose in the world (the XML pose is only MuJoCo's initial qpos).
+//! Reads `<include file>` (resolved against the main file's folder, each file once),
+//! `<compiler angle eulerseq inertiafromgeom inertiagrouprange>`, `<option gravity>`, `<default>`
+//! classes (nested, with `class` and `childclass`), and in `<worldbody>` nested `<body>`s with `pos`
+//! and any orientation (`quat` w-first, `axisangle`, `euler`, `xyaxes`, `zaxis`), `<inertial>`
+//! (`mass`, `pos`, orientation, `diaginertia` or `fullinertia`), `<geom>`s for the inertia of a body
+//! without `<inertial>`, `<joint>` (`hinge`, `slide`, `ball`, `free`; `pos`, `axis`, `ref`, `range`,
+//! `armature`, `damping`, `frictionloss`, `stiffness`, `springref`), `<freejoint>` and `<site>`s.
+//! Bodies and sites become frames; a body without joints is merged into its parent; several joints
+//! in one body become a chain of massless bodies, applied in order as MuJoCo does. A free joint's
+//! q is the body's pose in the world (the XML pose is only MuJoCo's initial qpos).
 //! Not read (a warning each): actuators, sensors, contacts, equality constraints, tendons,
-//! keyframes, assets. A body whose inertia would come from its geoms is an error naming it
-//! (inertia from geoms is not implemented yet).
+//! keyframes, assets. A mesh geom cannot give a body its inertia here (the mesh file is not read):
+//! such a body needs an `<inertial>`, and the error says so.
+//!
+//! Inertia from geoms, as MuJoCo's compiler computes it: each primitive is a solid of uniform
+//! density (`density`, default 1000 kg/m³, or the geom's `mass`; with `fromto`, the segment is the
+//! z axis, and a box or ellipsoid on it has x and y half-sizes both `size[0]`) whose principal
+//! moments about its centre are, with m its mass,
+//!   sphere of radius r:            ⅖ m r² (all three)
+//!   ellipsoid of semi-axes a,b,c:  m(b²+c²)/5, m(a²+c²)/5, m(a²+b²)/5
+//!   box of half-sides a,b,c:       m(b²+c²)/3, m(a²+c²)/3, m(a²+b²)/3
+//!   cylinder, radius r, length L:  m(3r²+L²)/12 across, m r²/2 along its axis
+//!   capsule, cylinder (mass m_c, length L) and two hemispheres (together a sphere of mass m_s):
+//!     across m_c(L²/12 + r²/4) + m_s(2r²/5 + L²/4 + 3Lr/8), along m_c r²/2 + m_s 2r²/5
+//! and the body's inertia is their sum, each shifted from its own pose (parallel-axis theorem).
 
 use crate::error::{Error, Result};
 use crate::io::read_model_file;
-use crate::io::xml::{location, parse_numbers};
+use crate::io::xml::{location, parse_number_list, parse_numbers};
 use crate::joint::Joint;
 use crate::model::{
     check_mass_and_inertia, check_positive_semidefinite, JointProperties, Model, ModelBuilder,
@@ -24,8 +38,9 @@ use crate::model::{
 use crate::spatial::{Inertia, Mat3, Transform, Vec3};
 use nalgebra::{Rotation3, Unit, UnitQuaternion};
 use roxmltree::{Document, Node};
-use std::collections::HashMap;
-use std::path::Path;
+use std::collections::{HashMap, HashSet};
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
 
 /// Sections of an MJCF file that do not describe the tree.
 const IGNORED_SECTIONS: [&str; 9] = [
@@ -40,33 +55,204 @@ const IGNORED_SECTIONS: [&str; 9] = [
     "statistic",
 ];
 
-/// Loads an MJCF file.
+/// MuJoCo's default geom density, kg/m³ (water).
+const DEFAULT_DENSITY: f64 = 1000.0;
+
+/// Loads an MJCF file and the files it includes.
 pub fn load_mjcf_file(path: &Path) -> Result<Model> {
-    let text = read_model_file(path)?;
-    load_mjcf_str(&text, &path.display().to_string())
+    let main = SourceFile {
+        source: path.display().to_string(),
+        text: read_model_file(path)?,
+    };
+    let folder = path.parent().unwrap_or(Path::new("."));
+    load_sources(&gather_includes(main, Some(folder))?)
 }
 
-/// Loads an MJCF document held in `text`; `source` names it in error messages.
+/// Loads an MJCF document held in `text`; `source` names it in error messages. `<include>` needs
+/// a file to resolve against: use [`load_mjcf_file`].
 pub fn load_mjcf_str(text: &str, source: &str) -> Result<Model> {
-    let document =
-        Document::parse(text).map_err(|e| Error::model(source, format!("malformed XML: {e}")))?;
-    let root = document.root_element();
+    let main = SourceFile {
+        source: source.to_string(),
+        text: text.to_string(),
+    };
+    load_sources(&gather_includes(main, None)?)
+}
+
+/// One file's text and the name errors give it.
+struct SourceFile {
+    source: String,
+    text: String,
+}
+
+/// The main file (first) and the files it includes, with where each `<include>` stands:
+/// (file index, the element's byte offset) -> index of the included file.
+struct Sources {
+    files: Vec<SourceFile>,
+    includes: HashMap<(usize, usize), usize>,
+}
+
+fn parse(file: &SourceFile) -> Result<Document<'_>> {
+    Document::parse(&file.text)
+        .map_err(|e| Error::model(&file.source, format!("malformed XML: {e}")))
+}
+
+/// Reads every file reachable through `<include file>` from `main`, breadth first.
+fn gather_includes(main: SourceFile, folder: Option<&Path>) -> Result<Sources> {
+    let mut sources = Sources {
+        files: vec![main],
+        includes: HashMap::new(),
+    };
+    let mut seen: HashSet<PathBuf> = HashSet::new();
+    let mut next = 0;
+    while next < sources.files.len() {
+        let file = &sources.files[next];
+        let document = parse(file)?;
+        let mut found = Vec::new();
+        for include in document.descendants().filter(|n| n.has_tag_name("include")) {
+            let error =
+                |message: &str| Error::model(location(&file.source, &document, include), message);
+            let name = include
+                .attribute("file")
+                .ok_or_else(|| error("missing attribute 'file'"))?;
+            let folder = folder.ok_or_else(|| {
+                error("<include> is resolved against the model's folder: load the model from its file")
+            })?;
+            let path = folder.join(name);
+            if !seen.insert(path.clone()) {
+                return Err(error(&format!("'{name}' is included more than once")));
+            }
+            found.push((include.range().start, path));
+        }
+        drop(document);
+        for (offset, path) in found {
+            let text = read_model_file(&path)?;
+            sources.includes.insert((next, offset), sources.files.len());
+            sources.files.push(SourceFile {
+                source: path.display().to_string(),
+                text,
+            });
+        }
+        next += 1;
+    }
+    Ok(sources)
+}
+
+fn load_sources(sources: &Sources) -> Result<Model> {
+    let documents = sources
+        .files
+        .iter()
+        .map(parse)
+        .collect::<Result<Vec<Document>>>()?;
+    let root = documents[0].root_element();
     let mut reader = Reader {
-        source,
-        document: &document,
+        sources,
+        documents: &documents,
         degrees: true,
         euler_sequence: "xyz".to_string(),
+        inertia_from_geoms: InertiaFromGeoms::Auto,
+        inertia_groups: (0, 5),
         defaults: HashMap::new(),
     };
     if !root.has_tag_name("mujoco") {
         return Err(reader.error(root, "expected the root element <mujoco>"));
     }
-    for compiler in root.children().filter(|c| c.has_tag_name("compiler")) {
+    let sections = reader.children(root)?;
+    for compiler in sections.iter().filter(|c| c.has_tag_name("compiler")) {
+        reader.read_compiler(*compiler)?;
+    }
+    for default in sections.iter().filter(|c| c.has_tag_name("default")) {
+        reader.read_defaults(*default, None)?;
+    }
+    let mut builder = ModelBuilder::new(root.attribute("model").unwrap_or("mjcf"), "world");
+    builder.add_frame("world", 0, Transform::IDENTITY);
+    for option in sections.iter().filter(|c| c.has_tag_name("option")) {
+        if let Some(text) = option.attribute("gravity") {
+            let gravity =
+                parse_numbers::<3>(text, "gravity").map_err(|m| reader.error(*option, m))?;
+            builder.gravity(Vec3::from(gravity));
+        }
+    }
+    for section in &sections {
+        if IGNORED_SECTIONS.contains(&section.tag_name().name()) {
+            builder.warn(format!(
+                "{}: not read (robodyn models the rigid-body tree only)",
+                reader.location(*section)
+            ));
+        }
+    }
+    for world in sections.iter().filter(|c| c.has_tag_name("worldbody")) {
+        reader.read_children(&mut builder, *world, 0, Transform::IDENTITY, "main")?;
+    }
+    Ok(builder.build())
+}
+
+/// `<compiler inertiafromgeom>`: where a body's inertia comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum InertiaFromGeoms {
+    /// From `<inertial>` when the body has one, else from its geoms (MuJoCo's default).
+    Auto,
+    /// Always from the geoms.
+    Always,
+    /// Only from `<inertial>`; a body without one is massless.
+    Never,
+}
+
+struct Reader<'a> {
+    sources: &'a Sources,
+    documents: &'a [Document<'a>],
+    degrees: bool,
+    euler_sequence: String,
+    inertia_from_geoms: InertiaFromGeoms,
+    /// geoms whose `group` lies outside this range give no inertia (`inertiagrouprange`)
+    inertia_groups: (i64, i64),
+    /// class -> element tag -> attribute -> value, each class holding its parents' values too
+    defaults: HashMap<String, HashMap<String, HashMap<String, String>>>,
+}
+
+impl<'a> Reader<'a> {
+    /// Which file `node` belongs to.
+    fn file_index(&self, node: Node) -> usize {
+        self.documents
+            .iter()
+            .position(|d| std::ptr::eq(d, node.document()))
+            .unwrap_or(0)
+    }
+
+    fn location(&self, node: Node) -> String {
+        let index = self.file_index(node);
+        location(
+            &self.sources.files[index].source,
+            &self.documents[index],
+            node,
+        )
+    }
+
+    /// The child elements of `node`, each `<include>` replaced by the children of the included
+    /// file's `<mujoco>` root.
+    fn children(&self, node: Node<'a, 'a>) -> Result<Vec<Node<'a, 'a>>> {
+        let mut children = Vec::new();
+        for child in node.children().filter(|c| c.is_element()) {
+            if !child.has_tag_name("include") {
+                children.push(child);
+                continue;
+            }
+            let included = self.sources.includes[&(self.file_index(child), child.range().start)];
+            let root = self.documents[included].root_element();
+            if !root.has_tag_name("mujoco") {
+                return Err(self.error(root, "an included file's root element must be <mujoco>"));
+            }
+            children.extend(self.children(root)?);
+        }
+        Ok(children)
+    }
+
+    /// `<compiler>`: angle unit, Euler sequence, where inertias come from.
+    fn read_compiler(&mut self, compiler: Node<'a, 'a>) -> Result<()> {
         match compiler.attribute("angle") {
-            None | Some("degree") => {}
-            Some("radian") => reader.degrees = false,
+            None | Some("degree") => self.degrees = true,
+            Some("radian") => self.degrees = false,
             Some(other) => {
-                return Err(reader.error(
+                return Err(self.error(
                     compiler,
                     format!("attribute 'angle': expected degree or radian, got '{other}'"),
                 ))
@@ -74,53 +260,49 @@ pub fn load_mjcf_str(text: &str, source: &str) -> Result<Model> {
         }
         if let Some(sequence) = compiler.attribute("eulerseq") {
             if sequence.len() != 3 || !sequence.chars().all(|c| "xyzXYZ".contains(c)) {
-                return Err(reader.error(
+                return Err(self.error(
                     compiler,
                     format!("attribute 'eulerseq': expected three of xyzXYZ, got '{sequence}'"),
                 ));
             }
-            reader.euler_sequence = sequence.to_string();
+            self.euler_sequence = sequence.to_string();
         }
-    }
-    for default in root.children().filter(|c| c.has_tag_name("default")) {
-        reader.read_defaults(default, None)?;
-    }
-    let mut builder = ModelBuilder::new(root.attribute("model").unwrap_or("mjcf"), "world");
-    builder.add_frame("world", 0, Transform::IDENTITY);
-    for option in root.children().filter(|c| c.has_tag_name("option")) {
-        if let Some(text) = option.attribute("gravity") {
-            let gravity =
-                parse_numbers::<3>(text, "gravity").map_err(|m| reader.error(option, m))?;
-            builder.gravity(Vec3::from(gravity));
+        self.inertia_from_geoms = match compiler.attribute("inertiafromgeom") {
+            None | Some("auto") => InertiaFromGeoms::Auto,
+            Some("true") => InertiaFromGeoms::Always,
+            Some("false") => InertiaFromGeoms::Never,
+            Some(other) => {
+                return Err(self.error(
+                    compiler,
+                    format!(
+                        "attribute 'inertiafromgeom': expected auto, true or false, got '{other}'"
+                    ),
+                ))
+            }
+        };
+        if let Some(text) = compiler.attribute("inertiagrouprange") {
+            let [low, high] = parse_numbers::<2>(text, "inertiagrouprange")
+                .map_err(|m| self.error(compiler, m))?;
+            self.inertia_groups = (low as i64, high as i64);
         }
-    }
-    for section in root.children().filter(|c| c.is_element()) {
-        let tag = section.tag_name().name();
-        if IGNORED_SECTIONS.contains(&tag) {
-            builder.warn(format!(
-                "{}: not read (robodyn models the rigid-body tree only)",
-                reader.location(section)
-            ));
+        // these rewrite the file's masses and inertias: refuse rather than differ from MuJoCo
+        for unsupported in [
+            "settotalmass",
+            "boundmass",
+            "boundinertia",
+            "balanceinertia",
+        ] {
+            if compiler
+                .attribute(unsupported)
+                .is_some_and(|v| !matches!(v, "0" | "-1" | "false"))
+            {
+                return Err(self.error(
+                    compiler,
+                    format!("attribute '{unsupported}' is not supported: it changes the model's inertias"),
+                ));
+            }
         }
-    }
-    for world in root.children().filter(|c| c.has_tag_name("worldbody")) {
-        reader.read_children(&mut builder, world, 0, Transform::IDENTITY, "main")?;
-    }
-    Ok(builder.build())
-}
-
-struct Reader<'a> {
-    source: &'a str,
-    document: &'a Document<'a>,
-    degrees: bool,
-    euler_sequence: String,
-    /// class -> element tag -> attribute -> value, each class holding its parents' values too
-    defaults: HashMap<String, HashMap<String, HashMap<String, String>>>,
-}
-
-impl<'a> Reader<'a> {
-    fn location(&self, node: Node) -> String {
-        location(self.source, self.document, node)
+        Ok(())
     }
 
     fn error(&self, node: Node, message: impl Into<String>) -> Error {
@@ -128,7 +310,7 @@ impl<'a> Reader<'a> {
     }
 
     /// A `<default>` element and its nested classes.
-    fn read_defaults(&mut self, node: Node, parent: Option<&str>) -> Result<()> {
+    fn read_defaults(&mut self, node: Node<'a, 'a>, parent: Option<&str>) -> Result<()> {
         let class = match (node.attribute("class"), parent) {
             (Some(class), _) => class.to_string(),
             (None, None) => "main".to_string(),
@@ -138,10 +320,8 @@ impl<'a> Reader<'a> {
             .and_then(|p| self.defaults.get(p))
             .cloned()
             .unwrap_or_default();
-        for element in node
-            .children()
-            .filter(|c| c.is_element() && !c.has_tag_name("default"))
-        {
+        let elements = self.children(node)?;
+        for element in elements.iter().filter(|c| !c.has_tag_name("default")) {
             let entry = values
                 .entry(element.tag_name().name().to_string())
                 .or_default();
@@ -150,8 +330,8 @@ impl<'a> Reader<'a> {
             }
         }
         self.defaults.insert(class.clone(), values);
-        for child in node.children().filter(|c| c.has_tag_name("default")) {
-            self.read_defaults(child, Some(&class))?;
+        for child in elements.iter().filter(|c| c.has_tag_name("default")) {
+            self.read_defaults(*child, Some(&class))?;
         }
         Ok(())
     }
@@ -167,6 +347,26 @@ impl<'a> Reader<'a> {
             .get(node.tag_name().name())?
             .get(name)
             .cloned()
+    }
+
+    /// The class named by `node`'s `attribute` (`class`: the one it takes its defaults from;
+    /// `childclass`: the one its children default to), else `class`; an unknown class is an error.
+    fn declared_class<'c>(
+        &self,
+        node: Node<'a, 'a>,
+        attribute: &str,
+        class: &'c str,
+    ) -> Result<&'c str>
+    where
+        'a: 'c,
+    {
+        match node.attribute(attribute) {
+            Some(own) if !self.defaults.contains_key(own) => {
+                Err(self.error(node, format!("unknown class '{own}'")))
+            }
+            Some(own) => Ok(own),
+            None => Ok(class),
+        }
     }
 
     fn numbers<const N: usize>(
@@ -261,17 +461,49 @@ impl<'a> Reader<'a> {
         ))
     }
 
-    /// The spatial inertia of a body, in its frame, from `<inertial>`.
-    fn inertia(&self, body: Node<'a, 'a>, class: &str) -> Result<Inertia> {
-        let Some(inertial) = body.children().find(|c| c.has_tag_name("inertial")) else {
-            if body.children().any(|c| c.has_tag_name("geom")) {
-                return Err(self.error(
-                    body,
-                    "no <inertial>: inertia from geoms (MuJoCo's inertiafromgeom) is not implemented; add an <inertial>",
-                ));
+    /// The spatial inertia of a body, in its frame: from `<inertial>` or from its geoms, as
+    /// `<compiler inertiafromgeom>` says.
+    fn body_inertia(
+        &self,
+        body: Node<'a, 'a>,
+        elements: &[Node<'a, 'a>],
+        class: &str,
+    ) -> Result<Inertia> {
+        let inertial = elements.iter().find(|c| c.has_tag_name("inertial"));
+        match (self.inertia_from_geoms, inertial) {
+            (InertiaFromGeoms::Never, None) => Ok(Inertia::ZERO),
+            (InertiaFromGeoms::Auto | InertiaFromGeoms::Never, Some(inertial)) => {
+                self.inertial(*inertial, class)
             }
-            return Ok(Inertia::ZERO);
-        };
+            (InertiaFromGeoms::Always, _) | (InertiaFromGeoms::Auto, None) => {
+                let total = self.geoms_inertia(elements, class)?;
+                check_mass_and_inertia(total.mass, &Mat3::zeros())
+                    .map_err(|m| self.error(body, m))?;
+                Ok(total)
+            }
+        }
+    }
+
+    /// The inertia of the geoms among `elements` and inside their `<frame>`s, in the frame the
+    /// elements are written in.
+    fn geoms_inertia(&self, elements: &[Node<'a, 'a>], class: &str) -> Result<Inertia> {
+        let mut total = Inertia::ZERO;
+        for element in elements {
+            if element.has_tag_name("geom") {
+                total += self.geom_inertia(*element, class)?;
+            } else if element.has_tag_name("frame") {
+                let inner_class = self.declared_class(*element, "childclass", class)?;
+                let inside = self.geoms_inertia(&self.children(*element)?, inner_class)?;
+                total += self
+                    .placement(*element, class)?
+                    .transpose_apply_inertia(&inside);
+            }
+        }
+        Ok(total)
+    }
+
+    /// `<inertial>`: mass, centre of mass and the inertia about it, in the body's frame.
+    fn inertial(&self, inertial: Node<'a, 'a>, class: &str) -> Result<Inertia> {
         let mass = self
             .numbers::<1>(inertial, class, "mass")?
             .ok_or_else(|| self.error(inertial, "missing attribute 'mass'"))?[0];
@@ -286,12 +518,152 @@ impl<'a> Reader<'a> {
                 return Err(self.error(inertial, "expected 'diaginertia' or 'fullinertia'"));
             };
         let frame = self.placement(inertial, class)?;
+        self.inertia_in_body(inertial, mass, &principal, &frame)
+    }
+
+    /// A solid of `mass` whose inertia about its centre, in its own axes, is `principal`, placed
+    /// at `X_{element←body}`: its spatial inertia in the body's frame (I_body = R I Rᵀ at the
+    /// centre, shifted by the parallel-axis theorem inside `Inertia::from_com`).
+    fn inertia_in_body(
+        &self,
+        element: Node<'a, 'a>,
+        mass: f64,
+        principal: &Mat3,
+        frame: &Transform,
+    ) -> Result<Inertia> {
         let rotation = frame.rotation.transpose();
         let inertia_com = rotation * principal * rotation.transpose();
         check_mass_and_inertia(mass, &inertia_com)
             .and_then(|_| check_positive_semidefinite(&inertia_com))
-            .map_err(|m| self.error(inertial, m))?;
+            .map_err(|m| self.error(element, m))?;
         Ok(Inertia::from_com(mass, &frame.translation, &inertia_com))
+    }
+
+    /// The inertia of a primitive `<geom>` of uniform density, in the body's frame.
+    fn geom_inertia(&self, geom: Node<'a, 'a>, class: &str) -> Result<Inertia> {
+        let class = self.declared_class(geom, "class", class)?;
+        let text = |name: &str| self.attribute(geom, class, name);
+        let group = match text("group") {
+            None => 0,
+            Some(g) => g.trim().parse::<i64>().map_err(|_| {
+                self.error(
+                    geom,
+                    format!("attribute 'group': expected an integer, got '{g}'"),
+                )
+            })?,
+        };
+        if group < self.inertia_groups.0 || group > self.inertia_groups.1 {
+            return Ok(Inertia::ZERO);
+        }
+        let given_mass = self.numbers::<1>(geom, class, "mass")?.map(|[m]| m);
+        if given_mass == Some(0.0) {
+            return Ok(Inertia::ZERO);
+        }
+        let kind = text("type").unwrap_or_else(|| "sphere".to_string());
+        let mut size = match text("size") {
+            Some(t) => parse_number_list(&t, "size").map_err(|m| self.error(geom, m))?,
+            None => Vec::new(),
+        };
+        // `fromto`: the geom spans the segment; its axis is z, its half-length the last size
+        let mut frame = self.placement(geom, class)?;
+        if let Some([x1, y1, z1, x2, y2, z2]) = self.numbers::<6>(geom, class, "fromto")? {
+            let (from, to) = (Vec3::new(x1, y1, z1), Vec3::new(x2, y2, z2));
+            let axis = to - from;
+            let half_length = axis.norm() / 2.0;
+            if half_length == 0.0
+                || !matches!(kind.as_str(), "capsule" | "cylinder" | "box" | "ellipsoid")
+            {
+                return Err(self.error(geom, "attribute 'fromto': expected two distinct points on a capsule, cylinder, box or ellipsoid"));
+            }
+            let radius = size.first().copied().unwrap_or(0.0);
+            // a box or ellipsoid along the segment has a square or round section of size[0]
+            size = if matches!(kind.as_str(), "box" | "ellipsoid") {
+                vec![radius, radius, half_length]
+            } else {
+                vec![radius, half_length]
+            };
+            let rotation = Rotation3::rotation_between(&Vec3::z(), &axis)
+                .unwrap_or_else(|| Rotation3::from_axis_angle(&Vec3::x_axis(), PI));
+            frame = Transform::from_pose(rotation.matrix(), &((from + to) / 2.0));
+        }
+        let needed = match kind.as_str() {
+            "sphere" => 1,
+            "capsule" | "cylinder" => 2,
+            "ellipsoid" | "box" => 3,
+            "mesh" | "sdf" => {
+                return Err(self.error(
+                    geom,
+                    format!("the inertia of a {kind} geom needs its file, which robodyn does not read: give the body an <inertial>"),
+                ))
+            }
+            other => {
+                return Err(self.error(
+                    geom,
+                    format!("a '{other}' geom has no volume to give the body an inertia: give the body an <inertial>"),
+                ))
+            }
+        };
+        if size.len() < needed || size[..needed].iter().any(|x| *x <= 0.0) {
+            return Err(self.error(
+                geom,
+                format!("attribute 'size': a {kind} needs {needed} positive numbers, got {size:?}"),
+            ));
+        }
+        // volume, and the principal moments per unit mass about the centre
+        let (volume, per_mass, capsule) = match kind.as_str() {
+            "sphere" => {
+                let r = size[0];
+                (4.0 / 3.0 * PI * r.powi(3), Vec3::repeat(0.4 * r * r), None)
+            }
+            "ellipsoid" => {
+                let (a, b, c) = (size[0], size[1], size[2]);
+                let moments = Vec3::new(b * b + c * c, a * a + c * c, a * a + b * b) / 5.0;
+                (4.0 / 3.0 * PI * a * b * c, moments, None)
+            }
+            "box" => {
+                let (a, b, c) = (size[0], size[1], size[2]);
+                let moments = Vec3::new(b * b + c * c, a * a + c * c, a * a + b * b) / 3.0;
+                (8.0 * a * b * c, moments, None)
+            }
+            "cylinder" => {
+                let (r, length) = (size[0], 2.0 * size[1]);
+                let across = (3.0 * r * r + length * length) / 12.0;
+                (
+                    PI * r * r * length,
+                    Vec3::new(across, across, r * r / 2.0),
+                    None,
+                )
+            }
+            _ => {
+                let (r, length) = (size[0], 2.0 * size[1]);
+                let (cylinder, sphere) = (PI * r * r * length, 4.0 / 3.0 * PI * r.powi(3));
+                (
+                    cylinder + sphere,
+                    Vec3::zeros(),
+                    Some((r, length, cylinder, sphere)),
+                )
+            }
+        };
+        let mass = match given_mass {
+            Some(mass) => mass,
+            None => {
+                self.numbers::<1>(geom, class, "density")?
+                    .map_or(DEFAULT_DENSITY, |[d]| d)
+                    * volume
+            }
+        };
+        let moments = match capsule {
+            // split the mass between the cylinder and the two hemispheres by volume
+            Some((r, length, cylinder, sphere)) => {
+                let (m_c, m_s) = (mass * cylinder / volume, mass * sphere / volume);
+                let across = m_c * (length * length / 12.0 + r * r / 4.0)
+                    + m_s * (0.4 * r * r + length * length / 4.0 + 3.0 * length * r / 8.0);
+                let along = m_c * r * r / 2.0 + m_s * 0.4 * r * r;
+                Vec3::new(across, across, along)
+            }
+            None => per_mass * mass,
+        };
+        self.inertia_in_body(geom, mass, &Mat3::from_diagonal(&moments), &frame)
     }
 
     /// The children of a body element (or the worldbody) attached to model body `body`, whose
@@ -304,14 +676,31 @@ impl<'a> Reader<'a> {
         to_element: Transform,
         class: &str,
     ) -> Result<()> {
-        for site in element.children().filter(|c| c.has_tag_name("site")) {
-            let name = site
-                .attribute("name")
-                .map_or_else(|| format!("site{}", site.range().start), str::to_string);
-            builder.add_frame(&name, body, self.placement(site, class)? * to_element);
-        }
-        for child in element.children().filter(|c| c.has_tag_name("body")) {
-            self.read_body(builder, child, body, to_element, class)?;
+        for child in self.children(element)? {
+            match child.tag_name().name() {
+                "site" => {
+                    let name = child
+                        .attribute("name")
+                        .map_or_else(|| format!("site{}", child.range().start), str::to_string);
+                    builder.add_frame(&name, body, self.placement(child, class)? * to_element);
+                }
+                "body" => self.read_body(builder, child, body, to_element, class)?,
+                // a <frame> only places what it holds: its pose composes with theirs
+                "frame" => {
+                    let to_frame = self.placement(child, class)? * to_element;
+                    let frame_class = self.declared_class(child, "childclass", class)?;
+                    self.read_children(builder, child, body, to_frame, frame_class)?;
+                }
+                "joint" | "freejoint" | "inertial" if element.has_tag_name("frame") => {
+                    return Err(self.error(child, "expected in a <body>, not in a <frame>"));
+                }
+                tag @ ("replicate" | "attach" | "composite" | "flexcomp") => {
+                    return Err(self.error(child, format!("<{tag}> is not supported")));
+                }
+                // joints, inertials and geoms are read with their body; cameras, lights and
+                // plugins are not part of the tree
+                _ => {}
+            }
         }
         Ok(())
     }
@@ -327,18 +716,13 @@ impl<'a> Reader<'a> {
         let name = node
             .attribute("name")
             .map_or_else(|| format!("body{}", node.range().start), str::to_string);
-        let child_class = node.attribute("childclass").unwrap_or(class);
-        if node
-            .attribute("childclass")
-            .is_some_and(|c| !self.defaults.contains_key(c))
-        {
-            return Err(self.error(node, format!("unknown class '{child_class}'")));
-        }
+        let child_class = self.declared_class(node, "childclass", class)?;
         // X_{B←parent body}
         let mut to_body = self.placement(node, class)? * parent_element;
-        let inertia = self.inertia(node, child_class)?;
-        let joints: Vec<Node> = node
-            .children()
+        let elements = self.children(node)?;
+        let inertia = self.body_inertia(node, &elements, child_class)?;
+        let joints: Vec<Node> = elements
+            .into_iter()
             .filter(|c| c.has_tag_name("joint") || c.has_tag_name("freejoint"))
             .collect();
         if joints.is_empty() {
@@ -349,13 +733,7 @@ impl<'a> Reader<'a> {
         let mut body = parent;
         let mut previous_position = Vec3::zeros();
         for (k, joint_node) in joints.iter().enumerate() {
-            let joint_class = joint_node.attribute("class").unwrap_or(child_class);
-            if joint_node
-                .attribute("class")
-                .is_some_and(|c| !self.defaults.contains_key(c))
-            {
-                return Err(self.error(*joint_node, format!("unknown class '{joint_class}'")));
-            }
+            let joint_class = self.declared_class(*joint_node, "class", child_class)?;
             let kind = if joint_node.has_tag_name("freejoint") {
                 "free".to_string()
             } else {
@@ -400,10 +778,20 @@ impl<'a> Reader<'a> {
                     .numbers::<1>(*joint_node, joint_class, key)?
                     .map_or(default, |[x]| x))
             };
+            // a hinge's positions (range, ref, springref) are angles in the compiler's unit
+            let position_unit = |x: f64| {
+                if matches!(joint, Joint::Revolute { .. }) {
+                    self.angle(x)
+                } else {
+                    x
+                }
+            };
             let mut properties = JointProperties {
                 armature: scalar("armature", 0.0)?,
                 damping: scalar("damping", 0.0)?,
                 friction: scalar("frictionloss", 0.0)?,
+                stiffness: scalar("stiffness", 0.0)?,
+                spring_reference: position_unit(scalar("springref", 0.0)?),
                 ..JointProperties::default()
             };
             let limited = self
@@ -413,16 +801,22 @@ impl<'a> Reader<'a> {
                 limited,
                 self.numbers::<2>(*joint_node, joint_class, "range")?,
             ) {
-                let unit = |x: f64| {
-                    if matches!(joint, Joint::Revolute { .. }) {
-                        self.angle(x)
-                    } else {
-                        x
-                    }
-                };
-                properties.lower = unit(lower);
-                properties.upper = unit(upper);
+                properties.lower = position_unit(lower);
+                properties.upper = position_unit(upper);
             }
+            // `ref`: the joint position at which the body has its XML pose, so the joint moves
+            // by q − ref: X_J(q − ref) X_tree = X_J(q) X_J(−ref) X_tree
+            let reference = position_unit(scalar("ref", 0.0)?);
+            let shift_by_reference = match (reference, joint.nq()) {
+                (0.0, _) => Transform::IDENTITY,
+                (_, 1) => joint.transform(&[-reference]),
+                _ => {
+                    return Err(self.error(
+                        *joint_node,
+                        "attribute 'ref': only hinge and slide joints take one",
+                    ))
+                }
+            };
             // a free joint places the body in the world: its XML pose is only MuJoCo's qpos0
             let x_tree = if joint == Joint::Free {
                 if k > 0
@@ -438,9 +832,9 @@ impl<'a> Reader<'a> {
                 Transform::IDENTITY
             } else if k == 0 {
                 // the joint frame sits at `pos` in the body's frame
-                Transform::from_translation(&position) * to_body
+                shift_by_reference * Transform::from_translation(&position) * to_body
             } else {
-                Transform::from_translation(&(position - previous_position))
+                shift_by_reference * Transform::from_translation(&(position - previous_position))
             };
             let joint_name = joint_node
                 .attribute("name")

@@ -24,19 +24,21 @@ pub(crate) fn location(source: &str, document: &Document, node: Node) -> String 
 
 /// `N` finite numbers separated by white space, or a message naming the attribute.
 pub(crate) fn parse_numbers<const N: usize>(text: &str, name: &str) -> Result<[f64; N], String> {
-    let values: Vec<&str> = text.split_whitespace().collect();
-    if values.len() != N {
-        return Err(format!(
-            "attribute '{name}': expected {N} numbers, got '{text}'"
-        ));
-    }
-    let mut out = [0.0; N];
-    for (slot, value) in out.iter_mut().zip(&values) {
-        *slot = value
-            .parse::<f64>()
-            .ok()
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| format!("attribute '{name}': expected finite numbers, got '{text}'"))?;
-    }
-    Ok(out)
+    let values = parse_number_list(text, name)?;
+    values
+        .try_into()
+        .map_err(|_| format!("attribute '{name}': expected {N} numbers, got '{text}'"))
+}
+
+/// Any count of finite numbers separated by white space, or a message naming the attribute.
+pub(crate) fn parse_number_list(text: &str, name: &str) -> Result<Vec<f64>, String> {
+    text.split_whitespace()
+        .map(|value| {
+            value
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| format!("attribute '{name}': expected finite numbers, got '{text}'"))
+        })
+        .collect()
 }
