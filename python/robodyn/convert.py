@@ -108,8 +108,6 @@ class MujocoLayout:
     def __init__(self, model, mj_model):
         self.model, self.mj_model = model, mj_model
         names = [mj_model.joint(j).name for j in range(mj_model.njnt)]
-        if mj_model.nv != model.nv:
-            raise ValueError(f"argument 'mj_model': expected {model.nv} velocity coordinates as the robodyn model has, got {mj_model.nv}")
         self.v_index = np.zeros(model.nv, dtype=int)
         self._joints = []
         for name, kind, iq, iv in zip(model.joint_names, model.joint_types, model.joint_idx_q, model.joint_idx_v):
@@ -120,6 +118,8 @@ class MujocoLayout:
             self._joints.append((kind, iq, iv, mj_iq))
             nv = {"free": 6, "spherical": 3}.get(kind, 1)
             self.v_index[iv : iv + nv] = np.arange(mj_iv, mj_iv + nv)
+        if mj_model.nv != model.nv:
+            raise ValueError(f"argument 'mj_model': expected {model.nv} velocity coordinates as the robodyn model has, got {mj_model.nv}")
 
     def _transform(self, q) -> np.ndarray:
         """T with v_mujoco (in robodyn order) = T v: diag(R, 1) on free joints, 1 elsewhere."""

@@ -120,3 +120,9 @@ def test_mjcf_loader_reads_the_same_robot(floating):
         assert_close(from_mjcf.mass_matrix(q), model.mass_matrix(q), CROSS_CHECK_TOLERANCE, "M")
         assert_close(from_mjcf.bias_forces(q, v), model.bias_forces(q, v), CROSS_CHECK_TOLERANCE, "bias")
         assert_close(from_mjcf.frame_pose(q, "tip"), model.frame_pose(q, "tip"), CROSS_CHECK_TOLERANCE, "tip")
+
+
+def test_mujoco_layout_rejects_a_model_with_more_joints():
+    extra = MJCF.replace('<joint name="ball_joint" type="ball"/>', '<joint name="ball_joint" type="ball"/><joint name="extra"/>')
+    with pytest.raises(ValueError, match="expected 12 velocity coordinates as the robodyn model has, got 13"):
+        MujocoLayout(robodyn.load_mjcf_string(MJCF), mujoco.MjModel.from_xml_string(extra))
