@@ -1,6 +1,7 @@
 //! PyO3 glue for robodyn: argument conversion, batching over all cores with the GIL released, and
 //! errors turned into `ValueError` / `FileNotFoundError`. No physics lives here.
 
+use nalgebra::{DMatrix, DVector};
 use numpy::ndarray::IxDyn;
 use numpy::{
     AllowTypeChange, PyArray1, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods,
@@ -389,6 +390,20 @@ impl PyModel {
     }
 }
 
+/// "argument 'method': expected ..., got '...'".
+fn unknown_method(method: &str, expected: &str) -> PyErr {
+    PyValueError::new_err(format!(
+        "argument 'method': expected {expected}, got '{method}'"
+    ))
+}
+
+/// The Christoffel symbols at q, row-major (i, j, k), in a new buffer.
+fn christoffel_of(model: &Model, worker: &mut Workspace, q: &[f64]) -> robodyn::Result<Vec<f64>> {
+    let mut gamma = vec![0.0; model.nv.pow(3)];
+    algo::christoffel_symbols(model, &mut worker.data, q, &mut gamma)?;
+    Ok(gamma)
+}
+
 /// Writes the first `rows` rows of a matrix (column-major in nalgebra) into a row-major output.
 fn write_row_major(matrix: &nalgebra::DMatrix<f64>, rows: usize, out: &mut [f64]) {
     let columns = matrix.ncols();
@@ -697,16 +712,27 @@ impl PyModel {
         self.with_external_forces(py, q, v, ("tau", tau), f_ext, algo::aba)
     }
 
-    /// Joint-space inertia matrix M(q) by CRBA, full and symmetric, armature included. (nv, nv).
+    /// Joint-space inertia matrix M(q), full and symmetric, armature included. (nv, nv).
+    /// `method`: "crba" (Featherstone's composite-rigid-body algorithm, the fastest), "rnea"
+    /// (column k = τ(q, 0, e_k) − g(q), n RNEA calls: seed 003) or "jacobians"
+    /// (Σ m J_vᵀ J_v + J_ωᵀ I J_ω over the bodies: seeds 000 and 003).
+    #[pyo3(signature = (q, method="crba"))]
     fn mass_matrix<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
+        method: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
+        type Method = for<'d> fn(&Model, &'d mut Data, &[f64]) -> robodyn::Result<&'d DMatrix<f64>>;
+        let algorithm: Method = match method {
+            "crba" => algo::crba,
+            "rnea" => algo::mass_matrix_by_rnea,
+            "jacobians" => algo::mass_matrix_by_jacobians,
+            other => return Err(unknown_method(other, "crba, rnea or jacobians")),
+        };
         let nv = self.model.nv;
         self.evaluate(py, &[self.q_arg("q", q)?], &[nv, nv], &|m, w, i, out| {
-            // M is exactly symmetric: its column-major storage is its row-major layout
-            out.copy_from_slice(algo::crba(m, &mut w.data, i[0])?.as_slice());
+            write_row_major(algorithm(m, &mut w.data, i[0])?, m.nv, out);
             Ok(())
         })
     }
@@ -742,21 +768,119 @@ impl PyModel {
         )
     }
 
-    /// Generalized gravity g(q) (RNEA with v = a = 0). (nv,).
+    /// Coriolis matrix C(q, v) (nv, nv), from the Christoffel symbols of the first kind:
+    /// C(q, v) v = bias_forces(q, v) − generalized_gravity(q), and Ṁ − 2C is skew-symmetric
+    /// (seed 000). A recursive O(n²) algorithm (Echeandia & Wensing 2021), no RNEA calls.
+    fn coriolis_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let nv = self.model.nv;
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[nv, nv],
+            &|m, w, i, out| {
+                write_row_major(
+                    algo::coriolis_matrix(m, &mut w.data, i[0], i[1])?,
+                    m.nv,
+                    out,
+                );
+                Ok(())
+            },
+        )
+    }
+
+    /// Generalized gravity g(q). (nv,). `method`: "rnea" (RNEA with v = a = 0) or "jacobians"
+    /// (−Σ J_cᵀ m g over the bodies' centres of mass: seed 000 "Gravity").
+    #[pyo3(signature = (q, method="rnea"))]
     fn generalized_gravity<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
+        method: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
+        type Method = for<'d> fn(&Model, &'d mut Data, &[f64]) -> robodyn::Result<&'d DVector<f64>>;
+        let algorithm: Method = match method {
+            "rnea" => algo::generalized_gravity,
+            "jacobians" => algo::generalized_gravity_by_jacobians,
+            other => return Err(unknown_method(other, "rnea or jacobians")),
+        };
         self.evaluate(
             py,
             &[self.q_arg("q", q)?],
             &[self.model.nv],
             &|m, w, i, out| {
-                out.copy_from_slice(algo::generalized_gravity(m, &mut w.data, i[0])?.as_slice());
+                out.copy_from_slice(algorithm(m, &mut w.data, i[0])?.as_slice());
                 Ok(())
             },
         )
+    }
+
+    /// Christoffel symbols of the first kind, (nv, nv, nv):
+    /// Γ[i, j, k] = ½ (∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i), so that C(q, v)_ij = Σ_k Γ[i, j, k] v_k
+    /// (seed 000). Exact: Γ[:, :, k] = C(q, e_k) by the recursive Coriolis algorithm. With
+    /// spherical or free joints (velocities that are not coordinate rates) the coordinate formula
+    /// has no meaning; Γ[:, :, k] = C(q, e_k) still holds.
+    fn christoffel<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let nv = self.model.nv;
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?],
+            &[nv, nv, nv],
+            &|m, w, i, out| {
+                algo::christoffel_symbols(m, &mut w.data, i[0], out)?;
+                Ok(())
+            },
+        )
+    }
+
+    /// Craig's centrifugal matrix C(q), (nv, nv) (seed 000, "Centrifugal and Coriolis
+    /// Computation"): the velocity terms are C(q) [q̇₁², …, q̇ₙ²] + B(q) [q̇₁q̇₂, q̇₁q̇₃, …];
+    /// C(q)_ij = Γ_ijj.
+    fn centrifugal_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let nv = self.model.nv;
+        self.evaluate(py, &[self.q_arg("q", q)?], &[nv, nv], &|m, w, i, out| {
+            let gamma = christoffel_of(m, w, i[0])?;
+            for (row, j) in (0..nv).flat_map(|row| (0..nv).map(move |j| (row, j))) {
+                out[row * nv + j] = gamma[(row * nv + j) * nv + j];
+            }
+            Ok(())
+        })
+    }
+
+    /// Craig's Coriolis matrix B(q), (nv, nv(nv−1)/2) (seed 000): multiplies the products
+    /// [q̇₁q̇₂, q̇₁q̇₃, …, q̇₁q̇ₙ, q̇₂q̇₃, …] (pairs j < k in that order); B(q)_i,(jk) = 2 Γ_ijk.
+    fn coriolis_pairs_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let nv = self.model.nv;
+        let pairs = nv * nv.saturating_sub(1) / 2;
+        self.evaluate(py, &[self.q_arg("q", q)?], &[nv, pairs], &|m, w, i, out| {
+            let gamma = christoffel_of(m, w, i[0])?;
+            for row in 0..nv {
+                let mut column = 0;
+                for j in 0..nv {
+                    for k in j + 1..nv {
+                        out[row * pairs + column] = 2.0 * gamma[(row * nv + j) * nv + k];
+                        column += 1;
+                    }
+                }
+            }
+            Ok(())
+        })
     }
 
     /// Pose of a frame (name or index) in the world: 4x4 homogeneous matrix.

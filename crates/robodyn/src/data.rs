@@ -31,6 +31,20 @@ pub struct Data {
     /// Motion subspace column of each velocity coordinate in world coordinates (the spatial
     /// Jacobian's columns); nv. Written by `crba`.
     pub s_world: Vec<Motion>,
+    /// Spatial velocity of body i in world coordinates; nbodies. Written by `coriolis_matrix`.
+    pub v_world: Vec<Motion>,
+    /// Rate Ṡ = v_i × ⁰S of each world-frame subspace column; nv. Written by `coriolis_matrix`.
+    pub s_dot_world: Vec<Motion>,
+    /// Composite Coriolis factor B^C_i = Σ B(I_k, v_k) over the subtree of body i (6x6 on
+    /// `[angular; linear]`, world coordinates); nbodies. Written by `coriolis_matrix`.
+    pub b_c: Vec<Mat6>,
+    /// Coriolis matrix C(q, q̇); nv x nv. Written by `coriolis_matrix`.
+    pub coriolis: DMatrix<f64>,
+    /// Generalized gravity g(q); nv. Written by `mass_matrix_by_rnea`.
+    pub gravity: DVector<f64>,
+    /// All zeros between uses; `christoffel_symbols` and `mass_matrix_by_rnea` set one
+    /// entry at a time to 1; nv.
+    pub unit_velocity: DVector<f64>,
     /// Joint-space inertia matrix M(q), full and symmetric; nv x nv. Written by `crba`.
     pub mass_matrix: DMatrix<f64>,
     /// M(q)⁻¹; nv x nv. Written by `inverse_mass_matrix`.
@@ -79,6 +93,12 @@ impl Data {
             tau: DVector::zeros(nv),
             i_c: vec![Inertia::ZERO; nb],
             s_world: vec![Motion::ZERO; nv],
+            v_world: vec![Motion::ZERO; nb],
+            s_dot_world: vec![Motion::ZERO; nv],
+            b_c: vec![Mat6::zeros(); nb],
+            coriolis: DMatrix::zeros(nv, nv),
+            gravity: DVector::zeros(nv),
+            unit_velocity: DVector::zeros(nv),
             mass_matrix: DMatrix::zeros(nv, nv),
             mass_matrix_inverse: DMatrix::zeros(nv, nv),
             cholesky: DMatrix::zeros(nv, nv),

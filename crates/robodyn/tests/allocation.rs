@@ -49,6 +49,7 @@ fn algorithms_allocate_nothing_after_data_new() {
         let f_ext = vec![robodyn::spatial::Force::ZERO; model.nbodies() - 1];
         let (q, v, a) = (q.as_slice(), v.as_slice(), a.as_slice());
         let frame = model.frames.len() - 1;
+        let mut gamma = vec![0.0; model.nv.pow(3)];
         let counts = [
             (
                 "forward_kinematics",
@@ -102,6 +103,36 @@ fn algorithms_allocate_nothing_after_data_new() {
                 "kinetic_energy",
                 allocations(|| {
                     kinetic_energy(&model, &mut data, q, v).unwrap();
+                }),
+            ),
+            (
+                "coriolis_matrix",
+                allocations(|| {
+                    coriolis_matrix(&model, &mut data, q, v).unwrap();
+                }),
+            ),
+            (
+                "christoffel_symbols",
+                allocations(|| {
+                    christoffel_symbols(&model, &mut data, q, &mut gamma).unwrap();
+                }),
+            ),
+            (
+                "mass_matrix_by_rnea",
+                allocations(|| {
+                    mass_matrix_by_rnea(&model, &mut data, q).unwrap();
+                }),
+            ),
+            (
+                "mass_matrix_by_jacobians",
+                allocations(|| {
+                    mass_matrix_by_jacobians(&model, &mut data, q).unwrap();
+                }),
+            ),
+            (
+                "generalized_gravity_by_jacobians",
+                allocations(|| {
+                    generalized_gravity_by_jacobians(&model, &mut data, q).unwrap();
                 }),
             ),
             (

@@ -109,6 +109,37 @@ fn planar_two_link_arm_m_v_g() {
     }
 }
 
+/// Seeds 000/002: the 2-link arm's Coriolis matrix, Christoffel symbols and Craig's split, and
+/// its M and G computed the notes' ways. With h = −m₂ l₁ l₂ sin q₂:
+/// C(q, q̇) = [[h q̇₂, h (q̇₁ + q̇₂)], [−h q̇₁, 0]], Γ_112 = Γ_121 = Γ_122 = h, Γ_211 = −h, others 0.
+#[test]
+fn planar_two_link_arm_coriolis_matrix_and_christoffel_symbols() {
+    let model = bundled_model("planar2", false).unwrap();
+    let mut data = Data::new(&model);
+    let (m2, l1, l2) = (1.0, 1.0, 0.5);
+    let states: [([f64; 2], [f64; 2]); 2] = [([0.3, -0.7], [0.5, 1.5]), ([1.2, 2.1], [-2.0, 0.3])];
+    for (q, v) in states {
+        let h = -m2 * l1 * l2 * q[1].sin();
+        let c = coriolis_matrix(&model, &mut data, &q, &v).unwrap();
+        // column-major: C11, C21, C12, C22
+        let expected = [h * v[1], -h * v[0], h * (v[0] + v[1]), 0.0];
+        assert_close("planar2 C", c.as_slice(), &expected, CLOSED_FORM_TOLERANCE);
+        let mut gamma = [0.0; 8];
+        christoffel_symbols(&model, &mut data, &q, &mut gamma).unwrap();
+        // Γ_ijk at (i, j, k) row-major: 111 112 121 122 211 212 221 222
+        let expected = [0.0, h, h, h, -h, 0.0, 0.0, 0.0];
+        assert_close("planar2 Γ", &gamma, &expected, CLOSED_FORM_TOLERANCE);
+        let m = crba(&model, &mut data, &q).unwrap().clone();
+        let by_jacobians = mass_matrix_by_jacobians(&model, &mut data, &q).unwrap();
+        assert_close(
+            "planar2 M by Jacobians",
+            by_jacobians.as_slice(),
+            m.as_slice(),
+            CLOSED_FORM_TOLERANCE,
+        );
+    }
+}
+
 /// Seed 001 forward kinematics of the 2-link arm: the tool frame {3} at
 /// (l1 c1 + l2 c12, l1 s1 + l2 s12), rotated by θ1 + θ2; and its geometric Jacobian.
 #[test]

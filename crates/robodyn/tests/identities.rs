@@ -580,3 +580,132 @@ fn jacobian_time_variation_is_the_derivative_of_the_jacobian() {
         }
     }
 }
+
+#[test]
+fn coriolis_matrix_gives_the_velocity_terms_and_a_skew_m_dot_minus_two_c() {
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        let (q, v, _) = state(&model, &mut rng);
+        let c = coriolis_matrix(&model, &mut data, q.as_slice(), v.as_slice())
+            .unwrap()
+            .clone();
+        // C v = bias − g
+        let bias = bias_forces(&model, &mut data, q.as_slice(), v.as_slice())
+            .unwrap()
+            .clone();
+        let gravity = generalized_gravity(&model, &mut data, q.as_slice())
+            .unwrap()
+            .clone();
+        let velocity_terms = bias - gravity;
+        assert_close(
+            &format!("{name} C v"),
+            (&c * &v).as_slice(),
+            velocity_terms.as_slice(),
+            IDENTITY_TOLERANCE,
+        );
+        // Ṁ along v by central differences; Ṁ − 2C + (Ṁ − 2C)ᵀ = 0
+        let forward = displaced(&model, &q, &(&v * FD_STEP));
+        let backward = displaced(&model, &q, &(&v * -FD_STEP));
+        let m_plus = crba(&model, &mut data, forward.as_slice()).unwrap().clone();
+        let m_minus = crba(&model, &mut data, backward.as_slice())
+            .unwrap()
+            .clone();
+        let m_dot = (m_plus - m_minus) / (2.0 * FD_STEP);
+        let n = &m_dot - &c * 2.0;
+        let symmetric_part = &n + n.transpose();
+        assert_close(
+            &format!("{name} Ṁ − 2C skew"),
+            symmetric_part.as_slice(),
+            &vec![0.0; model.nv * model.nv],
+            FD_TOLERANCE * m_dot.amax().max(1.0),
+        );
+    }
+}
+
+#[test]
+fn christoffel_symbols_are_the_derivatives_of_the_mass_matrix() {
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        let q = model.random_configuration(&mut rng);
+        let n = model.nv;
+        let mut gamma = vec![0.0; n * n * n];
+        christoffel_symbols(&model, &mut data, q.as_slice(), &mut gamma).unwrap();
+        // C(q, v) = Σ_k Γ_··k v_k for every model
+        let v = random_vector(&mut rng, n);
+        let c = coriolis_matrix(&model, &mut data, q.as_slice(), v.as_slice())
+            .unwrap()
+            .clone();
+        let contracted: Vec<f64> = (0..n * n)
+            .map(|index| {
+                let (i, j) = (index % n, index / n);
+                (0..n).map(|k| gamma[(i * n + j) * n + k] * v[k]).sum()
+            })
+            .collect();
+        assert_close(
+            &format!("{name} Σ Γ v"),
+            &contracted,
+            c.as_slice(),
+            IDENTITY_TOLERANCE,
+        );
+        // the coordinate formula needs velocities that are coordinate rates: no quaternion joints
+        if model.joints.iter().any(|j| j.quaternion_offset().is_some()) {
+            continue;
+        }
+        // ∂M/∂q_k by central differences
+        let derivatives: Vec<DMatrix<f64>> = (0..n)
+            .map(|k| {
+                let plus = displaced(&model, &q, &unit_step(n, k, FD_STEP));
+                let minus = displaced(&model, &q, &unit_step(n, k, -FD_STEP));
+                let m_plus = crba(&model, &mut data, plus.as_slice()).unwrap().clone();
+                let m_minus = crba(&model, &mut data, minus.as_slice()).unwrap().clone();
+                (m_plus - m_minus) / (2.0 * FD_STEP)
+            })
+            .collect();
+        // Γ_ijk = ½ (∂_k M_ij + ∂_j M_ik − ∂_i M_jk)
+        let expected: Vec<f64> = (0..n * n * n)
+            .map(|index| {
+                let (i, j, k) = (index / (n * n), (index / n) % n, index % n);
+                0.5 * (derivatives[k][(i, j)] + derivatives[j][(i, k)] - derivatives[i][(j, k)])
+            })
+            .collect();
+        assert_close(&format!("{name} Γ"), &gamma, &expected, FD_TOLERANCE);
+    }
+}
+
+#[test]
+fn mass_matrix_and_gravity_the_notes_ways_equal_crba_and_rnea() {
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        let q = model.random_configuration(&mut rng);
+        let m = crba(&model, &mut data, q.as_slice()).unwrap().clone();
+        let by_rnea = mass_matrix_by_rnea(&model, &mut data, q.as_slice())
+            .unwrap()
+            .clone();
+        let by_jacobians = mass_matrix_by_jacobians(&model, &mut data, q.as_slice())
+            .unwrap()
+            .clone();
+        for (method, other) in [("rnea", by_rnea), ("jacobians", by_jacobians)] {
+            assert_close(
+                &format!("{name} M by {method}"),
+                other.as_slice(),
+                m.as_slice(),
+                CLOSED_FORM_TOLERANCE,
+            );
+        }
+        let g = generalized_gravity(&model, &mut data, q.as_slice())
+            .unwrap()
+            .clone();
+        let g_jacobians = generalized_gravity_by_jacobians(&model, &mut data, q.as_slice())
+            .unwrap()
+            .clone();
+        assert_close(
+            &format!("{name} g by Jacobians"),
+            g_jacobians.as_slice(),
+            g.as_slice(),
+            CLOSED_FORM_TOLERANCE,
+        );
+    }
+}

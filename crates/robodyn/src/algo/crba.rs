@@ -19,25 +19,8 @@ use nalgebra::DMatrix;
 /// M(q), written into `data.mass_matrix`.
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMatrix<f64>> {
     model.check_configuration(q)?;
-    update_body_placements(model, data, q);
-
-    // world-frame inertias and motion subspaces: ⁰I_i = X_{i←0}ᵀ I_i X_{i←0}, ⁰S_i = X_{i←0}⁻¹ S_i
-    for i in 1..model.nbodies() {
-        data.i_c[i] = data.x_world[i].transpose_apply_inertia(&model.inertias[i]);
-        for (k, dof) in model.v_range(i).enumerate() {
-            data.s_world[dof] =
-                data.x_world[i].inverse_apply_motion(&model.joints[i].subspace_column(k));
-        }
-    }
-
-    // composite inertias, leaves to root: I^c_λ(i) += I^c_i (same coordinates, no transform)
-    for i in (1..model.nbodies()).rev() {
-        let parent = model.parent[i];
-        if parent != 0 {
-            let subtree = data.i_c[i];
-            data.i_c[parent] += subtree;
-        }
-    }
+    world_inertias_and_subspaces(model, data, q);
+    add_composite_inertias(model, data);
 
     // H_ij = ⁰S_jᵀ (I^c_i ⁰S_i) for j on the path from i to the root; other entries are zero
     let nv = model.nv;
@@ -61,4 +44,28 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMat
         }
     }
     Ok(&data.mass_matrix)
+}
+
+/// Poses, then each body's own inertia in world coordinates in `data.i_c` and the motion subspace
+/// columns in `data.s_world`: ⁰I_i = X_{i←0}ᵀ I_i X_{i←0}, ⁰S_i = X_{i←0}⁻¹ S_i.
+pub(crate) fn world_inertias_and_subspaces(model: &Model, data: &mut Data, q: &[f64]) {
+    update_body_placements(model, data, q);
+    for i in 1..model.nbodies() {
+        data.i_c[i] = data.x_world[i].transpose_apply_inertia(&model.inertias[i]);
+        for (k, dof) in model.v_range(i).enumerate() {
+            data.s_world[dof] =
+                data.x_world[i].inverse_apply_motion(&model.joints[i].subspace_column(k));
+        }
+    }
+}
+
+/// Composite inertias, leaves to root: I^c_λ(i) += I^c_i (world coordinates, no transform).
+pub(crate) fn add_composite_inertias(model: &Model, data: &mut Data) {
+    for i in (1..model.nbodies()).rev() {
+        let parent = model.parent[i];
+        if parent != 0 {
+            let subtree = data.i_c[i];
+            data.i_c[parent] += subtree;
+        }
+    }
 }

@@ -7,6 +7,7 @@
 pub const SINGULARITY_TOLERANCE: f64 = 1e-12;
 
 pub mod aba;
+pub mod coriolis;
 pub mod crba;
 pub mod energy;
 pub mod frame_motion;
@@ -16,8 +17,10 @@ pub mod kinematics;
 pub mod manipulability;
 pub mod minv;
 pub mod rnea;
+pub mod textbook_forms;
 
 pub use aba::aba;
+pub use coriolis::{christoffel_symbols, coriolis_matrix};
 pub use crba::crba;
 pub use energy::{center_of_mass, center_of_mass_jacobian, kinetic_energy, potential_energy};
 pub use frame_motion::{frame_acceleration, frame_velocity, jacobian_time_variation};
@@ -27,3 +30,6 @@ pub use kinematics::{forward_kinematics, frame_placement, frame_pose};
 pub use manipulability::manipulability;
 pub use minv::inverse_mass_matrix;
 pub use rnea::{bias_forces, generalized_gravity, rnea};
+pub use textbook_forms::{
+    generalized_gravity_by_jacobians, mass_matrix_by_jacobians, mass_matrix_by_rnea,
+};

@@ -49,7 +49,7 @@ pub fn generalized_gravity<'d>(
 }
 
 /// The two passes of Table 5.1; `None` stands for a zero velocity or acceleration.
-fn newton_euler<'d>(
+pub(crate) fn newton_euler<'d>(
     model: &Model,
     data: &'d mut Data,
     q: &[f64],

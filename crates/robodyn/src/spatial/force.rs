@@ -21,6 +21,18 @@ impl Force {
         Force { angular, linear }
     }
 
+    /// The 6x6 matrix `f ×̄` on `[angular; linear]` motions with `(f ×̄) m = m ×* f`
+    /// (Echeandia & Wensing 2021): `[-n× -f×; -f× 0]` for `f = (n, f)`.
+    #[inline]
+    pub fn bar_cross_matrix(&self) -> super::Mat6 {
+        let (n, f) = (super::skew(&self.angular), super::skew(&self.linear));
+        let mut x = super::Mat6::zeros();
+        x.fixed_view_mut::<3, 3>(0, 0).copy_from(&(-n));
+        x.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-f));
+        x.fixed_view_mut::<3, 3>(3, 0).copy_from(&(-f));
+        x
+    }
+
     /// The Plücker 6-vector `[angular; linear]` (moment; force).
     #[inline]
     pub fn to_vector(&self) -> nalgebra::Vector6<f64> {

@@ -74,6 +74,20 @@ impl Inertia {
     }
 }
 
+impl Inertia {
+    /// The body's Coriolis factor `B(I, v) = ½[(v×*) I + (I v)×̄ − I (v×)]` (Echeandia & Wensing
+    /// 2021, eq. 19) on `[angular; linear]`: `B v = v ×* I v` gives the body's velocity-product
+    /// force, and `İ − 2B = −(I v)×̄` is skew-symmetric, so the joint-space C it assembles makes
+    /// `Ṁ − 2C` skew-symmetric. `v` and `self` in the same coordinates.
+    pub fn coriolis_factor(&self, v: &Motion) -> Mat6 {
+        let inertia = self.to_matrix();
+        let v_cross = v.cross_matrix();
+        // v×* = −(v×)ᵀ
+        let force_cross = -v_cross.transpose();
+        (force_cross * inertia + self.mul_motion(v).bar_cross_matrix() - inertia * v_cross) * 0.5
+    }
+}
+
 impl Add for Inertia {
     type Output = Inertia;
     #[inline]

@@ -39,6 +39,17 @@ impl Motion {
         }
     }
 
+    /// The 6x6 matrix of `m ×` on `[angular; linear]`: `[ω× 0; v× ω×]` (Featherstone eq. 2.31).
+    #[inline]
+    pub fn cross_matrix(&self) -> super::Mat6 {
+        let (w, v) = (super::skew(&self.angular), super::skew(&self.linear));
+        let mut x = super::Mat6::zeros();
+        x.fixed_view_mut::<3, 3>(0, 0).copy_from(&w);
+        x.fixed_view_mut::<3, 3>(3, 0).copy_from(&v);
+        x.fixed_view_mut::<3, 3>(3, 3).copy_from(&w);
+        x
+    }
+
     /// The scalar product `m · f` (power).
     #[inline]
     pub fn dot(&self, f: &Force) -> f64 {
