@@ -30,6 +30,10 @@ from robodyn._core import (
     load_urdf,
     load_urdf_string,
 )
+from robodyn.operational_space import operational_space as _operational_space
+
+# methods composed in NumPy from the core's batched calls
+Model.operational_space = _operational_space
 
 __all__ = [
     "Model",
