@@ -405,6 +405,17 @@ fn christoffel_of(model: &Model, worker: &mut Workspace, q: &[f64]) -> robodyn::
 }
 
 /// Writes the first `rows` rows of a matrix (column-major in nalgebra) into a row-major output.
+/// `out = matrix · vector` (out has the matrix's rows).
+fn matrix_times(matrix: &DMatrix<f64>, vector: &[f64], out: &mut [f64]) {
+    for (row, value) in out.iter_mut().enumerate() {
+        *value = vector
+            .iter()
+            .enumerate()
+            .map(|(column, x)| matrix[(row, column)] * x)
+            .sum();
+    }
+}
+
 fn write_row_major(matrix: &nalgebra::DMatrix<f64>, rows: usize, out: &mut [f64]) {
     let columns = matrix.ncols();
     for (c, column) in matrix
@@ -1039,6 +1050,70 @@ impl PyModel {
         )
     }
 
+    /// The Lagrangian L = T − V (J): kinetic minus potential energy.
+    fn lagrangian<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[],
+            &|m, w, i, out| {
+                let kinetic = algo::kinetic_energy(m, &mut w.data, i[0], i[1])?;
+                out[0] = kinetic - algo::potential_energy(m, &mut w.data, i[0])?;
+                Ok(())
+            },
+        )
+    }
+
+    /// Centroidal momentum matrix A_G(q), (6, nv): h_G = A_G v, rows [linear momentum; angular
+    /// momentum about the centre of mass], world axes (Orin, Goswami & Lee 2013).
+    fn centroidal_momentum_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?],
+            &[6, self.model.nv],
+            &|m, w, i, out| {
+                write_row_major(
+                    algo::centroidal_momentum_matrix(m, &mut w.data, i[0])?,
+                    6,
+                    out,
+                );
+                Ok(())
+            },
+        )
+    }
+
+    /// Centroidal momentum h_G = A_G(q) v, (6,): [linear momentum m ċ; angular momentum about the
+    /// centre of mass], world axes.
+    fn centroidal_momentum<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[6],
+            &|m, w, i, out| {
+                matrix_times(
+                    algo::centroidal_momentum_matrix(m, &mut w.data, i[0])?,
+                    i[1],
+                    out,
+                );
+                Ok(())
+            },
+        )
+    }
+
     /// Potential energy -Σ m_i gᵀ c_i (J), zero at the world origin.
     fn potential_energy<'py>(
         &self,
@@ -1234,6 +1309,28 @@ impl PyModel {
             &[3, self.model.nv],
             &|m, w, i, out| {
                 write_row_major(algo::center_of_mass_jacobian(m, &mut w.data, i[0])?, 3, out);
+                Ok(())
+            },
+        )
+    }
+
+    /// Velocity of the centre of mass ċ = J_com(q) v, (3,), world axes.
+    fn center_of_mass_velocity<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[3],
+            &|m, w, i, out| {
+                matrix_times(
+                    algo::center_of_mass_jacobian(m, &mut w.data, i[0])?,
+                    i[1],
+                    out,
+                );
                 Ok(())
             },
         )

@@ -45,6 +45,9 @@ pub struct Data {
     /// All zeros between uses; `christoffel_symbols` and `mass_matrix_by_rnea` set one
     /// entry at a time to 1; nv.
     pub unit_velocity: DVector<f64>,
+    /// Centroidal momentum matrix A_G(q), rows [linear; angular about the centre of mass];
+    /// 6 x nv. Written by `centroidal_momentum_matrix`.
+    pub centroidal_matrix: DMatrix<f64>,
     /// Joint-space inertia matrix M(q), full and symmetric; nv x nv. Written by `crba`.
     pub mass_matrix: DMatrix<f64>,
     /// M(q)⁻¹; nv x nv. Written by `inverse_mass_matrix`.
@@ -99,6 +102,7 @@ impl Data {
             coriolis: DMatrix::zeros(nv, nv),
             gravity: DVector::zeros(nv),
             unit_velocity: DVector::zeros(nv),
+            centroidal_matrix: DMatrix::zeros(6, nv),
             mass_matrix: DMatrix::zeros(nv, nv),
             mass_matrix_inverse: DMatrix::zeros(nv, nv),
             cholesky: DMatrix::zeros(nv, nv),

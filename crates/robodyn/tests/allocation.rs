@@ -136,6 +136,12 @@ fn algorithms_allocate_nothing_after_data_new() {
                 }),
             ),
             (
+                "centroidal_momentum_matrix",
+                allocations(|| {
+                    centroidal_momentum_matrix(&model, &mut data, q).unwrap();
+                }),
+            ),
+            (
                 "center_of_mass",
                 allocations(|| {
                     center_of_mass(&model, &mut data, q).unwrap();

@@ -7,6 +7,7 @@
 pub const SINGULARITY_TOLERANCE: f64 = 1e-12;
 
 pub mod aba;
+pub mod centroidal;
 pub mod coriolis;
 pub mod crba;
 pub mod energy;
@@ -20,6 +21,7 @@ pub mod rnea;
 pub mod textbook_forms;
 
 pub use aba::aba;
+pub use centroidal::centroidal_momentum_matrix;
 pub use coriolis::{christoffel_symbols, coriolis_matrix};
 pub use crba::crba;
 pub use energy::{center_of_mass, center_of_mass_jacobian, kinetic_energy, potential_energy};
