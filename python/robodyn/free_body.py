@@ -41,26 +41,32 @@ class GimbalLockError(ValueError):
     """The 1-2-3 Euler-angle rates are singular: θ = ±90°."""
 
 
-def _vector(name, value, size=3) -> np.ndarray:
+def _vector(name, value, size=3, batch=False) -> np.ndarray:
+    """`size` finite numbers; with ``batch``, also a stack of them, shape (N, size)."""
     array = np.asarray(value, dtype=float)
-    if array.shape != (size,) or not np.all(np.isfinite(array)):
-        raise ValueError(f"argument '{name}': expected {size} finite numbers, got {np.asarray(value).tolist()}")
+    shape_ok = array.shape == (size,) or (batch and array.ndim == 2 and array.shape[1] == size)
+    if not shape_ok or not np.all(np.isfinite(array)):
+        raise ValueError(f"argument '{name}': expected {size} finite numbers{' (or N of them)' if batch else ''}, got {np.asarray(value).tolist()}")
     return array
 
 
 def angular_acceleration(inertia_body, omega_body, moment_body=(0.0, 0.0, 0.0)) -> np.ndarray:
-    """Euler's equations: ω̇_b = I_b⁻¹ [M_b − ω_b × (I_b ω_b)]."""
+    """Euler's equations: ω̇_b = I_b⁻¹ [M_b − ω_b × (I_b ω_b)]. ``omega_body`` and
+    ``moment_body`` may be stacks (N, 3)."""
     inertia_body = np.asarray(inertia_body, dtype=float)
-    omega = _vector("omega_body", omega_body)
-    moment = _vector("moment_body", moment_body)
-    return np.linalg.solve(inertia_body, moment - np.cross(omega, inertia_body @ omega))
+    omega = _vector("omega_body", omega_body, batch=True)
+    moment = _vector("moment_body", moment_body, batch=True)
+    rhs = moment - np.cross(omega, omega @ inertia_body.T)
+    return np.linalg.solve(inertia_body, rhs.T).T
 
 
 def quaternion_rate(quaternion, omega_body) -> np.ndarray:
-    """q̇ = ½ q ⊗ (ω_b, 0) for q = [qx, qy, qz, qw]."""
-    x, y, z, w = _vector("quaternion", quaternion, 4)
-    vector, omega = np.array([x, y, z]), _vector("omega_body", omega_body)
-    return 0.5 * np.concatenate([w * omega + np.cross(vector, omega), [-vector @ omega]])
+    """q̇ = ½ q ⊗ (ω_b, 0) for q = [qx, qy, qz, qw]; both may be stacks (N, 4) and (N, 3)."""
+    quaternion = _vector("quaternion", quaternion, 4, batch=True)
+    omega = _vector("omega_body", omega_body, batch=True)
+    vector, w = quaternion[..., :3], quaternion[..., 3:]
+    scalar = -np.sum(vector * omega, axis=-1, keepdims=True)
+    return 0.5 * np.concatenate([w * omega + np.cross(vector, omega), scalar], axis=-1)
 
 
 def quaternion_rotation(quaternion) -> np.ndarray:

@@ -83,3 +83,12 @@ def test_euler_angles_report_gimbal_lock_during_a_simulation():
         free_body.simulate(np.eye(3), [0.0, 1.0, 0.0], t_end=3.0, dt=1e-3, orientation="euler123")
     with pytest.raises(ValueError, match="argument 'orientation'"):
         free_body.simulate(np.eye(3), [0.0, 1.0, 0.0], t_end=1.0, dt=1e-3, orientation="rpy")
+
+
+def test_rates_take_stacks_of_states():
+    omegas = np.array([[0.4, -1.2, 2.0], [1.0, 0.0, 0.5]])
+    batch = free_body.angular_acceleration(ASYMMETRIC, omegas)
+    assert_close(batch[1], free_body.angular_acceleration(ASYMMETRIC, omegas[1]), IDENTITY_TOLERANCE, "ω̇ batch")
+    quaternions = np.array([[0.0, 0.0, 0.0, 1.0], [0.1, 0.2, 0.3, np.sqrt(0.86)]])
+    rates = free_body.quaternion_rate(quaternions, omegas)
+    assert_close(rates[1], free_body.quaternion_rate(quaternions[1], omegas[1]), IDENTITY_TOLERANCE, "q̇ batch")
