@@ -4,7 +4,10 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::{rngs::StdRng, SeedableRng};
-use robodyn::algo::{aba, crba, forward_kinematics, frame_pose, jacobian, rnea, Reference};
+use robodyn::algo::{
+    aba, centroidal_momentum_matrix, coriolis_matrix, crba, forward_kinematics, frame_pose,
+    jacobian, rnea, Reference,
+};
 use robodyn::io::{bundled_model, load_urdf_file, LoadOptions};
 use robodyn::{Data, Model};
 use std::hint::black_box;
@@ -86,6 +89,12 @@ fn benchmarks(c: &mut Criterion) {
         });
         c.bench_function(&format!("{name}/crba"), |b| {
             b.iter(|| crba(&model, &mut data, black_box(q)).map(|m| m[0]))
+        });
+        c.bench_function(&format!("{name}/coriolis_matrix"), |b| {
+            b.iter(|| coriolis_matrix(&model, &mut data, black_box(q), v.as_slice()).map(|m| m[0]))
+        });
+        c.bench_function(&format!("{name}/centroidal_momentum_matrix"), |b| {
+            b.iter(|| centroidal_momentum_matrix(&model, &mut data, black_box(q)).map(|m| m[0]))
         });
         c.bench_function(&format!("{name}/aba"), |b| {
             b.iter(|| {
