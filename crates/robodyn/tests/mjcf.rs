@@ -121,3 +121,23 @@ fn inertia_from_a_sphere_and_a_box_geom() {
     // about the body origin: I_xx is unchanged by a shift along x
     assert!((brick.rotational[(0, 0)] - mass * (0.04 + 0.09) / 3.0).abs() < 1e-12);
 }
+
+#[test]
+fn each_compiler_element_changes_only_what_it_sets() {
+    // the second <compiler> must not reset the angle unit to degrees
+    let text = "<mujoco><compiler angle='radian'/><compiler eulerseq='zyx'/><worldbody>
+        <body name='turned' axisangle='0 0 1 1.5707963267948966'/></worldbody></mujoco>";
+    let model = load_mjcf_str(text, "compilers.xml").unwrap();
+    let mut data = Data::new(&model);
+    let q = model.neutral();
+    let pose = frame_pose(
+        &model,
+        &mut data,
+        q.as_slice(),
+        model.frame_index("turned").unwrap(),
+    )
+    .unwrap()
+    .to_homogeneous();
+    // a quarter turn about z: the body's x axis along world y
+    assert!((pose[(1, 0)] - 1.0).abs() < 1e-12, "{pose}");
+}

@@ -248,8 +248,10 @@ impl<'a> Reader<'a> {
 
     /// `<compiler>`: angle unit, Euler sequence, where inertias come from.
     fn read_compiler(&mut self, compiler: Node<'a, 'a>) -> Result<()> {
+        // each <compiler> changes only the attributes it sets
         match compiler.attribute("angle") {
-            None | Some("degree") => self.degrees = true,
+            None => {}
+            Some("degree") => self.degrees = true,
             Some("radian") => self.degrees = false,
             Some(other) => {
                 return Err(self.error(
@@ -268,7 +270,8 @@ impl<'a> Reader<'a> {
             self.euler_sequence = sequence.to_string();
         }
         self.inertia_from_geoms = match compiler.attribute("inertiafromgeom") {
-            None | Some("auto") => InertiaFromGeoms::Auto,
+            None => self.inertia_from_geoms,
+            Some("auto") => InertiaFromGeoms::Auto,
             Some("true") => InertiaFromGeoms::Always,
             Some("false") => InertiaFromGeoms::Never,
             Some(other) => {
@@ -463,23 +466,16 @@ impl<'a> Reader<'a> {
 
     /// The spatial inertia of a body, in its frame: from `<inertial>` or from its geoms, as
     /// `<compiler inertiafromgeom>` says.
-    fn body_inertia(
-        &self,
-        body: Node<'a, 'a>,
-        elements: &[Node<'a, 'a>],
-        class: &str,
-    ) -> Result<Inertia> {
+    fn body_inertia(&self, elements: &[Node<'a, 'a>], class: &str) -> Result<Inertia> {
         let inertial = elements.iter().find(|c| c.has_tag_name("inertial"));
         match (self.inertia_from_geoms, inertial) {
             (InertiaFromGeoms::Never, None) => Ok(Inertia::ZERO),
             (InertiaFromGeoms::Auto | InertiaFromGeoms::Never, Some(inertial)) => {
                 self.inertial(*inertial, class)
             }
+            // each geom's mass and inertia is checked where it is read
             (InertiaFromGeoms::Always, _) | (InertiaFromGeoms::Auto, None) => {
-                let total = self.geoms_inertia(elements, class)?;
-                check_mass_and_inertia(total.mass, &Mat3::zeros())
-                    .map_err(|m| self.error(body, m))?;
-                Ok(total)
+                self.geoms_inertia(elements, class)
             }
         }
     }
@@ -610,38 +606,36 @@ impl<'a> Reader<'a> {
             ));
         }
         // volume, and the principal moments per unit mass about the centre
-        let (volume, per_mass, capsule) = match kind.as_str() {
+        let (volume, per_mass) = match kind.as_str() {
             "sphere" => {
                 let r = size[0];
-                (4.0 / 3.0 * PI * r.powi(3), Vec3::repeat(0.4 * r * r), None)
+                (4.0 / 3.0 * PI * r.powi(3), Vec3::repeat(0.4 * r * r))
             }
             "ellipsoid" => {
                 let (a, b, c) = (size[0], size[1], size[2]);
                 let moments = Vec3::new(b * b + c * c, a * a + c * c, a * a + b * b) / 5.0;
-                (4.0 / 3.0 * PI * a * b * c, moments, None)
+                (4.0 / 3.0 * PI * a * b * c, moments)
             }
             "box" => {
                 let (a, b, c) = (size[0], size[1], size[2]);
                 let moments = Vec3::new(b * b + c * c, a * a + c * c, a * a + b * b) / 3.0;
-                (8.0 * a * b * c, moments, None)
+                (8.0 * a * b * c, moments)
             }
             "cylinder" => {
                 let (r, length) = (size[0], 2.0 * size[1]);
                 let across = (3.0 * r * r + length * length) / 12.0;
-                (
-                    PI * r * r * length,
-                    Vec3::new(across, across, r * r / 2.0),
-                    None,
-                )
+                (PI * r * r * length, Vec3::new(across, across, r * r / 2.0))
             }
             _ => {
+                // capsule: the mass splits between the cylinder and the two hemispheres by volume
                 let (r, length) = (size[0], 2.0 * size[1]);
                 let (cylinder, sphere) = (PI * r * r * length, 4.0 / 3.0 * PI * r.powi(3));
-                (
-                    cylinder + sphere,
-                    Vec3::zeros(),
-                    Some((r, length, cylinder, sphere)),
-                )
+                let volume = cylinder + sphere;
+                let (m_c, m_s) = (cylinder / volume, sphere / volume);
+                let across = m_c * (length * length / 12.0 + r * r / 4.0)
+                    + m_s * (0.4 * r * r + length * length / 4.0 + 3.0 * length * r / 8.0);
+                let along = m_c * r * r / 2.0 + m_s * 0.4 * r * r;
+                (volume, Vec3::new(across, across, along))
             }
         };
         let mass = match given_mass {
@@ -652,17 +646,7 @@ impl<'a> Reader<'a> {
                     * volume
             }
         };
-        let moments = match capsule {
-            // split the mass between the cylinder and the two hemispheres by volume
-            Some((r, length, cylinder, sphere)) => {
-                let (m_c, m_s) = (mass * cylinder / volume, mass * sphere / volume);
-                let across = m_c * (length * length / 12.0 + r * r / 4.0)
-                    + m_s * (0.4 * r * r + length * length / 4.0 + 3.0 * length * r / 8.0);
-                let along = m_c * r * r / 2.0 + m_s * 0.4 * r * r;
-                Vec3::new(across, across, along)
-            }
-            None => per_mass * mass,
-        };
+        let moments = per_mass * mass;
         self.inertia_in_body(geom, mass, &Mat3::from_diagonal(&moments), &frame)
     }
 
@@ -720,7 +704,7 @@ impl<'a> Reader<'a> {
         // X_{B←parent body}
         let mut to_body = self.placement(node, class)? * parent_element;
         let elements = self.children(node)?;
-        let inertia = self.body_inertia(node, &elements, child_class)?;
+        let inertia = self.body_inertia(&elements, child_class)?;
         let joints: Vec<Node> = elements
             .into_iter()
             .filter(|c| c.has_tag_name("joint") || c.has_tag_name("freejoint"))
