@@ -45,6 +45,11 @@ def f(x):
     return f"{x:.10g}"
 
 
+def angle(x):
+    """Angles to the last digit, so that π/2 reads back as the double nearest π/2."""
+    return repr(float(x)) if x != 0 else "0"
+
+
 def main():
     lines = [
         '<?xml version="1.0"?>',
@@ -63,7 +68,7 @@ def main():
             f'  <joint name="{NAMES[i]}_joint" type="revolute">',
             f'    <parent link="{parent}"/>',
             f'    <child link="{LINKS[i]}"/>',
-            f'    <origin xyz="{" ".join(map(f, xyz))}" rpy="{" ".join(map(f, rpy))}"/>',
+            f'    <origin xyz="{" ".join(map(f, xyz))}" rpy="{" ".join(map(angle, rpy))}"/>',
             '    <axis xyz="0 0 1"/>',
             f'    <limit lower="{f(-2 * math.pi)}" upper="{f(2 * math.pi)}" effort="{f(EFFORT[i])}" velocity="{f(VELOCITY[i])}"/>',
             "  </joint>",
@@ -76,7 +81,7 @@ def main():
         lines += [
             f'  <link name="{LINKS[i]}">',
             "    <inertial>",
-            f'      <origin xyz="{" ".join(map(f, com))}" rpy="{f(ALPHA[i])} 0 0"/>',
+            f'      <origin xyz="{" ".join(map(f, com))}" rpy="{angle(ALPHA[i])} 0 0"/>',
             f'      <mass value="{f(MASS[i])}"/>',
             f'      <inertia ixx="{f(ixx)}" ixy="0" ixz="0" iyy="{f(iyy)}" iyz="0" izz="{f(izz)}"/>',
             "    </inertial>",
@@ -87,7 +92,7 @@ def main():
         '  <joint name="tool0_fixed_joint" type="fixed">',
         f'    <parent link="{parent}"/>',
         '    <child link="tool0"/>',
-        f'    <origin xyz="{f(A[5])} 0 {f(D[5])}" rpy="{f(ALPHA[5])} 0 0"/>',
+        f'    <origin xyz="{f(A[5])} 0 {f(D[5])}" rpy="{angle(ALPHA[5])} 0 0"/>',
         "  </joint>",
         '  <link name="tool0"/>',
         "</robot>",
