@@ -1,4 +1,4 @@
-"""The ``robodyn`` command: ``robodyn demo`` and ``robodyn models``."""
+"""The ``robodyn`` command: ``robodyn demo``, ``robodyn models`` and ``robodyn derive``."""
 
 from __future__ import annotations
 
@@ -6,6 +6,7 @@ import argparse
 import os
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -66,6 +67,45 @@ def demo(model_name: str = "ur5", batch: int = 10_000) -> int:
     return 0 if ok else 1
 
 
+def derive(model: str, rods: bool, latex: str | None, codegen: str | None, symbolic_params: bool,
+           newton_euler: bool, output: str | None) -> int:
+    """Print the closed-form equations of motion of a planar arm (``planar<n>``), the pendulum, or
+    a DH table (``.toml``) or URDF file."""
+    from robodyn import symbolic as sym
+
+    planar = model.removeprefix("planar")
+    if model.startswith("planar") and planar.isdigit():
+        chain = sym.planar_chain(int(planar), point_masses=not rods)
+    elif model == "pendulum":
+        chain = sym.pendulum()
+    elif model.lower().endswith(".toml"):
+        chain = sym.from_dh(model, symbolic_params=symbolic_params)
+    elif model.lower().endswith(".urdf"):
+        chain = sym.from_urdf(model, symbolic_params=symbolic_params)
+    else:
+        raise ValueError(f"model: expected planar<n>, pendulum, a .toml DH table or a .urdf file, got {model!r}")
+    start = time.perf_counter()
+    equations = sym.lagrange(chain)
+    if newton_euler:
+        difference = sym.newton_euler(chain).difference(equations)
+        agree = all(d == 0 for d in difference)
+        print(f"Newton–Euler and Euler–Lagrange agree: {'yes' if agree else 'NO'}", file=sys.stderr)
+    if codegen:
+        text = equations.codegen(codegen)
+    elif latex:
+        text = equations.latex(latex) + "\n"
+    else:
+        text = equations.text()
+    elapsed = time.perf_counter() - start
+    if output:
+        Path(output).write_text(text)
+        print(f"wrote {output}", file=sys.stderr)
+    else:
+        print(text, end="")
+    print(f"derived in {elapsed:.2f} s", file=sys.stderr)
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="robodyn", description="Rigid-body dynamics for robots.")
     commands = parser.add_subparsers(dest="command", required=True)
@@ -73,7 +113,25 @@ def main(argv: list[str] | None = None) -> int:
     demo_parser.add_argument("model", nargs="?", default="ur5", choices=robodyn.models())
     demo_parser.add_argument("--batch", type=int, default=10_000, help="batch size to time")
     commands.add_parser("models", help="list the bundled models")
+    derive_parser = commands.add_parser("derive", help="closed-form equations of motion (SymPy)")
+    derive_parser.add_argument("model", help="planar<n> (e.g. planar2), pendulum, a DH table .toml or a .urdf")
+    derive_parser.add_argument("--rods", action="store_true", help="planar links as uniform rods, not point masses")
+    derive_parser.add_argument("--latex", nargs="?", const="matrices", choices=["matrices", "torques"],
+                               help="print LaTeX: M, V, G as matrices (default) or each joint's torque")
+    derive_parser.add_argument("--codegen", choices=["c", "rust", "numpy"], help="print source code of M, C, G, tau")
+    derive_parser.add_argument("--symbolic-params", action="store_true",
+                               help="masses, lengths, inertias and g of a file as symbols")
+    derive_parser.add_argument("--newton-euler", action="store_true",
+                               help="also derive by Newton–Euler and report whether the two agree")
+    derive_parser.add_argument("-o", "--output", help="write to this file instead of standard output")
     args = parser.parse_args(argv)
+    if args.command == "derive":
+        try:
+            return derive(args.model, args.rods, args.latex, args.codegen, args.symbolic_params,
+                          args.newton_euler, args.output)
+        except (ValueError, FileNotFoundError) as error:
+            print(f"robodyn derive: {error}", file=sys.stderr)
+            return 2
     if args.command == "models":
         print("\n".join(robodyn.models()))
         return 0

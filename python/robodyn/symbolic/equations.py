@@ -234,5 +234,23 @@ class EquationsOfMotion:
 
         return NumericEquations(self, params)
 
+    def latex(self, form: str = "matrices") -> str:
+        """The equations in LaTeX as the notes print them (see :mod:`robodyn.symbolic.printing`)."""
+        from robodyn.symbolic.printing import latex
+
+        return latex(self, form)
+
+    def text(self) -> str:
+        """M, V, G (and F) entry by entry, in plain text with the notes' abbreviations."""
+        from robodyn.symbolic.printing import text
+
+        return text(self)
+
+    def codegen(self, language: str, params: dict | None = None, prefix: str | None = None) -> str:
+        """Standalone C, Rust or NumPy source of M, C, G and τ (see :mod:`robodyn.symbolic.codegen`)."""
+        from robodyn.symbolic.codegen import codegen
+
+        return codegen(self, language, params, prefix)
+
     def __repr__(self) -> str:
         return f"<EquationsOfMotion of '{self.chain.name}': {self.n} joints>"

@@ -11,12 +11,11 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-__all__ = ["NumericEquations", "parameter_values"]
+__all__ = ["NumericEquations", "known_values", "parameter_values"]
 
 
-def parameter_values(chain, params: dict | None, expressions) -> dict:
-    """The numbers to substitute: the chain's own values overridden by ``params``; raises
-    ``ValueError`` naming any parameter left without a value."""
+def known_values(chain, params: dict | None) -> dict:
+    """The chain's own parameter values overridden by ``params`` (keys: symbols or their names)."""
     values = dict(chain.values)
     for key, value in (params or {}).items():
         symbol = key if isinstance(key, sp.Symbol) else next(
@@ -25,6 +24,13 @@ def parameter_values(chain, params: dict | None, expressions) -> dict:
             raise ValueError(f"argument 'params': '{key}' is not a parameter of chain '{chain.name}' "
                              f"(its parameters: {[s.name for s in chain.parameters]})")
         values[symbol] = sp.sympify(value)
+    return values
+
+
+def parameter_values(chain, params: dict | None, expressions) -> dict:
+    """:func:`known_values`, raising ``ValueError`` that names any parameter of ``expressions``
+    left without a value."""
+    values = known_values(chain, params)
     coordinates = set(chain.q) | set(chain.qd) | set(chain.qdd)
     free = set().union(*(sp.sympify(e).free_symbols for e in expressions)) - coordinates
     missing = sorted(s.name for s in free if s not in values)
