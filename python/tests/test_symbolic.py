@@ -367,3 +367,42 @@ def test_frozen_closed_form_references_are_up_to_date(name):
     for record in (frozen, fresh):
         record["provenance"].pop("sympy")
     assert fresh == frozen
+
+
+def test_generalized_forces_enter_as_minus_q():
+    """Seed 003: d/dt ∂L/∂q̇ⱼ − ∂L/∂qⱼ = Qⱼ; a force Q on the pendulum leaves τ = … − Q."""
+    m, length = sp.symbols("m l", positive=True)
+    theta, thetad = sp.Symbol("theta_1", real=True), sp.Symbol("thetadot_1", real=True)
+    thetadd = sp.Symbol("thetaddot_1", real=True)
+    drag = -sp.Symbol("c", positive=True) * thetad**3
+    eom = sym.lagrange(sym.pendulum(), forces=[drag])
+    assert_identical(eom.tau, [m * length**2 * thetadd + m * g * length * sp.sin(theta) - drag], "τ")
+    with pytest.raises(ValueError, match="argument 'forces'"):
+        sym.lagrange(sym.pendulum(), forces=[1, 2])
+
+
+def test_a_branching_urdf(tmp_path):
+    """A tree (two pendulums hanging from one revolute base): Lagrange = Newton–Euler, and the
+    closed forms agree with the core."""
+    inertial = '<inertial><origin xyz="{x} 0 -0.3"/><mass value="{m}"/>' \
+               '<inertia ixx="0.01" ixy="0" ixz="0.002" iyy="0.02" iyz="0" izz="0.015"/></inertial>'
+    path = tmp_path / "tree.urdf"
+    path.write_text(
+        '<robot name="tree"><link name="world"/>'
+        f'<link name="base">{inertial.format(x=0, m=2.0)}</link>'
+        f'<link name="left">{inertial.format(x=0.1, m=1.0)}</link>'
+        f'<link name="right">{inertial.format(x=-0.1, m=0.5)}</link>'
+        '<joint name="turn" type="revolute"><parent link="world"/><child link="base"/><axis xyz="0 0 1"/></joint>'
+        '<joint name="left_hinge" type="revolute"><parent link="base"/><child link="left"/>'
+        '<origin xyz="0.2 0 0" rpy="0 0 0.5"/><axis xyz="0 1 0"/></joint>'
+        '<joint name="right_slide" type="prismatic"><parent link="base"/><child link="right"/>'
+        '<origin xyz="-0.2 0 0"/><axis xyz="0 0 1"/></joint></robot>'
+    )
+    chain = sym.from_urdf(path)
+    assert [link.parent for link in chain.links] == [-1, 0, 0]
+    eom = sym.lagrange(chain)
+    assert sym.newton_euler(chain).difference(eom) == sp.zeros(3, 1)
+    numeric, model = eom.lambdify(), robodyn.load(path)
+    for q, v, a in _random_states(3):
+        assert_close(numeric.tau(q, v, a), model.inverse_dynamics(q, v, a), CLOSED_FORM_TOLERANCE, "tree τ")
+        assert_close(numeric.M(q), model.mass_matrix(q), CLOSED_FORM_TOLERANCE, "tree M")

@@ -2,7 +2,8 @@
 
 The terms are read off τ the way seed 003 does ("E_OM ... M, C, G = ?"):
 ``M = ∂τ/∂q̈``, ``G = τ(q̇ = 0, q̈ = 0)`` (gravity and springs), ``V = τ − M q̈ − G − F`` (Coriolis
-and centrifugal, Craig's V of seed 001/002), and ``F`` the damping and friction forces. From M come
+and centrifugal, Craig's V of seed 001/002), and ``F`` the damping and friction forces (and −Q of
+any other generalized forces given to ``lagrange``). From M come
 the Christoffel symbols (seed 000, "Christoffel Symbols")
 
     Γᵢⱼₖ = ½ (∂Mᵢⱼ/∂qₖ + ∂Mᵢₖ/∂qⱼ − ∂Mⱼₖ/∂qᵢ),    Cᵢⱼ = Σₖ Γᵢⱼₖ q̇ₖ,   V = C q̇,
@@ -148,7 +149,8 @@ class EquationsOfMotion:
 
     @cached_property
     def F(self) -> sp.Matrix:
-        """Damping and friction forces F(q̇) = b q̇ + f_c sign(q̇), n × 1."""
+        """Damping and friction forces F(q̇) = b q̇ + f_c sign(q̇) (minus any other generalized
+        forces Q given to ``lagrange``), n × 1."""
         return self._out(sp.Matrix(self._dissipation))
 
     def _exact_tau(self) -> list:

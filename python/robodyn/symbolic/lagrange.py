@@ -7,7 +7,8 @@ seed 000, "Lagrange Formulation"; seed 002, "Lagrange Equation"):
        P = −Σᵢ mᵢ gᵀ p_cᵢ + Σ ½ k (q − q_ref)² + Σ ½ k (r − r₀)²
 3. L = K − P and, for every coordinate,
        τⱼ = d/dt (∂L/∂q̇ⱼ) − ∂L/∂qⱼ − Qⱼ,   d/dt = Σₖ q̇ₖ ∂/∂qₖ + q̈ₖ ∂/∂q̇ₖ
-   with the generalized forces of damping and friction Qⱼ = −bⱼ q̇ⱼ − f_cⱼ sign(q̇ⱼ).
+   with the generalized forces of damping and friction Qⱼ = −bⱼ q̇ⱼ − f_cⱼ sign(q̇ⱼ), plus any
+   others given as ``forces``.
 
 K and the gravity part of P are exact trigonometric polynomials (:mod:`robodyn.symbolic.trig`);
 springs and friction, whose terms are not, are differentiated by SymPy directly.
@@ -63,8 +64,16 @@ def spring_potential(chain: Chain, kinematics: ChainKinematics) -> sp.Expr:
     return energy
 
 
-def lagrange(chain: Chain) -> EquationsOfMotion:
-    """The Euler–Lagrange equations of ``chain`` (see the module docstring)."""
+def lagrange(chain: Chain, forces=None) -> EquationsOfMotion:
+    """The Euler–Lagrange equations of ``chain`` (see the module docstring). ``forces``: n more
+    generalized forces Qⱼ acting on the joints besides the actuators (expressions in q and q̇),
+    which enter F as −Q."""
+    if forces is not None:
+        forces = [sp.sympify(f) for f in forces]
+        if len(forces) != chain.n:
+            raise ValueError(f"argument 'forces': expected {chain.n} generalized forces, got {len(forces)}")
+    else:
+        forces = [sp.S.Zero] * chain.n
     kinematics = ChainKinematics(chain)
     ring = kinematics.ring
     n = chain.n
@@ -93,7 +102,8 @@ def lagrange(chain: Chain) -> EquationsOfMotion:
 
     springs = spring_potential(chain, kinematics)
     spring_forces = [sp.diff(springs, q) for q in chain.q]
-    dissipation = [link.damping * v + link.friction * sp.sign(v) for v, link in zip(chain.qd, chain.links)]
+    dissipation = [link.damping * v + link.friction * sp.sign(v) - force
+                   for v, link, force in zip(chain.qd, chain.links, forces)]
     return EquationsOfMotion(
         chain=chain,
         kinematics=kinematics,

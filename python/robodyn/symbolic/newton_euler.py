@@ -82,7 +82,7 @@ class NewtonEuler:
     def difference(self, equations) -> sp.Matrix:
         """τ_Newton–Euler − τ_Lagrange of the same chain, exactly, in canonical form: the zero
         vector when the two agree."""
-        angles = self.ring.angles
+        angles = self.ring.joint_angles
         return sp.Matrix([trig_canonical(a - b, angles) for a, b in zip(self._exact_tau(), equations._exact_tau())])
 
     def _exact_tau(self) -> list:

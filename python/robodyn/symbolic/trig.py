@@ -17,8 +17,9 @@ symbolic equality as well.
 :class:`TrigPoly` keeps every intermediate in that form, with exact rational coefficients held as
 SymPy sparse polynomials (``sympy.polys.rings``), so sums cancel as they are formed and nothing
 ever needs SymPy's general ``simplify`` (which takes minutes on a 6-DoF arm where this takes
-seconds). Anything else in the coefficients (a square root, cos of a constant angle, 1/m) enters
-as an opaque generator of the polynomial ring.
+seconds). A constant angle φ in a sine or cosine (a URDF rpy of 0.5 rad) is one more angle of the
+series, so that cos²φ + sin²φ is 1 there too; anything else in the coefficients (a square root,
+1/m) enters as an opaque generator of the polynomial ring.
 """
 
 from __future__ import annotations
@@ -80,11 +81,18 @@ class TrigRing:
     """
 
     def __init__(self, angles, generators=(), expressions=()):
-        self.angles = tuple(angles)
+        self.joint_angles = tuple(angles)
+        self.angles = self.joint_angles
+        # constant angles φ inside sin/cos become angles of their own
+        split = [self._split_phases(e) for e in expressions]
+        constants = sorted({f.args[0] for e in split for f in e.atoms(sp.cos, sp.sin) if f.args[0].is_number},
+                           key=sp.default_sort_key)
+        self.constant_angles = {phi: sp.Dummy(f"phi{k}", real=True) for k, phi in enumerate(constants)}
+        self.angles = self.joint_angles + tuple(self.constant_angles.values())
         self.zero_frequency = (0,) * len(self.angles)
         opaque: dict = {}
         symbols = set(generators)
-        for expression in expressions:
+        for expression in split:
             for value in _leaves(self.prepare(expression), self.angles):
                 if isinstance(value, sp.Symbol):
                     symbols.add(value)
@@ -102,16 +110,24 @@ class TrigRing:
         self.generators = dict(zip(names, gens))
         self.index = {symbol: k for k, symbol in enumerate(names)}
 
-    def prepare(self, expr) -> sp.Expr:
+    def _split_phases(self, expr) -> sp.Expr:
         """Floats as the exact decimals they print as; sin/cos of ``k·q + φ`` split into sin/cos of
         ``k·q`` times sin/cos φ."""
         expr = sp.sympify(expr)
         if expr.has(sp.Float):
             expr = expr.xreplace({f: sp.Rational(str(f)) for f in expr.atoms(sp.Float)})
         return expr.replace(
-            lambda e: isinstance(e, (sp.cos, sp.sin)) and _has_phase(e.args[0], self.angles),
-            lambda e: _split_phase(e, self.angles),
+            lambda e: isinstance(e, (sp.cos, sp.sin)) and _has_phase(e.args[0], self.joint_angles),
+            lambda e: _split_phase(e, self.joint_angles),
         )
+
+    def prepare(self, expr) -> sp.Expr:
+        """:meth:`_split_phases`, then every constant angle replaced by its own angle symbol."""
+        expr = self._split_phases(expr)
+        if not self.constant_angles:
+            return expr
+        return expr.xreplace({f: type(f)(self.constant_angles[f.args[0]])
+                              for f in expr.atoms(sp.cos, sp.sin) if f.args[0] in self.constant_angles})
 
     def coefficient(self, expr: sp.Expr):
         """An angle-free expression as a ring element."""
@@ -255,16 +271,30 @@ class TrigPoly:
         return TrigPoly(self.ring, terms)
 
     def as_expr(self) -> sp.Expr:
-        """The canonical SymPy expression."""
+        """The canonical SymPy expression; a constant angle's multiples are written out in
+        powers of its sine and cosine (cos 2φ = cos²φ − sin²φ), so that the expression reads
+        back into a ring with the same constant angles."""
         out = []
-        angles = self.ring.angles
+        ring = self.ring
+        joints = len(ring.joint_angles)
+        restore_constants = {d: phi for phi, d in ring.constant_angles.items()}
         for (k, kind), c in self.terms.items():
-            coefficient = c.as_expr().xreplace(self.ring.restore)
+            coefficient = c.as_expr().xreplace(ring.restore)
             if not any(k):
                 out.append(coefficient)
                 continue
-            argument = sp.Add(*[e * a for e, a in zip(k, angles) if e])
-            out.append(coefficient * (sp.cos(argument) if kind == "cos" else sp.sin(argument)))
+            joint = sp.Add(*[e * a for e, a in zip(k[:joints], ring.joint_angles) if e])
+            constant = sp.Add(*[e * a for e, a in zip(k[joints:], ring.angles[joints:]) if e])
+            if constant == 0:
+                out.append(coefficient * (sp.cos(joint) if kind == "cos" else sp.sin(joint)))
+                continue
+            # trig(A + B) with B the constant part, expanded in sin/cos of the constant angles
+            cos_b = sp.expand_trig(sp.cos(constant)).xreplace(restore_constants)
+            sin_b = sp.expand_trig(sp.sin(constant)).xreplace(restore_constants)
+            if kind == "cos":
+                out.append(coefficient * (sp.cos(joint) * cos_b - sp.sin(joint) * sin_b))
+            else:
+                out.append(coefficient * (sp.sin(joint) * cos_b + sp.cos(joint) * sin_b))
         return sp.Add(*out)
 
 
