@@ -194,6 +194,10 @@ def from_dh(table, convention: str | None = None, *, symbolic_params=False, grav
         decimals = True
     else:
         rows = table
+        # rows written with floats print their results as decimals too
+        decimals = isinstance(rows, list) and any(
+            isinstance(value, float) or (isinstance(value, (list, tuple)) and any(isinstance(x, float) for x in value))
+            for row in rows if isinstance(row, dict) for value in row.values())
     if not isinstance(rows, list) or not rows:
         raise ValueError(f"{source}: expected a non-empty list of rows ([[joint]] tables), got {rows!r}")
     if convention not in ("standard", "modified"):
