@@ -89,6 +89,13 @@ def _c_function(name, matrix, arguments, bindings, n, k):
     return f"void {name}({signature})\n{{\n" + "\n".join(body) + "\n}"
 
 
+def _nested(values: list[str], n: int, square: bool) -> str:
+    """``[a, b]`` or, for an n × n matrix in row-major order, ``[[a, b], [c, d]]``."""
+    if not square:
+        return "[" + ", ".join(values) + "]"
+    return "[" + ", ".join("[" + ", ".join(values[i * n:(i + 1) * n]) + "]" for i in range(n)) + "]"
+
+
 class _RustPrinter(C99CodePrinter):
     """Rust expressions: f64 literals and ``f64::cos(x)`` calls (SymPy's own Rust printer drops
     the parentheses of a sum multiplied by a method call)."""
@@ -124,12 +131,7 @@ def _rust_function(name, matrix, arguments, bindings, n, k):
     replacements, reduced = _cse(matrix)
     printer = _RustPrinter()
     body += [f"    let {s} = {printer.doprint(e)};" for s, e in replacements]
-    values = [printer.doprint(e) for e in reduced]
-    if square:
-        rows = ["[" + ", ".join(values[i * n:(i + 1) * n]) + "]" for i in range(n)]
-        body.append("    [" + ", ".join(rows) + "]")
-    else:
-        body.append("    [" + ", ".join(values) + "]")
+    body.append("    " + _nested([printer.doprint(e) for e in reduced], n, square))
     return (f"#[allow(unused_variables, non_snake_case, clippy::all)]\npub fn {name}({signature}) -> {returns} {{\n"
             + "\n".join(body) + "\n}")
 
@@ -140,10 +142,6 @@ def _numpy_function(name, matrix, arguments, bindings, n, k):
     body = [f"    {s} = {source}" for s, source in bindings]
     replacements, reduced = _cse(matrix)
     body += [f"    {s} = {printer.doprint(e)}" for s, e in replacements]
-    values = [printer.doprint(e) for e in reduced]
-    if square:
-        rows = ["[" + ", ".join(values[i * n:(i + 1) * n]) + "]" for i in range(n)]
-        body.append("    return numpy.array([" + ", ".join(rows) + "], dtype=float)")
-    else:
-        body.append("    return numpy.array([" + ", ".join(values) + "], dtype=float)")
+    nested = _nested([printer.doprint(e) for e in reduced], n, square)
+    body.append(f"    return numpy.array({nested}, dtype=float)")
     return f"def {name}({', '.join(arguments)}):\n" + "\n".join(body)
