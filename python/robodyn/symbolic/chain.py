@@ -230,14 +230,6 @@ class Chain:
         return dataclasses.replace(self, links=links, springs=springs, gravity=sub(self.gravity),
                                    values=remaining)
 
-    def ancestors(self, i: int) -> list[int]:
-        """Links from the base to link ``i`` (inclusive), in order."""
-        path = []
-        while i >= 0:
-            path.append(i)
-            i = self.links[i].parent
-        return path[::-1]
-
 
 def _sympify(value):
     if isinstance(value, (list, tuple)):

@@ -135,7 +135,7 @@ class EquationsOfMotion:
     def G(self) -> sp.Matrix:
         """Gravity and spring forces G(q) = ∂P/∂q, n × 1."""
         gravity = [g.as_expr() for g in self._gravity]
-        return self._out(sp.Matrix([g + sp.expand(s) for g, s in zip(gravity, self._spring_forces)]))
+        return self._out(sp.Matrix([g + s for g, s in zip(gravity, self._spring_forces)]))
 
     @cached_property
     def V(self) -> sp.Matrix:
@@ -154,7 +154,7 @@ class EquationsOfMotion:
         return self._out(sp.Matrix(self._dissipation))
 
     def _exact_tau(self) -> list:
-        return [t.as_expr() + sp.expand(s) + d for t, s, d in zip(self._rigid_tau, self._spring_forces, self._dissipation)]
+        return [t.as_expr() + s + d for t, s, d in zip(self._rigid_tau, self._spring_forces, self._dissipation)]
 
     @cached_property
     def tau(self) -> sp.Matrix:

@@ -70,12 +70,12 @@ class ChainKinematics:
         for q, link in zip(chain.q, chain.links):
             t = link.origin * link.joint_transform(q)
             self.rotation.append(r.matrix(t[:3, :3]))
-            self.position.append([row[0] for row in r.matrix(t[:3, 3])])
-            self.axis.append([row[0] for row in r.matrix(link.axis)])
+            self.position.append(r.vector(t[:3, 3]))
+            self.axis.append(r.vector(link.axis))
             self.mass.append(r(link.mass))
-            self.com.append([row[0] for row in r.matrix(link.com)])
+            self.com.append(r.vector(link.com))
             self.inertia.append(r.matrix(link.inertia))
-        self.gravity = [row[0] for row in r.matrix(chain.gravity)]
+        self.gravity = r.vector(chain.gravity)
 
     def parent_frame(self, i: int) -> int:
         """Frame number of the parent of frame i (links are frames 1..n)."""

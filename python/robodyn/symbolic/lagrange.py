@@ -22,7 +22,7 @@ from robodyn.symbolic.chain import Chain
 from robodyn.symbolic.equations import EquationsOfMotion
 from robodyn.symbolic.kinematics import ChainKinematics, dot, matvec, transpose
 
-__all__ = ["lagrange", "mass_matrix_by_jacobians"]
+__all__ = ["lagrange", "mass_matrix_by_jacobians", "passive_joint_forces"]
 
 
 def mass_matrix_by_jacobians(kinematics: ChainKinematics) -> list[list]:
@@ -33,7 +33,8 @@ def mass_matrix_by_jacobians(kinematics: ChainKinematics) -> list[list]:
     for i in range(1, n + 1):
         jv, jw = kinematics.jacobians(i)
         jv_columns, jw_columns = transpose(jv), transpose(jw)
-        i_jw = transpose(matvec_columns(kinematics.inertia[i - 1], jw_columns))
+        # columns of Iᵢ J_ωᵢ
+        i_jw = [matvec(kinematics.inertia[i - 1], column) for column in jw_columns]
         for a in range(n):
             for b in range(a, n):
                 term = kinematics.mass[i - 1] * dot(jv_columns[a], jv_columns[b]) + dot(jw_columns[a], i_jw[b])
@@ -42,11 +43,6 @@ def mass_matrix_by_jacobians(kinematics: ChainKinematics) -> list[list]:
         for b in range(a):
             mass[a][b] = mass[b][a]
     return mass
-
-
-def matvec_columns(matrix, columns):
-    """[matrix · column for every column], as rows of a 3 × n list."""
-    return transpose([matvec(matrix, column) for column in columns])
 
 
 def spring_potential(chain: Chain, kinematics: ChainKinematics) -> sp.Expr:
@@ -62,6 +58,14 @@ def spring_potential(chain: Chain, kinematics: ChainKinematics) -> sp.Expr:
         length = sp.sqrt(sum((a - b) ** 2 for a, b in zip(*ends)))
         energy += spring.stiffness * (length - spring.rest_length) ** 2 / 2
     return energy
+
+
+def passive_joint_forces(chain: Chain, kinematics: ChainKinematics) -> tuple[sp.Expr, list, list]:
+    """(spring energy, spring forces ∂P_spring/∂q, dissipative forces b q̇ + f_c sign(q̇))."""
+    springs = spring_potential(chain, kinematics)
+    spring_forces = [sp.expand(sp.diff(springs, q)) for q in chain.q]
+    dissipation = [link.damping * v + link.friction * sp.sign(v) for v, link in zip(chain.qd, chain.links)]
+    return springs, spring_forces, dissipation
 
 
 def lagrange(chain: Chain, forces=None) -> EquationsOfMotion:
@@ -100,10 +104,8 @@ def lagrange(chain: Chain, forces=None) -> EquationsOfMotion:
         )
         tau.append(rate - lagrangian.diff(chain.q[j]))
 
-    springs = spring_potential(chain, kinematics)
-    spring_forces = [sp.diff(springs, q) for q in chain.q]
-    dissipation = [link.damping * v + link.friction * sp.sign(v) - force
-                   for v, link, force in zip(chain.qd, chain.links, forces)]
+    springs, spring_forces, dissipation = passive_joint_forces(chain, kinematics)
+    dissipation = [d - force for d, force in zip(dissipation, forces)]
     return EquationsOfMotion(
         chain=chain,
         kinematics=kinematics,

@@ -297,9 +297,6 @@ def from_urdf(path, *, symbolic_params=False, gravity=None, angle_tolerance: flo
     if len(roots) != 1:
         raise ValueError(f"{path}: expected one root link, got {roots}")
 
-    def place(element, what):
-        return f"{path}: {what} '{element.get('name')}'"
-
     def numbers(element, attribute, where, default="0 0 0"):
         text = element.get(attribute, default) if element is not None else default
         values = text.split()
@@ -357,7 +354,7 @@ def from_urdf(path, *, symbolic_params=False, gravity=None, angle_tolerance: flo
 
     def visit(link_name, body_index, pose_in_body):
         for joint in children.get(link_name, []):
-            where = place(joint, "joint")
+            where = f"{path}: joint '{joint.get('name')}'"
             kind = joint.get("type")
             child = joint.find("child").get("link")
             if child not in links:

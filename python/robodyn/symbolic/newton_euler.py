@@ -32,7 +32,7 @@ import sympy as sp
 from robodyn.symbolic.chain import Chain
 from robodyn.symbolic.equations import as_given
 from robodyn.symbolic.kinematics import ChainKinematics, cross, dot, matvec, transpose
-from robodyn.symbolic.lagrange import spring_potential
+from robodyn.symbolic.lagrange import passive_joint_forces
 from robodyn.symbolic.trig import trig_canonical
 
 __all__ = ["newton_euler", "NewtonEuler"]
@@ -150,9 +150,8 @@ def newton_euler(chain: Chain) -> NewtonEuler:
         projected = f[i] if chain.links[i - 1].joint == "prismatic" else moment[i]
         tau.append(dot(projected, kinematics.axis[i - 1]))
 
-    springs = spring_potential(chain, kinematics)
-    passive = [sp.expand(sp.diff(springs, q)) + link.damping * v + link.friction * sp.sign(v)
-               for q, v, link in zip(chain.q, chain.qd, chain.links)]
+    _, spring_forces, dissipation = passive_joint_forces(chain, kinematics)
+    passive = [s + d for s, d in zip(spring_forces, dissipation)]
     vectors = {
         "omega": [omega[i] for i in range(1, n + 1)],
         "omega_dot": [omega_dot[i] for i in range(1, n + 1)],

@@ -70,16 +70,15 @@ class NumericEquations:
         shapes = {x.shape for x in arrays.values()}
         if len(shapes) > 1:
             raise ValueError(f"arguments {sorted(arrays)}: expected the same shape, got {sorted(shapes)}")
-        batch = next(iter(arrays.values())).ndim == 2
-        rows = next(iter(arrays.values())).shape[0] if batch else 1
-        zeros = np.zeros((rows, self.n))
-        stacks = [arrays.get(k, zeros).reshape(rows, self.n) for k in ("q", "v", "a")]
+        first = next(iter(arrays.values()))
+        batch = first.ndim == 2
+        rows = first.shape[0] if batch else 1
+        stacks = [arrays[k].reshape(rows, self.n) if k in arrays else np.zeros((rows, self.n)) for k in ("q", "v", "a")]
         function = self._functions[part]
-        out = np.array([np.asarray(function(*np.concatenate([s[r] for s in stacks])), dtype=float)
-                        for r in range(rows)])
-        out = out.reshape((rows,) + out.shape[1:])
-        if part != "M" and part != "C":
-            out = out.reshape(rows, self.n)
+        out = np.array([np.asarray(function(*row), dtype=float) for row in np.hstack(stacks)])
+        if part not in ("M", "C"):
+            # a constant column comes back as nested (n, 1) lists
+            out = out.reshape(len(out), self.n)
         return out if batch else out[0]
 
     def M(self, q) -> np.ndarray:

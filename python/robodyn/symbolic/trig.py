@@ -177,8 +177,9 @@ class TrigRing:
         matrix = sp.Matrix(matrix)
         return [[self(matrix[i, j]) for j in range(matrix.cols)] for i in range(matrix.rows)]
 
-    def generator(self, symbol: sp.Symbol):
-        return self.generators[symbol]
+    def vector(self, column) -> list["TrigPoly"]:
+        """A SymPy column as a list of TrigPoly."""
+        return [self(x) for x in sp.Matrix(column)]
 
 
 def _accumulate(terms: dict, k: tuple, kind: str, coefficient) -> dict:
@@ -238,9 +239,6 @@ class TrigPoly:
         return TrigPoly(self.ring, terms)
 
     __rmul__ = __mul__
-
-    def is_zero(self) -> bool:
-        return not self.terms
 
     def diff(self, symbol: sp.Symbol) -> "TrigPoly":
         """∂/∂symbol: an angle (d cos(k·q)/dq_j = −k_j sin(k·q)) or a generator."""
