@@ -39,6 +39,11 @@ pub enum Error {
     #[error("the result is not finite (entry {index} is {value}): the inputs are too large for float64 arithmetic")]
     Overflow { index: usize, value: f64 },
 
+    /// A simulation could not go on at time `time` (s): the state diverged, the controller or
+    /// the wrenches gave something unusable, or the equations became too stiff.
+    #[error("simulation stopped at t = {time} s: {message}")]
+    Simulation { time: f64, message: String },
+
     /// A frame name that the model does not have.
     #[error("unknown frame '{name}': the model's frames are {available}")]
     UnknownFrame { name: String, available: String },
@@ -53,6 +58,30 @@ impl Error {
         Error::InvalidModel {
             location: location.into(),
             message: message.into(),
+        }
+    }
+}
+
+impl Error {
+    /// The same error about argument `argument`, for a value checked under another name (a
+    /// configuration checked as `q` that the caller knows as `q0`).
+    pub fn for_argument(self, argument: &str) -> Self {
+        let argument = argument.to_string();
+        match self {
+            Error::Shape {
+                expected, received, ..
+            } => Error::Shape {
+                argument,
+                expected,
+                received,
+            },
+            Error::NotFinite { index, value, .. } => Error::NotFinite {
+                argument,
+                index,
+                value,
+            },
+            Error::InvalidValue { message, .. } => Error::InvalidValue { argument, message },
+            other => other,
         }
     }
 }

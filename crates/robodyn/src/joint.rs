@@ -204,6 +204,45 @@ impl Joint {
             }
         }
     }
+    /// The rate `ξ̇` of the tangent coordinates `ξ` in `q(t) = q₀ ⊕ ξ(t)` when the joint moves
+    /// with body velocity `v`: `ξ̇ = dexp⁻¹_{-ξ}(v) = v + ½ ad_ξ v + ¹⁄₁₂ ad_ξ² v − ¹⁄₇₂₀ ad_ξ⁴ v`
+    /// (the Bernoulli series, truncated after the term that a fifth-order Runge–Kutta–Munthe-Kaas
+    /// step needs; Iserles et al., *Lie-group methods*, Acta Numerica 2000, §2.3). `ad` is the cross
+    /// product on so(3) and the motion cross product on se(3); on a vector space it is zero and
+    /// `ξ̇ = v`.
+    pub fn tangent_rate(&self, xi: &[f64], v: &[f64], out: &mut [f64]) {
+        match self {
+            Joint::Fixed => {}
+            Joint::Revolute { .. } | Joint::Prismatic { .. } => out[0] = v[0],
+            Joint::Spherical => {
+                let (xi, v) = (Vec3::new(xi[0], xi[1], xi[2]), Vec3::new(v[0], v[1], v[2]));
+                let rate = bernoulli_series(v, |m| xi.cross(&m));
+                out.copy_from_slice(rate.as_slice());
+            }
+            Joint::Free => {
+                // twists are [linear; angular] in q's layout, (angular, linear) as a Motion
+                let xi = Motion::new(
+                    Vec3::new(xi[3], xi[4], xi[5]),
+                    Vec3::new(xi[0], xi[1], xi[2]),
+                );
+                let v = Motion::new(Vec3::new(v[3], v[4], v[5]), Vec3::new(v[0], v[1], v[2]));
+                let rate = bernoulli_series(v, |m| xi.cross_motion(&m));
+                out[0..3].copy_from_slice(rate.linear.as_slice());
+                out[3..6].copy_from_slice(rate.angular.as_slice());
+            }
+        }
+    }
+}
+
+/// `v + ½ ad v + ¹⁄₁₂ ad² v − ¹⁄₇₂₀ ad⁴ v` for the linear map `ad`.
+fn bernoulli_series<T>(v: T, ad: impl Fn(T) -> T) -> T
+where
+    T: Copy + std::ops::Add<Output = T> + std::ops::Mul<f64, Output = T>,
+{
+    let ad1 = ad(v);
+    let ad2 = ad(ad1);
+    let ad4 = ad(ad(ad2));
+    v + ad1 * 0.5 + ad2 * (1.0 / 12.0) + ad4 * (-1.0 / 720.0)
 }
 
 /// The unit quaternion of `[qx, qy, qz, qw]` (normalised).

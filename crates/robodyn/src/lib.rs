@@ -12,6 +12,7 @@
 pub mod algo;
 pub mod data;
 pub mod error;
+pub mod integrate;
 pub mod io;
 pub mod joint;
 pub mod model;

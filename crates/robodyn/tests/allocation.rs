@@ -2,7 +2,11 @@
 
 mod common;
 
+use nalgebra::DVector;
 use robodyn::algo::*;
+use robodyn::integrate::{
+    simulate, ControlLaw, DesiredMotion, Integrator, NativeController, SimulationOptions,
+};
 use robodyn::Data;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -150,6 +154,46 @@ fn algorithms_allocate_nothing_after_data_new() {
         ];
         for (algorithm, count) in counts {
             assert_eq!(count, 0, "{name}: {algorithm} allocated {count} times");
+        }
+        // a simulation allocates its buffers up front: ten times the steps, the same count
+        for integrator in [
+            Integrator::ExplicitEuler,
+            Integrator::SemiImplicitEuler,
+            Integrator::Rk4,
+            Integrator::Rk45 {
+                rtol: 1e-8,
+                atol: 1e-8,
+            },
+        ] {
+            let run = |t_end: f64| {
+                let options = SimulationOptions::new(integrator, 1e-3, t_end);
+                allocations(|| {
+                    let mut pd = NativeController::new(
+                        &model,
+                        ControlLaw::Pd {
+                            kp: DVector::from_element(model.nv, 0.1),
+                            kd: DVector::from_element(model.nv, 0.01),
+                            reference: DesiredMotion::Setpoint(model.neutral()),
+                            gravity_compensation: true,
+                        },
+                        options.passive,
+                        t_end,
+                    )
+                    .unwrap();
+                    simulate(
+                        &model,
+                        q,
+                        &vec![0.0; model.nv],
+                        &options,
+                        &mut pd,
+                        None,
+                        None,
+                    )
+                    .unwrap();
+                })
+            };
+            let (short, long) = (run(0.01), run(0.1));
+            assert_eq!(short, long, "{name}: {integrator:?} allocated per step");
         }
     }
 }
