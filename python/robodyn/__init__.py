@@ -31,12 +31,18 @@ from robodyn._core import (
     load_urdf_string,
 )
 from robodyn.operational_space import operational_space as _operational_space
+from robodyn.simulation import PD, ComputedTorque, GravityCompensation, Trajectory, simulate
 
 # methods composed in NumPy from the core's batched calls
 Model.operational_space = _operational_space
 
 __all__ = [
+    "ComputedTorque",
+    "GravityCompensation",
     "Model",
+    "PD",
+    "Trajectory",
+    "simulate",
     "ModelWarning",
     "from_dh",
     "load",

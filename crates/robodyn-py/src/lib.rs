@@ -19,6 +19,8 @@ use std::borrow::Cow;
 use std::collections::HashMap;
 use std::sync::Mutex;
 
+mod simulation;
+
 /// A core error as the Python exception the API promises.
 fn to_py_err(error: Error) -> PyErr {
     match error {
@@ -477,6 +479,22 @@ fn read_property(name: &'static str, value: &Bound<PyAny>, length: usize) -> PyR
     Ok(values)
 }
 
+/// Reads a settable per-coordinate property whose entries must be >= 0.
+fn read_non_negative(
+    name: &'static str,
+    value: &Bound<PyAny>,
+    length: usize,
+) -> PyResult<DVector<f64>> {
+    let values = read_property(name, value, length)?;
+    if let Some(k) = values.iter().position(|x| *x < 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "argument '{name}': expected values >= 0, got {} at index {k}",
+            values[k]
+        )));
+    }
+    Ok(DVector::from_vec(values))
+}
+
 #[pymethods]
 impl PyModel {
     /// The model's name (URDF `<robot name>`).
@@ -534,6 +552,27 @@ impl PyModel {
         self.model.frames.iter().map(|f| f.name.clone()).collect()
     }
 
+    /// The parent of each moving body, aligned with body_names: -1 for the world, else an index
+    /// into body_names.
+    #[getter]
+    fn body_parents(&self) -> Vec<isize> {
+        self.model.parent[1..]
+            .iter()
+            .map(|&p| p as isize - 1)
+            .collect()
+    }
+
+    /// The body each frame is attached to, aligned with frame_names: -1 for the world, else an
+    /// index into body_names.
+    #[getter]
+    fn frame_bodies(&self) -> Vec<isize> {
+        self.model
+            .frames
+            .iter()
+            .map(|f| f.body as isize - 1)
+            .collect()
+    }
+
     /// Gravity vector in world axes (m/s²), settable.
     #[getter]
     fn get_gravity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
@@ -556,14 +595,7 @@ impl PyModel {
 
     #[setter]
     fn set_armature(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
-        let values = read_property("armature", value, self.model.nv)?;
-        if let Some(k) = values.iter().position(|x| *x < 0.0) {
-            return Err(PyValueError::new_err(format!(
-                "argument 'armature': expected values >= 0, got {} at index {k}",
-                values[k]
-            )));
-        }
-        self.model.armature = nalgebra::DVector::from_vec(values);
+        self.model.armature = read_non_negative("armature", value, self.model.nv)?;
         Ok(())
     }
 
@@ -591,32 +623,60 @@ impl PyModel {
         vector_array(py, self.model.effort_limit.as_slice())
     }
 
-    /// Viscous damping per velocity coordinate (URDF `<dynamics damping>`), not applied by the
-    /// dynamics calls.
+    /// Viscous damping per velocity coordinate (URDF `<dynamics damping>`, MJCF `damping`),
+    /// settable. `simulate` applies it; the dynamics calls do not.
     #[getter]
-    fn damping<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn get_damping<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         vector_array(py, self.model.damping.as_slice())
     }
 
-    /// Dry friction per velocity coordinate (URDF `<dynamics friction>`), not applied by the
-    /// dynamics calls.
+    #[setter]
+    fn set_damping(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        self.model.damping = read_non_negative("damping", value, self.model.nv)?;
+        Ok(())
+    }
+
+    /// Coulomb friction per velocity coordinate (URDF `<dynamics friction>`, MJCF
+    /// `frictionloss`), settable. `simulate` applies it smoothed; the dynamics calls do not.
     #[getter]
-    fn friction<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn get_friction<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         vector_array(py, self.model.friction.as_slice())
     }
 
-    /// Joint spring stiffness per velocity coordinate (MJCF `stiffness`), not applied by the
-    /// dynamics calls.
+    #[setter]
+    fn set_friction(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        self.model.friction = read_non_negative("friction", value, self.model.nv)?;
+        Ok(())
+    }
+
+    /// Joint spring stiffness per velocity coordinate (MJCF `stiffness`), settable. `simulate`
+    /// applies it; the dynamics calls do not.
     #[getter]
-    fn stiffness<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn get_stiffness<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         vector_array(py, self.model.stiffness.as_slice())
     }
 
+    #[setter]
+    fn set_stiffness(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        self.model.stiffness = read_non_negative("stiffness", value, self.model.nv)?;
+        Ok(())
+    }
+
     /// The configuration at which the joint springs are relaxed, shape (nq,) (MJCF `springref`;
-    /// neutral for spherical and free joints).
+    /// neutral for spherical and free joints), settable to any valid configuration.
     #[getter]
-    fn spring_reference<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn get_spring_reference<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         vector_array(py, self.model.spring_reference.as_slice())
+    }
+
+    #[setter]
+    fn set_spring_reference(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        let values = read_property("spring_reference", value, self.model.nq)?;
+        self.model
+            .check_configuration(&values)
+            .map_err(|e| to_py_err(e.for_argument("spring_reference")))?;
+        self.model.spring_reference = DVector::from_vec(values);
+        Ok(())
     }
 
     /// URDF mimic relations as (joint, mimicked joint, multiplier, offset):
@@ -1513,5 +1573,6 @@ fn _core(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(load_mjcf_string, module)?)?;
     module.add_function(wrap_pyfunction!(load_dh_dict, module)?)?;
     module.add_function(wrap_pyfunction!(bundled_names, module)?)?;
+    module.add_function(wrap_pyfunction!(simulation::simulate, module)?)?;
     Ok(())
 }

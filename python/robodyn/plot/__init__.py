@@ -1,0 +1,190 @@
+"""Figures of a simulation: time series and a 3-D stick-figure animation (matplotlib).
+
+Both work headless: figures are drawn on matplotlib's Agg canvas unless ``show=True`` asks for a
+window. Install matplotlib with ``pip install robodyn[plot]``.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["animate_trajectory", "plot_trajectory", "stick_figure_points"]
+
+#: At most this many legend entries per panel; beyond it, the panel says how many it left out.
+MAX_LEGEND_ENTRIES = 12
+
+
+def _matplotlib() -> None:
+    """Fails with the install command when matplotlib is missing."""
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError as error:  # pragma: no cover - matplotlib is a declared extra
+        raise ImportError("plots need matplotlib: pip install 'robodyn[plot]'") from error
+
+
+def _units(model) -> tuple[str, str, str]:
+    """Units of q, v and τ for the model's joint kinds."""
+    kinds = set(model.joint_types)
+    if kinds <= {"revolute"}:
+        return "rad", "rad/s", "N·m"
+    if kinds <= {"prismatic"}:
+        return "m", "m/s", "N"
+    return "rad, m", "rad/s, m/s", "N·m, N"
+
+
+def _new_figure(rows: int, show: bool):
+    """A figure on the Agg canvas, or a pyplot window when shown."""
+    _matplotlib()
+    size = (10, 2.6 * rows)
+    if show:
+        import matplotlib.pyplot as plt
+
+        return plt.figure(figsize=size)
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=size)
+    FigureCanvasAgg(figure)
+    return figure
+
+
+def plot_trajectory(trajectory, path: str | os.PathLike[str] | None = None, show: bool | None = None):
+    """q, v, τ (controller and passive) and the energies over time, one panel each, with units and
+    the joints' names in the legends. Saves to ``path`` (PNG, PDF, SVG by its suffix) when given;
+    ``show`` opens a window (default: only when no path is given and a display exists). Returns the
+    matplotlib figure."""
+    model = trajectory.model
+    if show is None:
+        show = path is None and bool(os.environ.get("DISPLAY"))
+    figure = _new_figure(4, show)
+    axes = figure.subplots(4, 1, sharex=True)
+    q_unit, v_unit, tau_unit = _units(model)
+    q_names, v_names = trajectory.coordinate_names
+    t = trajectory.t
+    panels = [
+        (axes[0], trajectory.q, q_names, f"q [{q_unit}]"),
+        (axes[1], trajectory.v, v_names, f"v [{v_unit}]"),
+        (axes[2], trajectory.tau, v_names, f"τ [{tau_unit}]"),
+    ]
+    for axis, values, names, label in panels:
+        for k, name in enumerate(names):
+            axis.plot(t, values[:, k], label=name, linewidth=1.2)
+        axis.set_ylabel(label)
+    # one legend per set of names: colours follow the coordinate from panel to panel
+    _legend(axes[0], len(q_names))
+    if v_names != q_names:
+        _legend(axes[1], len(v_names))
+    if np.any(trajectory.tau_passive):
+        axes[2].set_prop_cycle(None)
+        for k in range(len(v_names)):
+            axes[2].plot(t, trajectory.tau_passive[:, k], linestyle="--", linewidth=0.8)
+        axes[2].set_title("solid: controller, dashed: passive (springs, damping, friction, limits)", fontsize=8)
+    energy = axes[3]
+    energy.plot(t, trajectory.energy, label="total", color="black", linewidth=1.5)
+    energy.plot(t, trajectory.kinetic_energy, label="kinetic", linewidth=1.0)
+    energy.plot(t, trajectory.potential_energy, label="potential (gravity)", linewidth=1.0)
+    if np.any(trajectory.spring_energy):
+        energy.plot(t, trajectory.spring_energy, label="springs", linewidth=1.0)
+    energy.set_ylabel("energy [J]")
+    energy.set_xlabel("time [s]")
+    energy.legend(fontsize=8, loc="upper right")
+    for axis in axes:
+        axis.grid(True, alpha=0.3)
+    figure.suptitle(
+        f"{model.name}: {trajectory.integrator}, {len(t)} samples over {t[-1]:g} s, "
+        f"{trajectory.steps} steps"
+    )
+    figure.tight_layout()
+    if path is not None:
+        figure.savefig(path, dpi=110)
+    if show:
+        import matplotlib.pyplot as plt
+
+        plt.show()
+    return figure
+
+
+def _legend(axis, entries: int) -> None:
+    handles, labels = axis.get_legend_handles_labels()
+    if entries > MAX_LEGEND_ENTRIES:
+        handles, labels = handles[:MAX_LEGEND_ENTRIES], labels[:MAX_LEGEND_ENTRIES]
+        labels[-1] += f" (+{entries - MAX_LEGEND_ENTRIES} more)"
+    axis.legend(handles, labels, fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
+
+
+def stick_figure_points(model, q) -> tuple[np.ndarray, list[tuple[int, int]]]:
+    """The robot as points and segments: the origins of the world, every body and every frame for
+    configurations ``q`` (T, nq), shape (T, P, 3), and the index pairs joined by a segment (body to
+    parent body, frame to its body)."""
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    frames = model.frame_names
+    # point 0 is the world origin, then one per frame
+    points = np.zeros((len(q), len(frames) + 1, 3))
+    for k, name in enumerate(frames):
+        points[:, k + 1] = np.asarray(model.frame_pose(q, name)).reshape(len(q), 4, 4)[:, :3, 3]
+    body_point = {}
+    for k, name in enumerate(frames):
+        body = model.frame_bodies[k]
+        if body >= 0 and model.body_names[body] == name:
+            body_point[body] = k + 1
+    segments = []
+    for body, parent in enumerate(model.body_parents):
+        if body in body_point:
+            segments.append((body_point.get(parent, 0), body_point[body]))
+    for k, body in enumerate(model.frame_bodies):
+        if body_point.get(body) != k + 1:
+            segments.append((body_point.get(body, 0), k + 1))
+    return points, segments
+
+
+def animate_trajectory(trajectory, path: str | os.PathLike[str], fps: int = 30, speed: float = 1.0):
+    """A 3-D stick figure of the robot moving along the trajectory, written to ``path``: a GIF
+    (Pillow), or an MP4 when the suffix is ``.mp4`` and ffmpeg is installed. ``speed`` > 1 plays
+    faster than real time. Returns the path."""
+    _matplotlib()
+    from matplotlib import animation
+
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".mp4":
+        if not animation.writers.is_available("ffmpeg"):
+            raise ValueError(f"argument 'path': writing {path.name} needs ffmpeg, which is not installed; write a .gif instead")
+        writer = animation.FFMpegWriter(fps=fps)
+    elif suffix == ".gif":
+        writer = animation.PillowWriter(fps=fps)
+    else:
+        raise ValueError(f"argument 'path': expected a .gif or .mp4 file, got '{path}'")
+    if not (fps > 0 and speed > 0):
+        raise ValueError(f"arguments 'fps' and 'speed': expected positive numbers, got {fps} and {speed}")
+    t = trajectory.t
+    frame_times = np.arange(0.0, t[-1] + 1e-12, speed / fps)
+    samples = np.minimum(np.searchsorted(t, frame_times), len(t) - 1)
+    points, segments = stick_figure_points(trajectory.model, trajectory.q[samples])
+
+    figure = _new_figure(2, show=False)
+    figure.set_size_inches(6, 6)
+    axis = figure.add_subplot(projection="3d")
+    low, high = points.reshape(-1, 3).min(axis=0), points.reshape(-1, 3).max(axis=0)
+    centre, half = (low + high) / 2, max(float(np.max(high - low)) / 2, 0.1) * 1.1
+    for setter, c in zip((axis.set_xlim, axis.set_ylim, axis.set_zlim), centre):
+        setter(c - half, c + half)
+    axis.set_box_aspect((1, 1, 1))
+    axis.set_xlabel("x [m]")
+    axis.set_ylabel("y [m]")
+    axis.set_zlabel("z [m]")
+    lines = [axis.plot([], [], [], color="tab:blue", linewidth=3, marker="o", markersize=4)[0] for _ in segments]
+    title = axis.set_title("")
+
+    def draw(frame: int):
+        for line, (a, b) in zip(lines, segments):
+            ends = points[frame, [a, b]]
+            line.set_data_3d(ends[:, 0], ends[:, 1], ends[:, 2])
+        title.set_text(f"{trajectory.model.name}   t = {t[samples[frame]]:.2f} s")
+        return [*lines, title]
+
+    movie = animation.FuncAnimation(figure, draw, frames=len(samples), blit=False)
+    movie.save(str(path), writer=writer, dpi=80)
+    return path
