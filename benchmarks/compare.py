@@ -1,5 +1,6 @@
-"""robodyn against Pinocchio and MuJoCo from Python, in one run: per-call time of each algorithm
-and a 10 000-state batch against a Python loop, printed as ratios (< 1 means robodyn is faster).
+"""robodyn against Pinocchio and MuJoCo from Python, in one run: per-call time of each algorithm,
+a 10 000-state batch against a Python loop, and a 10 s UR5 rollout (RK4, PD) against mj_step,
+printed as ratios (< 1 means robodyn is faster).
 
 Run: .venv/bin/python benchmarks/compare.py [--batch 10000] [--robots ur5 panda talos]
 Needs the bench extras (pip install '.[bench]'). Times are the best of several repeats.
@@ -162,6 +163,58 @@ def compare_mujoco(name: str, batch: int) -> list[tuple[str, float, float]]:
     return rows
 
 
+#: The rollout benchmark: duration (s) and step (s), RK4 in both libraries.
+ROLLOUT_DURATION, ROLLOUT_STEP = 10.0, 1e-3
+
+
+def mujoco_with_pd(urdf: Path, kp: np.ndarray, kd: np.ndarray) -> mujoco.MjModel:
+    """MuJoCo's import of the URDF with the same controller as robodyn's native PD: a position
+    actuator (gain kp) and a velocity actuator (gain kd) per joint, and gravity compensation of
+    every body (``gravcomp="1"``), all evaluated by MuJoCo inside its RK4 stages."""
+    plain = mujoco_model(urdf)
+    names = [plain.joint(j).name for j in range(plain.njnt)]
+    spec = mujoco.MjSpec.from_string(re.sub(r"<(visual|collision|gazebo|transmission)\b.*?</\1>", "", urdf.read_text(), flags=re.S))
+    for body in spec.bodies:
+        body.gravcomp = 1.0
+    for name, p_gain, d_gain in zip(names, kp, kd):
+        spec.add_actuator(target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT).set_to_position(kp=p_gain)
+        spec.add_actuator(target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT).set_to_velocity(kv=d_gain)
+    model = spec.compile()
+    model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
+    model.opt.timestep = ROLLOUT_STEP
+    return model
+
+
+def compare_rollout(name: str) -> list[tuple[str, float, float]]:
+    """A 10 s rollout at dt = 1 ms with RK4 and a PD controller with gravity compensation holding
+    the neutral configuration from a displaced start: robodyn.simulate (recording every step, with
+    energies) against one mj_step(nstep=10000) call."""
+    path, _ = ROBOTS[name]
+    urdf = robodyn._example_robot_data_dir() / path
+    m = robodyn.load(urdf)
+    q0 = np.full(m.nv, 0.3)
+    inertia = np.diag(m.mass_matrix(q0))
+    kp, kd = 100.0 * inertia, 20.0 * inertia
+    controller = robodyn.PD(kp, kd, q_ref=m.neutral(), gravity_compensation=True)
+    mj = mujoco_with_pd(urdf, kp, kd)
+    d = mujoco.MjData(mj)
+    steps = int(round(ROLLOUT_DURATION / ROLLOUT_STEP))
+
+    def ours():
+        return robodyn.simulate(m, q0, t_end=ROLLOUT_DURATION, dt=ROLLOUT_STEP, integrator="rk4", controller=controller)
+
+    def theirs():
+        mujoco.mj_resetData(mj, d)
+        d.qpos[:] = q0
+        d.ctrl[:] = 0.0
+        mujoco.mj_step(mj, d, nstep=steps)
+
+    final = ours().q[-1]
+    theirs()
+    print(f"{name} rollout: final configurations differ by {np.max(np.abs(final - d.qpos)):.1e} rad")
+    return [(f"{name} 10 s rollout, RK4 + PD", *best_times(ours, theirs, 1, 3))]
+
+
 def print_table(title: str, other: str, rows) -> None:
     print(f"\n{title}")
     print(f"{'case':<40}{'robodyn':>14}{other:>14}{'ratio':>9}")
@@ -179,6 +232,7 @@ def main() -> None:
           f"Python {platform.python_version()}, {platform.machine()}, {os.cpu_count()} cores")
     print_table("robodyn vs Pinocchio", "pinocchio", [row for name in args.robots for row in compare_robot(name, args.batch)])
     print_table("robodyn vs MuJoCo (fixed base)", "mujoco", [row for name in args.robots for row in compare_mujoco(name, args.batch)])
+    print_table("Simulation: robodyn.simulate vs mj_step", "mujoco", compare_rollout("ur5"))
 
 
 if __name__ == "__main__":

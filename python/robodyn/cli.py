@@ -1,4 +1,5 @@
-"""The ``robodyn`` command: ``robodyn demo``, ``robodyn models`` and ``robodyn derive``."""
+"""The ``robodyn`` command: ``robodyn demo``, ``robodyn models``, ``robodyn derive`` and
+``robodyn simulate``."""
 
 from __future__ import annotations
 
@@ -106,6 +107,58 @@ def derive(model: str, rods: bool, latex: str | None, codegen: str | None, symbo
     return 0
 
 
+#: Runs with more recorded samples than this show a progress bar.
+PROGRESS_BAR_SAMPLES = 2_000
+
+
+def _progress_bar(stream=sys.stderr, width: int = 40):
+    """A text progress bar on ``stream``, redrawn in place: ``[#####.....]  50 %``."""
+
+    def draw(fraction: float) -> None:
+        filled = int(round(fraction * width))
+        stream.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {fraction * 100:5.1f} %")
+        if fraction >= 1.0:
+            stream.write("\n")
+        stream.flush()
+
+    return draw
+
+
+def simulate(model: str, t_end: float, dt: float, integrator: str, q0: list[float] | None, controller: str,
+             plot: str | None, animate: str | None, csv: str | None, npz: str | None,
+             show_progress: bool | None = None) -> int:
+    """Simulate a model from rest and report the run; optionally save a plot, an animation and data."""
+    m = robodyn.load(model)
+    start_q = m.neutral() if q0 is None else np.asarray(q0, dtype=float)
+    controllers = {
+        "none": None,
+        "gravity": robodyn.GravityCompensation(),
+        "pd": robodyn.PD(kp=100.0 * np.diag(m.mass_matrix(start_q)), kd=20.0 * np.diag(m.mass_matrix(start_q)),
+                         q_ref=start_q, gravity_compensation=True),
+    }
+    if show_progress is None:
+        show_progress = t_end / dt > PROGRESS_BAR_SAMPLES and sys.stderr.isatty()
+    progress = _progress_bar() if show_progress else None
+    begin = time.perf_counter()
+    trajectory = robodyn.simulate(m, start_q, t_end=t_end, dt=dt, integrator=integrator,
+                                  controller=controllers[controller], progress=progress)
+    elapsed = time.perf_counter() - begin
+    drift = float(np.max(np.abs(trajectory.energy - trajectory.energy[0])))
+    print(f"{m.name}: {t_end:g} s with {integrator} in {elapsed:.3f} s ({trajectory.steps} steps, "
+          f"{trajectory.rejected_steps} rejected, {trajectory.evaluations} evaluations of the dynamics)")
+    print(f"energy: {trajectory.energy[0]:.6g} J at the start, {trajectory.energy[-1]:.6g} J at the end, "
+          f"largest change {drift:.3g} J")
+    for violation in trajectory.limit_violations:
+        print(f"limit: {violation['coordinate']} left its range at t = {violation['first_time']:.3f} s, "
+              f"by up to {violation['worst_excess']:.3g}")
+    for path, write in ((plot, trajectory.plot), (animate, trajectory.animate), (csv, trajectory.to_csv),
+                        (npz, trajectory.to_npz)):
+        if path:
+            write(path)
+            print(f"wrote {path}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="robodyn", description="Rigid-body dynamics for robots.")
     commands = parser.add_subparsers(dest="command", required=True)
@@ -124,7 +177,29 @@ def main(argv: list[str] | None = None) -> int:
     derive_parser.add_argument("--newton-euler", action="store_true",
                                help="also derive by Newton–Euler and report whether the two agree")
     derive_parser.add_argument("-o", "--output", help="write to this file instead of standard output")
+    simulate_parser = commands.add_parser("simulate", help="simulate a model and plot or animate the motion")
+    simulate_parser.add_argument("model", help="a bundled model name or a .urdf, MJCF .xml or DH .toml file")
+    simulate_parser.add_argument("--t", type=float, default=5.0, dest="t_end", help="duration in s (default 5)")
+    simulate_parser.add_argument("--dt", type=float, default=1e-3,
+                                 help="step (recording interval for rk45) in s (default 1e-3)")
+    simulate_parser.add_argument("--integrator", default="rk4", choices=robodyn.simulation.INTEGRATORS)
+    simulate_parser.add_argument("--q0", type=float, nargs="+", help="initial configuration (default: neutral)")
+    simulate_parser.add_argument("--controller", default="none", choices=["none", "gravity", "pd"],
+                                 help="no torque, gravity compensation, or PD holding q0 with gravity compensation")
+    simulate_parser.add_argument("--plot", help="save q, v, τ and energy over time (PNG, PDF or SVG)")
+    simulate_parser.add_argument("--animate", help="save a stick-figure animation (.gif, or .mp4 with ffmpeg)")
+    simulate_parser.add_argument("--csv", help="save the trajectory as CSV")
+    simulate_parser.add_argument("--npz", help="save the trajectory as NumPy .npz")
+    simulate_parser.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                                 help="show a progress bar (default: for long runs on a terminal)")
     args = parser.parse_args(argv)
+    if args.command == "simulate":
+        try:
+            return simulate(args.model, args.t_end, args.dt, args.integrator, args.q0, args.controller,
+                            args.plot, args.animate, args.csv, args.npz, args.progress)
+        except (ValueError, FileNotFoundError) as error:
+            print(f"robodyn simulate: {error}", file=sys.stderr)
+            return 2
     if args.command == "derive":
         try:
             return derive(args.model, args.rods, args.latex, args.codegen, args.symbolic_params,

@@ -296,3 +296,19 @@ def test_progress_is_reported():
     robodyn.simulate(m, [0.5], t_end=1.0, dt=1e-3, progress=fractions.append)
     assert fractions[0] == 0.0 and fractions[-1] == 1.0 and 50 <= len(fractions) <= 200
     assert fractions == sorted(fractions)
+
+
+def test_the_simulate_command_reports_plots_and_shows_progress(tmp_path, capsys):
+    from PIL import Image
+
+    from robodyn.cli import main
+
+    plot = tmp_path / "out.png"
+    assert main(["simulate", "ur5", "--t", "1", "--integrator", "rk45", "--dt", "0.01", "--plot", str(plot), "--progress"]) == 0
+    output = capsys.readouterr()
+    assert "ur5: 1 s with rk45" in output.out and "energy:" in output.out
+    assert output.err.rstrip().endswith("100.0 %") and "[####" in output.err
+    with Image.open(plot) as image:
+        assert image.format == "PNG"
+    assert main(["simulate", "missing.urdf"]) == 2
+    assert "robodyn simulate: model file not found" in capsys.readouterr().err

@@ -112,5 +112,44 @@ fn benchmarks(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, benchmarks);
+/// A 1 s rollout of the bundled UR5 at dt = 1 ms with RK4 and a native PD controller with gravity
+/// compensation holding the neutral configuration from a displaced start (gains scaled by M's
+/// diagonal so the stiff wrist stays stable at this step).
+fn rollout(c: &mut Criterion) {
+    use robodyn::integrate::{
+        simulate, ControlLaw, DesiredMotion, Integrator, NativeController, SimulationOptions,
+    };
+    let model = robodyn::io::bundled_model("ur5", false).unwrap();
+    let q0 = nalgebra::DVector::from_element(model.nv, 0.3);
+    let mut data = Data::new(&model);
+    let inertia = robodyn::algo::crba(&model, &mut data, q0.as_slice())
+        .unwrap()
+        .diagonal();
+    let options = SimulationOptions::new(Integrator::Rk4, 1e-3, 1.0);
+    let law = ControlLaw::Pd {
+        kp: inertia.scale(100.0),
+        kd: inertia.scale(20.0),
+        reference: DesiredMotion::Setpoint(model.neutral()),
+        gravity_compensation: true,
+    };
+    let v0 = vec![0.0; model.nv];
+    c.bench_function("ur5/rollout_rk4_pd_1s", |b| {
+        b.iter(|| {
+            let mut controller =
+                NativeController::new(&model, law.clone(), options.passive, 1.0).unwrap();
+            simulate(
+                &model,
+                black_box(q0.as_slice()),
+                &v0,
+                &options,
+                &mut controller,
+                None,
+                None,
+            )
+            .map(|t| t.q[0])
+        })
+    });
+}
+
+criterion_group!(benches, benchmarks, rollout);
 criterion_main!(benches);
