@@ -251,6 +251,14 @@ def test_files_plots_and_animation(tmp_path):
         assert image.format == "GIF" and image.n_frames == 11
     with pytest.raises(ValueError, match="'path'"):
         trajectory.animate(tmp_path / "run.avi")
+    from matplotlib import animation
+
+    if animation.writers.is_available("ffmpeg"):
+        trajectory.animate(tmp_path / "run.mp4")
+        assert (tmp_path / "run.mp4").stat().st_size > 1000
+    else:
+        with pytest.raises(ValueError, match="needs ffmpeg"):
+            trajectory.animate(tmp_path / "run.mp4")
 
 
 @pytest.mark.parametrize(
