@@ -175,10 +175,37 @@ pub struct NativeController {
     law: ControlLaw,
     passive: PassiveForces,
     data: Data,
+    tracking: Tracking,
+}
+
+/// The reference at the current instant and the error from it.
+struct Tracking {
     q_d: Vec<f64>,
     v_d: Vec<f64>,
     a_d: Vec<f64>,
+    /// e = q_d ⊖ q (nv); scratch between uses.
     error: Vec<f64>,
+}
+
+impl Tracking {
+    /// The reference at t into q_d, v_d, a_d, and the tracking error e = q_d ⊖ q.
+    fn update(
+        &mut self,
+        model: &Model,
+        reference: &DesiredMotion,
+        t: f64,
+        q: &[f64],
+    ) -> Result<()> {
+        reference.evaluate(
+            model,
+            t,
+            &mut self.q_d,
+            &mut self.v_d,
+            &mut self.a_d,
+            &mut self.error,
+        )?;
+        model.difference(q, &self.q_d, &mut self.error)
+    }
 }
 
 impl NativeController {
@@ -201,10 +228,12 @@ impl NativeController {
             law,
             passive,
             data: Data::new(model),
-            q_d: vec![0.0; model.nq],
-            v_d: vec![0.0; model.nv],
-            a_d: vec![0.0; model.nv],
-            error: vec![0.0; model.nv],
+            tracking: Tracking {
+                q_d: vec![0.0; model.nq],
+                v_d: vec![0.0; model.nv],
+                a_d: vec![0.0; model.nv],
+                error: vec![0.0; model.nv],
+            },
         })
     }
 }
@@ -229,15 +258,7 @@ impl Controller for NativeController {
                 reference,
                 gravity_compensation,
             } => {
-                reference.evaluate(
-                    model,
-                    t,
-                    &mut self.q_d,
-                    &mut self.v_d,
-                    &mut self.a_d,
-                    &mut self.error,
-                )?;
-                model.difference(q, &self.q_d, &mut self.error)?;
+                self.tracking.update(model, reference, t, q)?;
                 if *gravity_compensation {
                     tau.copy_from_slice(generalized_gravity(model, &mut self.data, q)?.as_slice());
                 } else {
@@ -245,28 +266,22 @@ impl Controller for NativeController {
                 }
                 // τ += K_p e + K_d (v_d − q̇)
                 for j in 0..model.nv {
-                    tau[j] += kp[j] * self.error[j] + kd[j] * (self.v_d[j] - v[j]);
+                    tau[j] +=
+                        kp[j] * self.tracking.error[j] + kd[j] * (self.tracking.v_d[j] - v[j]);
                 }
             }
             ControlLaw::ComputedTorque { kp, kd, reference } => {
-                reference.evaluate(
-                    model,
-                    t,
-                    &mut self.q_d,
-                    &mut self.v_d,
-                    &mut self.a_d,
-                    &mut self.error,
-                )?;
-                model.difference(q, &self.q_d, &mut self.error)?;
+                self.tracking.update(model, reference, t, q)?;
                 // a* = a_d + K_d (v_d − q̇) + K_p e, kept in a_d
                 for j in 0..model.nv {
-                    self.a_d[j] += kd[j] * (self.v_d[j] - v[j]) + kp[j] * self.error[j];
+                    self.tracking.a_d[j] +=
+                        kd[j] * (self.tracking.v_d[j] - v[j]) + kp[j] * self.tracking.error[j];
                 }
                 // τ = RNEA(q, q̇, a*) − τ_passive
-                self.passive.torque(model, q, v, &mut self.error);
-                let inverse_dynamics = rnea(model, &mut self.data, q, v, &self.a_d, None)?;
+                self.passive.torque(model, q, v, &mut self.tracking.error);
+                let inverse_dynamics = rnea(model, &mut self.data, q, v, &self.tracking.a_d, None)?;
                 for j in 0..model.nv {
-                    tau[j] = inverse_dynamics[j] - self.error[j];
+                    tau[j] = inverse_dynamics[j] - self.tracking.error[j];
                 }
             }
         }
