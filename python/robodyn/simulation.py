@@ -121,10 +121,10 @@ class GravityCompensation:
 
 
 def _controller_argument(model, controller):
-    if controller is None or callable(controller) and not hasattr(controller, "_spec"):
-        return controller
     if hasattr(controller, "_spec"):
         return controller._spec(model)
+    if controller is None or callable(controller):
+        return controller
     if isinstance(controller, (list, tuple, np.ndarray)):
         return {"kind": "constant", "tau": np.asarray(controller, dtype=float)}
     raise ValueError(

@@ -465,18 +465,30 @@ fn parse_task(task: &Bound<PyAny>) -> PyResult<Vec<usize>> {
     }
 }
 
-/// Reads a settable per-coordinate property.
-fn read_property(name: &'static str, value: &Bound<PyAny>, length: usize) -> PyResult<Vec<f64>> {
-    let argument = Argument::new(name, value, SampleShape::vector(length))?;
+/// The values of an argument that must be one sample, not a batch.
+fn single_sample<'a>(argument: &'a Argument) -> PyResult<Cow<'a, [f64]>> {
     if argument.batch()?.is_some() {
         return Err(PyValueError::new_err(format!(
-            "argument '{name}': expected shape ({length},), got {}",
+            "argument '{}': expected shape {}, got {}",
+            argument.name,
+            shape_text(argument.sample_shape.as_slice()),
             shape_text(argument.array.shape())
         )));
     }
-    let values = argument.values().into_owned();
+    Ok(argument.values())
+}
+
+/// Reads one finite sample of `shape` (a settable property, a constant input).
+fn read_sample(name: &'static str, value: &Bound<PyAny>, shape: SampleShape) -> PyResult<Vec<f64>> {
+    let argument = Argument::new(name, value, shape)?;
+    let values = single_sample(&argument)?.into_owned();
     robodyn::error::check_finite(name, &values).map_err(to_py_err)?;
     Ok(values)
+}
+
+/// Reads a settable per-coordinate property.
+fn read_property(name: &'static str, value: &Bound<PyAny>, length: usize) -> PyResult<Vec<f64>> {
+    read_sample(name, value, SampleShape::vector(length))
 }
 
 /// Reads a settable per-coordinate property whose entries must be >= 0.

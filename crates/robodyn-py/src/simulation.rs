@@ -70,6 +70,7 @@ impl ExternalWrenches for PythonWrenches<'_> {
 }
 
 /// The same wrenches at every instant.
+#[derive(Clone)]
 struct ConstantWrenches(Vec<Force>);
 
 impl ExternalWrenches for ConstantWrenches {
@@ -99,14 +100,7 @@ fn call_back(
     let result = callable.call1((t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, v)))?;
     let argument = Argument::new(name, &result, shape)
         .map_err(|e| PyValueError::new_err(format!("{} (returned at t = {t})", e.value(py))))?;
-    if argument.batch()?.is_some() {
-        return Err(PyValueError::new_err(format!(
-            "the {name} returned an array of shape {:?} at t = {t}, expected one of shape {:?}",
-            argument.array.shape(),
-            shape.as_slice()
-        )));
-    }
-    out.copy_from_slice(&argument.values());
+    out.copy_from_slice(&crate::single_sample(&argument)?);
     Ok(())
 }
 
@@ -307,17 +301,8 @@ pub fn simulate<'py>(
     };
     let constant_wrenches = match wrenches {
         Some(value) if !value.is_callable() => {
-            let argument =
-                Argument::new("wrenches", value, SampleShape::matrix(m.nbodies() - 1, 6))?;
-            if argument.batch()?.is_some() {
-                return Err(PyValueError::new_err(format!(
-                    "argument 'wrenches': expected shape ({}, 6) or a callable (t, q, v) -> wrenches, got {:?}",
-                    m.nbodies() - 1,
-                    argument.array.shape()
-                )));
-            }
-            let values = argument.values();
-            robodyn::error::check_finite("wrenches", &values).map_err(to_py_err)?;
+            let shape = SampleShape::matrix(m.nbodies() - 1, 6);
+            let values = crate::read_sample("wrenches", value, shape)?;
             let mut forces = vec![Force::ZERO; m.nbodies() - 1];
             crate::fill_forces(&mut forces, &values);
             Some(ConstantWrenches(forces))
@@ -325,9 +310,11 @@ pub fn simulate<'py>(
         _ => None,
     };
     let python_wrenches = wrenches.filter(|w| w.is_callable());
-    if let Some(law) = &law {
-        NativeController::new(m, law.clone(), options.passive, t_end).map_err(to_py_err)?;
-    }
+    // built once (which checks it), cloned for each rollout
+    let native = law
+        .map(|law| NativeController::new(m, law, options.passive, t_end))
+        .transpose()
+        .map_err(to_py_err)?;
 
     let state = |k: usize| {
         (
@@ -335,18 +322,15 @@ pub fn simulate<'py>(
             &v_values[k * m.nv..(k + 1) * m.nv],
         )
     };
-    let runs: Vec<Trajectory> = match (&law, python_wrenches) {
-        (Some(law), None) if progress.is_none() => {
+    let runs: Vec<Trajectory> = match (&native, python_wrenches) {
+        (Some(native), None) if progress.is_none() => {
             // all native: release the GIL, rollouts in parallel
             let result: robodyn::Result<Vec<Trajectory>> = py.detach(|| {
                 (0..rollouts)
                     .into_par_iter()
                     .map(|k| {
-                        let mut controller =
-                            NativeController::new(m, law.clone(), options.passive, t_end)?;
-                        let mut wrenches = constant_wrenches
-                            .as_ref()
-                            .map(|w| ConstantWrenches(w.0.clone()));
+                        let mut controller = native.clone();
+                        let mut wrenches = constant_wrenches.clone();
                         let (q, v) = state(k);
                         run(
                             m,
@@ -367,12 +351,8 @@ pub fn simulate<'py>(
             // Python callbacks: one rollout after another, with the GIL
             let mut runs = Vec::with_capacity(rollouts);
             for k in 0..rollouts {
-                let mut native = law
-                    .as_ref()
-                    .map(|law| NativeController::new(m, law.clone(), options.passive, t_end))
-                    .transpose()
-                    .map_err(to_py_err)?;
-                let mut python = match (&law, controller) {
+                let mut native = native.clone();
+                let mut python = match (&native, controller) {
                     (None, Some(callable)) => Some(PythonController {
                         callable: callable.clone(),
                         raised: None,
@@ -389,9 +369,7 @@ pub fn simulate<'py>(
                     buffer: vec![0.0; (m.nbodies() - 1) * 6],
                     raised: None,
                 });
-                let mut fixed_wrenches = constant_wrenches
-                    .as_ref()
-                    .map(|w| ConstantWrenches(w.0.clone()));
+                let mut fixed_wrenches = constant_wrenches.clone();
                 let wrenches: Option<&mut dyn ExternalWrenches> =
                     match (callable_wrenches.as_mut(), fixed_wrenches.as_mut()) {
                         (Some(w), _) => Some(w),

@@ -170,7 +170,9 @@ pub enum ControlLaw {
     },
 }
 
-/// A [`ControlLaw`] with the workspace it needs; allocates only in [`NativeController::new`].
+/// A [`ControlLaw`] with the workspace it needs; allocates only in [`NativeController::new`]
+/// (and when cloned, one copy per rollout).
+#[derive(Debug, Clone)]
 pub struct NativeController {
     law: ControlLaw,
     passive: PassiveForces,
@@ -179,6 +181,7 @@ pub struct NativeController {
 }
 
 /// The reference at the current instant and the error from it.
+#[derive(Debug, Clone)]
 struct Tracking {
     q_d: Vec<f64>,
     v_d: Vec<f64>,

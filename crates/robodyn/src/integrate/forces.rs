@@ -85,16 +85,6 @@ impl PassiveForces {
             }
         }
     }
-
-    /// Potential energy stored in the joint springs, ½ Σ k (q ⊖ q_ref)², using `scratch` (nv).
-    pub fn spring_energy(&self, model: &Model, q: &[f64], scratch: &mut [f64]) -> f64 {
-        spring_displacement(model, q, scratch);
-        0.5 * scratch
-            .iter()
-            .zip(model.stiffness.iter())
-            .map(|(x, k)| k * x * x)
-            .sum::<f64>()
-    }
 }
 
 /// q ⊖ q_ref, joint by joint on its group, into `out` (nv).
