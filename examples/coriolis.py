@@ -1,4 +1,4 @@
-"""Seed 000/002: the 2-link arm's velocity terms, as the Coriolis matrix C(q, q̇), as Christoffel
+"""The TU Berlin and TUM notes: the 2-link arm's velocity terms, as the Coriolis matrix C(q, q̇), as Christoffel
 symbols, and as Craig's centrifugal C(q) and Coriolis B(q) matrices.
 
     python examples/coriolis.py

@@ -1,5 +1,5 @@
-"""Seed 000, "Inertia Tensor Example": a uniform box of sides w, l, h about its corner, the
-parallel-axis theorem, and its principal moments; seed 003: I = R I_b Rᵀ.
+"""The TU Berlin notes, "Inertia Tensor Example": a uniform box of sides w, l, h about its corner, the
+parallel-axis theorem, and its principal moments; the UR5 dynamics notes: I = R I_b Rᵀ.
 
     python examples/inertia_tensor.py
 """

@@ -1,4 +1,4 @@
-"""Seed 003, "Simulate": q̈ = −M⁻¹(C + G), integrated with Euler's method, Runge–Kutta of fixed
+"""The UR5 dynamics notes, "Simulate": q̈ = −M⁻¹(C + G), integrated with Euler's method, Runge–Kutta of fixed
 order 4 and an adaptive Runge–Kutta ("odeint"), on the notes' pendulum and the 2-link arm; then
 an animation of q.
 
@@ -16,7 +16,7 @@ parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("--animate", help="write the 2-link arm's swing as a GIF (or MP4 with ffmpeg)")
 args, _ = parser.parse_known_args()
 
-# the pendulum of seed 003: m l² θ̈ + m g l sin θ = 0, small swings take 2π√(l/g)
+# the pendulum of the UR5 dynamics notes: m l² θ̈ + m g l sin θ = 0, small swings take 2π√(l/g)
 pendulum = robodyn.load("pendulum")
 swing = robodyn.simulate(pendulum, [1e-3], t_end=5.0, dt=1e-3, integrator="rk45", rtol=1e-11, atol=1e-11)
 theta, t = swing.q[:, 0], swing.t
@@ -32,7 +32,7 @@ for integrator, dt in (("euler", 1e-3), ("euler", 5e-4), ("rk4", 1e-2), ("rk4", 
     print(f"  {integrator:<5} dt = {dt:<7g} {abs(run.q[-1, 0] - reference.q[-1, 0]):.2e} rad")
 print("  halving dt halves Euler's error and divides RK4's by 16")
 
-# the 2-link arm of seeds 001/002 falling from rest, no torque: energy is conserved
+# the 2-link arm of the ECE 470 and TUM notes falling from rest, no torque: energy is conserved
 arm = robodyn.load("planar2")
 fall = robodyn.simulate(arm, [0.3, 0.5], t_end=5.0, dt=1e-2, integrator="rk45", rtol=1e-11, atol=1e-11)
 show("total energy T + V at t = 0 and at t = 5 s (J)", fall.energy[0], fall.energy[-1], 1e-8)

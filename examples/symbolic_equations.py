@@ -1,4 +1,4 @@
-"""Seeds 001/002/003: the equations of motion derived symbolically, as the notes derive them by
+"""The ECE 470, TUM and UR5 dynamics notes: the equations of motion derived symbolically, as the notes derive them by
 hand: Euler–Lagrange for the 2-link arm (M, V, G), Newton–Euler giving the same τ, the pendulum,
 and the closed forms evaluated next to the numeric core.
 
@@ -14,14 +14,14 @@ from robodyn import symbolic as sym
 
 arm = sym.planar_chain(2)  # the notes' arm: point masses m_i at the ends of links l_i, gravity along -y
 eom = sym.lagrange(arm)
-print(eom.latex())  # M, V, G with c_12 = cos(q_1 + q_2) as seed 001 prints them
+print(eom.latex())  # M, V, G with c_12 = cos(q_1 + q_2) as the ECE 470 notes print them
 
 # Newton–Euler (Craig's iteration) gives the same torques, symbolically
 assert sym.newton_euler(arm).difference(eom) == sp.zeros(2, 1)
 print("Newton–Euler τ − Euler–Lagrange τ = 0")
-print(eom.latex("torques"))  # seed 002, eq. 6.58
+print(eom.latex("torques"))  # the TUM notes, eq. 6.58
 
-# the pendulum of seed 003
+# the pendulum of the UR5 dynamics notes
 print(sym.lagrange(sym.pendulum()).latex("torques"))  # m l² θ̈ + m g l sin θ = τ
 
 # the closed forms with the bundled planar2's numbers, next to the numeric core

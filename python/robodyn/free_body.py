@@ -1,4 +1,4 @@
-"""A free-floating rigid body, as seed 003 ("Free Floating Body (free joint)") writes its motion.
+"""A free-floating rigid body, as the UR5 dynamics notes ("Free Floating Body (free joint)") writes its motion.
 
 Translation, in world axes: m v̇ = m g, ṗ = v. Rotation, in body axes (Euler's equations):
 
@@ -12,7 +12,7 @@ angles (R = R_x(φ) R_y(θ) R_z(ψ)), whose rates
                               [−sin θ cos ψ, sin θ sin ψ, cos θ]] ω_b
 
 are singular at θ = ±90° (gimbal lock): there :func:`euler123_rates` raises ``GimbalLockError``.
-The world-frame inertia is I = R I_b Rᵀ (seed 003, "Relation between I and I_b").
+The world-frame inertia is I = R I_b Rᵀ (the UR5 dynamics notes, "Relation between I and I_b").
 
 Quaternions are ``[qx, qy, qz, qw]``, robodyn's order. :func:`simulate` integrates these equations
 with RK4; the same body as a robodyn model (a free joint, ABA) gives the same ω̇_b (tested).

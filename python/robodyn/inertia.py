@@ -1,4 +1,4 @@
-"""The inertia tensor, as seed 000 ("Inertia Tensor") and seed 003 ("Relation between I and I_b")
+"""The inertia tensor, as the TU Berlin notes ("Inertia Tensor") and the UR5 dynamics notes ("Relation between I and I_b")
 teach it: tensors of primitive solids, the parallel-axis theorem, rotation, principal axes, a
 physical-validity check, and the spatial inertia built from (mass, centre of mass, inertia).
 
@@ -63,7 +63,7 @@ def _about_axis(along: float, across: float, axis: str) -> np.ndarray:
 def solid_box(mass: float, size, about: str = "center") -> np.ndarray:
     """A box with side lengths ``size = (a, b, c)`` along x, y, z. ``about="center"``:
     diag(m(b²+c²)/12, m(a²+c²)/12, m(a²+b²)/12). ``about="corner"``: about the corner at the
-    origin with the box along +x, +y, +z (seed 000's example, sides w, l, h):
+    origin with the box along +x, +y, +z (the TU Berlin notes' example, sides w, l, h):
     I_xx = m/3 (b² + c²), I_xy = m/4 a b, …, i.e. the matrix [[m/3(l²+h²), −m/4 wl, −m/4 hw], …]."""
     mass = _positive("mass", mass)
     a, b, c = (_positive("size", s) for s in np.asarray(size, dtype=float).reshape(3))
@@ -154,7 +154,7 @@ def _point_term(mass: float, p: np.ndarray) -> np.ndarray:
 
 
 def shift_from_com(inertia_com, mass: float, com) -> np.ndarray:
-    """Parallel-axis theorem (seed 000): the inertia about a frame's origin A, given the inertia
+    """Parallel-axis theorem (the TU Berlin notes): the inertia about a frame's origin A, given the inertia
     about the centre of mass C (same axes) and C's position p_C in A:
     ᴬI = ᶜI + m [(p_Cᵀ p_C) 1 − p_C p_Cᵀ]."""
     return _matrix("inertia_com", inertia_com) + _point_term(float(mass), _vector("com", com))
@@ -166,7 +166,7 @@ def shift_to_com(inertia, mass: float, com) -> np.ndarray:
 
 
 def rotate(inertia, rotation) -> np.ndarray:
-    """The same tensor in other axes (seed 000 "Rotation Transformation"): ᴮI = ᴮR_A ᴬI ᴮR_Aᵀ,
+    """The same tensor in other axes (the TU Berlin notes "Rotation Transformation"): ᴮI = ᴮR_A ᴬI ᴮR_Aᵀ,
     with ``rotation`` = ᴮR_A mapping A coordinates to B coordinates."""
     rotation = _matrix("rotation", rotation)
     if not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-9) or np.linalg.det(rotation) <= 0:

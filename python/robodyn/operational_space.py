@@ -1,4 +1,4 @@
-"""Cartesian (operational-space) dynamics of a frame: seed 002, "Cartesian state space equation".
+"""Cartesian (operational-space) dynamics of a frame: the TUM notes, "Cartesian state space equation".
 
 For a task x of k rows of a frame's motion (its Jacobian J, k × nv), the joint-space equation
 M q̈ + C q̇ + g = τ with τ = Jᵀ F becomes

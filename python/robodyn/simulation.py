@@ -1,6 +1,6 @@
 """Simulation: integrate M(q) q̈ + C(q, q̇) q̇ + g(q) = τ + τ_passive + Σ Jᵀ f_ext in time.
 
-Seed 003 ends where this begins: "q̈ = −M⁻¹(C + G); simulate: integrate … Euler's method,
+The UR5 dynamics notes end where this begins: "q̈ = −M⁻¹(C + G); simulate: integrate … Euler's method,
 Runge–Kutta fixed order 4, odeint (adaptive) … once we obtain q we can do an animation"::
 
     m = robodyn.load("ur5")

@@ -1,4 +1,4 @@
-"""DH tables from Python and TOML: the same robots as URDF, seed 001's arm, errors."""
+"""DH tables from Python and TOML: the same robots as URDF, the ECE 470 notes' arm, errors."""
 
 from __future__ import annotations
 

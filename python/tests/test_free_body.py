@@ -1,4 +1,4 @@
-"""The free-floating body of seed 003: Euler's equations, quaternion and 1-2-3 Euler-angle
+"""The free-floating body of the UR5 dynamics notes: Euler's equations, quaternion and 1-2-3 Euler-angle
 kinematics, conservation, precession, the Dzhanibekov effect, and agreement with the engine."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""robodyn.inertia: the notes' inertia tensors (seed 000), checked against their closed forms,
+"""robodyn.inertia: the notes' inertia tensors (the TU Berlin notes), checked against their closed forms,
 against MuJoCo's inertia of the same primitive, and against robodyn's own mass matrix."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from robodyn import inertia
 
 
 def test_box_about_a_corner_is_the_notes_example():
-    """Seed 000, "Inertia Tensor Example": sides w (x), l (y), h (z), about the corner."""
+    """The TU Berlin notes, "Inertia Tensor Example": sides w (x), l (y), h (z), about the corner."""
     m, w, l, h = 3.0, 0.2, 0.5, 0.3
     expected = [
         [m / 3 * (l**2 + h**2), -m / 4 * w * l, -m / 4 * h * w],

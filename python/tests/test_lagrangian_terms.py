@@ -1,6 +1,6 @@
 """The lecture notes' dynamics terms (issue 4, parts 1 and 2): the Coriolis matrix and Christoffel
 symbols, Craig's centrifugal/Coriolis split, the mass matrix three ways and gravity two ways;
-identities, closed forms of the 2-link arm (seeds 000/002), and Pinocchio's computeCoriolisMatrix."""
+identities, closed forms of the 2-link arm (the TU Berlin and TUM notes), and Pinocchio's computeCoriolisMatrix."""
 
 from __future__ import annotations
 
@@ -79,8 +79,8 @@ def test_christoffel_symbols_and_craigs_split():
 
 
 def test_two_link_arm_closed_forms():
-    """Seed 000's 2-link arm: C(q) = [[0, −m₂l₁l₂s₂], [m₂l₁l₂s₂, 0]], B(q) = [−2m₂l₁l₂s₂, 0]ᵀ;
-    C(q, q̇) = [[h q̇₂, h(q̇₁ + q̇₂)], [−h q̇₁, 0]] with h = −m₂l₁l₂s₂ (seed 002)."""
+    """The TU Berlin notes' 2-link arm: C(q) = [[0, −m₂l₁l₂s₂], [m₂l₁l₂s₂, 0]], B(q) = [−2m₂l₁l₂s₂, 0]ᵀ;
+    C(q, q̇) = [[h q̇₂, h(q̇₁ + q̇₂)], [−h q̇₁, 0]] with h = −m₂l₁l₂s₂ (the TUM notes)."""
     model = robodyn.load("planar2")
     m2, l1, l2 = 1.0, 1.0, 0.5
     q, v = np.array([0.4, 1.1]), np.array([0.7, -1.3])

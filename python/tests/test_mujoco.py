@@ -50,15 +50,14 @@ def test_urdf_robots_agree_with_mujoco(robot):
     check_against_mujoco(model, mj, 5, name)
 
 
-SHARED_MJCF = REPOSITORY.parent / "shared" / "mjcf"
 TEST_MJCF = REPOSITORY / "testdata" / "mjcf"
 
-#: MJCF models read by robodyn's loader and by MuJoCo: Menagerie's UR5e and Panda (meshes removed,
-#: in shared/mjcf beside the repository) and the iiwa 14 written from Menagerie's inertial data,
+#: MJCF models read by robodyn's loader and by MuJoCo: Menagerie's UR5e and Panda (meshes removed)
+#: and the iiwa 14 written from Menagerie's inertial data,
 #: through a scene that <include>s it.
 MJCF_MODELS = {
-    "ur5e": SHARED_MJCF / "ur5e_nomesh.xml",
-    "panda": SHARED_MJCF / "panda_nomesh.xml",
+    "ur5e": TEST_MJCF / "ur5e_nomesh.xml",
+    "panda": TEST_MJCF / "panda_nomesh.xml",
     "iiwa14": TEST_MJCF / "iiwa14_scene.xml",
 }
 
@@ -66,7 +65,6 @@ MJCF_MODELS = {
 @pytest.mark.parametrize("name", sorted(MJCF_MODELS))
 def test_mjcf_models_agree_with_mujoco(name):
     path = MJCF_MODELS[name]
-    assert path.exists(), f"{path}: the MJCF test models live in shared/mjcf beside the repository"
     model = robodyn.load(path, check_inertia=True)
     mj = rigid_body_only(mujoco.MjModel.from_xml_path(str(path)))
     assert model.joint_names == [mj.joint(j).name for j in range(mj.njnt)]

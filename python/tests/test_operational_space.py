@@ -1,4 +1,4 @@
-"""Cartesian / operational-space dynamics (seed 002 "Cartesian state space equation"): both forms
+"""Cartesian / operational-space dynamics (the TUM notes "Cartesian state space equation"): both forms
 of Λ, μ, p, the equation F = Λ ẍ + μ + p itself, J̄, and the behaviour at singularities."""
 
 from __future__ import annotations

@@ -52,7 +52,7 @@ CHAINS = {
 
 
 def test_two_link_arm_matches_seed_001():
-    """Seed 001 "Dynamic Equation": M, V and G of the 2-link arm with point masses, exactly."""
+    """The ECE 470 notes "Dynamic Equation": M, V and G of the 2-link arm with point masses, exactly."""
     eom = sym.lagrange(sym.planar_chain(2))
     assert_identical(eom.M, [[l2**2 * m2 + 2 * l1 * l2 * m2 * c2 + l1**2 * (m1 + m2), l2**2 * m2 + l1 * l2 * m2 * c2],
                              [l2**2 * m2 + l1 * l2 * m2 * c2, l2**2 * m2]], "M")
@@ -63,7 +63,7 @@ def test_two_link_arm_matches_seed_001():
 
 
 def test_two_link_arm_torques_match_seed_002_eq_6_58():
-    """Seed 002, eq. 6.58: τ₁ and τ₂ by Euler–Lagrange and by Newton–Euler."""
+    """The TUM notes, eq. 6.58: τ₁ and τ₂ by Euler–Lagrange and by Newton–Euler."""
     tau1 = (m2 * l2**2 * (qdd1 + qdd2) + m2 * l1 * l2 * c2 * (2 * qdd1 + qdd2) + (m1 + m2) * l1**2 * qdd1
             - m2 * l1 * l2 * s2 * qd2**2 - 2 * m2 * l1 * l2 * s2 * qd1 * qd2 + m2 * l2 * g * c12 + (m1 + m2) * l1 * g * c1)
     tau2 = m2 * l1 * l2 * c2 * qdd1 + m2 * l1 * l2 * s2 * qd1**2 + m2 * l2 * g * c12 + m2 * l2**2 * (qdd1 + qdd2)
@@ -73,7 +73,7 @@ def test_two_link_arm_torques_match_seed_002_eq_6_58():
 
 
 def test_two_link_arm_newton_euler_intermediates_match_seed_002():
-    """Seed 002's outward iteration for the 2-link arm: ¹v̇_C₁ and ²F₂ (eq. 6.55 and after)."""
+    """The TUM notes' outward iteration for the 2-link arm: ¹v̇_C₁ and ²F₂ (eq. 6.55 and after)."""
     ne = sym.newton_euler(sym.planar_chain(2))
     s1, s12 = sp.sin(q1), sp.sin(q1 + q2)
     assert_identical(ne.omega[1], [0, 0, qd1 + qd2], "²ω₂")
@@ -84,7 +84,7 @@ def test_two_link_arm_newton_euler_intermediates_match_seed_002():
 
 
 def test_pendulum_matches_seed_003():
-    """Seed 003: m l² θ̈ + m g l sin θ = τ; with a spring k (θ − θ_r) and a damper b θ̇ added."""
+    """The UR5 dynamics notes: m l² θ̈ + m g l sin θ = τ; with a spring k (θ − θ_r) and a damper b θ̇ added."""
     m, length = sp.symbols("m l", positive=True)
     theta, thetadd = sp.Symbol("theta_1", real=True), sp.Symbol("thetaddot_1", real=True)
     thetad = sp.Symbol("thetadot_1", real=True)
@@ -100,7 +100,7 @@ def test_pendulum_matches_seed_003():
 
 
 def test_point_spring_energy():
-    """Seed 003's spring V = ½ k (r − r₀)²: a spring from the pivot's height to the bob."""
+    """The UR5 dynamics notes' spring V = ½ k (r − r₀)²: a spring from the pivot's height to the bob."""
     m, length = sp.symbols("m l", positive=True)
     k, rest = sp.symbols("k r_0", positive=True)
     theta = sp.Symbol("theta_1", real=True)
@@ -133,7 +133,7 @@ def test_mass_matrix_rate_minus_twice_coriolis_is_skew(name):
 
 
 def test_craig_split_recombines_to_v():
-    """C(q)[q̇²] + B(q)[q̇q̇] = V, and B has n(n−1)/2 columns (seed 000)."""
+    """C(q)[q̇²] + B(q)[q̇q̇] = V, and B has n(n−1)/2 columns (the TU Berlin notes)."""
     for name in ("planar3", "spatial rpp"):
         eom = sym.lagrange(CHAINS[name]())
         assert eom.coriolis_pairs.shape == (eom.n, eom.n * (eom.n - 1) // 2)
@@ -142,7 +142,7 @@ def test_craig_split_recombines_to_v():
 
 
 def test_christoffel_symbols_of_the_two_link_arm():
-    """Seed 000 "Christoffel Symbols": b₁₂₂ = −m₂l₁l₂s₂ = b₁₁₂·1 and b₂₁₁ = m₂l₁l₂s₂."""
+    """The TU Berlin notes "Christoffel Symbols": b₁₂₂ = −m₂l₁l₂s₂ = b₁₁₂·1 and b₂₁₁ = m₂l₁l₂s₂."""
     gamma = sym.lagrange(sym.planar_chain(2)).christoffel
     assert sp.expand(gamma[0, 1, 1] + m2 * l1 * l2 * s2) == 0
     assert sp.expand(gamma[0, 0, 1] + m2 * l1 * l2 * s2) == 0
@@ -151,7 +151,7 @@ def test_christoffel_symbols_of_the_two_link_arm():
 
 
 def test_extract_terms_reads_m_v_g_off_tau():
-    """Seed 003's reading of M, C, G off the equations, applied to Newton–Euler's τ."""
+    """The UR5 dynamics notes' reading of M, C, G off the equations, applied to Newton–Euler's τ."""
     arm = sym.planar_chain(2)
     eom = sym.lagrange(arm)
     mass, velocity, gravity = sym.extract_terms(sym.newton_euler(arm).tau, arm.q, arm.qd, arm.qdd)
@@ -370,7 +370,7 @@ def test_frozen_closed_form_references_are_up_to_date(name):
 
 
 def test_generalized_forces_enter_as_minus_q():
-    """Seed 003: d/dt ∂L/∂q̇ⱼ − ∂L/∂qⱼ = Qⱼ; a force Q on the pendulum leaves τ = … − Q."""
+    """The UR5 dynamics notes: d/dt ∂L/∂q̇ⱼ − ∂L/∂qⱼ = Qⱼ; a force Q on the pendulum leaves τ = … − Q."""
     m, length = sp.symbols("m l", positive=True)
     theta, thetad = sp.Symbol("theta_1", real=True), sp.Symbol("thetadot_1", real=True)
     thetadd = sp.Symbol("thetaddot_1", real=True)

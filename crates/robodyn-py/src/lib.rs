@@ -797,8 +797,8 @@ impl PyModel {
 
     /// Joint-space inertia matrix M(q), full and symmetric, armature included. (nv, nv).
     /// `method`: "crba" (Featherstone's composite-rigid-body algorithm, the fastest), "rnea"
-    /// (column k = τ(q, 0, e_k) − g(q), n RNEA calls: seed 003) or "jacobians"
-    /// (Σ m J_vᵀ J_v + J_ωᵀ I J_ω over the bodies: seeds 000 and 003).
+    /// (column k = τ(q, 0, e_k) − g(q), n RNEA calls: the UR5 dynamics notes) or "jacobians"
+    /// (Σ m J_vᵀ J_v + J_ωᵀ I J_ω over the bodies: the TU Berlin and UR5 dynamics notes).
     #[pyo3(signature = (q, method="crba"))]
     fn mass_matrix<'py>(
         &self,
@@ -853,7 +853,7 @@ impl PyModel {
 
     /// Coriolis matrix C(q, v) (nv, nv), from the Christoffel symbols of the first kind:
     /// C(q, v) v = bias_forces(q, v) − generalized_gravity(q), and Ṁ − 2C is skew-symmetric
-    /// (seed 000). A recursive O(n²) algorithm (Echeandia & Wensing 2021), no RNEA calls.
+    /// (the TU Berlin notes). A recursive O(n²) algorithm (Echeandia & Wensing 2021), no RNEA calls.
     fn coriolis_matrix<'py>(
         &self,
         py: Python<'py>,
@@ -877,7 +877,7 @@ impl PyModel {
     }
 
     /// Generalized gravity g(q). (nv,). `method`: "rnea" (RNEA with v = a = 0) or "jacobians"
-    /// (−Σ J_cᵀ m g over the bodies' centres of mass: seed 000 "Gravity").
+    /// (−Σ J_cᵀ m g over the bodies' centres of mass: the TU Berlin notes "Gravity").
     #[pyo3(signature = (q, method="rnea"))]
     fn generalized_gravity<'py>(
         &self,
@@ -904,7 +904,7 @@ impl PyModel {
 
     /// Christoffel symbols of the first kind, (nv, nv, nv):
     /// Γ[i, j, k] = ½ (∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i), so that C(q, v)_ij = Σ_k Γ[i, j, k] v_k
-    /// (seed 000). Exact: Γ[:, :, k] = C(q, e_k) by the recursive Coriolis algorithm. With
+    /// (the TU Berlin notes). Exact: Γ[:, :, k] = C(q, e_k) by the recursive Coriolis algorithm. With
     /// spherical or free joints (velocities that are not coordinate rates) the coordinate formula
     /// has no meaning; Γ[:, :, k] = C(q, e_k) still holds.
     fn christoffel<'py>(
@@ -924,7 +924,7 @@ impl PyModel {
         )
     }
 
-    /// Craig's centrifugal matrix C(q), (nv, nv) (seed 000, "Centrifugal and Coriolis
+    /// Craig's centrifugal matrix C(q), (nv, nv) (the TU Berlin notes, "Centrifugal and Coriolis
     /// Computation"): the velocity terms are C(q) [q̇₁², …, q̇ₙ²] + B(q) [q̇₁q̇₂, q̇₁q̇₃, …];
     /// C(q)_ij = Γ_ijj.
     fn centrifugal_matrix<'py>(
@@ -942,7 +942,7 @@ impl PyModel {
         })
     }
 
-    /// Craig's Coriolis matrix B(q), (nv, nv(nv−1)/2) (seed 000): multiplies the products
+    /// Craig's Coriolis matrix B(q), (nv, nv(nv−1)/2) (the TU Berlin notes): multiplies the products
     /// [q̇₁q̇₂, q̇₁q̇₃, …, q̇₁q̇ₙ, q̇₂q̇₃, …] (pairs j < k in that order); B(q)_i,(jk) = 2 Γ_ijk.
     fn coriolis_pairs_matrix<'py>(
         &self,

@@ -1,4 +1,4 @@
-//! Closed forms from the lecture notes (../shared/seeds/).
+//! Closed forms from the lecture notes (cited by course; the README lists them).
 
 mod common;
 
@@ -9,7 +9,7 @@ use robodyn::Data;
 
 const G: f64 = robodyn::model::STANDARD_GRAVITY;
 
-/// Seed 003, "The pendulum": m l² q̈ + m g l sin q = τ with m = 1 kg, l = 1 m.
+/// The UR5 dynamics notes, "The pendulum": m l² q̈ + m g l sin q = τ with m = 1 kg, l = 1 m.
 #[test]
 fn pendulum_equation_of_motion() {
     let model = bundled_model("pendulum", false).unwrap();
@@ -34,7 +34,7 @@ fn pendulum_equation_of_motion() {
     }
 }
 
-/// Seed 001 "Dynamic Equation" and seed 002 eq. 6.58: the 2-link planar arm with point masses at
+/// The ECE 470 notes "Dynamic Equation" and the TUM notes eq. 6.58: the 2-link planar arm with point masses at
 /// the link ends, τ = M(θ) θ̈ + V(θ, θ̇) + G(θ), gravity along -y.
 #[test]
 fn planar_two_link_arm_m_v_g() {
@@ -87,7 +87,7 @@ fn planar_two_link_arm_m_v_g() {
             &expected_bias,
             CLOSED_FORM_TOLERANCE,
         );
-        // seed 002, eq. 6.58, τ written out
+        // the TUM notes, eq. 6.58, τ written out
         let tau = rnea(&model, &mut data, &q, &v, &a, None).unwrap();
         let tau_2 = m2 * l1 * l2 * c2 * a[0]
             + m2 * l1 * l2 * s2 * v[0] * v[0]
@@ -109,7 +109,7 @@ fn planar_two_link_arm_m_v_g() {
     }
 }
 
-/// Seeds 000/002: the 2-link arm's Coriolis matrix, Christoffel symbols and Craig's split, and
+/// The TU Berlin and TUM notes: the 2-link arm's Coriolis matrix, Christoffel symbols and Craig's split, and
 /// its M and G computed the notes' ways. With h = −m₂ l₁ l₂ sin q₂:
 /// C(q, q̇) = [[h q̇₂, h (q̇₁ + q̇₂)], [−h q̇₁, 0]], Γ_112 = Γ_121 = Γ_122 = h, Γ_211 = −h, others 0.
 #[test]
@@ -140,7 +140,7 @@ fn planar_two_link_arm_coriolis_matrix_and_christoffel_symbols() {
     }
 }
 
-/// Seed 001 forward kinematics of the 2-link arm: the tool frame {3} at
+/// The ECE 470 notes forward kinematics of the 2-link arm: the tool frame {3} at
 /// (l1 c1 + l2 c12, l1 s1 + l2 s12), rotated by θ1 + θ2; and its geometric Jacobian.
 #[test]
 fn planar_two_link_arm_kinematics() {
@@ -205,7 +205,7 @@ fn planar_two_link_arm_kinematics() {
     );
 }
 
-/// Seed 000 "Gravity": g(q) = -Σ J_ciᵀ m_i g, with J_ci the Jacobian of link i's centre of mass.
+/// The TU Berlin notes "Gravity": g(q) = -Σ J_ciᵀ m_i g, with J_ci the Jacobian of link i's centre of mass.
 #[test]
 fn gravity_torques_from_com_jacobians() {
     let model = bundled_model("planar2", false).unwrap();
@@ -234,7 +234,7 @@ fn gravity_torques_from_com_jacobians() {
     );
 }
 
-/// Seed 001, "Manipulability": for the 2-link arm's planar position task, √det(J Jᵀ) = l1 l2 |s2|,
+/// The ECE 470 notes, "Manipulability": for the 2-link arm's planar position task, √det(J Jᵀ) = l1 l2 |s2|,
 /// zero at the stretched-out singularity.
 #[test]
 fn planar_two_link_arm_manipulability() {

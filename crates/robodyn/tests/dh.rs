@@ -1,4 +1,4 @@
-//! DH tables (seed 001's convention is the modified one): transforms, and the same robots as URDF.
+//! DH tables (the ECE 470 notes' convention is the modified one): transforms, and the same robots as URDF.
 
 mod common;
 
@@ -11,7 +11,7 @@ use robodyn::Data;
 /// angles with 10 significant digits).
 const SAME_ROBOT_TOLERANCE: f64 = 1e-9;
 
-/// Seed 001's 2-link planar arm, modified DH: frames {1}, {2} and the tool frame {3}.
+/// The ECE 470 notes' 2-link planar arm, modified DH: frames {1}, {2} and the tool frame {3}.
 const PLANAR2: &str = r#"
 name = "planar2_dh"
 convention = "modified"
@@ -58,7 +58,7 @@ fn seed_001_planar_arm_transforms_and_dynamics() {
     let (l1, l2) = (1.0, 0.5);
     for q in [[0.3_f64, -0.7], [1.2, 2.1], [-2.5, 0.4]] {
         let (c1, s1, c2, s2) = (q[0].cos(), q[0].sin(), q[1].cos(), q[1].sin());
-        // seed 001: ⁰₁T = Rz(θ1), ¹₂T = [Rz(θ2), (l1, 0, 0)], ²₃T = [1, (l2, 0, 0)]
+        // the ECE 470 notes: ⁰₁T = Rz(θ1), ¹₂T = [Rz(θ2), (l1, 0, 0)], ²₃T = [1, (l2, 0, 0)]
         let t01 = nalgebra::Matrix4::new(
             c1, -s1, 0.0, 0.0, s1, c1, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0,
         );
@@ -102,7 +102,7 @@ fn seed_001_planar_arm_transforms_and_dynamics() {
 
 #[test]
 fn seed_001_prismatic_row() {
-    // seed 001's table, row ¹₂T: α = 0, a = 0, θ = 90°, d = q2
+    // the ECE 470 notes' table, row ¹₂T: α = 0, a = 0, θ = 90°, d = q2
     let text = r#"
         convention = "modified"
         angle_unit = "degree"

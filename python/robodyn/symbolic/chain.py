@@ -1,16 +1,16 @@
 """The symbolic robot: a tree of links, each moved by one revolute or prismatic joint, with SymPy
 expressions for every length, mass, inertia and for gravity.
 
-Each link's frame sits at its joint (the frame Craig's iterative Newton–Euler uses, seed 002):
+Each link's frame sits at its joint (the frame Craig's iterative Newton–Euler uses, the TUM notes):
 ``ⁱ⁻¹Tᵢ(qᵢ) = origin_i · joint_i(qᵢ)``, where ``origin_i`` is the joint frame in the parent's frame
 at qᵢ = 0 and ``joint_i`` turns about (revolute) or slides along (prismatic) the unit ``axis`` given
 in the joint frame. A DH row and a URDF joint both reduce to this form; a planar chain is the
-notes' arm (seed 001, "Given the following 2-link planar manipulator").
+notes' arm (the ECE 470 notes, "Given the following 2-link planar manipulator").
 
 Mass properties are in the link's frame: centre of mass ``com`` and inertia ``inertia`` about the
-centre of mass (products of inertia with their sign, as seed 002's I_c). Passive elements:
+centre of mass (products of inertia with their sign, as the TUM notes' I_c). Passive elements:
 joint springs ``½ k (q − q_ref)²``, viscous damping ``b q̇`` and Coulomb friction ``f_c sign(q̇)``
-per joint, and linear springs between two points (seed 003's ``½ k (r − r₀)²``).
+per joint, and linear springs between two points (the UR5 dynamics notes' ``½ k (r − r₀)²``).
 """
 
 from __future__ import annotations

@@ -1,14 +1,14 @@
 """The equations of motion ``τ = M(q) q̈ + V(q, q̇) + G(q) + F(q̇)`` and everything read off them.
 
-The terms are read off τ the way seed 003 does ("E_OM ... M, C, G = ?"):
+The terms are read off τ the way the UR5 dynamics notes do ("E_OM ... M, C, G = ?"):
 ``M = ∂τ/∂q̈``, ``G = τ(q̇ = 0, q̈ = 0)`` (gravity and springs), ``V = τ − M q̈ − G − F`` (Coriolis
-and centrifugal, Craig's V of seed 001/002), and ``F`` the damping and friction forces (and −Q of
+and centrifugal, Craig's V of the ECE 470 and TUM notes), and ``F`` the damping and friction forces (and −Q of
 any other generalized forces given to ``lagrange``). From M come
-the Christoffel symbols (seed 000, "Christoffel Symbols")
+the Christoffel symbols (the TU Berlin notes, "Christoffel Symbols")
 
     Γᵢⱼₖ = ½ (∂Mᵢⱼ/∂qₖ + ∂Mᵢₖ/∂qⱼ − ∂Mⱼₖ/∂qᵢ),    Cᵢⱼ = Σₖ Γᵢⱼₖ q̇ₖ,   V = C q̇,
 
-with Ṁ − 2C skew-symmetric, and Craig's split ``V = C(q)[q̇²] + B(q)[q̇q̇]`` (seed 000, "Centrifugal
+with Ṁ − 2C skew-symmetric, and Craig's split ``V = C(q)[q̇²] + B(q)[q̇q̇]`` (the TU Berlin notes, "Centrifugal
 and Coriolis Computation"): ``C(q)ᵢⱼ = Γᵢⱼⱼ`` and ``B(q)`` with columns ``2Γᵢⱼₖ`` for j < k in the
 order q̇₁q̇₂, q̇₁q̇₃, …, q̇₁q̇ₙ, q̇₂q̇₃, ….
 """
@@ -35,7 +35,7 @@ def as_given(expr, decimals: bool):
 
 
 def extract_terms(tau, q, qd, qdd) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
-    """Seed 003's reading of (M, V, G) off any expression for τ: ``M = ∂τ/∂q̈``,
+    """The UR5 dynamics notes' reading of (M, V, G) off any expression for τ: ``M = ∂τ/∂q̈``,
     ``G = τ(q̇ = 0, q̈ = 0)``, ``V = τ(q̈ = 0) − G``; each entry in canonical trigonometric form."""
     tau = sp.Matrix(tau)
     at_rest = {v: 0 for v in qd} | {a: 0 for a in qdd}
@@ -163,7 +163,7 @@ class EquationsOfMotion:
 
     @cached_property
     def christoffel(self) -> sp.Array:
-        """Christoffel symbols of the first kind Γ[i, j, k] (seed 000's b_ijk), n × n × n."""
+        """Christoffel symbols of the first kind Γ[i, j, k] (the TU Berlin notes' b_ijk), n × n × n."""
         gamma = self._christoffel
         return self._out(sp.Array([[[gamma[i][j][k].as_expr() for k in range(self.n)] for j in range(self.n)]
                                    for i in range(self.n)]))

@@ -3,11 +3,11 @@ form (see :mod:`robodyn.symbolic.trig`).
 
 Frames are numbered 0 (the base) and 1..n (link i's joint frame). ``transform(j, i)`` is ʲTᵢ for
 an ancestor frame j of i, the product of the links' ``ⁱ⁻¹Tᵢ(qᵢ) = origin_i · joint_i(qᵢ)``
-(seed 001, "Frames and transforms"). The Jacobians are the notes' geometric ones (seed 001, "Recall
+(the ECE 470 notes, "Frames and transforms"). The Jacobians are the notes' geometric ones (the ECE 470 notes, "Recall
 in Wk 04: Jacobian"): column j of link i's centre-of-mass Jacobian is ``Ẑⱼ × (p_c − pⱼ)`` for a
 revolute joint j and ``Ẑⱼ`` for a prismatic one; of its angular Jacobian ``Ẑⱼ`` and 0. Both are
 expressed in link i's own frame, where its inertia is constant, so that
-``M = Σᵢ mᵢ J_vᵢᵀ J_vᵢ + J_ωᵢᵀ Iᵢ J_ωᵢ`` (seed 000, "Mass Matrix") needs no rotated inertias.
+``M = Σᵢ mᵢ J_vᵢᵀ J_vᵢ + J_ωᵢᵀ Iᵢ J_ωᵢ`` (the TU Berlin notes, "Mass Matrix") needs no rotated inertias.
 """
 
 from __future__ import annotations

@@ -1,9 +1,9 @@
-"""Equations of motion by Euler–Lagrange, the notes' recipe (seed 003, "Euler-Lagrange method";
-seed 000, "Lagrange Formulation"; seed 002, "Lagrange Equation"):
+"""Equations of motion by Euler–Lagrange, the notes' recipe (the UR5 dynamics notes, "Euler-Lagrange method";
+the TU Berlin notes, "Lagrange Formulation"; the TUM notes, "Lagrange Equation"):
 
-1. kinetic energy through the link Jacobians (seed 000, "Mass Matrix"; seed 003 step ②)
+1. kinetic energy through the link Jacobians (the TU Berlin notes, "Mass Matrix"; the UR5 dynamics notes step ②)
        K = ½ q̇ᵀ [Σᵢ mᵢ J_vᵢᵀ J_vᵢ + J_ωᵢᵀ Iᵢ J_ωᵢ] q̇ = ½ q̇ᵀ M(q) q̇
-2. potential energy of gravity and springs (seed 002 "u_i = −mᵢ gᵀ p_Cᵢ"; seed 003 "V")
+2. potential energy of gravity and springs (the TUM notes "u_i = −mᵢ gᵀ p_Cᵢ"; the UR5 dynamics notes "V")
        P = −Σᵢ mᵢ gᵀ p_cᵢ + Σ ½ k (q − q_ref)² + Σ ½ k (r − r₀)²
 3. L = K − P and, for every coordinate,
        τⱼ = d/dt (∂L/∂q̇ⱼ) − ∂L/∂qⱼ − Qⱼ,   d/dt = Σₖ q̇ₖ ∂/∂qₖ + q̈ₖ ∂/∂q̇ₖ

@@ -49,11 +49,11 @@ def _rotation(axis: sp.Matrix, angle) -> sp.Matrix:
 
 def planar_chain(n: int, point_masses: bool = True, *, coordinate: str = "q", base_angle=0,
                  name: str | None = None) -> Chain:
-    """The notes' planar arm of ``n`` links in the x-y plane, every joint about z (seed 001,
+    """The notes' planar arm of ``n`` links in the x-y plane, every joint about z (the ECE 470 notes,
     "Given the following 2-link planar manipulator"): ``⁰₁T = Rz(q₁)``, ``ⁱ⁻¹ᵢT = Tx(lᵢ₋₁) Rz(qᵢ)``.
 
     Link i has length ``l_i`` and mass ``m_i``: a point mass at its distal end (``point_masses``,
-    ``ⁱP_Cᵢ = lᵢ X̂ᵢ`` and ``ᶜⁱIᵢ = 0`` as in seed 002) or a uniform thin rod (centre at lᵢ/2,
+    ``ⁱP_Cᵢ = lᵢ X̂ᵢ`` and ``ᶜⁱIᵢ = 0`` as in the TUM notes) or a uniform thin rod (centre at lᵢ/2,
     inertia mᵢlᵢ²/12 about y and z). Gravity ``g`` acts along −y (the notes' ``⁰v̇₀ = g Ŷ₀``).
     ``base_angle`` turns the first link at q = 0 (−π/2 hangs it down); frame ``"tool"`` is the tip.
     """
@@ -78,7 +78,7 @@ def planar_chain(n: int, point_masses: bool = True, *, coordinate: str = "q", ba
 
 
 def pendulum(*, coordinate: str = "theta") -> Chain:
-    """Seed 003's simple pendulum: a point mass m on a massless rod of length l, θ = 0 hanging
+    """The UR5 dynamics notes' simple pendulum: a point mass m on a massless rod of length l, θ = 0 hanging
     down, so that ``m l² θ̈ + m g l sin θ = τ``."""
     chain = planar_chain(1, coordinate=coordinate, base_angle=-sp.pi / 2, name="pendulum")
     m, length = sp.Symbol("m_1", positive=True), sp.Symbol("l_1", positive=True)
@@ -143,7 +143,7 @@ class _Parameters:
         symbols = {}
         for a, b in ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)):
             label = "xyz"[a] + "xyz"[b]
-            # the tensor holds −I_xy etc. (seed 002's I_c); the symbol is I_xy itself
+            # the tensor holds −I_xy etc. (the TUM notes' I_c); the symbol is I_xy itself
             sign = 1 if a == b else -1
             symbols[(a, b)] = sign * self("inertia", f"I_{i}{label}", sign * inertia[a, b], positive=a == b)
         tensor = sp.Matrix(3, 3, lambda a, b: symbols[(min(a, b), max(a, b))])

@@ -1,8 +1,8 @@
-"""Iterative Newton–Euler, symbolic: Craig's equations 6.45–6.53 as seeds 001 and 002 write them.
+"""Iterative Newton–Euler, symbolic: Craig's equations 6.45–6.53 as the ECE 470 and TUM notes write them.
 
 Every vector is expressed in the frame of its link (the joint frame i), ``ⁱ⁺¹ᵢR`` is the transpose
 of the rotation of ``ⁱTᵢ₊₁`` and ``ⁱPᵢ₊₁`` its translation; Ẑ is the joint axis in its own frame.
-Gravity enters as an acceleration of the base, ``⁰v̇₀ = −g`` (seed 002, "To include gravity").
+Gravity enters as an acceleration of the base, ``⁰v̇₀ = −g`` (the TUM notes, "To include gravity").
 
 Outward, i: 0 → n−1 (revolute joint i+1; for a prismatic one ω and ω̇ only rotate and v̇ gains
 ``2 ω × ḋ Ẑ + d̈ Ẑ``)::

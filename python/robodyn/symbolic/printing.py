@@ -2,7 +2,7 @@
 
 :func:`abbreviate` replaces every sine or cosine of a sum of distinct joint coordinates by the
 symbol ``s_{12…}`` / ``c_{12…}``; :func:`latex` and :func:`text` print the equations of motion
-with it, as matrices (seed 001, "Dynamic Equation") or joint by joint (seed 002, eq. 6.58).
+with it, as matrices (the ECE 470 notes, "Dynamic Equation") or joint by joint (the TUM notes, eq. 6.58).
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 //! The Coriolis matrix C(q, q̇) of M(q) q̈ + C(q, q̇) q̇ + g(q) = τ, the one built from the
 //! Christoffel symbols of the first kind, C_ij = Σ_k Γ_ijk q̇_k with
-//! Γ_ijk = ½ (∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i) (seed 000, "Coriolis and centrifugal terms"),
+//! Γ_ijk = ½ (∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i) (the TU Berlin notes, "Coriolis and centrifugal terms"),
 //! so that C q̇ is the velocity-product part of the bias forces and Ṁ − 2C is skew-symmetric.
 //!
 //! Reference: S. Echeandia and P. M. Wensing, "Numerical Methods to Compute the Coriolis Matrix

@@ -5,7 +5,7 @@
 //! of the subtree rooted at body i. Table 6.2 evaluates it in body coordinates, carrying the force
 //! `F = I^c_i S_i` up the tree; here every quantity is expressed once in world coordinates, where
 //! composite inertias add without transforms and each `H_ij` is a single dot product (the form
-//! Pinocchio uses). Seed 003 obtains the same M from n RNEA calls; the tests check it.
+//! Pinocchio uses). The UR5 dynamics notes obtain the same M from n RNEA calls; the tests check it.
 //! Input: q (nq). Writes `data.x_up`, `data.x_world`, `data.s_world`, `data.i_c` (world
 //! coordinates), `data.mass_matrix` (full, symmetric, armature on the diagonal).
 //! Cost: O(n) transforms plus one 6-vector dot product per pair (joint, ancestor joint).

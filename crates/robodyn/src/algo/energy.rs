@@ -1,9 +1,9 @@
 //! Energies and the centre of mass.
 //!
-//! Kinetic energy `T = Σ ½ v_iᵀ I_i v_i + ½ Σ armature_k q̇_k²` (Featherstone §2.13 and seed 002's
+//! Kinetic energy `T = Σ ½ v_iᵀ I_i v_i + ½ Σ armature_k q̇_k²` (Featherstone §2.13 and the TUM notes'
 //! `k_i = ½ m_i v_cᵀ v_c + ½ ωᵀ I ω`), equal to `½ q̇ᵀ M q̇`. Potential energy
-//! `V = -Σ m_i gᵀ c_i` (seed 002), c_i the body's centre of mass in world coordinates.
-//! The centre-of-mass Jacobian `J_com = Σ m_i J_{c_i} / m` (seed 000's COM Jacobians, summed) is
+//! `V = -Σ m_i gᵀ c_i` (the TUM notes), c_i the body's centre of mass in world coordinates.
+//! The centre-of-mass Jacobian `J_com = Σ m_i J_{c_i} / m` (the TU Berlin notes' COM Jacobians, summed) is
 //! computed per joint from the mass `m_j` and first moment `h_j` of the subtree it carries:
 //! column k is `(m_j v_O + ω × h_j) / m` for the world-coordinates motion `(ω, v_O)` of its axis.
 //! Writes `data.x_up`, and `data.v` (kinetic) or `data.x_world` (potential, centre of mass, its

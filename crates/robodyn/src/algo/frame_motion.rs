@@ -3,7 +3,7 @@
 //! Reference: Featherstone, *Rigid Body Dynamics Algorithms* (2008), §2.10-2.11 and the outward
 //! pass of Table 5.1 without gravity: `v_i = X_i v_λ(i) + S_i q̇_i`,
 //! `a_i = X_i a_λ(i) + S_i q̈_i + v_i × S_i q̇_i`, here only along the frame's support. The classical
-//! (textbook) acceleration of the frame's origin is the spatial one plus `ω × v` (seed 001,
+//! (textbook) acceleration of the frame's origin is the spatial one plus `ω × v` (the ECE 470 notes,
 //! "Recap: Acceleration"): `p̈ = a_O + ω × ṗ`. With q̈ = 0 it is `J̇ q̇`, the bias acceleration.
 //! The time derivative of the Jacobian follows from `S` being constant in its body: in world
 //! coordinates each column `s = X⁻¹ S_k` changes as `ṡ = v_j × s` (Featherstone §2.9), `v_j` the

@@ -1,6 +1,6 @@
 //! Frame Jacobians: the 6 x nv matrix J with `[v; ω] = J q̇`, rows `[linear; angular]`.
 //!
-//! Reference: seed 001/000's geometric Jacobian (column i of a revolute joint: `[z_i × (p - p_i); z_i]`,
+//! Reference: the ECE 470 and TU Berlin notes' geometric Jacobian (column i of a revolute joint: `[z_i × (p - p_i); z_i]`,
 //! prismatic: `[z_i; 0]`), computed generally as in Featherstone (2008) §8.1: column k of joint j
 //! is the joint's subspace column `S_k` mapped to world coordinates, `X_{j←0}⁻¹ S_k = (ω, v_O)`;
 //! the linear velocity of the frame's origin p is then `v_O + ω × p`.

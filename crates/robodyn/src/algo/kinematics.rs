@@ -2,7 +2,7 @@
 //!
 //! Reference: Featherstone, *Rigid Body Dynamics Algorithms* (2008), §4.4 (`jcalc`) and the
 //! first lines of Table 5.1: `X_J = jcalc(q_i)`, `X_{i←λ(i)} = X_J X_T(i)`, and the world
-//! transform `X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}`; seed 001 ("forward kinematics": chained `T`).
+//! transform `X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}`; the ECE 470 notes ("forward kinematics": chained `T`).
 //! Cost: one 3x3 rotation product per body.
 
 use crate::error::{Error, Result};

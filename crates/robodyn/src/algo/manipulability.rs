@@ -1,4 +1,4 @@
-//! Manipulability measures of a frame's Jacobian (seed 001, "Manipulability").
+//! Manipulability measures of a frame's Jacobian (the ECE 470 notes, "Manipulability").
 //!
 //! Reference: Yoshikawa, "Manipulability of robotic mechanisms", IJRR 4(2), 1985:
 //! `w = √det(J Jᵀ)`, the product of J's singular values, zero at a singularity (and whenever the

@@ -1,7 +1,7 @@
 //! Recursive Newton–Euler algorithm: inverse dynamics τ = M(q) q̈ + C(q, q̇) q̇ + g(q) - Σ Jᵀ f_ext.
 //!
 //! Reference: Featherstone, *Rigid Body Dynamics Algorithms* (2008), Table 5.1; the notes' iterative
-//! Newton–Euler (seed 001, seed 002 eqs. 6.45-6.53: outward velocities and accelerations, inward
+//! Newton–Euler (the ECE 470 and TUM notes eqs. 6.45-6.53: outward velocities and accelerations, inward
 //! forces and torques). Gravity enters as a fictitious base acceleration `a_0 = -g`.
 //! Inputs: q (nq), v (nv), a (nv), optional external forces per moving body (in the body's frame,
 //! at its origin). Writes `data.x_up`, `data.v`, `data.a`, `data.f`, `data.tau`. Cost: O(n).

@@ -1,14 +1,14 @@
 //! The mass matrix and the gravity vector the way the lecture notes build them, next to the
 //! recursive algorithms (CRBA, RNEA) that compute the same quantities faster.
 //!
-//! - M from n RNEA calls (seed 003, "Compute M numerically"): column k of M is the torque that
+//! - M from n RNEA calls (the UR5 dynamics notes, "Compute M numerically"): column k of M is the torque that
 //!   produces the unit acceleration e_k at rest without gravity, τ(q, 0, e_k) − g(q).
 //!   Cost n RNEA passes, O(n²).
-//! - M from the bodies' Jacobians (seed 000 "Mass Matrix", seed 003 "TMT method"):
+//! - M from the bodies' Jacobians (the TU Berlin notes "Mass Matrix", the UR5 dynamics notes "TMT method"):
 //!   M = Σ_i m_i J_vᵢᵀ J_vᵢ + J_ωᵢᵀ ⁰I_i J_ωᵢ, with J_vᵢ the Jacobian of body i's centre of mass and
 //!   J_ωᵢ of its angular velocity, both in world axes, and ⁰I_i its inertia about its centre of mass
 //!   in world axes. Rotor inertia (armature) is added on the diagonal, as M has it. Cost O(N d²).
-//! - g from the same Jacobians (seed 000 "Gravity"): g(q) = −Σ_i J_vᵢᵀ m_i g₀, g₀ the gravity
+//! - g from the same Jacobians (the TU Berlin notes "Gravity"): g(q) = −Σ_i J_vᵢᵀ m_i g₀, g₀ the gravity
 //!   vector. Cost O(N d).
 //!
 //! Column of J for velocity coordinate b supporting body i: from the world-frame subspace column

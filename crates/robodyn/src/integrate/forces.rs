@@ -5,7 +5,7 @@
 //! ```
 //!
 //! - Springs: stiffness K per velocity coordinate, relaxed at `spring_reference` (MJCF `stiffness`
-//!   and `springref`; seed 003's spring potential ½ k (q − q_ref)²). On spherical and free joints
+//!   and `springref`; the UR5 dynamics notes' spring potential ½ k (q − q_ref)²). On spherical and free joints
 //!   q ⊖ q_ref is the rotation (and displacement) on the group.
 //! - Viscous damping D (URDF `<dynamics damping>`, MJCF `damping`).
 //! - Coulomb friction F_c (URDF `friction`, MJCF `frictionloss`), smoothed: the ideal

@@ -4,7 +4,7 @@
 //! M(q) q̈ + C(q, q̇) q̇ + g(q) = τ_control(t, q, q̇) + τ_passive(q, q̇) + Σ J_iᵀ f_ext,i(t, q, q̇)
 //! ```
 //!
-//! integrated in time from (q₀, v₀), as seed 003 ends: "q̈ = −M⁻¹(C + G); simulate: integrate …
+//! integrated in time from (q₀, v₀), as the UR5 dynamics notes end: "q̈ = −M⁻¹(C + G); simulate: integrate …
 //! Euler's method, Runge–Kutta fixed order 4, odeint (adaptive)".
 //!
 //! - [`lie_group`]: the rate of the tangent coordinates ξ in q = q₀ ⊕ ξ, so that spherical and free

@@ -1,5 +1,5 @@
 //! Robots from Denavit–Hartenberg tables, standard (Denavit–Hartenberg 1955) or modified (Craig,
-//! *Introduction to Robotics*, §3.4; the convention of seed 001).
+//! *Introduction to Robotics*, §3.4; the convention of the ECE 470 notes).
 //!
 //! Row i of a table holds (a, α, d, θ) and the joint kind; the joint variable adds to θ_i
 //! (revolute) or to d_i (prismatic), so the table's θ or d is the joint offset.
