@@ -19,6 +19,8 @@ import sys
 import warnings
 from pathlib import Path
 
+import numpy as np
+
 from robodyn._core import (
     Model,
     bundled_names,
@@ -75,16 +77,32 @@ def _example_robot_data_dir() -> Path | None:
 
 
 def _find_file(name: str) -> Path:
-    """``name`` as a path, or else a file of that name in example-robot-data's robots folder."""
+    """``name`` as a path, or else a file of that name in example-robot-data's robots folder.
+
+    Raises ``FileNotFoundError`` saying where robodyn looked and how to get example-robot-data."""
     path = Path(name).expanduser()
-    if path.exists() or path.parent != Path("."):
+    if path.exists():
         return path
+    looked = [f"{path.resolve()}"]
     robots = _example_robot_data_dir()
-    if robots is not None:
-        matches = sorted(robots.rglob(path.name))
-        if matches:
-            return matches[0]
-    return path
+    if path.parent == Path("."):
+        if robots is not None:
+            matches = sorted(robots.rglob(path.name))
+            if matches:
+                return matches[0]
+            looked.append(f"example-robot-data's robots folder {robots}")
+        else:
+            looked.append("example-robot-data (not installed: pip install 'robodyn[robots]' brings its URDFs)")
+    raise FileNotFoundError(
+        f"model file not found: '{name}'; looked in {' and in '.join(looked)}; "
+        f"bundled models are {models()}"
+    )
+
+
+def _check_flag(value: object, argument: str) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"argument '{argument}': expected True or False, got {value!r}")
+    return bool(value)
 
 
 def load(name_or_path: str | os.PathLike[str], floating_base: bool = False, check_inertia: bool = True) -> Model:
@@ -92,45 +110,48 @@ def load(name_or_path: str | os.PathLike[str], floating_base: bool = False, chec
 
     ``name_or_path`` is a bundled model's name (see :func:`models`), a path to a URDF file, an MJCF
     file (``.xml``, MuJoCo's format), or a DH table in TOML (``.toml``, the format :func:`from_dh`
-    documents). A bare
-    file name that does not exist in the working directory is also looked up in the
-    ``example-robot-data`` package when it is installed (``robodyn.load("talos_full_v2.urdf")``).
+    documents). A bare file name that does not exist in the working directory is also looked up in
+    the ``example-robot-data`` package when it is installed (``pip install 'robodyn[robots]'``;
+    ``robodyn.load("talos_full_v2.urdf")``).
     ``floating_base=True`` puts a free joint named ``root_joint`` between the world and the root
     link (q gains ``[x, y, z, qx, qy, qz, qw]``, v gains ``[v_linear, omega]`` in the base frame).
 
     ``check_inertia=False`` loads a file whose inertia tensors are not positive semi-definite (a few
     published URDFs have them) and reports each as a :class:`ModelWarning` instead of failing.
 
-    Raises ``FileNotFoundError`` for a missing file and ``ValueError`` for an invalid model, naming
-    the file, element and line.
+    Raises ``FileNotFoundError`` for a missing file (saying where robodyn looked) and ``ValueError``
+    for an invalid model, naming the file, element and line, or for a wrong argument.
     """
     if not isinstance(name_or_path, (str, os.PathLike)):
         raise ValueError(f"argument 'name_or_path': expected a model name or a path, got {name_or_path!r}")
+    floating_base = _check_flag(floating_base, "floating_base")
+    check_inertia = _check_flag(check_inertia, "check_inertia")
     text = os.fspath(name_or_path)
     if text in bundled_names():
         return load_bundled(text, floating_base)
-    path = _find_file(text)
-    suffix = path.suffix.lower()
-    if suffix == ".toml":
-        return load_dh(str(path))
-    if suffix == ".xml":
-        model = load_mjcf(str(path))
-        for message in model.warnings:
-            warnings.warn(message, ModelWarning, stacklevel=2)
-        return model
-    if suffix != ".urdf":
-        if not path.exists():
-            raise FileNotFoundError(
-                f"model file not found: '{text}' (and it is not a bundled model: {models()})"
-            )
+    suffix = Path(text).suffix.lower()
+    if suffix not in {".toml", ".xml", ".urdf"}:
+        if not Path(text).expanduser().exists():
+            raise FileNotFoundError(f"model file not found: '{text}' (and it is not a bundled model: {models()})")
         raise ValueError(
             f"argument 'name_or_path': expected a .urdf, MJCF .xml or .toml (DH table) file or one of {models()}, "
             f"got '{text}'"
         )
-    model = load_urdf(str(path), floating_base, check_inertia)
+    path = _find_file(text)
+    if suffix == ".toml":
+        return load_dh(str(path))
+    model = load_mjcf(str(path)) if suffix == ".xml" else load_urdf(str(path), floating_base, check_inertia)
     for message in model.warnings:
         warnings.warn(message, ModelWarning, stacklevel=2)
     return model
+
+
+def _rows_or_none(rows: object) -> list[object]:
+    """The rows of a DH table as a list, or a list holding only None when ``rows`` is not iterable."""
+    try:
+        return list(rows)  # type: ignore[call-overload]
+    except TypeError:
+        return [None]
 
 
 def from_dh(
@@ -160,6 +181,8 @@ def from_dh(
     ``"tool"``. ``angle_unit="degree"`` reads α, θ, revolute limits and rpy in degrees. A ``.toml``
     file with the same keys (``[[joint]]`` rows) loads with :func:`load`.
     """
+    if isinstance(rows, (str, bytes, dict)) or not all(isinstance(row, dict) for row in _rows_or_none(rows)):
+        raise ValueError(f"argument 'rows': expected a list of dicts, one per joint, got {rows!r}")
     document = {"name": name, "convention": convention, "angle_unit": angle_unit, "joint": list(rows)}
     for key, value in (("base", base), ("tool", tool), ("gravity", gravity)):
         if value is not None:

@@ -42,6 +42,8 @@ __all__ = [
 
 #: The integrator names :func:`simulate` accepts.
 INTEGRATORS = ("euler", "semi_implicit_euler", "rk4", "rk45")
+#: What :func:`simulate` does at a joint limit: report it, or also push back with a penalty.
+LIMIT_MODELS = ("report", "penalty")
 
 
 def _reference_spec(q_ref, reference) -> dict[str, Any]:
@@ -58,15 +60,36 @@ def _reference_spec(q_ref, reference) -> dict[str, Any]:
                 raise ValueError(
                     f"argument 'reference': expected (times, q, v) or a Trajectory, got {reference!r}"
                 ) from None
-        return {"times": np.asarray(times, dtype=float), "q": np.asarray(q, dtype=float), "v": np.asarray(v, dtype=float)}
+        return {"times": _numbers("reference", times), "q": _numbers("reference", q), "v": _numbers("reference", v)}
     if q_ref is None:
         raise ValueError("argument 'q_ref': a PD or computed-torque controller needs q_ref or reference")
-    return {"q_ref": np.asarray(q_ref, dtype=float)}
+    return {"q_ref": _numbers("q_ref", q_ref)}
 
 
-def _gains(model, value) -> np.ndarray:
+def _numbers(name: str, value: Any) -> np.ndarray:
+    """``value`` as a float array of finite numbers, or a ValueError naming the argument."""
+    try:
+        raw = np.asarray(value)
+    except (TypeError, ValueError):
+        raw = np.asarray(None)
+    if raw.dtype.kind not in "iuf":
+        raise ValueError(f"argument '{name}': expected numbers, got {value!r}")
+    array = raw.astype(float)
+    if not np.isfinite(array).all():
+        raise ValueError(f"argument '{name}': expected finite numbers, got {value!r}")
+    return array
+
+
+def _real(name: str, value: Any) -> float:
+    """One finite number (an int or a float, not a bool)."""
+    if isinstance(value, (bool, np.bool_)) or np.ndim(value) != 0:
+        raise ValueError(f"argument '{name}': expected a number, got {value!r}")
+    return float(_numbers(name, value))
+
+
+def _gains(model, name: str, value: Any) -> np.ndarray:
     """A gain per velocity coordinate; a scalar applies to all."""
-    gains = np.asarray(value, dtype=float)
+    gains = _numbers(name, value)
     if gains.ndim == 0:
         gains = np.full(model.nv, float(gains))
     return gains
@@ -89,7 +112,7 @@ class PD:
     gravity_compensation: bool = False
 
     def _spec(self, model) -> dict[str, Any]:
-        return {"kind": "pd", "kp": _gains(model, self.kp), "kd": _gains(model, self.kd),
+        return {"kind": "pd", "kp": _gains(model, "kp", self.kp), "kd": _gains(model, "kd", self.kd),
                 "gravity_compensation": bool(self.gravity_compensation), **_reference_spec(self.q_ref, self.reference)}
 
 
@@ -108,7 +131,7 @@ class ComputedTorque:
     reference: Any = None
 
     def _spec(self, model) -> dict[str, Any]:
-        return {"kind": "computed_torque", "kp": _gains(model, self.kp), "kd": _gains(model, self.kd),
+        return {"kind": "computed_torque", "kp": _gains(model, "kp", self.kp), "kd": _gains(model, "kd", self.kd),
                 **_reference_spec(self.q_ref, self.reference)}
 
 
@@ -126,7 +149,7 @@ def _controller_argument(model, controller):
     if controller is None or callable(controller):
         return controller
     if isinstance(controller, (list, tuple, np.ndarray)):
-        return {"kind": "constant", "tau": np.asarray(controller, dtype=float)}
+        return {"kind": "constant", "tau": _numbers("controller", controller)}
     raise ValueError(
         f"argument 'controller': expected None, a constant torque of {model.nv} values, robodyn.PD, "
         f"robodyn.ComputedTorque, robodyn.GravityCompensation or a callable (t, q, v) -> tau, got {controller!r}"
@@ -297,15 +320,17 @@ def simulate(
     Raises ``ValueError`` naming the argument for bad input, and when the simulation diverges (with
     the time it happened); an exception raised by a callback propagates unchanged.
     """
-    q0 = np.asarray(q0, dtype=float)
-    if v0 is None:
-        v0 = np.zeros(q0.shape[:-1] + (model.nv,))
+    q0 = _numbers("q0", q0)
+    v0 = np.zeros(q0.shape[:-1] + (model.nv,)) if v0 is None else _numbers("v0", v0)
     if integrator not in INTEGRATORS:
         raise ValueError(f"argument 'integrator': expected one of {list(INTEGRATORS)}, got {integrator!r}")
+    if limits not in LIMIT_MODELS:
+        raise ValueError(f"argument 'limits': expected one of {list(LIMIT_MODELS)}, got {limits!r}")
     result = _core.simulate(
-        model, q0, v0, float(t_end), float(dt), integrator, float(rtol), float(atol),
-        float("inf") if max_step is None else float(max_step), _controller_argument(model, controller),
-        wrenches, float(friction_velocity), limits, float(limit_stiffness), float(limit_damping), progress,
+        model, q0, v0, _real("t_end", t_end), _real("dt", dt), integrator, _real("rtol", rtol), _real("atol", atol),
+        float("inf") if max_step is None else _real("max_step", max_step), _controller_argument(model, controller),
+        wrenches, _real("friction_velocity", friction_velocity), limits, _real("limit_stiffness", limit_stiffness),
+        _real("limit_damping", limit_damping), progress,
     )
     series = ("q", "v", "a", "tau", "tau_passive")
     statistics = ("steps", "rejected_steps", "evaluations")

@@ -243,3 +243,12 @@ def test_workspace_samples_frame_positions(ur5):
     np.testing.assert_array_equal(points, ur5.frame_pose(states, "tool0")[:, :3, 3])
     # the UR5's reach: shoulder offset plus the two arm links plus the wrist
     assert np.max(np.linalg.norm(points - [0, 0, 0.089159], axis=1)) < 0.425 + 0.39225 + 0.2
+
+
+def test_ignored_mimic_tags_are_one_warning(robots_dir):
+    """Talos's grippers have twelve mimic tags on joints the reduced model fixes: one warning."""
+    with pytest.warns(robodyn.ModelWarning) as caught:
+        m = robodyn.load(robots_dir / "talos_data/robots/talos_reduced.urdf")
+    mimic = [w for w in m.warnings if "<mimic>" in w]
+    assert len(mimic) == 1 and "12 <mimic> tag(s) ignored" in mimic[0], m.warnings
+    assert len([w for w in caught if "<mimic>" in str(w.message)]) == 1

@@ -1,7 +1,9 @@
 //! `simulate`: the binding of `robodyn::integrate`. Native controllers and constant wrenches run
 //! with the GIL released (batches on all cores); Python callables are called back with the GIL.
 
-use crate::{to_py_err, Argument, PyModel, SampleShape};
+use crate::args::{read_property, read_sample, single_sample, Argument, SampleShape};
+use crate::model::{fill_forces, PyModel};
+use crate::to_py_err;
 use nalgebra::DVector;
 use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -64,7 +66,7 @@ impl ExternalWrenches for PythonWrenches<'_> {
         let shape = SampleShape::matrix(forces.len(), 6);
         let result = call_back(&self.callable, t, q, v, "wrenches", shape, &mut self.buffer);
         keep_raised(&mut self.raised, result, t)?;
-        crate::fill_forces(forces, &self.buffer);
+        fill_forces(forces, &self.buffer);
         Ok(())
     }
 }
@@ -100,7 +102,7 @@ fn call_back(
     let result = callable.call1((t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, v)))?;
     let argument = Argument::new(name, &result, shape)
         .map_err(|e| PyValueError::new_err(format!("{} (returned at t = {t})", e.value(py))))?;
-    out.copy_from_slice(&crate::single_sample(&argument)?);
+    out.copy_from_slice(&single_sample(&argument)?);
     Ok(())
 }
 
@@ -123,11 +125,7 @@ fn control_law(model: &Model, spec: &Bound<PyDict>) -> PyResult<ControlLaw> {
         })
     };
     let vector = |key: &'static str, length: usize| -> PyResult<DVector<f64>> {
-        Ok(DVector::from_vec(crate::read_property(
-            key,
-            &item(key)?,
-            length,
-        )?))
+        Ok(DVector::from_vec(read_property(key, &item(key)?, length)?))
     };
     let kind: String = item("kind")?.extract()?;
     let reference = || -> PyResult<DesiredMotion> {
@@ -302,9 +300,9 @@ pub fn simulate<'py>(
     let constant_wrenches = match wrenches {
         Some(value) if !value.is_callable() => {
             let shape = SampleShape::matrix(m.nbodies() - 1, 6);
-            let values = crate::read_sample("wrenches", value, shape)?;
+            let values = read_sample("wrenches", value, shape)?;
             let mut forces = vec![Force::ZERO; m.nbodies() - 1];
-            crate::fill_forces(&mut forces, &values);
+            fill_forces(&mut forces, &values);
             Some(ConstantWrenches(forces))
         }
         _ => None,

@@ -190,7 +190,13 @@ fn questionable_input_loads_with_a_warning() {
         model.warnings[0].contains("positive semi-definite")
             && model.warnings[0].contains("check_inertia is off")
     );
-    assert!(model.warnings[1].contains("<mimic joint='zz'> ignored"));
+    assert!(
+        model.warnings[1].contains("1 <mimic> tag(s) ignored")
+            && model.warnings[1].contains("'j' (line ")
+            && model.warnings[1].contains("mimics 'zz'"),
+        "{}",
+        model.warnings[1]
+    );
     // with the check on (the default) the inertia is an error
     assert!(load_urdf_str(&text, "odd.urdf", LoadOptions::default()).is_err());
 }

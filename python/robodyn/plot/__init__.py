@@ -1,7 +1,7 @@
 """Figures of a simulation: time series and a 3-D stick-figure animation (matplotlib).
 
 Both work headless: figures are drawn on matplotlib's Agg canvas unless ``show=True`` asks for a
-window. Install matplotlib with ``pip install robodyn[plot]``.
+window. matplotlib is one of robodyn's dependencies.
 """
 
 from __future__ import annotations
@@ -21,8 +21,8 @@ def _matplotlib() -> None:
     """Fails with the install command when matplotlib is missing."""
     try:
         import matplotlib  # noqa: F401
-    except ImportError as error:  # pragma: no cover - matplotlib is a declared extra
-        raise ImportError("plots need matplotlib: pip install 'robodyn[plot]'") from error
+    except ImportError as error:  # pragma: no cover - matplotlib is a dependency
+        raise ImportError("plots need matplotlib, a dependency of robodyn: pip install matplotlib") from error
 
 
 def _units(model) -> tuple[str, str, str]:

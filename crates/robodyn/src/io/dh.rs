@@ -335,10 +335,16 @@ impl DocumentReader<'_> {
         let convention = match self.text("top level", document, "convention")? {
             Some("standard") => DhConvention::Standard,
             Some("modified") => DhConvention::Modified,
-            other => {
+            Some(other) => {
                 return Err(self.error(
                     "top level",
-                    format!("'convention': expected \"standard\" or \"modified\", got {other:?}"),
+                    format!("'convention': expected \"standard\" or \"modified\", got \"{other}\""),
+                ))
+            }
+            None => {
+                return Err(self.error(
+                    "top level",
+                    "'convention': missing; expected \"standard\" or \"modified\"".to_string(),
                 ))
             }
         };
@@ -391,10 +397,16 @@ impl DocumentReader<'_> {
         let joint = match self.text(place, row, "type")? {
             Some("revolute") => DhJoint::Revolute,
             Some("prismatic") => DhJoint::Prismatic,
-            other => {
+            Some(other) => {
                 return Err(self.error(
                     place,
-                    format!("'type': expected \"revolute\" or \"prismatic\", got {other:?}"),
+                    format!("'type': expected \"revolute\" or \"prismatic\", got \"{other}\""),
+                ))
+            }
+            None => {
+                return Err(self.error(
+                    place,
+                    "'type': missing; expected \"revolute\" or \"prismatic\"".to_string(),
                 ))
             }
         };

@@ -379,7 +379,8 @@ impl<'a> Parser<'a> {
             ));
         }
 
-        // mimic relations, between moving joints
+        // mimic relations, between moving joints; the others are reported in one warning
+        let mut ignored = Vec::new();
         for joint in joints {
             if let Some((mimicked, multiplier, offset)) = joint.mimic {
                 match (body_of_joint.get(joint.name), body_of_joint.get(mimicked)) {
@@ -389,14 +390,22 @@ impl<'a> Parser<'a> {
                         multiplier,
                         offset,
                     }),
-                    _ => builder.warn(format!(
-                        "{}: <mimic joint='{mimicked}'> ignored: both '{}' and '{mimicked}' must be \
-                         moving joints of the model",
-                        self.location(joint.node),
-                        joint.name
+                    _ => ignored.push(format!(
+                        "'{}' (line {}) mimics '{mimicked}'",
+                        joint.name,
+                        self.document.text_pos_at(joint.node.range().start).row
                     )),
                 }
             }
+        }
+        if !ignored.is_empty() {
+            builder.warn(format!(
+                "{}: {} <mimic> tag(s) ignored, because the joint or the joint it mimics is not a \
+                 moving joint of the model: {}",
+                self.source,
+                ignored.len(),
+                ignored.join(", ")
+            ));
         }
         Ok(builder.build())
     }

@@ -1,0 +1,324 @@
+//! Argument handling: numeric arguments (one sample or a batch, any array-like) and the named
+//! options of the calls, each error a `ValueError` naming the argument.
+
+use crate::to_py_err;
+use nalgebra::DVector;
+use numpy::{AllowTypeChange, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyBool;
+use robodyn::algo::Reference;
+use std::borrow::Cow;
+
+/// The shape of one sample of an argument: one or two dimensions, stored without allocating.
+#[derive(Clone, Copy)]
+pub(crate) struct SampleShape {
+    pub(crate) dims: [usize; 2],
+    pub(crate) ndim: usize,
+}
+
+impl SampleShape {
+    pub(crate) fn vector(n: usize) -> Self {
+        SampleShape {
+            dims: [n, 0],
+            ndim: 1,
+        }
+    }
+
+    pub(crate) fn matrix(rows: usize, columns: usize) -> Self {
+        SampleShape {
+            dims: [rows, columns],
+            ndim: 2,
+        }
+    }
+
+    pub(crate) fn as_slice(&self) -> &[usize] {
+        &self.dims[..self.ndim]
+    }
+}
+
+/// A numeric argument: its name, the array, and the shape of one sample.
+pub(crate) struct Argument<'py> {
+    pub(crate) name: &'static str,
+    pub(crate) array: Bound<'py, PyArrayDyn<f64>>,
+    pub(crate) sample_shape: SampleShape,
+}
+
+impl<'py> Argument<'py> {
+    pub(crate) fn new(
+        name: &'static str,
+        value: &Bound<'py, PyAny>,
+        sample_shape: SampleShape,
+    ) -> PyResult<Self> {
+        // a float64 ndarray is used as it is; anything else goes through numpy.asarray
+        if let Ok(array) = value.cast::<PyArrayDyn<f64>>() {
+            return Ok(Argument {
+                name,
+                array: array.clone(),
+                sample_shape,
+            });
+        }
+        let converted = value.extract::<PyArrayLikeDyn<'py, f64, AllowTypeChange>>().map_err(|_| {
+            PyValueError::new_err(format!(
+                "argument '{name}': expected an array of numbers of shape {} or (N, ...), got {}",
+                shape_text(sample_shape.as_slice()),
+                value.repr().map(|r| r.to_string()).unwrap_or_else(|_| "an unreadable object".into())
+            ))
+        })?;
+        Ok(Argument {
+            name,
+            array: (**converted).clone(),
+            sample_shape,
+        })
+    }
+
+    /// The batch size, `None` for a single sample; errors if the shape fits neither.
+    pub(crate) fn batch(&self) -> PyResult<Option<usize>> {
+        let shape = self.array.shape();
+        let sample = self.sample_shape.as_slice();
+        if shape == sample {
+            Ok(None)
+        } else if shape.len() == sample.len() + 1 && shape[1..] == *sample {
+            Ok(Some(shape[0]))
+        } else {
+            let batch_shape: Vec<String> = std::iter::once("N".to_string())
+                .chain(sample.iter().map(|n| n.to_string()))
+                .collect();
+            Err(PyValueError::new_err(format!(
+                "argument '{}': expected shape {} or ({}), got {}",
+                self.name,
+                shape_text(sample),
+                batch_shape.join(", "),
+                shape_text(shape)
+            )))
+        }
+    }
+
+    /// The values in C order, borrowed when the array is contiguous.
+    pub(crate) fn values(&self) -> Cow<'_, [f64]> {
+        if self.array.is_c_contiguous() {
+            // SAFETY: no Rust code holds a mutable view of an input: the only array robodyn writes
+            // is the output, which each call creates itself.
+            if let Ok(slice) = unsafe { self.array.as_slice() } {
+                return Cow::Borrowed(slice);
+            }
+        }
+        Cow::Owned(self.array.to_owned_array().iter().copied().collect())
+    }
+}
+
+pub(crate) fn shape_text(shape: &[usize]) -> String {
+    match shape {
+        [n] => format!("({n},)"),
+        _ => format!(
+            "({})",
+            shape
+                .iter()
+                .map(|n| n.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+/// The Jacobian/velocity reference named by the user.
+pub(crate) fn parse_reference(reference: &str) -> PyResult<Reference> {
+    match reference {
+        "world" => Ok(Reference::World),
+        "local" => Ok(Reference::Local),
+        "spatial" => Ok(Reference::Spatial),
+        other => Err(PyValueError::new_err(format!(
+            "argument 'reference': expected 'world', 'local' or 'spatial', got '{other}'"
+        ))),
+    }
+}
+
+/// The Jacobian rows of a task: "full", "position", "orientation" or a list of row indices.
+pub(crate) fn parse_task(task: &Bound<PyAny>) -> PyResult<Vec<usize>> {
+    match task.extract::<String>().as_deref() {
+        Ok("full") => Ok((0..6).collect()),
+        Ok("position") => Ok((0..3).collect()),
+        Ok("orientation") => Ok((3..6).collect()),
+        Ok(other) => Err(PyValueError::new_err(format!(
+            "argument 'task': expected 'full', 'position', 'orientation' or a list of rows 0..5, got '{other}'"
+        ))),
+        Err(_) => task.extract::<Vec<usize>>().map_err(|_| {
+            PyValueError::new_err(format!(
+                "argument 'task': expected 'full', 'position', 'orientation' or a list of rows 0..5, got {}",
+                task.repr().map(|r| r.to_string()).unwrap_or_default()
+            ))
+        }),
+    }
+}
+
+/// "argument 'method': expected ..., got '...'".
+pub(crate) fn unknown_method(method: &str, expected: &str) -> PyErr {
+    PyValueError::new_err(format!(
+        "argument 'method': expected {expected}, got '{method}'"
+    ))
+}
+
+/// The values of an argument that must be one sample, not a batch.
+pub(crate) fn single_sample<'a>(argument: &'a Argument) -> PyResult<Cow<'a, [f64]>> {
+    if argument.batch()?.is_some() {
+        return Err(PyValueError::new_err(format!(
+            "argument '{}': expected shape {}, got {}",
+            argument.name,
+            shape_text(argument.sample_shape.as_slice()),
+            shape_text(argument.array.shape())
+        )));
+    }
+    Ok(argument.values())
+}
+
+/// Reads one finite sample of `shape` (a settable property, a constant input).
+pub(crate) fn read_sample(
+    name: &'static str,
+    value: &Bound<PyAny>,
+    shape: SampleShape,
+) -> PyResult<Vec<f64>> {
+    let argument = Argument::new(name, value, shape)?;
+    let values = single_sample(&argument)?.into_owned();
+    robodyn::error::check_finite(name, &values).map_err(to_py_err)?;
+    Ok(values)
+}
+
+/// Reads a settable per-coordinate property.
+pub(crate) fn read_property(
+    name: &'static str,
+    value: &Bound<PyAny>,
+    length: usize,
+) -> PyResult<Vec<f64>> {
+    read_sample(name, value, SampleShape::vector(length))
+}
+
+/// Reads a settable per-coordinate property whose entries must be >= 0.
+pub(crate) fn read_non_negative(
+    name: &'static str,
+    value: &Bound<PyAny>,
+    length: usize,
+) -> PyResult<DVector<f64>> {
+    let values = read_property(name, value, length)?;
+    if let Some(k) = values.iter().position(|x| *x < 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "argument '{name}': expected values >= 0, got {} at index {k}",
+            values[k]
+        )));
+    }
+    Ok(DVector::from_vec(values))
+}
+
+/// How a value shows in a message: its `repr`.
+pub(crate) fn describe(value: &Bound<PyAny>) -> String {
+    value
+        .repr()
+        .map(|r| r.to_string())
+        .unwrap_or_else(|_| "an unreadable object".into())
+}
+
+fn expected(name: &str, what: &str, value: &Bound<PyAny>) -> PyErr {
+    PyValueError::new_err(format!(
+        "argument '{name}': expected {what}, got {}",
+        describe(value)
+    ))
+}
+
+/// A non-negative integer below 2⁶⁴ (a seed): a Python or NumPy integer, never a bool or a float.
+pub(crate) fn non_negative_integer(name: &str, value: &Bound<PyAny>) -> PyResult<u64> {
+    if value.is_instance_of::<PyBool>() {
+        return Err(expected(name, "a non-negative integer", value));
+    }
+    value
+        .extract::<u64>()
+        .map_err(|_| expected(name, "a non-negative integer", value))
+}
+
+/// A count or a size: a non-negative integer that fits in memory.
+pub(crate) fn count(name: &str, value: &Bound<PyAny>) -> PyResult<usize> {
+    usize::try_from(non_negative_integer(name, value)?)
+        .map_err(|_| expected(name, "a smaller integer", value))
+}
+
+/// A number (int or float) that is finite.
+pub(crate) fn real(name: &str, value: &Bound<PyAny>) -> PyResult<f64> {
+    match value.extract::<f64>() {
+        Ok(x) if x.is_finite() && !value.is_instance_of::<PyBool>() => Ok(x),
+        _ => Err(expected(name, "a finite number", value)),
+    }
+}
+
+/// True or False (a Python or NumPy bool).
+pub(crate) fn flag(name: &str, value: &Bound<PyAny>) -> PyResult<bool> {
+    let is_numpy_bool = value
+        .get_type()
+        .name()
+        .is_ok_and(|type_name| type_name == "bool" || type_name == "bool_");
+    match value.extract::<bool>() {
+        Ok(x) if is_numpy_bool => Ok(x),
+        _ => Err(expected(name, "True or False", value)),
+    }
+}
+
+/// A string.
+pub(crate) fn text(name: &str, value: &Bound<PyAny>) -> PyResult<String> {
+    value
+        .extract::<String>()
+        .map_err(|_| expected(name, "a string", value))
+}
+
+/// A path: a string or an `os.PathLike`.
+pub(crate) fn path(name: &str, value: &Bound<PyAny>) -> PyResult<std::path::PathBuf> {
+    value
+        .extract::<std::path::PathBuf>()
+        .map_err(|_| expected(name, "a path (str or os.PathLike)", value))
+}
+
+/// One converter per argument name, for `#[pyo3(from_py_with = named::…)]`: a value of the wrong
+/// type is a `ValueError` naming the argument, not PyO3's `TypeError` or `OverflowError`.
+pub(crate) mod named {
+
+    use pyo3::prelude::*;
+
+    macro_rules! converters {
+        ($($argument:ident: $convert:ident -> $type:ty;)*) => {$(
+            pub(crate) fn $argument(value: &Bound<PyAny>) -> PyResult<$type> {
+                super::$convert(stringify!($argument), value)
+            }
+        )*};
+    }
+
+    /// The same for an argument whose default is None: None stays None.
+    macro_rules! optional_converters {
+        ($($function:ident($argument:ident): $convert:ident -> $type:ty;)*) => {$(
+            pub(crate) fn $function(value: &Bound<PyAny>) -> PyResult<Option<$type>> {
+                if value.is_none() {
+                    return Ok(None);
+                }
+                super::$convert(stringify!($argument), value).map(Some)
+            }
+        )*};
+    }
+
+    converters! {
+        n: count -> usize;
+        seed: non_negative_integer -> u64;
+        max_iterations: count -> usize;
+        restarts: count -> usize;
+        dt: real -> f64;
+        tolerance: real -> f64;
+        damping: real -> f64;
+        position_only: flag -> bool;
+        floating_base: flag -> bool;
+        check_inertia: flag -> bool;
+        method: text -> String;
+        reference: text -> String;
+        source: text -> String;
+        text: text -> String;
+        path: path -> std::path::PathBuf;
+    }
+
+    optional_converters! {
+        optional_n(n): count -> usize;
+        optional_seed(seed): non_negative_integer -> u64;
+    }
+}

@@ -1,0 +1,351 @@
+//! Dynamics: RNEA, ABA, M three ways, bias forces, gravity, the Coriolis matrix and Christoffel
+//! symbols, Craig's split, energies and centroidal momentum.
+
+use crate::args::*;
+use crate::model::*;
+use nalgebra::{DMatrix, DVector};
+use pyo3::prelude::*;
+use robodyn::algo;
+use robodyn::{Data, Model};
+
+impl PyModel {
+    /// Dynamics with optional external forces: `algorithm(q, v, x, f_ext)`.
+    pub(crate) fn with_external_forces<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        x: (&'static str, &Bound<'py, PyAny>),
+        f_ext: Option<&Bound<'py, PyAny>>,
+        algorithm: DynamicsAlgorithm,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let mut arguments = vec![
+            self.q_arg("q", q)?,
+            self.v_arg("v", v)?,
+            self.v_arg(x.0, x.1)?,
+        ];
+        if let Some(f) = f_ext {
+            arguments.push(Argument::new(
+                "f_ext",
+                f,
+                SampleShape::matrix(self.model.nbodies() - 1, 6),
+            )?);
+        }
+        self.evaluate(py, &arguments, &[self.model.nv], &|m, w, i, out| {
+            let Workspace { data, forces } = w;
+            let forces = i.get(3).map(|flat| {
+                fill_forces(forces, flat);
+                &forces[..]
+            });
+            out.copy_from_slice(algorithm(m, data, i[0], i[1], i[2], forces)?.as_slice());
+            Ok(())
+        })
+    }
+}
+
+/// The Christoffel symbols at q, row-major (i, j, k), in a new buffer.
+pub(crate) fn christoffel_of(
+    model: &Model,
+    worker: &mut Workspace,
+    q: &[f64],
+) -> robodyn::Result<Vec<f64>> {
+    let mut gamma = vec![0.0; model.nv.pow(3)];
+    algo::christoffel_symbols(model, &mut worker.data, q, &mut gamma)?;
+    Ok(gamma)
+}
+
+#[pymethods]
+impl PyModel {
+    /// Inverse dynamics by RNEA: τ = M(q) a + C(q, v) v + g(q) - Σ J_iᵀ f_ext_i.
+    /// `f_ext`: optional (nbodies, 6) wrenches [force; torque] on each body (rows as body_names),
+    /// in the body's frame, at its origin.
+    #[pyo3(signature = (q, v, a, f_ext=None))]
+    fn inverse_dynamics<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        a: &Bound<'py, PyAny>,
+        f_ext: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.with_external_forces(py, q, v, ("a", a), f_ext, algo::rnea)
+    }
+
+    /// Forward dynamics by ABA: a = M(q)⁻¹ (τ - C(q, v) v - g(q) + Σ J_iᵀ f_ext_i).
+    #[pyo3(signature = (q, v, tau, f_ext=None))]
+    fn forward_dynamics<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        tau: &Bound<'py, PyAny>,
+        f_ext: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.with_external_forces(py, q, v, ("tau", tau), f_ext, algo::aba)
+    }
+
+    /// Joint-space inertia matrix M(q), full and symmetric, armature included. (nv, nv).
+    /// `method`: "crba" (Featherstone's composite-rigid-body algorithm, the fastest), "rnea"
+    /// (column k = τ(q, 0, e_k) − g(q), n RNEA calls: the UR5 dynamics notes) or "jacobians"
+    /// (Σ m J_vᵀ J_v + J_ωᵀ I J_ω over the bodies: the TU Berlin and UR5 dynamics notes).
+    #[pyo3(signature = (q, method="crba".to_string()), text_signature = "($self, q, method='crba')")]
+    fn mass_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = named::method)] method: String,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        type Method = for<'d> fn(&Model, &'d mut Data, &[f64]) -> robodyn::Result<&'d DMatrix<f64>>;
+        let algorithm: Method = match method.as_str() {
+            "crba" => algo::crba,
+            "rnea" => algo::mass_matrix_by_rnea,
+            "jacobians" => algo::mass_matrix_by_jacobians,
+            other => return Err(unknown_method(other, "crba, rnea or jacobians")),
+        };
+        let nv = self.model.nv;
+        self.evaluate(py, &[self.q_arg("q", q)?], &[nv, nv], &|m, w, i, out| {
+            write_row_major(algorithm(m, &mut w.data, i[0])?, m.nv, out);
+            Ok(())
+        })
+    }
+
+    /// M(q)⁻¹. (nv, nv).
+    fn inverse_mass_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let nv = self.model.nv;
+        self.evaluate(py, &[self.q_arg("q", q)?], &[nv, nv], &|m, w, i, out| {
+            write_row_major(algo::inverse_mass_matrix(m, &mut w.data, i[0])?, m.nv, out);
+            Ok(())
+        })
+    }
+
+    /// Bias forces C(q, v) v + g(q) (RNEA with a = 0). (nv,).
+    fn bias_forces<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[self.model.nv],
+            &|m, w, i, out| {
+                out.copy_from_slice(algo::bias_forces(m, &mut w.data, i[0], i[1])?.as_slice());
+                Ok(())
+            },
+        )
+    }
+
+    /// Coriolis matrix C(q, v) (nv, nv), from the Christoffel symbols of the first kind:
+    /// C(q, v) v = bias_forces(q, v) − generalized_gravity(q), and Ṁ − 2C is skew-symmetric
+    /// (the TU Berlin notes). A recursive O(n²) algorithm (Echeandia & Wensing 2021), no RNEA calls.
+    fn coriolis_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let nv = self.model.nv;
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[nv, nv],
+            &|m, w, i, out| {
+                write_row_major(
+                    algo::coriolis_matrix(m, &mut w.data, i[0], i[1])?,
+                    m.nv,
+                    out,
+                );
+                Ok(())
+            },
+        )
+    }
+
+    /// Generalized gravity g(q). (nv,). `method`: "rnea" (RNEA with v = a = 0) or "jacobians"
+    /// (−Σ J_cᵀ m g over the bodies' centres of mass: the TU Berlin notes "Gravity").
+    #[pyo3(signature = (q, method="rnea".to_string()), text_signature = "($self, q, method='rnea')")]
+    fn generalized_gravity<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = named::method)] method: String,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        type Method = for<'d> fn(&Model, &'d mut Data, &[f64]) -> robodyn::Result<&'d DVector<f64>>;
+        let algorithm: Method = match method.as_str() {
+            "rnea" => algo::generalized_gravity,
+            "jacobians" => algo::generalized_gravity_by_jacobians,
+            other => return Err(unknown_method(other, "rnea or jacobians")),
+        };
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?],
+            &[self.model.nv],
+            &|m, w, i, out| {
+                out.copy_from_slice(algorithm(m, &mut w.data, i[0])?.as_slice());
+                Ok(())
+            },
+        )
+    }
+
+    /// Christoffel symbols of the first kind, (nv, nv, nv):
+    /// Γ[i, j, k] = ½ (∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i), so that C(q, v)_ij = Σ_k Γ[i, j, k] v_k
+    /// (the TU Berlin notes). Exact: Γ[:, :, k] = C(q, e_k) by the recursive Coriolis algorithm. With
+    /// spherical or free joints (velocities that are not coordinate rates) the coordinate formula
+    /// has no meaning; Γ[:, :, k] = C(q, e_k) still holds.
+    fn christoffel<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let nv = self.model.nv;
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?],
+            &[nv, nv, nv],
+            &|m, w, i, out| {
+                algo::christoffel_symbols(m, &mut w.data, i[0], out)?;
+                Ok(())
+            },
+        )
+    }
+
+    /// Craig's centrifugal matrix C(q), (nv, nv) (the TU Berlin notes, "Centrifugal and Coriolis
+    /// Computation"): the velocity terms are C(q) [q̇₁², …, q̇ₙ²] + B(q) [q̇₁q̇₂, q̇₁q̇₃, …];
+    /// C(q)_ij = Γ_ijj.
+    fn centrifugal_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let nv = self.model.nv;
+        self.evaluate(py, &[self.q_arg("q", q)?], &[nv, nv], &|m, w, i, out| {
+            let gamma = christoffel_of(m, w, i[0])?;
+            for (row, j) in (0..nv).flat_map(|row| (0..nv).map(move |j| (row, j))) {
+                out[row * nv + j] = gamma[(row * nv + j) * nv + j];
+            }
+            Ok(())
+        })
+    }
+
+    /// Craig's Coriolis matrix B(q), (nv, nv(nv−1)/2) (the TU Berlin notes): multiplies the products
+    /// [q̇₁q̇₂, q̇₁q̇₃, …, q̇₁q̇ₙ, q̇₂q̇₃, …] (pairs j < k in that order); B(q)_i,(jk) = 2 Γ_ijk.
+    fn coriolis_pairs_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let nv = self.model.nv;
+        let pairs = nv * nv.saturating_sub(1) / 2;
+        self.evaluate(py, &[self.q_arg("q", q)?], &[nv, pairs], &|m, w, i, out| {
+            let gamma = christoffel_of(m, w, i[0])?;
+            for row in 0..nv {
+                let mut column = 0;
+                for j in 0..nv {
+                    for k in j + 1..nv {
+                        out[row * pairs + column] = 2.0 * gamma[(row * nv + j) * nv + k];
+                        column += 1;
+                    }
+                }
+            }
+            Ok(())
+        })
+    }
+
+    /// Kinetic energy ½ vᵀ M(q) v (J), rotor energy included.
+    fn kinetic_energy<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[],
+            &|m, w, i, out| {
+                out[0] = algo::kinetic_energy(m, &mut w.data, i[0], i[1])?;
+                Ok(())
+            },
+        )
+    }
+
+    /// The Lagrangian L = T − V (J): kinetic minus potential energy.
+    fn lagrangian<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[],
+            &|m, w, i, out| {
+                let kinetic = algo::kinetic_energy(m, &mut w.data, i[0], i[1])?;
+                out[0] = kinetic - algo::potential_energy(m, &mut w.data, i[0])?;
+                Ok(())
+            },
+        )
+    }
+
+    /// Potential energy -Σ m_i gᵀ c_i (J), zero at the world origin.
+    fn potential_energy<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(py, &[self.q_arg("q", q)?], &[], &|m, w, i, out| {
+            out[0] = algo::potential_energy(m, &mut w.data, i[0])?;
+            Ok(())
+        })
+    }
+
+    /// Centroidal momentum matrix A_G(q), (6, nv): h_G = A_G v, rows [linear momentum; angular
+    /// momentum about the centre of mass], world axes (Orin, Goswami & Lee 2013).
+    fn centroidal_momentum_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?],
+            &[6, self.model.nv],
+            &|m, w, i, out| {
+                write_row_major(
+                    algo::centroidal_momentum_matrix(m, &mut w.data, i[0])?,
+                    6,
+                    out,
+                );
+                Ok(())
+            },
+        )
+    }
+
+    /// Centroidal momentum h_G = A_G(q) v, (6,): [linear momentum m ċ; angular momentum about the
+    /// centre of mass], world axes.
+    fn centroidal_momentum<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[6],
+            &|m, w, i, out| {
+                matrix_times(
+                    algo::centroidal_momentum_matrix(m, &mut w.data, i[0])?,
+                    i[1],
+                    out,
+                );
+                Ok(())
+            },
+        )
+    }
+}

@@ -1,0 +1,381 @@
+//! Kinematics: frame poses, Jacobians and their derivatives, frame velocities and accelerations,
+//! the centre of mass, manipulability, workspace sampling and inverse kinematics.
+
+use crate::args::*;
+use crate::model::*;
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use rand::{rngs::StdRng, SeedableRng};
+use robodyn::algo;
+use robodyn::Error;
+
+impl PyModel {
+    /// One of the two measures of `algo::manipulability`, per state.
+    pub(crate) fn manipulability_measure<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+        task: Option<&Bound<'py, PyAny>>,
+        measure: fn((f64, f64)) -> f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let frame = self.frame_index(frame)?;
+        let rows = task.map_or_else(|| Ok((0..6).collect()), parse_task)?;
+        self.evaluate(py, &[self.q_arg("q", q)?], &[], &|m, w, i, out| {
+            out[0] = measure(algo::manipulability(m, &mut w.data, i[0], frame, &rows)?);
+            Ok(())
+        })
+    }
+}
+
+#[pymethods]
+impl PyModel {
+    /// Pose of a frame (name or index) in the world: 4x4 homogeneous matrix.
+    fn frame_pose<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let frame = self.frame_index(frame)?;
+        self.evaluate(py, &[self.q_arg("q", q)?], &[4, 4], &|m, w, i, out| {
+            let pose = algo::frame_pose(m, &mut w.data, i[0], frame)?.to_homogeneous();
+            for (r, row) in out.chunks_exact_mut(4).enumerate() {
+                for (c, value) in row.iter_mut().enumerate() {
+                    *value = pose[(r, c)];
+                }
+            }
+            Ok(())
+        })
+    }
+
+    /// Jacobian of a frame, (6, nv), rows [linear; angular]. `reference`: "world" (velocity of the
+    /// frame's origin and angular velocity in world axes: the geometric Jacobian), "local" (the
+    /// same in the frame's axes) or "spatial" (spatial velocity in world coordinates).
+    #[pyo3(signature = (q, frame, reference="world".to_string()), text_signature = "($self, q, frame, reference='world')")]
+    fn jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = named::reference)] reference: String,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let frame = self.frame_index(frame)?;
+        let reference = parse_reference(&reference)?;
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?],
+            &[6, self.model.nv],
+            &|m, w, i, out| {
+                write_row_major(
+                    algo::jacobian(m, &mut w.data, i[0], frame, reference)?,
+                    6,
+                    out,
+                );
+                Ok(())
+            },
+        )
+    }
+
+    /// Time derivative J̇(q, v) of a frame's Jacobian, (6, nv), same references as `jacobian`;
+    /// J̇ v equals `frame_acceleration(q, v, 0, frame, reference)`.
+    #[pyo3(signature = (q, v, frame, reference="world".to_string()), text_signature = "($self, q, v, frame, reference='world')")]
+    fn jacobian_time_variation<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = named::reference)] reference: String,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (frame, reference) = (self.frame_index(frame)?, parse_reference(&reference)?);
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[6, self.model.nv],
+            &|m, w, i, out| {
+                write_row_major(
+                    algo::jacobian_time_variation(m, &mut w.data, i[0], i[1], frame, reference)?,
+                    6,
+                    out,
+                );
+                Ok(())
+            },
+        )
+    }
+
+    /// Velocity of a frame, (6,) [linear; angular] = J(q) v: "world" (its origin's velocity and
+    /// angular velocity in world axes), "local" (the same in its axes) or "spatial".
+    #[pyo3(signature = (q, v, frame, reference="world".to_string()), text_signature = "($self, q, v, frame, reference='world')")]
+    fn frame_velocity<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = named::reference)] reference: String,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (frame, reference) = (self.frame_index(frame)?, parse_reference(&reference)?);
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[6],
+            &|m, w, i, out| {
+                out.copy_from_slice(&algo::frame_velocity(
+                    m,
+                    &mut w.data,
+                    i[0],
+                    i[1],
+                    frame,
+                    reference,
+                )?);
+                Ok(())
+            },
+        )
+    }
+
+    /// Acceleration of a frame, (6,) [linear; angular] = J(q) a + J̇(q, v) v: "world" (the
+    /// classical acceleration of its origin and its angular acceleration, world axes), "local"
+    /// (the same in its axes) or "spatial" (Featherstone's spatial acceleration, world
+    /// coordinates). With a = 0 it is J̇ v.
+    #[pyo3(signature = (q, v, a, frame, reference="world".to_string()), text_signature = "($self, q, v, a, frame, reference='world')")]
+    fn frame_acceleration<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        a: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = named::reference)] reference: String,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (frame, reference) = (self.frame_index(frame)?, parse_reference(&reference)?);
+        let arguments = [
+            self.q_arg("q", q)?,
+            self.v_arg("v", v)?,
+            self.v_arg("a", a)?,
+        ];
+        self.evaluate(py, &arguments, &[6], &|m, w, i, out| {
+            out.copy_from_slice(&algo::frame_acceleration(
+                m,
+                &mut w.data,
+                i[0],
+                i[1],
+                i[2],
+                frame,
+                reference,
+            )?);
+            Ok(())
+        })
+    }
+
+    /// Centre of mass of the robot in world coordinates. (3,).
+    fn center_of_mass<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(py, &[self.q_arg("q", q)?], &[3], &|m, w, i, out| {
+            out.copy_from_slice(algo::center_of_mass(m, &mut w.data, i[0])?.as_slice());
+            Ok(())
+        })
+    }
+
+    /// Jacobian of the centre of mass, (3, nv) in world axes: ċ = J_com v.
+    fn center_of_mass_jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?],
+            &[3, self.model.nv],
+            &|m, w, i, out| {
+                write_row_major(algo::center_of_mass_jacobian(m, &mut w.data, i[0])?, 3, out);
+                Ok(())
+            },
+        )
+    }
+
+    /// Velocity of the centre of mass ċ = J_com(q) v, (3,), world axes.
+    fn center_of_mass_velocity<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[3],
+            &|m, w, i, out| {
+                matrix_times(
+                    algo::center_of_mass_jacobian(m, &mut w.data, i[0])?,
+                    i[1],
+                    out,
+                );
+                Ok(())
+            },
+        )
+    }
+
+    /// Yoshikawa's manipulability √det(J Jᵀ) of a frame for a task: "full" (6 rows), "position",
+    /// "orientation" or a list of rows of [vx, vy, vz, ωx, ωy, ωz]. Zero at a singularity.
+    #[pyo3(signature = (q, frame, task=None))]
+    fn manipulability<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+        task: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.manipulability_measure(py, q, frame, task, |(w, _)| w)
+    }
+
+    /// σ_min / σ_max of a frame's task Jacobian (see `manipulability`): 1 when isotropic, 0 at a
+    /// singularity.
+    #[pyo3(signature = (q, frame, task=None))]
+    fn inverse_condition_number<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+        task: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.manipulability_measure(py, q, frame, task, |(_, inverse_condition)| {
+            inverse_condition
+        })
+    }
+
+    /// Workspace sampling: the world positions (n, 3) of a frame's origin over n random
+    /// configurations (see `random_configuration`), computed on all cores.
+    #[pyo3(signature = (frame, n=10_000, seed=None))]
+    fn workspace<'py>(
+        &self,
+        py: Python<'py>,
+        frame: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = named::n)] n: usize,
+        #[pyo3(from_py_with = named::optional_seed)] seed: Option<u64>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let states = self.random_configuration(py, Some(n), seed)?;
+        let poses = self.frame_pose(py, &states, frame)?;
+        // the translation column of each pose
+        let slicing = (
+            pyo3::types::PySlice::full(py),
+            pyo3::types::PySlice::new(py, 0, 3, 1),
+            3,
+        );
+        poses.get_item(slicing)?.call_method0("copy")
+    }
+
+    /// Inverse kinematics: a configuration placing `frame` at `target`, a 4x4 pose (or N poses,
+    /// solved in parallel), by damped least squares from `q0` (default: neutral) and then from up
+    /// to `restarts` random configurations. `position_only` matches only the target's position.
+    /// Returns a dict: "q" (nq,), "success" (bool), "iterations" (int), "residual" (the error
+    /// norm, m and rad), with a leading N for a batch. Results do not depend on batch position.
+    #[pyo3(signature = (frame, target, q0=None, position_only=false, tolerance=1e-10, max_iterations=200, restarts=20, damping=1e-6, seed=0))]
+    #[allow(clippy::too_many_arguments)]
+    fn inverse_kinematics<'py>(
+        &self,
+        py: Python<'py>,
+        frame: &Bound<'py, PyAny>,
+        target: &Bound<'py, PyAny>,
+        q0: Option<&Bound<'py, PyAny>>,
+        #[pyo3(from_py_with = named::position_only)] position_only: bool,
+        #[pyo3(from_py_with = named::tolerance)] tolerance: f64,
+        #[pyo3(from_py_with = named::max_iterations)] max_iterations: usize,
+        #[pyo3(from_py_with = named::restarts)] restarts: usize,
+        #[pyo3(from_py_with = named::damping)] damping: f64,
+        #[pyo3(from_py_with = named::seed)] seed: u64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let frame = self.frame_index(frame)?;
+        let options = algo::IkOptions {
+            position_only,
+            tolerance,
+            max_iterations,
+            restarts,
+            damping,
+        };
+        let target = Argument::new("target", target, SampleShape::matrix(4, 4))?;
+        let q0 = match q0 {
+            Some(q0) => self.q_arg("q0", q0)?,
+            None => {
+                // the neutral configuration, once per target
+                let neutral = self.model.neutral();
+                let starts = match target.batch()? {
+                    None => PyArray1::from_slice(py, neutral.as_slice()).into_any(),
+                    Some(n) => {
+                        let repeated: Vec<f64> =
+                            (0..n).flat_map(|_| neutral.iter().copied()).collect();
+                        PyArray1::from_vec(py, repeated)
+                            .reshape([n, self.model.nq])?
+                            .into_any()
+                    }
+                };
+                self.q_arg("q0", &starts)?
+            }
+        };
+        let nq = self.model.nq;
+        let packed = self.evaluate(py, &[target, q0], &[nq + 3], &|m, w, i, out| {
+            let pose = i[0];
+            let rotation = nalgebra::Matrix3::new(
+                pose[0], pose[1], pose[2], pose[4], pose[5], pose[6], pose[8], pose[9], pose[10],
+            );
+            let orthonormal =
+                (rotation.transpose() * rotation - nalgebra::Matrix3::identity()).norm() < 1e-6
+                    && rotation.determinant() > 0.0
+                    && pose[12..16] == [0.0, 0.0, 0.0, 1.0];
+            if !orthonormal {
+                return Err(Error::InvalidValue {
+                    argument: "target".into(),
+                    message: "expected a 4x4 homogeneous pose [R p; 0 0 0 1] with R a rotation"
+                        .into(),
+                });
+            }
+            let position = nalgebra::Vector3::new(pose[3], pose[7], pose[11]);
+            let target = robodyn::spatial::Transform::from_pose(&rotation, &position);
+            // the restarts' random states depend on the sample, never on its place in a batch
+            let mut hasher = std::collections::hash_map::DefaultHasher::new();
+            std::hash::Hash::hash(&seed, &mut hasher);
+            for value in pose.iter().chain(i[1]) {
+                std::hash::Hash::hash(&value.to_bits(), &mut hasher);
+            }
+            let mut rng = StdRng::seed_from_u64(std::hash::Hasher::finish(&hasher));
+            let solution =
+                algo::inverse_kinematics(m, &mut w.data, frame, &target, i[1], &options, &mut rng)?;
+            out[..m.nq].copy_from_slice(solution.q.as_slice());
+            out[m.nq] = f64::from(u8::from(solution.success));
+            out[m.nq + 1] = solution.iterations as f64;
+            out[m.nq + 2] = solution.residual;
+            Ok(())
+        })?;
+        // unpack [q, success, iterations, residual] along the last axis
+        let result = PyDict::new(py);
+        let ellipsis = py.Ellipsis().into_bound(py);
+        let column = |k: usize| (ellipsis.clone(), k);
+        result.set_item(
+            "q",
+            packed
+                .get_item((
+                    ellipsis.clone(),
+                    pyo3::types::PySlice::new(py, 0, nq as isize, 1),
+                ))?
+                .call_method0("copy")?,
+        )?;
+        result.set_item(
+            "success",
+            packed
+                .get_item(column(nq))?
+                .call_method1("astype", ("bool",))?,
+        )?;
+        result.set_item(
+            "iterations",
+            packed
+                .get_item(column(nq + 1))?
+                .call_method1("astype", ("int64",))?,
+        )?;
+        result.set_item("residual", packed.get_item(column(nq + 2))?)?;
+        Ok(result)
+    }
+}

@@ -1,0 +1,256 @@
+//! The Python `Model`: a core model with its preallocated workspace, and the one evaluation path
+//! every numeric method takes (one sample in the caller's thread, a batch on all cores with the GIL
+//! released).
+
+use crate::args::*;
+use crate::to_py_err;
+use nalgebra::DMatrix;
+use numpy::ndarray::IxDyn;
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
+use pyo3::prelude::*;
+use rayon::prelude::*;
+use robodyn::spatial::Force;
+use robodyn::{Data, Error, Model};
+use std::borrow::Cow;
+use std::collections::HashMap;
+use std::sync::Mutex;
+
+/// What a kernel works in: the algorithm workspace and a buffer for external forces.
+pub(crate) struct Workspace {
+    pub(crate) data: Data,
+    pub(crate) forces: Vec<Force>,
+}
+
+impl Workspace {
+    pub(crate) fn new(model: &Model) -> Self {
+        Workspace {
+            data: Data::new(model),
+            forces: vec![Force::ZERO; model.nbodies() - 1],
+        }
+    }
+}
+
+/// Copies a flat array of `[linear; angular]` rows, one per body, into `forces`.
+pub(crate) fn fill_forces(forces: &mut [Force], flat: &[f64]) {
+    for (force, row) in forces.iter_mut().zip(flat.chunks_exact(6)) {
+        *force = Force::from_array(&[row[0], row[1], row[2], row[3], row[4], row[5]]);
+    }
+}
+
+/// A core algorithm taking (q, v, a or τ, external forces) and returning a vector in `Data`.
+pub(crate) type DynamicsAlgorithm = for<'d> fn(
+    &Model,
+    &'d mut Data,
+    &[f64],
+    &[f64],
+    &[f64],
+    Option<&[Force]>,
+) -> robodyn::Result<&'d nalgebra::DVector<f64>>;
+
+/// One computation on one sample: inputs (flattened, in argument order) to a flattened output.
+pub(crate) type Kernel<'k> =
+    dyn Fn(&Model, &mut Workspace, &[&[f64]], &mut [f64]) -> robodyn::Result<()> + Sync + 'k;
+
+/// The most numeric arguments a method takes (q, v, a, f_ext).
+pub(crate) const MAX_ARGUMENTS: usize = 4;
+
+/// Runs `kernel` and rejects a result that is not finite (finite inputs so large that the
+/// arithmetic overflowed), so that no NaN or infinity reaches the caller.
+pub(crate) fn run_kernel(
+    kernel: &Kernel,
+    model: &Model,
+    workspace: &mut Workspace,
+    inputs: &[&[f64]],
+    out: &mut [f64],
+) -> robodyn::Result<()> {
+    kernel(model, workspace, inputs, out)?;
+    match out.iter().position(|x| !x.is_finite()) {
+        None => Ok(()),
+        Some(index) => Err(Error::Overflow {
+            index,
+            value: out[index],
+        }),
+    }
+}
+
+/// A robot model with its preallocated workspace. Every numeric method takes one state (q of
+/// shape (nq,)) or a batch (shape (N, nq)), returning the result or a stack of N results; batches
+/// release the GIL and run on all cores.
+#[pyclass(name = "Model", module = "robodyn._core")]
+pub(crate) struct PyModel {
+    pub(crate) model: Model,
+    pub(crate) workspace: Mutex<Workspace>,
+    /// Frame name to index, for the calls that take a frame by name.
+    pub(crate) frame_indices: HashMap<String, usize>,
+}
+
+impl PyModel {
+    pub(crate) fn wrap(model: Model) -> Self {
+        let workspace = Mutex::new(Workspace::new(&model));
+        let mut frame_indices = HashMap::new();
+        for (index, frame) in model.frames.iter().enumerate() {
+            // the first frame of a name wins, as in Model::frame_index
+            frame_indices.entry(frame.name.clone()).or_insert(index);
+        }
+        PyModel {
+            model,
+            workspace,
+            frame_indices,
+        }
+    }
+
+    /// Runs `kernel` on one sample or a batch of the `arguments`, producing `output_shape` per
+    /// sample.
+    pub(crate) fn evaluate<'py>(
+        &self,
+        py: Python<'py>,
+        arguments: &[Argument<'py>],
+        output_shape: &[usize],
+        kernel: &Kernel,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let batch = arguments[0].batch()?;
+        for argument in &arguments[1..] {
+            if argument.batch()? != batch {
+                return Err(PyValueError::new_err(format!(
+                    "argument '{}': expected {} like argument '{}', got shape {}",
+                    argument.name,
+                    match batch {
+                        None => "a single sample".to_string(),
+                        Some(n) => format!("a batch of {n}"),
+                    },
+                    arguments[0].name,
+                    shape_text(argument.array.shape())
+                )));
+            }
+        }
+        let values: [Cow<[f64]>; MAX_ARGUMENTS] = std::array::from_fn(|k| {
+            arguments
+                .get(k)
+                .map_or(Cow::Borrowed(&[][..]), |a| a.values())
+        });
+        let values = &values[..arguments.len()];
+        let output_size: usize = output_shape.iter().product();
+        let model = &self.model;
+        match batch {
+            None => {
+                let mut inputs: [&[f64]; MAX_ARGUMENTS] = [&[]; MAX_ARGUMENTS];
+                for (input, value) in inputs.iter_mut().zip(values) {
+                    *input = value.as_ref();
+                }
+                let inputs = &inputs[..values.len()];
+                let output = PyArrayDyn::<f64>::zeros(py, IxDyn(output_shape), false);
+                // SAFETY: the array was created just above and nothing else refers to it yet.
+                let out = unsafe { output.as_slice_mut() }
+                    .map_err(|e| PyValueError::new_err(e.to_string()))?;
+                match self.workspace.try_lock() {
+                    Ok(mut workspace) => run_kernel(kernel, model, &mut workspace, inputs, out),
+                    Err(_) => run_kernel(kernel, model, &mut Workspace::new(model), inputs, out),
+                }
+                .map_err(to_py_err)?;
+                if output_shape.is_empty() {
+                    return output.get_item(());
+                }
+                Ok(output.into_any())
+            }
+            Some(n) => {
+                let sizes: Vec<usize> = arguments
+                    .iter()
+                    .map(|a| a.sample_shape.as_slice().iter().product())
+                    .collect();
+                let mut out = vec![0.0; n * output_size];
+                let result = py.detach(|| {
+                    out.par_chunks_mut(output_size.max(1))
+                        .enumerate()
+                        .try_for_each_init(
+                            || (Workspace::new(model), Vec::with_capacity(values.len())),
+                            |(workspace, inputs), (k, out)| {
+                                inputs.clear();
+                                inputs.extend(
+                                    values
+                                        .iter()
+                                        .zip(&sizes)
+                                        .map(|(v, s)| &v[k * s..(k + 1) * s]),
+                                );
+                                run_kernel(kernel, model, workspace, inputs, out)
+                                    .map_err(|e| (k, e))
+                            },
+                        )
+                });
+                if let Err((k, error)) = result {
+                    let message = format!("batch element {k}: {error}");
+                    return Err(match error {
+                        Error::FileNotFound { .. } => PyFileNotFoundError::new_err(message),
+                        _ => PyValueError::new_err(message),
+                    });
+                }
+                let shape: Vec<usize> = std::iter::once(n)
+                    .chain(output_shape.iter().copied())
+                    .collect();
+                Ok(PyArray1::from_vec(py, out).reshape(shape)?.into_any())
+            }
+        }
+    }
+
+    pub(crate) fn q_arg<'py>(
+        &self,
+        name: &'static str,
+        value: &Bound<'py, PyAny>,
+    ) -> PyResult<Argument<'py>> {
+        Argument::new(name, value, SampleShape::vector(self.model.nq))
+    }
+
+    pub(crate) fn v_arg<'py>(
+        &self,
+        name: &'static str,
+        value: &Bound<'py, PyAny>,
+    ) -> PyResult<Argument<'py>> {
+        Argument::new(name, value, SampleShape::vector(self.model.nv))
+    }
+
+    pub(crate) fn frame_index(&self, frame: &Bound<PyAny>) -> PyResult<usize> {
+        if let Ok(name) = frame.extract::<&str>() {
+            return match self.frame_indices.get(name) {
+                Some(&index) => Ok(index),
+                None => self.model.frame_index(name).map_err(to_py_err),
+            };
+        }
+        match frame.extract::<usize>() {
+            Ok(index) if index < self.model.frames.len() => Ok(index),
+            _ => Err(PyValueError::new_err(format!(
+                "argument 'frame': expected a frame name or an index below {}, got {}",
+                self.model.frames.len(),
+                frame.repr()?
+            ))),
+        }
+    }
+}
+
+/// Writes the first `rows` rows of a matrix (column-major in nalgebra) into a row-major output.
+pub(crate) fn write_row_major(matrix: &nalgebra::DMatrix<f64>, rows: usize, out: &mut [f64]) {
+    let columns = matrix.ncols();
+    for (c, column) in matrix
+        .as_slice()
+        .chunks_exact(matrix.nrows().max(1))
+        .enumerate()
+    {
+        for (r, value) in column.iter().take(rows).enumerate() {
+            out[r * columns + c] = *value;
+        }
+    }
+}
+
+pub(crate) fn vector_array<'py>(py: Python<'py>, values: &[f64]) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_slice(py, values)
+}
+
+/// `out = matrix · vector` (out has the matrix's rows).
+pub(crate) fn matrix_times(matrix: &DMatrix<f64>, vector: &[f64], out: &mut [f64]) {
+    for (row, value) in out.iter_mut().enumerate() {
+        *value = vector
+            .iter()
+            .enumerate()
+            .map(|(column, x)| matrix[(row, column)] * x)
+            .sum();
+    }
+}

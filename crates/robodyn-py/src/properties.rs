@@ -1,0 +1,313 @@
+//! Model properties (sizes, names, limits, settable gravity, armature and passive forces) and
+//! configurations (neutral, random, integrate, difference).
+
+use crate::args::*;
+use crate::model::*;
+use crate::to_py_err;
+use nalgebra::DVector;
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use rand::{rngs::StdRng, SeedableRng};
+
+#[pymethods]
+impl PyModel {
+    /// The model's name (URDF `<robot name>`).
+    #[getter]
+    fn name(&self) -> &str {
+        &self.model.name
+    }
+
+    /// Number of configuration coordinates.
+    #[getter]
+    fn nq(&self) -> usize {
+        self.model.nq
+    }
+
+    /// Number of velocity coordinates (degrees of freedom).
+    #[getter]
+    fn nv(&self) -> usize {
+        self.model.nv
+    }
+
+    /// Names of the moving joints, in q/v order (depth-first, file order).
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        self.model.joint_names[1..].to_vec()
+    }
+
+    /// Kind of each moving joint: "revolute", "prismatic", "spherical" or "free".
+    #[getter]
+    fn joint_types(&self) -> Vec<&'static str> {
+        self.model.joints[1..].iter().map(|j| j.kind()).collect()
+    }
+
+    /// First index of each joint in q (aligned with joint_names).
+    #[getter]
+    fn joint_idx_q(&self) -> Vec<usize> {
+        self.model.idx_q[1..].to_vec()
+    }
+
+    /// First index of each joint in v (aligned with joint_names).
+    #[getter]
+    fn joint_idx_v(&self) -> Vec<usize> {
+        self.model.idx_v[1..].to_vec()
+    }
+
+    /// Names of the moving bodies (the child link of each joint, aligned with joint_names); the
+    /// rows of `f_ext`.
+    #[getter]
+    fn body_names(&self) -> Vec<String> {
+        self.model.body_names[1..].to_vec()
+    }
+
+    /// Names of every frame: one per URDF link, moving or merged through a fixed joint.
+    #[getter]
+    fn frame_names(&self) -> Vec<String> {
+        self.model.frames.iter().map(|f| f.name.clone()).collect()
+    }
+
+    /// The parent of each moving body, aligned with body_names: -1 for the world, else an index
+    /// into body_names.
+    #[getter]
+    fn body_parents(&self) -> Vec<isize> {
+        self.model.parent[1..]
+            .iter()
+            .map(|&p| p as isize - 1)
+            .collect()
+    }
+
+    /// The body each frame is attached to, aligned with frame_names: -1 for the world, else an
+    /// index into body_names.
+    #[getter]
+    fn frame_bodies(&self) -> Vec<isize> {
+        self.model
+            .frames
+            .iter()
+            .map(|f| f.body as isize - 1)
+            .collect()
+    }
+
+    /// Gravity vector in world axes (m/s²), settable.
+    #[getter]
+    fn get_gravity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.gravity.as_slice())
+    }
+
+    #[setter]
+    fn set_gravity(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        let values = read_property("gravity", value, 3)?;
+        self.model.gravity = nalgebra::Vector3::from_row_slice(&values);
+        Ok(())
+    }
+
+    /// Rotor inertia per velocity coordinate (kg m² or kg), settable: it adds to M's diagonal and
+    /// to inverse and forward dynamics.
+    #[getter]
+    fn get_armature<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.armature.as_slice())
+    }
+
+    #[setter]
+    fn set_armature(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        self.model.armature = read_non_negative("armature", value, self.model.nv)?;
+        Ok(())
+    }
+
+    /// Lower position limits, shape (nq,), -inf where none.
+    #[getter]
+    fn lower_position_limit<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.lower_position_limit.as_slice())
+    }
+
+    /// Upper position limits, shape (nq,), inf where none.
+    #[getter]
+    fn upper_position_limit<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.upper_position_limit.as_slice())
+    }
+
+    /// Velocity limits, shape (nv,), inf where none.
+    #[getter]
+    fn velocity_limit<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.velocity_limit.as_slice())
+    }
+
+    /// Effort limits, shape (nv,), inf where none.
+    #[getter]
+    fn effort_limit<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.effort_limit.as_slice())
+    }
+
+    /// Viscous damping per velocity coordinate (URDF `<dynamics damping>`, MJCF `damping`),
+    /// settable. `simulate` applies it; the dynamics calls do not.
+    #[getter]
+    fn get_damping<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.damping.as_slice())
+    }
+
+    #[setter]
+    fn set_damping(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        self.model.damping = read_non_negative("damping", value, self.model.nv)?;
+        Ok(())
+    }
+
+    /// Coulomb friction per velocity coordinate (URDF `<dynamics friction>`, MJCF
+    /// `frictionloss`), settable. `simulate` applies it smoothed; the dynamics calls do not.
+    #[getter]
+    fn get_friction<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.friction.as_slice())
+    }
+
+    #[setter]
+    fn set_friction(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        self.model.friction = read_non_negative("friction", value, self.model.nv)?;
+        Ok(())
+    }
+
+    /// Joint spring stiffness per velocity coordinate (MJCF `stiffness`), settable. `simulate`
+    /// applies it; the dynamics calls do not.
+    #[getter]
+    fn get_stiffness<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.stiffness.as_slice())
+    }
+
+    #[setter]
+    fn set_stiffness(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        self.model.stiffness = read_non_negative("stiffness", value, self.model.nv)?;
+        Ok(())
+    }
+
+    /// The configuration at which the joint springs are relaxed, shape (nq,) (MJCF `springref`;
+    /// neutral for spherical and free joints), settable to any valid configuration.
+    #[getter]
+    fn get_spring_reference<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.spring_reference.as_slice())
+    }
+
+    #[setter]
+    fn set_spring_reference(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        let values = read_property("spring_reference", value, self.model.nq)?;
+        self.model
+            .check_configuration(&values)
+            .map_err(|e| to_py_err(e.for_argument("spring_reference")))?;
+        self.model.spring_reference = DVector::from_vec(values);
+        Ok(())
+    }
+
+    /// URDF mimic relations as (joint, mimicked joint, multiplier, offset):
+    /// q[joint] = multiplier * q[mimicked] + offset. Reported, not enforced.
+    #[getter]
+    fn mimic_joints(&self) -> Vec<(String, String, f64, f64)> {
+        self.model
+            .mimics
+            .iter()
+            .map(|m| {
+                (
+                    self.model.joint_names[m.joint].clone(),
+                    self.model.joint_names[m.mimicked].clone(),
+                    m.multiplier,
+                    m.offset,
+                )
+            })
+            .collect()
+    }
+
+    /// What the loader accepted but you should know: ignored mimic tags, unchecked inertias.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.model.warnings.clone()
+    }
+
+    /// Total mass (kg).
+    #[getter]
+    fn total_mass(&self) -> f64 {
+        self.model.total_mass()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "robodyn.Model('{}', nq={}, nv={}, joints={}, frames={})",
+            self.model.name,
+            self.model.nq,
+            self.model.nv,
+            self.model.nbodies() - 1,
+            self.model.frames.len()
+        )
+    }
+
+    /// The neutral configuration: zero angles, identity quaternions. Shape (nq,).
+    fn neutral<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, self.model.neutral().as_slice())
+    }
+
+    /// A random configuration within the position limits (angles in [-π, π] and translations in
+    /// [-1, 1] m where a joint has none; uniform rotations). `n` gives a batch (n, nq); `seed`
+    /// makes it reproducible.
+    #[pyo3(signature = (n=None, seed=None))]
+    pub(crate) fn random_configuration<'py>(
+        &self,
+        py: Python<'py>,
+        #[pyo3(from_py_with = named::optional_n)] n: Option<usize>,
+        #[pyo3(from_py_with = named::optional_seed)] seed: Option<u64>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let mut rng = match seed {
+            Some(seed) => StdRng::seed_from_u64(seed),
+            None => StdRng::from_os_rng(),
+        };
+        match n {
+            None => Ok(
+                vector_array(py, self.model.random_configuration(&mut rng).as_slice()).into_any(),
+            ),
+            Some(n) => {
+                let mut values = Vec::with_capacity(n * self.model.nq);
+                for _ in 0..n {
+                    values.extend_from_slice(self.model.random_configuration(&mut rng).as_slice());
+                }
+                Ok(PyArray1::from_vec(py, values)
+                    .reshape([n, self.model.nq])?
+                    .into_any())
+            }
+        }
+    }
+
+    /// q ⊕ v dt: moves q with constant velocity v for dt seconds on each joint's Lie group.
+    #[pyo3(signature = (q, v, dt=1.0))]
+    fn integrate<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = named::dt)] dt: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        if !dt.is_finite() {
+            return Err(PyValueError::new_err(format!(
+                "argument 'dt': expected a finite number, got {dt}"
+            )));
+        }
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[self.model.nq],
+            &|m, _, i, out| {
+                robodyn::error::check_finite("v", i[1])?;
+                let step: Vec<f64> = i[1].iter().map(|x| x * dt).collect();
+                m.integrate(i[0], &step, out)
+            },
+        )
+    }
+
+    /// q1 ⊖ q0: the velocity that moves q0 to q1 in unit time. (nv,).
+    fn difference<'py>(
+        &self,
+        py: Python<'py>,
+        q0: &Bound<'py, PyAny>,
+        q1: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q0", q0)?, self.q_arg("q1", q1)?],
+            &[self.model.nv],
+            &|m, _, i, out| m.difference(i[0], i[1], out),
+        )
+    }
+}
