@@ -251,12 +251,13 @@ class Trajectory:
 
         return plot_trajectory(self, path, show)
 
-    def animate(self, path: str | os.PathLike[str], fps: int = 30, speed: float = 1.0):
+    def animate(self, path: str | os.PathLike[str], fps: int = 30, speed: float = 1.0,
+                progress: Callable[[float], Any] | None = None):
         """A 3-D stick figure of the robot, as a GIF or (with ffmpeg) MP4 (see
         :func:`robodyn.plot.animate_trajectory`)."""
         from robodyn.plot import animate_trajectory
 
-        return animate_trajectory(self, path, fps=fps, speed=speed)
+        return animate_trajectory(self, path, fps=fps, speed=speed, progress=progress)
 
 
 def _joint_of_q(model, k: int) -> str:

@@ -35,6 +35,7 @@ fn _core(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(load_mjcf_string, module)?)?;
     module.add_function(wrap_pyfunction!(load_dh_dict, module)?)?;
     module.add_function(wrap_pyfunction!(bundled_names, module)?)?;
+    module.add_function(wrap_pyfunction!(bundled_urdf, module)?)?;
     module.add_function(wrap_pyfunction!(simulation::simulate, module)?)?;
     Ok(())
 }

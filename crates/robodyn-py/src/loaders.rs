@@ -131,6 +131,12 @@ pub(crate) fn load_bundled(name: &str, floating_base: bool) -> PyResult<PyModel>
         .map_err(to_py_err)
 }
 
+/// The URDF text and gravity of a bundled model (for the symbolic layer, which reads URDF).
+#[pyfunction]
+pub(crate) fn bundled_urdf(name: &str) -> PyResult<(&'static str, [f64; 3])> {
+    robodyn::io::bundled_urdf(name).map_err(to_py_err)
+}
+
 /// Names of the bundled models.
 #[pyfunction]
 pub(crate) fn bundled_names() -> Vec<&'static str> {

@@ -218,6 +218,12 @@ impl PyModel {
         self.model.warnings.clone()
     }
 
+    /// The mass of each moving body (kg), aligned with body_names (fixed links merged in).
+    #[getter]
+    fn body_masses(&self) -> Vec<f64> {
+        self.model.inertias[1..].iter().map(|i| i.mass).collect()
+    }
+
     /// Total mass (kg).
     #[getter]
     fn total_mass(&self) -> f64 {

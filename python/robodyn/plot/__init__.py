@@ -8,10 +8,11 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Any, Callable
 
 import numpy as np
 
-__all__ = ["animate_trajectory", "plot_trajectory", "stick_figure_points"]
+__all__ = ["animate_trajectory", "check_animation_path", "check_figure_path", "plot_trajectory", "stick_figure_points"]
 
 #: At most this many legend entries per panel; beyond it, the panel says how many it left out.
 MAX_LEGEND_ENTRIES = 12
@@ -140,23 +141,56 @@ def stick_figure_points(model, q) -> tuple[np.ndarray, list[tuple[int, int]]]:
     return points, segments
 
 
-def animate_trajectory(trajectory, path: str | os.PathLike[str], fps: int = 30, speed: float = 1.0):
-    """A 3-D stick figure of the robot moving along the trajectory, written to ``path``: a GIF
-    (Pillow), or an MP4 when the suffix is ``.mp4`` and ffmpeg is installed. ``speed`` > 1 plays
-    faster than real time. Returns the path."""
+def _writable_folder(path: Path, argument: str) -> None:
+    folder = path.resolve().parent
+    if not folder.is_dir():
+        raise ValueError(f"argument '{argument}': the folder {folder} does not exist")
+    if not os.access(folder, os.W_OK):
+        raise ValueError(f"argument '{argument}': the folder {folder} is not writable")
+
+
+def check_figure_path(path: str | os.PathLike[str], argument: str = "path") -> Path:
+    """``path`` if a figure can be saved there (a format matplotlib writes, a writable folder), else a
+    ValueError naming ``argument``."""
+    _matplotlib()
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    path = Path(path)
+    formats = FigureCanvasAgg.get_supported_filetypes()
+    if path.suffix.lower().lstrip(".") not in formats:
+        raise ValueError(f"argument '{argument}': expected a file ending in one of "
+                         f"{', '.join('.' + f for f in sorted(formats))}, got '{path}'")
+    _writable_folder(path, argument)
+    return path
+
+
+def check_animation_path(path: str | os.PathLike[str], argument: str = "path") -> Path:
+    """``path`` if an animation can be written there (.gif, or .mp4 with ffmpeg installed, in a
+    writable folder), else a ValueError naming ``argument``."""
     _matplotlib()
     from matplotlib import animation
 
     path = Path(path)
     suffix = path.suffix.lower()
-    if suffix == ".mp4":
-        if not animation.writers.is_available("ffmpeg"):
-            raise ValueError(f"argument 'path': writing {path.name} needs ffmpeg, which is not installed; write a .gif instead")
-        writer = animation.FFMpegWriter(fps=fps)
-    elif suffix == ".gif":
-        writer = animation.PillowWriter(fps=fps)
-    else:
-        raise ValueError(f"argument 'path': expected a .gif or .mp4 file, got '{path}'")
+    if suffix not in (".gif", ".mp4"):
+        raise ValueError(f"argument '{argument}': expected a .gif or .mp4 file, got '{path}'")
+    if suffix == ".mp4" and not animation.writers.is_available("ffmpeg"):
+        raise ValueError(f"argument '{argument}': writing {path.name} needs ffmpeg, which is not installed; "
+                         "write a .gif instead")
+    _writable_folder(path, argument)
+    return path
+
+
+def animate_trajectory(trajectory, path: str | os.PathLike[str], fps: int = 30, speed: float = 1.0,
+                       progress: Callable[[float], Any] | None = None):
+    """A 3-D stick figure of the robot moving along the trajectory, written to ``path``: a GIF
+    (Pillow), or an MP4 when the suffix is ``.mp4`` and ffmpeg is installed. ``speed`` > 1 plays
+    faster than real time. ``progress(fraction)`` is called after each frame is written. Returns
+    the path."""
+    from matplotlib import animation
+
+    path = check_animation_path(path)
+    writer = animation.FFMpegWriter(fps=fps) if path.suffix.lower() == ".mp4" else animation.PillowWriter(fps=fps)
     if not (fps > 0 and speed > 0):
         raise ValueError(f"arguments 'fps' and 'speed': expected positive numbers, got {fps} and {speed}")
     t = trajectory.t
@@ -186,5 +220,6 @@ def animate_trajectory(trajectory, path: str | os.PathLike[str], fps: int = 30, 
         return [*lines, title]
 
     movie = animation.FuncAnimation(figure, draw, frames=len(samples), blit=False)
-    movie.save(str(path), writer=writer, dpi=80)
+    report = None if progress is None else (lambda frame, frames: progress((frame + 1) / frames))
+    movie.save(str(path), writer=writer, dpi=80, progress_callback=report)
     return path

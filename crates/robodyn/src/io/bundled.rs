@@ -31,24 +31,29 @@ pub fn bundled_names() -> Vec<&'static str> {
     BUNDLED.iter().map(|(name, _, _)| *name).collect()
 }
 
+/// The URDF text and gravity of a bundled model, by name.
+pub fn bundled_urdf(name: &str) -> Result<(&'static str, [f64; 3])> {
+    BUNDLED
+        .iter()
+        .find(|(n, _, _)| *n == name)
+        .map(|(_, text, gravity)| (*text, *gravity))
+        .ok_or_else(|| Error::InvalidValue {
+            argument: "name".into(),
+            message: format!(
+                "expected one of the bundled models {}, got '{name}'",
+                bundled_names().join(", ")
+            ),
+        })
+}
+
 /// A bundled model by name.
 pub fn bundled_model(name: &str, floating_base: bool) -> Result<Model> {
-    let (_, text, gravity) =
-        BUNDLED
-            .iter()
-            .find(|(n, _, _)| *n == name)
-            .ok_or_else(|| Error::InvalidValue {
-                argument: "name".into(),
-                message: format!(
-                    "expected one of the bundled models {:?}, got '{name}'",
-                    bundled_names()
-                ),
-            })?;
+    let (text, gravity) = bundled_urdf(name)?;
     let mut model = load_urdf_str(
         text,
         &format!("{name}.urdf (bundled)"),
         LoadOptions::floating(floating_base),
     )?;
-    model.gravity = Vec3::from(*gravity);
+    model.gravity = Vec3::from(gravity);
     Ok(model)
 }

@@ -7,7 +7,7 @@ pub mod mjcf;
 pub mod urdf;
 mod xml;
 
-pub use bundled::{bundled_model, bundled_names};
+pub use bundled::{bundled_model, bundled_names, bundled_urdf};
 pub use dh::{
     build_dh, load_dh_document, load_dh_file, load_dh_str, DhConvention, DhJoint, DhRow, DhTable,
 };
