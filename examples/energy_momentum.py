@@ -16,8 +16,8 @@ show("T = ½ q̇ᵀ M q̇", 0.5 * v @ ur5.mass_matrix(q) @ v, ur5.kinetic_energy
 qdd, h = ur5.forward_dynamics(q, v, tau), 1e-6
 
 
-def energy(t):
-    return ur5.kinetic_energy(q + t * v, v + t * qdd) + ur5.potential_energy(q + t * v)
+def energy(t: float) -> float:
+    return float(ur5.kinetic_energy(q + t * v, v + t * qdd)) + float(ur5.potential_energy(q + t * v))
 
 
 show("d(T + V)/dt = q̇ᵀ τ", v @ tau, (energy(h) - energy(-h)) / (2 * h), 1e-6)

@@ -25,9 +25,10 @@ from __future__ import annotations
 import csv
 import os
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any, Callable, Sequence, Union, overload
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robodyn import _core
 
@@ -276,15 +277,44 @@ def _coordinate_names(model) -> tuple[list[str], list[str]]:
     return q_names, v_names
 
 
+#: One configuration, (nq,), and a batch of them, (N, nq), as the type checker sees them.
+Configuration = Union["np.ndarray[tuple[int], np.dtype[Any]]", Sequence[float]]
+Configurations = Union["np.ndarray[tuple[int, int], np.dtype[Any]]", Sequence[Sequence[float]]]
+
+
+@overload
+def simulate(model: _core.Model, q0: Configuration, v0: ArrayLike | None = None, t_end: float = 1.0,
+             dt: float = 1e-3, integrator: str = "rk4", controller: Any = None, wrenches: Any = None, *,
+             rtol: float = 1e-6, atol: float = 1e-9, max_step: float | None = None, friction_velocity: float = 1e-2,
+             limits: str = "report", limit_stiffness: float = 1e4, limit_damping: float = 1e2,
+             progress: Callable[[float], Any] | None = None) -> Trajectory: ...
+
+
+@overload
+def simulate(model: _core.Model, q0: Configurations, v0: ArrayLike | None = None, t_end: float = 1.0,
+             dt: float = 1e-3, integrator: str = "rk4", controller: Any = None, wrenches: Any = None, *,
+             rtol: float = 1e-6, atol: float = 1e-9, max_step: float | None = None, friction_velocity: float = 1e-2,
+             limits: str = "report", limit_stiffness: float = 1e4, limit_damping: float = 1e2,
+             progress: Callable[[float], Any] | None = None) -> list[Trajectory]: ...
+
+
+@overload
+def simulate(model: _core.Model, q0: ArrayLike, v0: ArrayLike | None = None, t_end: float = 1.0,
+             dt: float = 1e-3, integrator: str = "rk4", controller: Any = None, wrenches: Any = None, *,
+             rtol: float = 1e-6, atol: float = 1e-9, max_step: float | None = None, friction_velocity: float = 1e-2,
+             limits: str = "report", limit_stiffness: float = 1e4, limit_damping: float = 1e2,
+             progress: Callable[[float], Any] | None = None) -> Trajectory | list[Trajectory]: ...
+
+
 def simulate(
-    model,
-    q0,
-    v0=None,
+    model: _core.Model,
+    q0: ArrayLike,
+    v0: ArrayLike | None = None,
     t_end: float = 1.0,
     dt: float = 1e-3,
     integrator: str = "rk4",
-    controller=None,
-    wrenches=None,
+    controller: Any = None,
+    wrenches: Any = None,
     *,
     rtol: float = 1e-6,
     atol: float = 1e-9,
@@ -296,6 +326,10 @@ def simulate(
     progress: Callable[[float], Any] | None = None,
 ) -> Trajectory | list[Trajectory]:
     """Simulate ``model`` from (``q0``, ``v0``) at t = 0 to ``t_end``, recording every ``dt``.
+
+    For a type checker, a configuration typed as one vector (``m.neutral()``, a list of numbers)
+    gives a :class:`Trajectory` and a batch (``m.random_configuration(n)``, a list of lists) a list;
+    an array of unknown shape gives either.
 
     ``q0`` of shape (nq,) gives one :class:`Trajectory`; a batch (N, nq) with ``v0`` (N, nv) gives N
     of them, simulated in parallel on all cores when everything is native (no Python callable).
