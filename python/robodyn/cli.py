@@ -253,6 +253,8 @@ def _symbolic_chain(model: str, rods: bool, symbolic_params: bool) -> Any:
         return sym.from_dh(model, symbolic_params=symbolic_params)
     if suffix == ".urdf":
         return sym.from_urdf(model, symbolic_params=symbolic_params)
+    if suffix == ".xml":
+        raise UsageError(f"argument model: the symbolic layer reads URDF files and DH tables, not MJCF, got '{model}'")
     raise UsageError(f"argument model: expected planar<n>, pendulum, a bundled model ({', '.join(robodyn.models())}), "
                      f"a DH table .toml or a .urdf file, got '{model}'")
 

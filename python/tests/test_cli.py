@@ -3,6 +3,7 @@ one line naming it and exit status 2, checked before any work is done; never a t
 
 from __future__ import annotations
 
+import io
 import subprocess
 import sys
 
@@ -27,6 +28,7 @@ BAD_ARGUMENTS = [
     (["info", "robot.sdf"], "not a bundled model"),
     (["derive", "nothing"], "argument model: expected planar<n>"),
     (["derive", "missing.toml"], "model file not found: 'missing.toml'"),
+    (["derive", "robot.xml"], "argument model: the symbolic layer reads URDF files and DH tables, not MJCF"),
     (["derive", "planar2", "-o", "/no/such/folder/eom.c"], "argument -o/--output: the folder /no/such/folder does not exist"),
     (["simulate", "ur5", "--t", "-1"], "argument --t: expected a positive number, got -1"),
     (["simulate", "ur5", "--dt", "0"], "argument --dt: expected a positive number, got 0"),
@@ -137,3 +139,31 @@ def test_limit_messages_have_units(capsys, tmp_path):
     assert len(limits) == 2, limits
     assert limits[0].startswith("limit: hinge left its range") and limits[0].endswith(" rad")
     assert limits[1].startswith("limit: slide left its range") and limits[1].endswith(" m")
+
+
+class Terminal(io.StringIO):
+    """Standard error as a terminal, so that progress shows."""
+
+    def isatty(self) -> bool:
+        return True
+
+
+def test_a_long_derivation_shows_its_progress_on_a_terminal(monkeypatch, capsys):
+    import robodyn.cli as cli
+
+    terminal = Terminal()
+    monkeypatch.setattr(cli, "DERIVE_STATUS_AFTER_S", 0.0)
+    monkeypatch.setattr(sys, "stderr", terminal)
+    assert main(["derive", "planar3", "--rods", "--newton-euler"]) == 0
+    shown = terminal.getvalue()
+    assert "Euler–Lagrange equations of planar3 ... done in" in shown
+    assert "Newton–Euler, and the difference ... done in" in shown
+
+
+def test_writing_a_gif_shows_its_progress_on_a_terminal(monkeypatch, tmp_path):
+    terminal = Terminal()
+    monkeypatch.setattr(sys, "stderr", terminal)
+    assert main(["simulate", "planar2", "--t", "0.2", "--dt", "0.01", "--animate", str(tmp_path / "swing.gif")]) == 0
+    frames = terminal.getvalue()
+    assert frames.startswith("\rwriting frames [") and frames.rstrip().endswith("100.0 %")
+    assert (tmp_path / "swing.gif").read_bytes()[:6] == b"GIF89a"
