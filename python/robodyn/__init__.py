@@ -105,7 +105,9 @@ def _check_flag(value: object, argument: str) -> bool:
     return bool(value)
 
 
-def load(name_or_path: str | os.PathLike[str], floating_base: bool = False, check_inertia: bool = True) -> Model:
+def load(
+    name_or_path: str | os.PathLike[str], floating_base: bool = False, check_inertia: bool = True, strict: bool = False
+) -> Model:
     """Load a robot model.
 
     ``name_or_path`` is a bundled model's name (see :func:`models`), a path to a URDF file, an MJCF
@@ -119,6 +121,10 @@ def load(name_or_path: str | os.PathLike[str], floating_base: bool = False, chec
     ``check_inertia=False`` loads a file whose inertia tensors are not positive semi-definite (a few
     published URDFs have them) and reports each as a :class:`ModelWarning` instead of failing.
 
+    A URDF element or attribute the specification does not know (a typo such as ``<inertal>``) is a
+    :class:`ModelWarning` naming the file, line and the nearest known name; in MJCF it is an error,
+    as in MuJoCo. ``strict=True`` turns every warning into a ``ValueError``.
+
     Raises ``FileNotFoundError`` for a missing file (saying where robodyn looked) and ``ValueError``
     for an invalid model, naming the file, element and line, or for a wrong argument.
     """
@@ -126,7 +132,18 @@ def load(name_or_path: str | os.PathLike[str], floating_base: bool = False, chec
         raise ValueError(f"argument 'name_or_path': expected a model name or a path, got {name_or_path!r}")
     floating_base = _check_flag(floating_base, "floating_base")
     check_inertia = _check_flag(check_inertia, "check_inertia")
+    strict = _check_flag(strict, "strict")
     text = os.fspath(name_or_path)
+    model = _load_model(text, floating_base, check_inertia)
+    if strict and model.warnings:
+        raise ValueError("strict=True: " + " | ".join(model.warnings))
+    for message in model.warnings:
+        warnings.warn(message, ModelWarning, stacklevel=2)
+    return model
+
+
+def _load_model(text: str, floating_base: bool, check_inertia: bool) -> Model:
+    """The model ``load`` names, before its warnings are reported."""
     if text in bundled_names():
         return load_bundled(text, floating_base)
     suffix = Path(text).suffix.lower()
@@ -140,10 +157,7 @@ def load(name_or_path: str | os.PathLike[str], floating_base: bool = False, chec
     path = _find_file(text)
     if suffix == ".toml":
         return load_dh(str(path))
-    model = load_mjcf(str(path)) if suffix == ".xml" else load_urdf(str(path), floating_base, check_inertia)
-    for message in model.warnings:
-        warnings.warn(message, ModelWarning, stacklevel=2)
-    return model
+    return load_mjcf(str(path)) if suffix == ".xml" else load_urdf(str(path), floating_base, check_inertia)
 
 
 def _rows_or_none(rows: object) -> list[object]:

@@ -4,7 +4,9 @@
 pub mod bundled;
 pub mod dh;
 pub mod mjcf;
+mod schema;
 pub mod urdf;
+mod urdf_schema;
 mod xml;
 
 pub use bundled::{bundled_model, bundled_names, bundled_urdf};

@@ -11,6 +11,8 @@
 //! Visual, collision, transmission and gazebo elements are ignored.
 
 use crate::error::{Error, Result};
+use crate::io::schema;
+use crate::io::urdf_schema::URDF_SCHEMA;
 use crate::io::xml::{location, parse_numbers};
 use crate::io::{read_model_file, LoadOptions};
 use crate::joint::Joint;
@@ -31,18 +33,78 @@ pub fn load_urdf_file(path: &Path, options: LoadOptions) -> Result<Model> {
 
 /// Loads a URDF document held in `text`; `source` names it in error messages.
 pub fn load_urdf_str(text: &str, source: &str, options: LoadOptions) -> Result<Model> {
+    let mut warnings = Vec::new();
+    let document = match Document::parse(text) {
+        Ok(document) => document,
+        Err(error) => {
+            // ROS's parser accepts an XML declaration after comments or blank lines; so do we
+            let late = late_declaration(text)
+                .ok_or_else(|| Error::model(source, format!("malformed XML: {error}")))?;
+            warnings.push(format!(
+                "{source}: the XML declaration is not at the start of the file (line {}): read \
+                 as if it were",
+                text[..late.start].matches('\n').count() + 1
+            ));
+            let mut blanked = text.to_string();
+            blanked.replace_range(late.clone(), &" ".repeat(late.len()));
+            return load_urdf_document(&blanked, source, options, warnings);
+        }
+    };
+    parse_urdf(&document, source, options, warnings)
+}
+
+/// The byte range of an `<?xml …?>` declaration that follows comments or white space, if any.
+fn late_declaration(text: &str) -> Option<std::ops::Range<usize>> {
+    let start = text.find("<?xml")?;
+    let end = start + text[start..].find("?>")? + 2;
+    (start > 0).then_some(start..end)
+}
+
+/// Parses `text` (whose declaration was blanked out) and loads it.
+fn load_urdf_document(
+    text: &str,
+    source: &str,
+    options: LoadOptions,
+    warnings: Vec<String>,
+) -> Result<Model> {
     let document =
         Document::parse(text).map_err(|e| Error::model(source, format!("malformed XML: {e}")))?;
+    parse_urdf(&document, source, options, warnings)
+}
+
+fn parse_urdf(
+    document: &Document,
+    source: &str,
+    options: LoadOptions,
+    warnings: Vec<String>,
+) -> Result<Model> {
     let mut parser = Parser {
         source,
-        document: &document,
+        document,
         options,
-        warnings: Vec::new(),
+        warnings,
     };
     let robot = document.root_element();
     if robot.tag_name().name() != "robot" {
         return Err(parser.error(robot, "expected the root element <robot>"));
     }
+    // unknown elements and attributes are warnings naming the nearest known name, one per name
+    let mut unknown: Vec<(String, String, usize)> = Vec::new();
+    schema::check(URDF_SCHEMA, 0, robot, &mut |node, message| {
+        match unknown.iter_mut().find(|(known, _, _)| *known == message) {
+            Some((_, _, count)) => *count += 1,
+            None => unknown.push((message, parser.location(node), 1)),
+        }
+        Ok(())
+    })?;
+    parser.warnings.extend(
+        unknown
+            .into_iter()
+            .map(|(message, first, count)| match count {
+                1 => format!("{first}: {message}"),
+                _ => format!("{first}: {message} ({count} times; the first is here)"),
+            }),
+    );
     let links = parser.links(robot)?;
     let joints = parser.joints(robot, &links)?;
     parser.build(robot, &links, &joints)
@@ -155,7 +217,13 @@ impl<'a> Parser<'a> {
         let inertia_com = match Self::child(inertial, "inertia") {
             None => Mat3::zeros(),
             Some(node) => {
-                let get = |name: &str| self.numbers(node, name, [0.0]).map(|[x]| x);
+                let get = |name: &str| -> Result<f64> {
+                    let [value] = self.numbers(node, name, [f64::NAN])?;
+                    if value.is_nan() {
+                        return Err(self.error(node, format!("missing attribute '{name}'")));
+                    }
+                    Ok(value)
+                };
                 let (ixx, ixy, ixz) = (get("ixx")?, get("ixy")?, get("ixz")?);
                 let (iyy, iyz, izz) = (get("iyy")?, get("iyz")?, get("izz")?);
                 Mat3::new(ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz)
@@ -200,7 +268,10 @@ impl<'a> Parser<'a> {
             let kind = self.attribute(node, "type")?;
             let axis = match Self::child(node, "axis") {
                 None => Vec3::x(),
-                Some(a) => Vec3::from(self.numbers(a, "xyz", [1.0, 0.0, 0.0])?),
+                Some(a) => Vec3::from(
+                    parse_numbers::<3>(self.attribute(a, "xyz")?, "xyz")
+                        .map_err(|message| self.error(a, message))?,
+                ),
             };
             let unit_axis = || -> Result<Vec3> {
                 let norm = axis.norm();

@@ -1,0 +1,124 @@
+"""Model files are checked as MuJoCo checks MJCF: a typo is never read as a default. In URDF an
+unknown element or attribute is a ModelWarning naming the file, line and nearest known name
+(strict=True makes it an error); a missing required attribute is an error; what ROS's parser
+accepts as XML loads."""
+
+from __future__ import annotations
+
+import warnings
+
+import pytest
+
+import robodyn
+
+LINK = """<link name="{name}"><inertial><origin xyz="0 0 0.1"/><mass value="1"/>
+  <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>"""
+
+
+def robot(body: str, header: str = "") -> str:
+    return f"""{header}<robot name="r">
+  {LINK.format(name="base")}
+  {LINK.format(name="arm")}
+  {body}
+</robot>"""
+
+
+JOINT = """<joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+  <limit lower="-1" upper="1" effort="10" velocity="2"/></joint>"""
+
+
+def load(tmp_path, text, **options):
+    path = tmp_path / "robot.urdf"
+    path.write_text(text)
+    return robodyn.load(path, **options)
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        (robot(JOINT).replace('<inertial><origin xyz="0 0 0.1"/>', '<inertal><origin xyz="0 0 0.1"/>', 1)
+         .replace("</inertial></link>", "</inertal></link>", 1),
+         "robot.urdf: <link name='base'>/<inertal> (line 2): unknown element <inertal> in <link>; did you mean <inertial>?"),
+        (robot(JOINT.replace("<limit ", "<limt ")),
+         "<joint name='j'>/<limt> (line 7): unknown element <limt> in <joint>; did you mean <limit>?"),
+        (robot(JOINT.replace('effort="10"', 'efort="10" effort="10"')),
+         "unknown attribute 'efort' of <limit>; did you mean 'effort'?"),
+        (robot(JOINT).replace("<robot ", '<robot nmae="x" ', 1), "unknown attribute 'nmae' of <robot>; did you mean 'name'?"),
+        (robot(JOINT + '<jiont name="k"/>'), "unknown element <jiont> in <robot>; did you mean <joint>?"),
+    ],
+)
+def test_a_typo_is_a_warning_naming_the_file_line_and_nearest_name(tmp_path, text, expected):
+    with pytest.warns(robodyn.ModelWarning) as caught:
+        model = load(tmp_path, text)
+    assert any(expected in w for w in model.warnings), model.warnings
+    assert any(expected in str(w.message) for w in caught)
+    with pytest.raises(ValueError, match="strict=True: .*" + expected.split(": ")[-1].replace("?", r"\?").replace("<", "<")[:20]):
+        load(tmp_path, text, strict=True)
+
+
+def test_a_typo_inside_an_attribute_name_is_not_read_as_a_default(tmp_path):
+    """`ixxx="0.1"` used to load as ixx = 0; now the missing ixx is an error."""
+    text = robot(JOINT).replace('ixx="0.01"', 'ixxx="0.01"', 1)
+    with pytest.raises(ValueError, match=r"<link name='base'>/<inertia> \(line 3\): missing attribute 'ixx'"):
+        load(tmp_path, text)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (robot(JOINT).replace('<mass value="1"/>', "<mass/>", 1), "missing attribute 'value'"),
+        (robot(JOINT.replace(' type="revolute"', "")), "missing attribute 'type'"),
+        (robot(JOINT.replace('<axis xyz="0 0 1"/>', "<axis/>")), "missing attribute 'xyz'"),
+        (robot(JOINT.replace('<parent link="base"/>', "<parent/>")), "missing attribute 'link'"),
+        (robot(JOINT).replace('<origin xyz="0 0 0.1"/>', '<origin xyz="0.07, 0, -0.69"/>', 1), "attribute 'xyz'"),
+        (robot(JOINT).replace('<origin xyz="0 0 0.1"/>', '<origin rpy="0 0 0 1"/>', 1), "attribute 'rpy': expected 3 numbers"),
+        (robot(JOINT.replace('upper="1"', 'upper="$(optenv LIMIT 1)"')), "attribute 'upper'"),
+    ],
+)
+def test_missing_required_attributes_and_malformed_values_are_errors(tmp_path, text, message):
+    with pytest.raises(ValueError, match=message) as error:
+        load(tmp_path, text)
+    assert "robot.urdf" in str(error.value) and "(line " in str(error.value)
+
+
+def test_elements_that_are_not_robodyns_business_pass_silently(tmp_path):
+    text = robot(JOINT + """
+  <material name="blue"><color rgba="0 0 1 1"/></material>
+  <gazebo reference="arm"><mu1>0.2</mu1><anything at="all"/></gazebo>
+  <transmission name="t"><type>SimpleTransmission</type><joint name="j"/></transmission>
+  <ros2_control name="c" type="system"><hardware><plugin>mock</plugin></hardware></ros2_control>""").replace(
+        '<link name="arm">', '<link name="arm"><visual name="v"><origin xyz="0 0 0"/><geometry><mesh filename="arm.stl" scale="1 1 1"/></geometry>'
+        '<material name="blue"/></visual><collision><geometry><cylinder radius="0.1" length="0.2"/></geometry></collision>', 1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        model = load(tmp_path, text, strict=True)
+    assert model.warnings == []
+
+
+def test_an_xml_declaration_after_a_comment_loads_with_a_warning(tmp_path):
+    """As in two URDFs pybullet ships: a comment, blank lines, then <?xml ...?>."""
+    text = robot(JOINT, header='<!-- exported -->\n\n<?xml version="1.0" ?>\n')
+    with pytest.warns(robodyn.ModelWarning, match=r"the XML declaration is not at the start of the file \(line 3\)"):
+        model = load(tmp_path, text)
+    assert model.joint_names == ["j"]
+    with pytest.raises(ValueError, match="XML declaration"):
+        load(tmp_path, text, strict=True)
+
+
+def test_unknown_names_are_grouped_per_name(tmp_path):
+    text = robot(JOINT).replace('<mass value="1"/>', '<mass value="1" unit="kg"/>')
+    with pytest.warns(robodyn.ModelWarning):
+        model = load(tmp_path, text)
+    assert len(model.warnings) == 1 and "(2 times; the first is here)" in model.warnings[0]
+
+
+def test_published_urdfs(robots_dir):
+    """UR5 and Solo12 follow the specification; the Panda's <dynamics> carries four attributes of its
+    own, reported once each."""
+    for path in ("ur_description/urdf/ur5_robot.urdf", "solo_description/robots/solo12.urdf"):
+        model = robodyn.load(robots_dir / path, strict=True)
+        assert model.warnings == []
+    with pytest.warns(robodyn.ModelWarning):
+        panda = robodyn.load(robots_dir / "panda_description/urdf/panda.urdf")
+    assert sorted(w.split("unknown attribute ")[1].split(" of")[0] for w in panda.warnings) == ["'D'", "'K'", "'mu_coulomb'", "'mu_viscous'"]
+    assert all("times; the first is here" in w for w in panda.warnings)
