@@ -11,6 +11,8 @@
 //! Bodies and sites become frames; a body without joints is merged into its parent; several joints
 //! in one body become a chain of massless bodies, applied in order as MuJoCo does. A free joint's
 //! q is the body's pose in the world (the XML pose is only MuJoCo's initial qpos).
+//! Every element and attribute is first checked against MuJoCo's schema (`mjcf_schema.rs`): an
+//! unknown name is an error, as in MuJoCo.
 //! Not read (a warning each): actuators, sensors, contacts, equality constraints, tendons,
 //! keyframes, assets. A mesh geom cannot give a body its inertia here (the mesh file is not read):
 //! such a body needs an `<inertial>`, and the error says so.
@@ -28,7 +30,9 @@
 //! and the body's inertia is their sum, each shifted from its own pose (parallel-axis theorem).
 
 use crate::error::{Error, Result};
+use crate::io::mjcf_schema::MJCF_SCHEMA;
 use crate::io::read_model_file;
+use crate::io::schema;
 use crate::io::xml::{location, parse_number_list, parse_numbers};
 use crate::joint::Joint;
 use crate::model::{
@@ -156,6 +160,14 @@ fn load_sources(sources: &Sources) -> Result<Model> {
     if !root.has_tag_name("mujoco") {
         return Err(reader.error(root, "expected the root element <mujoco>"));
     }
+    // unknown elements and attributes are errors, as in MuJoCo
+    schema::check(
+        MJCF_SCHEMA,
+        0,
+        root,
+        &|node| reader.children(node),
+        &mut |node, message| Err(reader.error(node, message)),
+    )?;
     let sections = reader.children(root)?;
     for compiler in sections.iter().filter(|c| c.has_tag_name("compiler")) {
         reader.read_compiler(*compiler)?;

@@ -4,6 +4,7 @@
 pub mod bundled;
 pub mod dh;
 pub mod mjcf;
+mod mjcf_schema;
 mod schema;
 pub mod urdf;
 mod urdf_schema;

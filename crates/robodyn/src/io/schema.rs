@@ -35,13 +35,23 @@ fn suggestion(name: &str, known: &[&str], brackets: bool) -> String {
     }
 }
 
+/// The child elements of a node as a format sees them (MJCF replaces each `<include>` by the
+/// included file's elements).
+pub(crate) type Children<'c, 'a> = dyn Fn(Node<'a, 'a>) -> Result<Vec<Node<'a, 'a>>> + 'c;
+
+/// The child elements of a node, as they stand in the document.
+pub(crate) fn element_children<'a>(node: Node<'a, 'a>) -> Result<Vec<Node<'a, 'a>>> {
+    Ok(node.children().filter(|c| c.is_element()).collect())
+}
+
 /// Checks `node` (an element of kind `schema[index]`) and everything below it. Each unknown child
 /// element or attribute goes to `report(node, message)`, which decides whether it is an error.
 /// Elements and attributes in an XML namespace (`xacro:…`) are left alone.
-pub(crate) fn check(
+pub(crate) fn check<'a>(
     schema: &[SchemaElement],
     index: usize,
-    node: Node,
+    node: Node<'a, 'a>,
+    children: &Children<'_, 'a>,
     report: &mut dyn FnMut(Node, String) -> Result<()>,
 ) -> Result<()> {
     let element = &schema[index];
@@ -61,13 +71,13 @@ pub(crate) fn check(
             )?;
         }
     }
-    for child in node.children().filter(|c| c.is_element()) {
+    for child in children(node)? {
         if child.tag_name().namespace().is_some() {
             continue;
         }
         let name = child.tag_name().name();
         match element.children.iter().find(|&&k| schema[k].name == name) {
-            Some(&k) => check(schema, k, child, report)?,
+            Some(&k) => check(schema, k, child, children, report)?,
             None => {
                 let known: Vec<&str> = element.children.iter().map(|&k| schema[k].name).collect();
                 report(

@@ -90,13 +90,19 @@ fn parse_urdf(
     }
     // unknown elements and attributes are warnings naming the nearest known name, one per name
     let mut unknown: Vec<(String, String, usize)> = Vec::new();
-    schema::check(URDF_SCHEMA, 0, robot, &mut |node, message| {
-        match unknown.iter_mut().find(|(known, _, _)| *known == message) {
-            Some((_, _, count)) => *count += 1,
-            None => unknown.push((message, parser.location(node), 1)),
-        }
-        Ok(())
-    })?;
+    schema::check(
+        URDF_SCHEMA,
+        0,
+        robot,
+        &schema::element_children,
+        &mut |node, message| {
+            match unknown.iter_mut().find(|(known, _, _)| *known == message) {
+                Some((_, _, count)) => *count += 1,
+                None => unknown.push((message, parser.location(node), 1)),
+            }
+            Ok(())
+        },
+    )?;
     parser.warnings.extend(
         unknown
             .into_iter()
