@@ -8,7 +8,7 @@ max(1, max|mujoco|)``), after converting MuJoCo's conventions with
 - ``"M"``: the joint-space inertia matrix (``mj_fullM``, armature included);
 - ``"bias"``: C(q, v) v + g(q) (from ``qfrc_bias``);
 - ``"forward_dynamics"``: q̈ for random τ (``qacc`` with ``qfrc_applied = τ``);
-- ``"inverse_dynamics"``: τ for random q̈ (``mj_rne``, which leaves the armature out);
+- ``"inverse_dynamics"``: τ for random q̈ (``mj_rne``, plus the armature times ``qacc`` it leaves out);
 - ``"body_pose"``, ``"site_pose"``: every body's and site's position and rotation;
 - ``"jacobian"``: every body's world-aligned Jacobian (``mj_jacBody``);
 - ``"jacobian_dot_v"``: every body's J̇v, the classical acceleration at q̈ = 0 (``mj_jacDot``).
@@ -94,9 +94,10 @@ def mujoco_discrepancies(model, mj_model, seed: int = 0, states: int = 3) -> dic
             pose = model.frame_pose(q, mj_model.site(site).name)
             record("site_pose", pose[:3, 3], data.site_xpos[site])
             record("site_pose", pose[:3, :3], data.site_xmat[site].reshape(3, 3))
-        # inverse dynamics last: it overwrites qacc
+        # inverse dynamics last: it overwrites qacc; mj_rne leaves out the rotors' armature · qacc
         result = np.zeros(nv)
         data.qacc[:] = layout.a_to_mujoco(q, v, a)
         mujoco.mj_rne(mj_model, data, 1, result)
-        record("inverse_dynamics", model.inverse_dynamics(q, v, a) - model.armature * a, layout.force_from_mujoco(q, result))
+        result += mj_model.dof_armature * data.qacc
+        record("inverse_dynamics", model.inverse_dynamics(q, v, a), layout.force_from_mujoco(q, result))
     return errors

@@ -110,7 +110,11 @@ impl PyModel {
 
     #[setter]
     fn set_armature(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
-        self.model.armature = read_non_negative("armature", value, self.model.nv)?;
+        let armature = read_non_negative("armature", value, self.model.nv)?;
+        self.model
+            .check_armature(armature.as_slice())
+            .map_err(to_py_err)?;
+        self.model.armature = armature;
         Ok(())
     }
 

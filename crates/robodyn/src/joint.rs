@@ -120,6 +120,32 @@ impl Joint {
         }
     }
 
+    /// Entry (r, c) of the velocity-dependent part of the rotor (armature) force, `K(v)` with
+    /// `τ_rotor = A (q̈ + K(v) q̇)`, for this joint's slice `v`. Zero except on a free joint, whose
+    /// armature acts, as in MuJoCo, on the world-frame linear velocity R v_lin: its rate in body
+    /// axes is v̇_lin + ω × v_lin, so K's linear block is [ω×] (skew-symmetric, so Ṁ − 2C stays
+    /// skew and the rotor does no work). Needs the same armature on the three linear coordinates.
+    #[inline]
+    pub fn rotor_velocity_term(&self, r: usize, c: usize, v: &[f64]) -> f64 {
+        match self {
+            Joint::Free if r < 3 && c < 3 => skew(&Vec3::new(v[3], v[4], v[5]))[(r, c)],
+            _ => 0.0,
+        }
+    }
+
+    /// Checks the armature of this joint's velocity coordinates: a free joint's acts on its
+    /// world-frame linear velocity, so it must be the same along the three linear coordinates.
+    pub fn check_armature(&self, armature: &[f64]) -> Result<(), String> {
+        match self {
+            Joint::Free if armature[0] != armature[1] || armature[0] != armature[2] => Err(format!(
+                "a free joint's armature acts on its world-frame linear velocity (as in MuJoCo) and \
+                 must be the same on its three linear coordinates, got {:?}",
+                &armature[..3]
+            )),
+            _ => Ok(()),
+        }
+    }
+
     /// The joint velocity `v_J = S q̇` for this joint's slice `v` of the velocity.
     #[inline]
     pub fn motion(&self, v: &[f64]) -> Motion {

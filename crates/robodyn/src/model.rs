@@ -242,6 +242,20 @@ impl Model {
         Ok(())
     }
 
+    /// Checks a per-coordinate armature for this model (non-negative everywhere is the caller's
+    /// check): a free joint's must be the same on its three linear coordinates.
+    pub fn check_armature(&self, armature: &[f64]) -> Result<()> {
+        for i in 1..self.nbodies() {
+            self.joints[i]
+                .check_armature(&armature[self.v_range(i)])
+                .map_err(|message| Error::InvalidValue {
+                    argument: "armature".into(),
+                    message: format!("joint '{}': {message}", self.joint_names[i]),
+                })?;
+        }
+        Ok(())
+    }
+
     /// Total mass.
     pub fn total_mass(&self) -> f64 {
         self.inertias.iter().skip(1).map(|i| i.mass).sum()
@@ -415,6 +429,15 @@ impl ModelBuilder {
         let merged = placement.transpose_apply_inertia(&inertia);
         self.model.inertias[body] += merged;
         self.add_frame(name, body, placement);
+    }
+
+    /// Scales every body's mass and inertia by `factor` (MJCF's `settotalmass`).
+    pub fn scale_inertias(&mut self, factor: f64) {
+        for inertia in &mut self.model.inertias {
+            inertia.mass *= factor;
+            inertia.first_moment *= factor;
+            inertia.rotational *= factor;
+        }
     }
 
     /// Adds a named frame on `body` at `placement` (`X_{frame←body}`).

@@ -54,10 +54,16 @@ pub fn aba<'d>(
         let joint = &model.joints[i];
         let nv_i = joint.nv();
         let dofs = model.v_range(i);
+        let v_i = &v[dofs.clone()];
         for k in 0..nv_i {
-            // U_i = I^A_i S_i;  u_i = τ_i - S_iᵀ p^A_i
+            // U_i = I^A_i S_i;  u_i = τ_i - S_iᵀ p^A_i - armature K(q̇_i) q̇_i
             data.u[i][k] = mat6_mul_motion(&data.i_a[i], &joint.subspace_column(k));
-            data.u_tau[i][k] = tau[dofs.start + k] - joint.project_force(k, &data.p_a[i]);
+            let rotor: f64 = (0..nv_i)
+                .map(|c| joint.rotor_velocity_term(k, c, v_i) * v_i[c])
+                .sum();
+            data.u_tau[i][k] = tau[dofs.start + k]
+                - joint.project_force(k, &data.p_a[i])
+                - model.armature[dofs.start + k] * rotor;
         }
         // D_i = S_iᵀ U_i + armature
         let mut d = Mat6::identity();

@@ -87,6 +87,18 @@ fn fill_coriolis_matrix(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
             }
         }
     }
+
+    // the rotors: armature K(q̇_i) on each joint's own block
+    for i in 1..model.nbodies() {
+        let dofs = model.v_range(i);
+        let v_i = &v[dofs.clone()];
+        for (r, row) in dofs.clone().enumerate() {
+            for (c, column) in dofs.clone().enumerate() {
+                coriolis[(row, column)] +=
+                    model.armature[row] * model.joints[i].rotor_velocity_term(r, c, v_i);
+            }
+        }
+    }
 }
 
 /// The Christoffel symbols of the first kind, Γ_ijk = ½ (∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i),

@@ -101,10 +101,17 @@ pub(crate) fn newton_euler<'d>(
     // inward pass: project onto the joint axes, pass the rest to the parent
     for i in (1..model.nbodies()).rev() {
         let joint = &model.joints[i];
-        for (k, dof) in model.v_range(i).enumerate() {
-            // τ_i = S_iᵀ f_i + armature q̈_i
-            let rotor = a.map_or(0.0, |a| model.armature[dof] * a[dof]);
-            data.tau[dof] = joint.project_force(k, &data.f[i]) + rotor;
+        let dofs = model.v_range(i);
+        for (k, dof) in dofs.clone().enumerate() {
+            // τ_i = S_iᵀ f_i + armature (q̈_i + K(q̇_i) q̇_i)
+            let mut rate = a.map_or(0.0, |a| a[dof]);
+            if let Some(v) = v {
+                let v_i = &v[dofs.clone()];
+                rate += (0..v_i.len())
+                    .map(|c| joint.rotor_velocity_term(k, c, v_i) * v_i[c])
+                    .sum::<f64>();
+            }
+            data.tau[dof] = joint.project_force(k, &data.f[i]) + model.armature[dof] * rate;
         }
         let parent = model.parent[i];
         if parent != 0 {

@@ -1,7 +1,7 @@
 //! MJCF loader (MuJoCo's XML, <https://mujoco.readthedocs.io/en/stable/XMLreference.html>), the
 //! part that describes a robot's rigid-body tree.
 //!
-//! Reads `<include file>` (resolved against the main file's folder, each file once),
+//! Reads `<include file>` (resolved against the including file's folder, each file once),
 //! `<compiler angle eulerseq inertiafromgeom inertiagrouprange>`, `<option gravity>`, `<default>`
 //! classes (nested, with `class` and `childclass`), and in `<worldbody>` nested `<body>`s with `pos`
 //! and any orientation (`quat` w-first, `axisangle`, `euler`, `xyaxes`, `zaxis`), `<inertial>`
@@ -30,6 +30,7 @@
 //! and the body's inertia is their sum, each shifted from its own pose (parallel-axis theorem).
 
 use crate::error::{Error, Result};
+use crate::io::mjcf_mass::MassRules;
 use crate::io::mjcf_schema::MJCF_SCHEMA;
 use crate::io::read_model_file;
 use crate::io::schema;
@@ -42,6 +43,7 @@ use crate::model::{
 use crate::spatial::{Inertia, Mat3, Transform, Vec3};
 use nalgebra::{Rotation3, Unit, UnitQuaternion};
 use roxmltree::{Document, Node};
+use std::cell::Cell;
 use std::collections::{HashMap, HashSet};
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
@@ -67,9 +69,9 @@ pub fn load_mjcf_file(path: &Path) -> Result<Model> {
     let main = SourceFile {
         source: path.display().to_string(),
         text: read_model_file(path)?,
+        folder: Some(path.parent().unwrap_or(Path::new(".")).to_path_buf()),
     };
-    let folder = path.parent().unwrap_or(Path::new("."));
-    load_sources(&gather_includes(main, Some(folder))?)
+    load_sources(&gather_includes(main)?)
 }
 
 /// Loads an MJCF document held in `text`; `source` names it in error messages. `<include>` needs
@@ -78,14 +80,17 @@ pub fn load_mjcf_str(text: &str, source: &str) -> Result<Model> {
     let main = SourceFile {
         source: source.to_string(),
         text: text.to_string(),
+        folder: None,
     };
-    load_sources(&gather_includes(main, None)?)
+    load_sources(&gather_includes(main)?)
 }
 
-/// One file's text and the name errors give it.
+/// One file's text, the name errors give it, and the folder its `<include>`s are resolved
+/// against (its own, as MuJoCo resolves them; none for a string).
 struct SourceFile {
     source: String,
     text: String,
+    folder: Option<PathBuf>,
 }
 
 /// The main file (first) and the files it includes, with where each `<include>` stands:
@@ -101,7 +106,7 @@ fn parse(file: &SourceFile) -> Result<Document<'_>> {
 }
 
 /// Reads every file reachable through `<include file>` from `main`, breadth first.
-fn gather_includes(main: SourceFile, folder: Option<&Path>) -> Result<Sources> {
+fn gather_includes(main: SourceFile) -> Result<Sources> {
     let mut sources = Sources {
         files: vec![main],
         includes: HashMap::new(),
@@ -118,7 +123,7 @@ fn gather_includes(main: SourceFile, folder: Option<&Path>) -> Result<Sources> {
             let name = include
                 .attribute("file")
                 .ok_or_else(|| error("missing attribute 'file'"))?;
-            let folder = folder.ok_or_else(|| {
+            let folder = file.folder.as_deref().ok_or_else(|| {
                 error("<include> is resolved against the model's folder: load the model from its file")
             })?;
             let path = folder.join(name);
@@ -134,6 +139,7 @@ fn gather_includes(main: SourceFile, folder: Option<&Path>) -> Result<Sources> {
             sources.files.push(SourceFile {
                 source: path.display().to_string(),
                 text,
+                folder: path.parent().map(Path::to_path_buf),
             });
         }
         next += 1;
@@ -156,6 +162,8 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         inertia_from_geoms: InertiaFromGeoms::Auto,
         inertia_groups: (0, 5),
         defaults: HashMap::new(),
+        mass_rules: MassRules::default(),
+        total_mass: Cell::new(0.0),
     };
     if !root.has_tag_name("mujoco") {
         return Err(reader.error(root, "expected the root element <mujoco>"));
@@ -195,6 +203,9 @@ fn load_sources(sources: &Sources) -> Result<Model> {
     for world in sections.iter().filter(|c| c.has_tag_name("worldbody")) {
         reader.read_children(&mut builder, *world, 0, Transform::IDENTITY, "main")?;
     }
+    if let Some(factor) = reader.mass_rules.total_mass_scale(reader.total_mass.get()) {
+        builder.scale_inertias(factor);
+    }
     Ok(builder.build())
 }
 
@@ -219,6 +230,10 @@ struct Reader<'a> {
     inertia_groups: (i64, i64),
     /// class -> element tag -> attribute -> value, each class holding its parents' values too
     defaults: HashMap<String, HashMap<String, HashMap<String, String>>>,
+    /// `boundmass`, `boundinertia`, `balanceinertia`, `settotalmass`
+    mass_rules: MassRules,
+    /// the mass of every body read so far, those welded to the world included
+    total_mass: Cell<f64>,
 }
 
 impl<'a> Reader<'a> {
@@ -300,23 +315,30 @@ impl<'a> Reader<'a> {
                 .map_err(|m| self.error(compiler, m))?;
             self.inertia_groups = (low as i64, high as i64);
         }
-        // these rewrite the file's masses and inertias: refuse rather than differ from MuJoCo
-        for unsupported in [
-            "settotalmass",
-            "boundmass",
-            "boundinertia",
-            "balanceinertia",
-        ] {
-            if compiler
-                .attribute(unsupported)
-                .is_some_and(|v| !matches!(v, "0" | "-1" | "false"))
-            {
+        // the options that rewrite masses and inertias (mjcf_mass.rs)
+        let number = |name: &str| -> Result<Option<f64>> {
+            compiler
+                .attribute(name)
+                .map(|text| parse_numbers::<1>(text, name).map(|[x]| x))
+                .transpose()
+                .map_err(|m| self.error(compiler, m))
+        };
+        let mut rules = self.mass_rules;
+        rules.bound_mass = number("boundmass")?.unwrap_or(rules.bound_mass);
+        rules.bound_inertia = number("boundinertia")?.unwrap_or(rules.bound_inertia);
+        rules.total_mass = number("settotalmass")?.unwrap_or(rules.total_mass);
+        rules.balance_inertia = match compiler.attribute("balanceinertia") {
+            None => rules.balance_inertia,
+            Some("true") => true,
+            Some("false") => false,
+            Some(other) => {
                 return Err(self.error(
                     compiler,
-                    format!("attribute '{unsupported}' is not supported: it changes the model's inertias"),
-                ));
+                    format!("attribute 'balanceinertia': expected true or false, got '{other}'"),
+                ))
             }
-        }
+        };
+        self.mass_rules = rules;
         Ok(())
     }
 
@@ -476,6 +498,36 @@ impl<'a> Reader<'a> {
         ))
     }
 
+    /// A geom's or site's `fromto` (x1 y1 z1 x2 y2 z2), when it has one: the frame at the
+    /// segment's midpoint with z pointing from the second point to the first (the shortest
+    /// rotation from z, as MuJoCo places it), and the half-length. Only capsules, cylinders, boxes
+    /// and ellipsoids take one.
+    fn segment(
+        &self,
+        node: Node<'a, 'a>,
+        class: &str,
+        kind: &str,
+    ) -> Result<Option<(Transform, f64)>> {
+        let Some([x1, y1, z1, x2, y2, z2]) = self.numbers::<6>(node, class, "fromto")? else {
+            return Ok(None);
+        };
+        let (from, to) = (Vec3::new(x1, y1, z1), Vec3::new(x2, y2, z2));
+        let axis = from - to;
+        let half_length = axis.norm() / 2.0;
+        if half_length == 0.0 || !matches!(kind, "capsule" | "cylinder" | "box" | "ellipsoid") {
+            return Err(self.error(
+                node,
+                "attribute 'fromto': expected two distinct points on a capsule, cylinder, box or ellipsoid",
+            ));
+        }
+        let rotation = Rotation3::rotation_between(&Vec3::z(), &axis)
+            .unwrap_or_else(|| Rotation3::from_axis_angle(&Vec3::x_axis(), PI));
+        Ok(Some((
+            Transform::from_pose(rotation.matrix(), &((from + to) / 2.0)),
+            half_length,
+        )))
+    }
+
     /// The spatial inertia of a body, in its frame: from `<inertial>` or from its geoms, as
     /// `<compiler inertiafromgeom>` says.
     fn body_inertia(&self, elements: &[Node<'a, 'a>], class: &str) -> Result<Inertia> {
@@ -523,7 +575,8 @@ impl<'a> Reader<'a> {
             {
                 Mat3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
             } else {
-                return Err(self.error(inertial, "expected 'diaginertia' or 'fullinertia'"));
+                // MuJoCo reads an <inertial> without a tensor as a point mass
+                Mat3::zeros()
             };
         let frame = self.placement(inertial, class)?;
         self.inertia_in_body(inertial, mass, &principal, &frame)
@@ -574,15 +627,7 @@ impl<'a> Reader<'a> {
         };
         // `fromto`: the geom spans the segment; its axis is z, its half-length the last size
         let mut frame = self.placement(geom, class)?;
-        if let Some([x1, y1, z1, x2, y2, z2]) = self.numbers::<6>(geom, class, "fromto")? {
-            let (from, to) = (Vec3::new(x1, y1, z1), Vec3::new(x2, y2, z2));
-            let axis = to - from;
-            let half_length = axis.norm() / 2.0;
-            if half_length == 0.0
-                || !matches!(kind.as_str(), "capsule" | "cylinder" | "box" | "ellipsoid")
-            {
-                return Err(self.error(geom, "attribute 'fromto': expected two distinct points on a capsule, cylinder, box or ellipsoid"));
-            }
+        if let Some((segment, half_length)) = self.segment(geom, class, &kind)? {
             let radius = size.first().copied().unwrap_or(0.0);
             // a box or ellipsoid along the segment has a square or round section of size[0]
             size = if matches!(kind.as_str(), "box" | "ellipsoid") {
@@ -590,9 +635,7 @@ impl<'a> Reader<'a> {
             } else {
                 vec![radius, half_length]
             };
-            let rotation = Rotation3::rotation_between(&Vec3::z(), &axis)
-                .unwrap_or_else(|| Rotation3::from_axis_angle(&Vec3::x_axis(), PI));
-            frame = Transform::from_pose(rotation.matrix(), &((from + to) / 2.0));
+            frame = segment;
         }
         let needed = match kind.as_str() {
             "sphere" => 1,
@@ -678,7 +721,15 @@ impl<'a> Reader<'a> {
                     let name = child
                         .attribute("name")
                         .map_or_else(|| format!("site{}", child.range().start), str::to_string);
-                    builder.add_frame(&name, body, self.placement(child, class)? * to_element);
+                    let site_class = self.declared_class(child, "class", class)?;
+                    let kind = self
+                        .attribute(child, site_class, "type")
+                        .unwrap_or_else(|| "sphere".to_string());
+                    let placement = match self.segment(child, site_class, &kind)? {
+                        Some((segment, _)) => segment,
+                        None => self.placement(child, site_class)?,
+                    };
+                    builder.add_frame(&name, body, placement * to_element);
                 }
                 "body" => self.read_body(builder, child, body, to_element, class)?,
                 // a <frame> only places what it holds: its pose composes with theirs
@@ -716,7 +767,11 @@ impl<'a> Reader<'a> {
         // X_{B←parent body}
         let mut to_body = self.placement(node, class)? * parent_element;
         let elements = self.children(node)?;
-        let inertia = self.body_inertia(&elements, child_class)?;
+        let inertia = self
+            .mass_rules
+            .apply_to_body(self.body_inertia(&elements, child_class)?)
+            .map_err(|m| self.error(node, m))?;
+        self.total_mass.set(self.total_mass.get() + inertia.mass);
         let joints: Vec<Node> = elements
             .into_iter()
             .filter(|c| c.has_tag_name("joint") || c.has_tag_name("freejoint"))

@@ -4,6 +4,7 @@
 pub mod bundled;
 pub mod dh;
 pub mod mjcf;
+mod mjcf_mass;
 mod mjcf_schema;
 mod schema;
 pub mod urdf;

@@ -1,0 +1,77 @@
+"""MJCF features MuJoCo applies to the model, each on a test model in testdata/mjcf/, compared field
+by field with MuJoCo (robodyn.crosscheck): nested includes, the compiler's mass options, an
+<inertial> without a tensor, armature on a free joint, sites placed by fromto."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+from conftest import CROSS_CHECK_TOLERANCE, REPOSITORY
+
+import robodyn
+from robodyn.crosscheck import mujoco_discrepancies, rigid_body_only
+
+TEST_MJCF = REPOSITORY / "testdata" / "mjcf"
+FEATURE_MODELS = ["nested/scene.xml", "compiler_mass.xml", "free_armature.xml"]
+
+
+def mujoco_and_robodyn(name):
+    path = TEST_MJCF / name
+    return rigid_body_only(mujoco.MjModel.from_xml_path(str(path))), robodyn.load(path)
+
+
+@pytest.mark.parametrize("name", FEATURE_MODELS)
+def test_feature_models_agree_with_mujoco(name):
+    mj, model = mujoco_and_robodyn(name)
+    errors = mujoco_discrepancies(model, mj, seed=3, states=4)
+    assert {"M", "bias", "forward_dynamics", "body_pose"} <= set(errors)
+    assert ("site_pose" in errors) == (mj.nsite > 0)
+    too_large = {k: v for k, v in errors.items() if v > CROSS_CHECK_TOLERANCE}
+    assert not too_large, too_large
+
+
+def test_compiler_mass_options_give_mujocos_masses():
+    mj, model = mujoco_and_robodyn("compiler_mass.xml")
+    # settotalmass counts the pedestal welded to the world, which robodyn merges into the world
+    assert mj.body_mass[1:].sum() == pytest.approx(12.0)
+    assert model.total_mass == pytest.approx(mj.body_mass[2:].sum(), rel=1e-14)
+    # the rod's thin tensor was balanced, the tip raised to boundmass before scaling
+    assert np.allclose(mj.body_inertia[3], mj.body_inertia[3].mean())
+    assert model.body_masses[-1] == pytest.approx(mj.body_mass[-1], rel=1e-14)
+
+
+def test_free_joint_armature_acts_on_the_world_frame_linear_velocity():
+    """With the body spinning, MuJoCo's armature on a free joint adds a(ω × v) in body axes;
+    forward dynamics agrees only with that term."""
+    mj, model = mujoco_and_robodyn("free_armature.xml")
+    assert model.armature[:6].tolist() == [0.01] * 6
+    errors = mujoco_discrepancies(model, mj, seed=11, states=6)
+    assert errors["forward_dynamics"] < CROSS_CHECK_TOLERANCE and errors["bias"] < CROSS_CHECK_TOLERANCE
+    # Ṁ − 2C stays skew-symmetric with the rotor term
+    q, v = model.random_configuration(seed=2), np.linspace(-2, 2, model.nv)
+    h = 1e-6
+    m_dot = (model.mass_matrix(model.integrate(q, v, h)) - model.mass_matrix(model.integrate(q, v, -h))) / (2 * h)
+    skew = m_dot - 2 * model.coriolis_matrix(q, v)
+    assert np.abs(skew + skew.T).max() < 1e-7
+    assert np.allclose(model.coriolis_matrix(q, v) @ v, model.bias_forces(q, v) - model.generalized_gravity(q), atol=1e-12)
+
+
+def test_a_free_joints_armature_must_be_isotropic():
+    model = robodyn.load(TEST_MJCF / "free_armature.xml")
+    with pytest.raises(ValueError, match="joint 'root': a free joint's armature acts on its world-frame linear velocity"):
+        model.armature = [0.01, 0.02, 0.01, 0.0, 0.0, 0.0, 0.05]
+
+
+def test_a_sphere_site_with_fromto_is_refused_as_in_mujoco():
+    text = '<mujoco><worldbody><body><joint/><geom size="0.1"/><site name="s" size="0.01" fromto="0 0 0 1 0 0"/></body></worldbody></mujoco>'
+    with pytest.raises(ValueError, match="fromto"):
+        mujoco.MjModel.from_xml_string(text)
+    with pytest.raises(ValueError, match=r"<site name='s'> \(line 1\): attribute 'fromto': expected two distinct points on a capsule"):
+        robodyn.load_mjcf_string(text)
+
+
+def test_nested_includes_resolve_against_the_including_file(tmp_path):
+    mj, model = mujoco_and_robodyn("nested/scene.xml")
+    assert model.joint_names == ["shoulder", "elbow"]
+    assert model.armature.tolist() == [0.02, 0.02] == mj.dof_armature.tolist()
