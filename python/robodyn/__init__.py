@@ -23,6 +23,7 @@ import numpy as np
 
 from robodyn._core import (
     Model,
+    SimulationError,
     bundled_names,
     load_bundled,
     load_dh,
@@ -43,6 +44,7 @@ __all__ = [
     "GravityCompensation",
     "Model",
     "PD",
+    "SimulationError",
     "Trajectory",
     "simulate",
     "ModelWarning",

@@ -12,6 +12,8 @@ FloatArray = NDArray[np.float64]
 Vector = np.ndarray[tuple[int], np.dtype[np.float64]]
 Matrix = np.ndarray[tuple[int, int], np.dtype[np.float64]]
 
+class SimulationError(ValueError): ...
+
 class Model:
     @property
     def name(self) -> str: ...

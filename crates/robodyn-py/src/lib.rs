@@ -16,10 +16,21 @@ mod simulation;
 use loaders::*;
 use model::PyModel;
 
+pyo3::create_exception!(
+    robodyn,
+    SimulationError,
+    PyValueError,
+    "A simulation stopped: it diverged (the message says when, which quantity and joint, and \
+     a step that keeps it stable), or its controller or wrenches gave something unusable."
+);
+
 /// A core error as the Python exception the API promises.
 pub(crate) fn to_py_err(error: Error) -> PyErr {
     match error {
         Error::FileNotFound { .. } => PyFileNotFoundError::new_err(error.to_string()),
+        Error::Simulation { .. } | Error::Diverged { .. } => {
+            SimulationError::new_err(error.to_string())
+        }
         _ => PyValueError::new_err(error.to_string()),
     }
 }
@@ -27,6 +38,7 @@ pub(crate) fn to_py_err(error: Error) -> PyErr {
 #[pymodule]
 fn _core(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<PyModel>()?;
+    module.add("SimulationError", module.py().get_type::<SimulationError>())?;
     module.add_function(wrap_pyfunction!(load_urdf, module)?)?;
     module.add_function(wrap_pyfunction!(load_urdf_string, module)?)?;
     module.add_function(wrap_pyfunction!(load_bundled, module)?)?;

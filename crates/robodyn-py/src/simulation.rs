@@ -409,6 +409,10 @@ fn batch_error(batch: Option<usize>, k: usize, error: Error) -> Error {
             time,
             message: format!("rollout {k}: {message}"),
         },
+        (Some(_), Error::Diverged { time, message }) => Error::Diverged {
+            time,
+            message: format!("rollout {k}: {message}"),
+        },
         (_, error) => error,
     }
 }

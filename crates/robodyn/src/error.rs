@@ -44,6 +44,11 @@ pub enum Error {
     #[error("simulation stopped at t = {time} s: {message}")]
     Simulation { time: f64, message: String },
 
+    /// A simulation left the bounds of a sensible motion at time `time` (s): a non-finite state,
+    /// a speed or an energy beyond its bound, or a fixed step far too large for the dynamics.
+    #[error("simulation diverged at t = {time:.6} s: {message}")]
+    Diverged { time: f64, message: String },
+
     /// A frame name that the model does not have.
     #[error("unknown frame '{name}': the model's frames are {available}")]
     UnknownFrame { name: String, available: String },

@@ -307,3 +307,29 @@ fn bad_options_are_refused_with_their_name() {
     assert!(error.to_string().contains("'q0'"), "{error}");
     assert!(Integrator::from_name("rk5", 1e-6, 1e-6).is_err());
 }
+
+#[test]
+fn a_diverging_run_stops_with_the_time_joint_and_a_stable_step() {
+    let model = bundled_model("ur5", false).unwrap();
+    let q0 = vec![0.3; model.nv];
+    let mut zero = NativeController::new(
+        &model,
+        ControlLaw::Constant(DVector::zeros(model.nv)),
+        PassiveForces::default(),
+        2.0,
+    )
+    .unwrap();
+    let options = SimulationOptions::new(Integrator::Rk4, 0.1, 2.0);
+    let error = simulate(&model, &q0, &[0.0; 6], &options, &mut zero, None, None).unwrap_err();
+    let robodyn::Error::Diverged { time, message } = &error else {
+        panic!("expected a divergence, got {error}");
+    };
+    assert!(*time > 0.0 && *time <= 2.0);
+    assert!(
+        message.contains("joint '") && message.contains("keeps it stable"),
+        "{message}"
+    );
+    // the same motion at a sane step is untouched by the guard
+    let options = SimulationOptions::new(Integrator::Rk4, 1e-3, 2.0);
+    assert!(simulate(&model, &q0, &[0.0; 6], &options, &mut zero, None, None).is_ok());
+}

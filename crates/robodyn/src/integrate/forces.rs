@@ -87,6 +87,16 @@ impl PassiveForces {
     }
 }
 
+/// The energy stored in the joint springs, ½ Σ k (q ⊖ q_ref)²; `scratch` (nv) holds q ⊖ q_ref.
+pub fn spring_energy(model: &Model, q: &[f64], scratch: &mut [f64]) -> f64 {
+    spring_displacement(model, q, scratch);
+    0.5 * scratch
+        .iter()
+        .zip(model.stiffness.iter())
+        .map(|(d, k)| k * d * d)
+        .sum::<f64>()
+}
+
 /// q ⊖ q_ref, joint by joint on its group, into `out` (nv).
 fn spring_displacement(model: &Model, q: &[f64], out: &mut [f64]) {
     for i in 1..model.nbodies() {

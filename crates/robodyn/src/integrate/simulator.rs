@@ -15,6 +15,11 @@ use crate::integrate::schemes::{Integrator, State, Stepper};
 use crate::model::Model;
 use crate::spatial::Force;
 use crate::Data;
+use guard::{fixed_step, EnergyAccount, STEP_CHECK_INTERVAL};
+
+mod guard;
+
+pub use guard::{ENERGY_GROWTH_BOUND, SPEED_BOUND};
 
 /// The most samples one simulation records, so that a tiny `dt` fails clearly instead of
 /// exhausting memory.
@@ -163,6 +168,8 @@ struct Dynamics<'a> {
     tau_passive: Vec<f64>,
     tau_total: Vec<f64>,
     evaluations: usize,
+    /// The energy and the work put in so far (the divergence guard).
+    energy: EnergyAccount,
 }
 
 impl Dynamics<'_> {
@@ -194,19 +201,6 @@ impl Dynamics<'_> {
         let qdd =
             aba(model, &mut self.data, q, v, &self.tau_total, f_ext).map_err(|e| at_time(t, e))?;
         a.copy_from_slice(qdd.as_slice());
-        if let Some(index) = a.iter().position(|x| !x.is_finite()) {
-            return Err(at_time(
-                t,
-                invalid(
-                    "dt",
-                    format!(
-                        "the acceleration q̈[{index}] is {}: the simulation diverged (a smaller step \
-                         or tolerance, or smaller gains, may keep it stable)",
-                        a[index]
-                    ),
-                ),
-            ));
-        }
         Ok(())
     }
 
@@ -220,6 +214,7 @@ impl Dynamics<'_> {
         a: &mut [f64],
     ) -> Result<()> {
         self.acceleration(t, q, v, a)?;
+        self.check_sample(t, q, v, a)?;
         trajectory.t.push(t);
         trajectory.q.extend_from_slice(q);
         trajectory.v.extend_from_slice(v);
@@ -265,10 +260,14 @@ pub fn simulate<'a>(
             tau_passive: vec![0.0; model.nv],
             tau_total: vec![0.0; model.nv],
             evaluations: 0,
+            energy: EnergyAccount::new(model),
         },
         stepper: Stepper::new(model),
+        check_stepper: Stepper::new(model),
         state: State::new(model),
         sample: State::new(model),
+        middle: State::new(model),
+        delta: vec![0.0; model.nv],
         trajectory: Trajectory::with_capacity(samples, model)?,
         progress,
         statistics: Statistics::default(),
@@ -285,7 +284,20 @@ pub fn simulate<'a>(
     )?;
     simulation.report(0)?;
     match options.integrator {
-        Integrator::Rk45 { rtol, atol } => simulation.adaptive((rtol, atol))?,
+        Integrator::Rk45 { rtol, atol } => {
+            simulation
+                .adaptive((rtol, atol))
+                .map_err(|error| match error {
+                    Error::Diverged { time, message } => Error::Diverged {
+                        time,
+                        message: format!(
+                        "{message}; if the motion should stay bounded, tighter rtol and atol or \
+                             a smaller max_step may keep it so"
+                    ),
+                    },
+                    other => other,
+                })?
+        }
         _ => simulation.fixed_step()?,
     }
     simulation.statistics.evaluations = simulation.dynamics.evaluations;
@@ -300,10 +312,15 @@ struct Simulation<'a> {
     samples: usize,
     dynamics: Dynamics<'a>,
     stepper: Stepper,
-    /// The state at the start of the next step, with its acceleration.
+    /// The half steps of the step-doubling check.
+    check_stepper: Stepper,
+    /// The state at the start of the next step, with its acceleration (the last good state).
     state: State,
-    /// A recorded state between steps (RK45's dense output).
+    /// A recorded state: the next one of a fixed step, or one between steps (RK45's dense output).
     sample: State,
+    /// The state halfway through a step-doubling check, and the Δq it measures.
+    middle: State,
+    delta: Vec<f64>,
     trajectory: Trajectory,
     progress: Option<Progress<'a>>,
     statistics: Statistics,
@@ -322,38 +339,40 @@ impl Simulation<'_> {
     }
 
     /// Steps of dt from sample to sample; every scheme starts from the acceleration recorded at
-    /// the step's start.
+    /// the step's start. The first step, and every `STEP_CHECK_INTERVAL`-th, is checked against
+    /// two half steps; a divergence reports the step that would keep the motion stable.
     fn fixed_step(&mut self) -> Result<()> {
-        let model = self.model;
-        let tableau = self.options.integrator.tableau();
         for k in 1..self.samples {
             let t_next = self.options.sample_time(k, self.samples);
             let h = t_next - self.state.t;
-            let dynamics = &mut self.dynamics;
-            match tableau {
-                Some(tableau) => self.stepper.runge_kutta(
-                    model,
-                    tableau,
-                    &self.state,
-                    h,
-                    &mut |t, q, v, a| dynamics.acceleration(t, q, v, a),
-                )?,
-                None => self.stepper.semi_implicit_euler(model, &self.state, h)?,
-            }
-            self.statistics.steps += 1;
-            let state = &mut self.state;
-            state.t = t_next;
-            state.q.copy_from_slice(&self.stepper.q_end);
-            state.v.copy_from_slice(&self.stepper.v_end);
-            self.dynamics.record(
-                &mut self.trajectory,
-                t_next,
-                &state.q,
-                &state.v,
-                &mut state.a,
-            )?;
+            self.fixed_sample(k, t_next, h)
+                .map_err(|error| self.with_suggested_step(error, h))?;
             self.report(k)?;
         }
+        Ok(())
+    }
+
+    /// The step to sample `k` at `t_next`: taken, checked, recorded, and then made the state.
+    fn fixed_sample(&mut self, k: usize, t_next: f64, h: f64) -> Result<()> {
+        fixed_step(
+            self.model,
+            self.options.integrator,
+            &mut self.dynamics,
+            &mut self.stepper,
+            &self.state,
+            h,
+        )?;
+        if k == 1 || k % STEP_CHECK_INTERVAL == 0 {
+            self.check_step(h)?;
+        }
+        self.statistics.steps += 1;
+        let next = &mut self.sample;
+        next.t = t_next;
+        next.q.copy_from_slice(&self.stepper.q_end);
+        next.v.copy_from_slice(&self.stepper.v_end);
+        self.dynamics
+            .record(&mut self.trajectory, t_next, &next.q, &next.v, &mut next.a)?;
+        std::mem::swap(&mut self.state, &mut self.sample);
         Ok(())
     }
 
