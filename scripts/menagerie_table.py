@@ -35,33 +35,38 @@ def model_files(paths: list[str]) -> list[Path]:
     return files
 
 
-def row(path: Path) -> str | None:
-    """One table row, or None when MuJoCo itself does not load the file."""
+def first_line(error: Exception) -> str:
+    return " ".join(str(error).split("\n")[0].split()).replace("|", "\\|")
+
+
+def row(path: Path, root: Path | None = None) -> str:
+    """One table row: whether MuJoCo and robodyn load the file, and how far apart they are."""
+    name = path.relative_to(root) if root else path
     try:
         mj_model = mujoco.MjModel.from_xml_path(str(path))
-    except Exception:  # MuJoCo's own error: not a model file, or one MuJoCo rejects
-        return None
+    except Exception as error:  # MuJoCo's own error, e.g. a mesh file this copy lacks
+        return f"| `{name}` | MuJoCo does not load it here | {first_line(error)} |"
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
             model = robodyn.load(path)
         except ValueError as error:
-            return f"| {path} | no | {error} |"
-    ignored = sorted({str(w.message).split(": <")[-1].split(">")[0] for w in caught})
+            return f"| `{name}` | no | {first_line(error)} |"
+    ignored = sorted({str(w.message).split(": <")[-1].split(">")[0] for w in caught if ": <" in str(w.message)})
     errors = mujoco_discrepancies(model, mj_model, seed=0, states=2)
     worst = max(errors.values())
     verdict = "matches" if worst <= TOLERANCE else "DIFFERS"
     note = f"nq = {model.nq}; not read: {', '.join(f'<{t}>' for t in ignored)}" if ignored else f"nq = {model.nq}"
-    return f"| {path} | yes | {verdict} (largest relative error {worst:.1e}); {note} |"
+    return f"| `{name}` | yes | {verdict} (largest relative error {worst:.1e}); {note} |"
 
 
 def main(paths: list[str]) -> None:
     print("| model | loads | result |")
     print("|---|---|---|")
-    for path in model_files(paths):
-        line = row(path)
-        if line is not None:
-            print(line, flush=True)
+    for path in paths:
+        root = Path(path) if Path(path).is_dir() else None
+        for file in model_files([path]):
+            print(row(file, root), flush=True)
 
 
 if __name__ == "__main__":

@@ -103,11 +103,17 @@ class PinocchioLayout:
 
 
 class MujocoLayout:
-    """Maps between a robodyn model and the MuJoCo model of the same robot (joints by name)."""
+    """Maps between a robodyn model and the MuJoCo model of the same robot (joints by name; an
+    unnamed MuJoCo joint by the name robodyn gives it, ``<body>_joint<k>``, k its index in its
+    body)."""
 
     def __init__(self, model, mj_model):
         self.model, self.mj_model = model, mj_model
-        names = [mj_model.joint(j).name for j in range(mj_model.njnt)]
+        names = []
+        for j in range(mj_model.njnt):
+            body = int(mj_model.jnt_bodyid[j])
+            index_in_body = j - int(mj_model.body_jntadr[body])
+            names.append(mj_model.joint(j).name or f"{mj_model.body(body).name}_joint{index_in_body}")
         self.v_index = np.zeros(model.nv, dtype=int)
         self._joints = []
         for name, kind, iq, iv in zip(model.joint_names, model.joint_types, model.joint_idx_q, model.joint_idx_v):

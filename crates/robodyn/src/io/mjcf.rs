@@ -34,7 +34,7 @@ use crate::io::mjcf_mass::MassRules;
 use crate::io::mjcf_schema::MJCF_SCHEMA;
 use crate::io::read_model_file;
 use crate::io::schema;
-use crate::io::xml::{location, parse_number_list, parse_numbers};
+use crate::io::xml::{check_nesting, location, parse_number_list, parse_numbers};
 use crate::joint::Joint;
 use crate::model::{
     check_mass_and_inertia, check_positive_semidefinite, JointProperties, Model, ModelBuilder,
@@ -101,8 +101,10 @@ struct Sources {
 }
 
 fn parse(file: &SourceFile) -> Result<Document<'_>> {
-    Document::parse(&file.text)
-        .map_err(|e| Error::model(&file.source, format!("malformed XML: {e}")))
+    let document = Document::parse(&file.text)
+        .map_err(|e| Error::model(&file.source, format!("malformed XML: {e}")))?;
+    check_nesting(&file.source, &document)?;
+    Ok(document)
 }
 
 /// Reads every file reachable through `<include file>` from `main`, breadth first.

@@ -11,6 +11,8 @@ pub mod urdf;
 mod urdf_schema;
 mod xml;
 
+pub use xml::MAX_NESTING;
+
 pub use bundled::{bundled_model, bundled_names, bundled_urdf};
 pub use dh::{
     build_dh, load_dh_document, load_dh_file, load_dh_str, DhConvention, DhJoint, DhRow, DhTable,

@@ -13,7 +13,7 @@
 use crate::error::{Error, Result};
 use crate::io::schema;
 use crate::io::urdf_schema::URDF_SCHEMA;
-use crate::io::xml::{location, parse_numbers};
+use crate::io::xml::{check_nesting, location, parse_numbers};
 use crate::io::{read_model_file, LoadOptions};
 use crate::joint::Joint;
 use crate::model::{
@@ -84,6 +84,7 @@ fn parse_urdf(
         options,
         warnings,
     };
+    check_nesting(source, document)?;
     let robot = document.root_element();
     if robot.tag_name().name() != "robot" {
         return Err(parser.error(robot, "expected the root element <robot>"));

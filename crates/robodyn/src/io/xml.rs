@@ -1,6 +1,32 @@
 //! Helpers shared by the XML loaders (URDF, MJCF): where an element is, and number lists.
 
+use crate::error::Error;
 use roxmltree::{Document, Node};
+
+/// The deepest element nesting a model file may have: the loaders walk the tree recursively, and
+/// a deeper file is refused rather than overflowing the stack (robot trees are a few dozen levels
+/// deep; MuJoCo's XML parser stops at 500).
+pub const MAX_NESTING: usize = 200;
+
+/// Refuses a document nested deeper than [`MAX_NESTING`] elements (walked with an explicit
+/// stack, so the check itself cannot overflow).
+pub(crate) fn check_nesting(source: &str, document: &Document) -> crate::Result<()> {
+    let mut pending = vec![(document.root_element(), 1usize)];
+    while let Some((node, depth)) = pending.pop() {
+        if depth > MAX_NESTING {
+            return Err(Error::model(
+                location(source, document, node),
+                format!("elements nested more than {MAX_NESTING} deep"),
+            ));
+        }
+        pending.extend(
+            node.children()
+                .filter(|c| c.is_element())
+                .map(|c| (c, depth + 1)),
+        );
+    }
+    Ok(())
+}
 
 /// "file: <element name='...'> (line n)"; an element without a name is shown under its nearest
 /// named ancestor below the document's root element, e.g. "<link name='arm'>/<inertial>".
