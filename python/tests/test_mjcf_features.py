@@ -75,3 +75,13 @@ def test_nested_includes_resolve_against_the_including_file(tmp_path):
     mj, model = mujoco_and_robodyn("nested/scene.xml")
     assert model.joint_names == ["shoulder", "elbow"]
     assert model.armature.tolist() == [0.02, 0.02] == mj.dof_armature.tolist()
+
+
+def test_the_medium_is_switched_off_for_the_comparison():
+    """robodyn models no fluid: a model in air (Menagerie's Crazyflie sets density and viscosity)
+    is compared with MuJoCo's rigid-body dynamics alone."""
+    text = (TEST_MJCF / "free_armature.xml").read_text().replace("<compiler", '<option density="1.225" viscosity="1.8e-5" wind="1 0 0"/><compiler')
+    mj = mujoco.MjModel.from_xml_string(text)
+    errors = mujoco_discrepancies(robodyn.load_mjcf_string(text), mj, seed=5, states=3)
+    assert max(errors.values()) < CROSS_CHECK_TOLERANCE
+    assert mj.opt.density == mj.opt.viscosity == 0.0 and not mj.opt.wind.any()
