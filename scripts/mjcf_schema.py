@@ -1,4 +1,4 @@
-"""Writes crates/robodyn/src/io/mjcf_schema.rs: the elements and attributes MuJoCo's MJCF reader
+"""Writes crates/robodyn/src/io/mjcf/schema_table.rs: the elements and attributes MuJoCo's MJCF reader
 knows, read from the schema MuJoCo itself prints (`mujoco.mj_printSchema`), so that robodyn refuses
 exactly the names MuJoCo refuses. Run after upgrading MuJoCo:
 
@@ -18,7 +18,7 @@ from pathlib import Path
 
 import mujoco
 
-TARGET = Path(__file__).resolve().parents[1] / "crates" / "robodyn" / "src" / "io" / "mjcf_schema.rs"
+TARGET = Path(__file__).resolve().parents[1] / "crates" / "robodyn" / "src" / "io" / "mjcf" / "schema_table.rs"
 #: the printed schema: an element per line, three spaces per level, its attributes from this column
 ATTRIBUTE_COLUMN = 30
 FRAME_ATTRIBUTES = ["axisangle", "childclass", "euler", "name", "pos", "quat", "xyaxes", "zaxis"]

@@ -9,7 +9,8 @@ max(1, max|mujoco|)``), after converting MuJoCo's conventions with
 - ``"bias"``: C(q, v) v + g(q) (from ``qfrc_bias``);
 - ``"forward_dynamics"``: q̈ for random τ (``qacc`` with ``qfrc_applied = τ``);
 - ``"inverse_dynamics"``: τ for random q̈ (``mj_rne``, plus the armature times ``qacc`` it leaves out);
-- ``"body_pose"``, ``"site_pose"``: every body's and site's position and rotation;
+- ``"body_pose"``, ``"site_pose"``: every named body's and site's position and rotation (an unnamed one
+  has no name to find it by in robodyn);
 - ``"jacobian"``: every body's world-aligned Jacobian (``mj_jacBody``);
 - ``"jacobian_dot_v"``: every body's J̇v, the classical acceleration at q̈ = 0 (``mj_jacDot``).
 
@@ -83,8 +84,11 @@ def mujoco_discrepancies(model, mj_model, seed: int = 0, states: int = 3) -> dic
         record("forward_dynamics", model.forward_dynamics(q, v, tau), layout.a_from_mujoco(q, v, data.qacc))
         # frames: the point's acceleration at robodyn q̈ = 0 is J_mj a_mj + J̇_mj v_mj
         a_mj = layout.a_to_mujoco(q, v, np.zeros(model.nv))
+        # bodies and sites by name (an unnamed one has no name to find it by in robodyn)
         for body in range(1, mj_model.nbody):
             name = mj_model.body(body).name
+            if not name:
+                continue
             pose = model.frame_pose(q, name)
             record("body_pose", pose[:3, 3], data.xpos[body])
             record("body_pose", pose[:3, :3], data.xmat[body].reshape(3, 3))
@@ -95,6 +99,8 @@ def mujoco_discrepancies(model, mj_model, seed: int = 0, states: int = 3) -> dic
             expected = jacobian @ a_mj + np.vstack([jacp_dot, jacr_dot]) @ v_mj
             record("jacobian_dot_v", model.jacobian_time_variation(q, v, name) @ v, expected)
         for site in range(mj_model.nsite):
+            if not mj_model.site(site).name:
+                continue
             pose = model.frame_pose(q, mj_model.site(site).name)
             record("site_pose", pose[:3, 3], data.site_xpos[site])
             record("site_pose", pose[:3, :3], data.site_xmat[site].reshape(3, 3))

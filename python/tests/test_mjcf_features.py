@@ -13,7 +13,7 @@ import robodyn
 from robodyn.crosscheck import mujoco_discrepancies, rigid_body_only
 
 TEST_MJCF = REPOSITORY / "testdata" / "mjcf"
-FEATURE_MODELS = ["nested/scene.xml", "compiler_mass.xml", "free_armature.xml"]
+FEATURE_MODELS = ["nested/scene.xml", "compiler_mass.xml", "free_armature.xml", "framed_joints.xml"]
 
 
 def mujoco_and_robodyn(name):

@@ -236,7 +236,7 @@ def test_mjcf_include(tmp_path):
         ("<mujoco><worldbody><body name='x'><inertial mass='1' diaginertia='0.1 0.1 1'/><joint/></body></worldbody></mujoco>",
          r"<body name='x'> \(line 1\): the principal moments .* must satisfy A \+ B >= C \(use <compiler balanceinertia"),
         ("<mujoco><worldbody><replicate count='2'/></worldbody></mujoco>", "<replicate> is not supported"),
-        ("<mujoco><worldbody><frame><joint/></frame></worldbody></mujoco>", "not in a <frame>"),
+        ("<mujoco><worldbody><frame><joint/></frame></worldbody></mujoco>", "the world body cannot have joints"),
         ("<mujoco><worldbody><body name='x'><inertial mass='1' diaginertia='1 1 1'/><joint type='ball' ref='1'/></body></worldbody></mujoco>", "'ref': only hinge and slide"),
         ("<mujoco><worldbody><body name='x'><inertial mass='1' diaginertia='1 1 1'/><joint type='screw'/></body></worldbody></mujoco>", "unknown joint type 'screw'"),
         ("<mujoco><default><default><joint/></default></default></mujoco>", "needs a 'class'"),

@@ -68,9 +68,9 @@ def test_frames_and_includes_are_checked_too(tmp_path):
 
 
 def test_the_schema_table_is_mujocos():
-    """crates/robodyn/src/io/mjcf_schema.rs is what scripts/mjcf_schema.py makes of the installed
+    """crates/robodyn/src/io/mjcf/schema_table.rs is what scripts/mjcf_schema.py makes of the installed
     MuJoCo's schema (when it is the version the table says)."""
-    table = (REPOSITORY / "crates/robodyn/src/io/mjcf_schema.rs").read_text()
+    table = (REPOSITORY / "crates/robodyn/src/io/mjcf/schema_table.rs").read_text()
     version = re.search(r"as MuJoCo (\S+) reads them", table).group(1)
     assert version == mujoco.__version__, f"the table is MuJoCo {version}'s; run scripts/mjcf_schema.py for {mujoco.__version__}"
     result = subprocess.run([sys.executable, str(REPOSITORY / "scripts/mjcf_schema.py"), "--check"], capture_output=True, text=True)

@@ -4,8 +4,6 @@
 pub mod bundled;
 pub mod dh;
 pub mod mjcf;
-mod mjcf_mass;
-mod mjcf_schema;
 mod schema;
 pub mod urdf;
 mod urdf_schema;

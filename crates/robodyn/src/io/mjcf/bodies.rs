@@ -1,0 +1,283 @@
+//! The body tree of an MJCF file: bodies, their joints (those in `<frame>`s too), sites and
+//! frames, into the model builder.
+
+use super::Reader;
+use crate::error::Result;
+use crate::joint::Joint;
+use crate::model::{JointProperties, ModelBuilder, NewBody};
+use crate::spatial::{Inertia, Transform, Vec3};
+use nalgebra::Unit;
+use roxmltree::Node;
+
+/// Whether `element` is a `<frame>` of the worldbody itself (not of one of its bodies).
+fn in_world_frame(element: Node) -> bool {
+    element.has_tag_name("frame")
+        && element
+            .ancestors()
+            .skip(1)
+            .find(|a| a.has_tag_name("body") || a.has_tag_name("worldbody"))
+            .is_some_and(|a| a.has_tag_name("worldbody"))
+}
+
+impl<'a> Reader<'a> {
+    /// The elements among a body's `elements` whose tag is one of `tags`, its own and those inside
+    /// its `<frame>`s (document order), each with `X_{frame←body}` (the identity for its own) and
+    /// the class in effect there.
+    pub(super) fn framed_elements<'c>(
+        &self,
+        elements: &[Node<'a, 'a>],
+        class: &'c str,
+        tags: &[&str],
+        to_frame: Transform,
+        found: &mut Vec<(Node<'a, 'a>, Transform, &'c str)>,
+    ) -> Result<()>
+    where
+        'a: 'c,
+    {
+        for element in elements {
+            let tag = element.tag_name().name();
+            if tags.contains(&tag) {
+                found.push((*element, to_frame, class));
+            } else if tag == "frame" {
+                let inner_class = self.declared_class(*element, "childclass", class)?;
+                let inner = self.placement(*element, class)? * to_frame;
+                self.framed_elements(&self.children(*element)?, inner_class, tags, inner, found)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The children of a body element (or the worldbody) attached to model body `body`, whose
+    /// frame is at `to_element` (`X_{element←body}`).
+    pub(super) fn read_children(
+        &self,
+        builder: &mut ModelBuilder,
+        element: Node<'a, 'a>,
+        body: usize,
+        to_element: Transform,
+        class: &str,
+    ) -> Result<()> {
+        for child in self.children(element)? {
+            match child.tag_name().name() {
+                "site" => {
+                    let name = child
+                        .attribute("name")
+                        .map_or_else(|| format!("site{}", child.range().start), str::to_string);
+                    let site_class = self.declared_class(child, "class", class)?;
+                    let kind = self
+                        .attribute(child, site_class, "type")
+                        .unwrap_or_else(|| "sphere".to_string());
+                    let placement = match self.segment(child, site_class, &kind)? {
+                        Some((segment, _)) => segment,
+                        None => self.placement(child, site_class)?,
+                    };
+                    builder.add_frame(&name, body, placement * to_element);
+                }
+                "body" => self.read_body(builder, child, body, to_element, class)?,
+                // a <frame> only places what it holds: its pose composes with theirs
+                "frame" => {
+                    let to_frame = self.placement(child, class)? * to_element;
+                    let frame_class = self.declared_class(child, "childclass", class)?;
+                    self.read_children(builder, child, body, to_frame, frame_class)?;
+                }
+                // in a body's <frame>s they are read with the body; the world has none
+                "joint" | "freejoint" | "inertial" if in_world_frame(element) => {
+                    return Err(self.error(
+                        child,
+                        "the world body cannot have joints or an inertial (as in MuJoCo)",
+                    ));
+                }
+                tag @ ("replicate" | "attach" | "composite" | "flexcomp") => {
+                    return Err(self.error(child, format!("<{tag}> is not supported")));
+                }
+                // joints, inertials and geoms are read with their body; cameras, lights and
+                // plugins are not part of the tree
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    pub(super) fn read_body(
+        &self,
+        builder: &mut ModelBuilder,
+        node: Node<'a, 'a>,
+        parent: usize,
+        parent_element: Transform,
+        class: &str,
+    ) -> Result<()> {
+        let name = node
+            .attribute("name")
+            .map_or_else(|| format!("body{}", node.range().start), str::to_string);
+        let child_class = self.declared_class(node, "childclass", class)?;
+        // X_{B←parent body}
+        let mut to_body = self.placement(node, class)? * parent_element;
+        let elements = self.children(node)?;
+        let inertia = self
+            .mass_rules
+            .apply_to_body(self.body_inertia(&elements, child_class)?)
+            .map_err(|m| self.error(node, m))?;
+        self.total_mass.set(self.total_mass.get() + inertia.mass);
+        // the body's joints, those in its <frame>s too, with X_{frame←body}
+        let mut joints = Vec::new();
+        self.framed_elements(
+            &elements,
+            child_class,
+            &["joint", "freejoint"],
+            Transform::IDENTITY,
+            &mut joints,
+        )?;
+        if joints.is_empty() {
+            // no joint: merged into the parent, kept as a frame
+            builder.add_fixed_link(parent, to_body, inertia, &name);
+            return self.read_children(builder, node, parent, to_body, child_class);
+        }
+        let mut body = parent;
+        let mut previous_position = Vec3::zeros();
+        for (k, (joint_node, to_frame, frame_class)) in joints.iter().enumerate() {
+            let joint_class = self.declared_class(*joint_node, "class", frame_class)?;
+            // a joint in a <frame> has its pos and axis in the frame's axes
+            let in_body = to_frame.rotation.transpose();
+            let kind = if joint_node.has_tag_name("freejoint") {
+                "free".to_string()
+            } else {
+                self.attribute(*joint_node, joint_class, "type")
+                    .unwrap_or_else(|| "hinge".to_string())
+            };
+            let axis = in_body
+                * Vec3::from(
+                    self.numbers::<3>(*joint_node, joint_class, "axis")?
+                        .unwrap_or([0.0, 0.0, 1.0]),
+                );
+            let unit_axis = || {
+                Unit::try_new(axis, 1e-12)
+                    .map(|a| a.into_inner())
+                    .ok_or_else(|| {
+                        self.error(*joint_node, "attribute 'axis': expected a non-zero vector")
+                    })
+            };
+            let joint = match kind.as_str() {
+                "hinge" => Joint::Revolute { axis: unit_axis()? },
+                "slide" => Joint::Prismatic { axis: unit_axis()? },
+                "ball" => Joint::Spherical,
+                "free" => Joint::Free,
+                other => {
+                    return Err(self.error(
+                        *joint_node,
+                        format!(
+                            "unknown joint type '{other}': expected hinge, slide, ball or free"
+                        ),
+                    ))
+                }
+            };
+            let position = if joint == Joint::Free {
+                Vec3::zeros()
+            } else {
+                in_body
+                    * Vec3::from(
+                        self.numbers::<3>(*joint_node, joint_class, "pos")?
+                            .unwrap_or([0.0; 3]),
+                    )
+                    + to_frame.translation
+            };
+            let scalar = |key: &str, default: f64| -> Result<f64> {
+                Ok(self
+                    .numbers::<1>(*joint_node, joint_class, key)?
+                    .map_or(default, |[x]| x))
+            };
+            // a hinge's positions (range, ref, springref) are angles in the compiler's unit
+            let position_unit = |x: f64| {
+                if matches!(joint, Joint::Revolute { .. }) {
+                    self.angle(x)
+                } else {
+                    x
+                }
+            };
+            let mut properties = JointProperties {
+                armature: scalar("armature", 0.0)?,
+                damping: scalar("damping", 0.0)?,
+                friction: scalar("frictionloss", 0.0)?,
+                stiffness: scalar("stiffness", 0.0)?,
+                spring_reference: position_unit(scalar("springref", 0.0)?),
+                ..JointProperties::default()
+            };
+            let limited = self
+                .attribute(*joint_node, joint_class, "limited")
+                .is_none_or(|l| l != "false");
+            if let (true, Some([lower, upper])) = (
+                limited,
+                self.numbers::<2>(*joint_node, joint_class, "range")?,
+            ) {
+                properties.lower = position_unit(lower);
+                properties.upper = position_unit(upper);
+            }
+            // `ref`: the joint position at which the body has its XML pose, so the joint moves
+            // by q − ref: X_J(q − ref) X_tree = X_J(q) X_J(−ref) X_tree
+            let reference = position_unit(scalar("ref", 0.0)?);
+            let shift_by_reference = match (reference, joint.nq()) {
+                (0.0, _) => Transform::IDENTITY,
+                (_, 1) => joint.transform(&[-reference]),
+                _ => {
+                    return Err(self.error(
+                        *joint_node,
+                        "attribute 'ref': only hinge and slide joints take one",
+                    ))
+                }
+            };
+            // a free joint places the body in the world: its XML pose is only MuJoCo's qpos0
+            let x_tree = if joint == Joint::Free {
+                if k > 0
+                    || !node
+                        .parent_element()
+                        .is_some_and(|p| p.has_tag_name("worldbody"))
+                {
+                    return Err(self.error(
+                        *joint_node,
+                        "a free joint must be the only joint of a child of the worldbody",
+                    ));
+                }
+                Transform::IDENTITY
+            } else if k == 0 {
+                // the joint frame sits at `pos` in the body's frame
+                shift_by_reference * Transform::from_translation(&position) * to_body
+            } else {
+                shift_by_reference * Transform::from_translation(&(position - previous_position))
+            };
+            let joint_name = joint_node
+                .attribute("name")
+                .map_or_else(|| format!("{name}_joint{k}"), str::to_string);
+            let last = k + 1 == joints.len();
+            // the body's own frame, relative to the last joint frame: X_{B←J} = translation(-pos)
+            let to_own_frame = if joint == Joint::Free {
+                Transform::IDENTITY
+            } else {
+                Transform::from_translation(&(-position))
+            };
+            // the model body carries the MJCF body's name when their frames coincide
+            let body_name = if last && to_own_frame == Transform::IDENTITY {
+                name.clone()
+            } else {
+                format!("{name}/{joint_name}")
+            };
+            body = builder.add_body(NewBody {
+                parent: body,
+                joint,
+                joint_name: &joint_name,
+                x_tree,
+                properties,
+                name: &body_name,
+                inertia: if last {
+                    to_own_frame.transpose_apply_inertia(&inertia)
+                } else {
+                    Inertia::ZERO
+                },
+            })?;
+            previous_position = position;
+            to_body = to_own_frame;
+        }
+        if to_body != Transform::IDENTITY {
+            builder.add_frame(&name, body, to_body);
+        }
+        self.read_children(builder, node, body, to_body, child_class)
+    }
+}

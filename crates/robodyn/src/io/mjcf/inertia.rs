@@ -1,0 +1,253 @@
+//! The inertia of an MJCF body: from its `<inertial>` or from its geoms.
+//!
+//! Inertia from geoms, as MuJoCo's compiler computes it: each primitive is a solid of uniform
+//! density (`density`, default 1000 kg/m³, or the geom's `mass`; with `fromto`, the segment is the
+//! z axis, and a box or ellipsoid on it has x and y half-sizes both `size[0]`) whose principal
+//! moments about its centre are, with m its mass,
+//!   sphere of radius r:            ⅖ m r² (all three)
+//!   ellipsoid of semi-axes a,b,c:  m(b²+c²)/5, m(a²+c²)/5, m(a²+b²)/5
+//!   box of half-sides a,b,c:       m(b²+c²)/3, m(a²+c²)/3, m(a²+b²)/3
+//!   cylinder, radius r, length L:  m(3r²+L²)/12 across, m r²/2 along its axis
+//!   capsule, cylinder (mass m_c, length L) and two hemispheres (together a sphere of mass m_s):
+//!     across m_c(L²/12 + r²/4) + m_s(2r²/5 + L²/4 + 3Lr/8), along m_c r²/2 + m_s 2r²/5
+//! and the body's inertia is their sum, each shifted from its own pose (parallel-axis theorem).
+
+use super::Reader;
+use crate::error::Result;
+use crate::io::xml::parse_number_list;
+use crate::model::{check_mass_and_inertia, check_positive_semidefinite};
+use crate::spatial::{Inertia, Mat3, Transform, Vec3};
+use nalgebra::Rotation3;
+use roxmltree::Node;
+use std::f64::consts::PI;
+
+/// MuJoCo's default geom density, kg/m³ (water).
+const DEFAULT_DENSITY: f64 = 1000.0;
+
+/// `<compiler inertiafromgeom>`: where a body's inertia comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum InertiaFromGeoms {
+    /// From `<inertial>` when the body has one, else from its geoms (MuJoCo's default).
+    Auto,
+    /// Always from the geoms.
+    Always,
+    /// Only from `<inertial>`; a body without one is massless.
+    Never,
+}
+
+impl<'a> Reader<'a> {
+    /// A geom's or site's `fromto` (x1 y1 z1 x2 y2 z2), when it has one: the frame at the
+    /// segment's midpoint with z pointing from the second point to the first (the shortest
+    /// rotation from z, as MuJoCo places it), and the half-length. Only capsules, cylinders, boxes
+    /// and ellipsoids take one.
+    pub(super) fn segment(
+        &self,
+        node: Node<'a, 'a>,
+        class: &str,
+        kind: &str,
+    ) -> Result<Option<(Transform, f64)>> {
+        let Some([x1, y1, z1, x2, y2, z2]) = self.numbers::<6>(node, class, "fromto")? else {
+            return Ok(None);
+        };
+        let (from, to) = (Vec3::new(x1, y1, z1), Vec3::new(x2, y2, z2));
+        let axis = from - to;
+        let half_length = axis.norm() / 2.0;
+        if half_length == 0.0 || !matches!(kind, "capsule" | "cylinder" | "box" | "ellipsoid") {
+            return Err(self.error(
+                node,
+                "attribute 'fromto': expected two distinct points on a capsule, cylinder, box or ellipsoid",
+            ));
+        }
+        let rotation = Rotation3::rotation_between(&Vec3::z(), &axis)
+            .unwrap_or_else(|| Rotation3::from_axis_angle(&Vec3::x_axis(), PI));
+        Ok(Some((
+            Transform::from_pose(rotation.matrix(), &((from + to) / 2.0)),
+            half_length,
+        )))
+    }
+
+    /// The spatial inertia of a body, in its frame: from `<inertial>` or from its geoms, as
+    /// `<compiler inertiafromgeom>` says.
+    pub(super) fn body_inertia(&self, elements: &[Node<'a, 'a>], class: &str) -> Result<Inertia> {
+        let mut inertials = Vec::new();
+        self.framed_elements(
+            elements,
+            class,
+            &["inertial"],
+            Transform::IDENTITY,
+            &mut inertials,
+        )?;
+        match (self.inertia_from_geoms, inertials.first()) {
+            (InertiaFromGeoms::Never, None) => Ok(Inertia::ZERO),
+            (
+                InertiaFromGeoms::Auto | InertiaFromGeoms::Never,
+                Some((inertial, to_frame, class)),
+            ) => Ok(to_frame.transpose_apply_inertia(&self.inertial(*inertial, class)?)),
+            // each geom's mass and inertia is checked where it is read
+            (InertiaFromGeoms::Always, _) | (InertiaFromGeoms::Auto, None) => {
+                self.geoms_inertia(elements, class)
+            }
+        }
+    }
+
+    /// The inertia of the geoms among `elements` and inside their `<frame>`s, in the frame the
+    /// elements are written in.
+    pub(super) fn geoms_inertia(&self, elements: &[Node<'a, 'a>], class: &str) -> Result<Inertia> {
+        let mut total = Inertia::ZERO;
+        for element in elements {
+            if element.has_tag_name("geom") {
+                total += self.geom_inertia(*element, class)?;
+            } else if element.has_tag_name("frame") {
+                let inner_class = self.declared_class(*element, "childclass", class)?;
+                let inside = self.geoms_inertia(&self.children(*element)?, inner_class)?;
+                total += self
+                    .placement(*element, class)?
+                    .transpose_apply_inertia(&inside);
+            }
+        }
+        Ok(total)
+    }
+
+    /// `<inertial>`: mass, centre of mass and the inertia about it, in the body's frame.
+    pub(super) fn inertial(&self, inertial: Node<'a, 'a>, class: &str) -> Result<Inertia> {
+        let mass = self
+            .numbers::<1>(inertial, class, "mass")?
+            .ok_or_else(|| self.error(inertial, "missing attribute 'mass'"))?[0];
+        let principal =
+            if let Some([a, b, c]) = self.numbers::<3>(inertial, class, "diaginertia")? {
+                Mat3::from_diagonal(&Vec3::new(a, b, c))
+            } else if let Some([xx, yy, zz, xy, xz, yz]) =
+                self.numbers::<6>(inertial, class, "fullinertia")?
+            {
+                Mat3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
+            } else {
+                // MuJoCo reads an <inertial> without a tensor as a point mass
+                Mat3::zeros()
+            };
+        let frame = self.placement(inertial, class)?;
+        self.inertia_in_body(inertial, mass, &principal, &frame)
+    }
+
+    /// A solid of `mass` whose inertia about its centre, in its own axes, is `principal`, placed
+    /// at `X_{element←body}`: its spatial inertia in the body's frame (I_body = R I Rᵀ at the
+    /// centre, shifted by the parallel-axis theorem inside `Inertia::from_com`).
+    pub(super) fn inertia_in_body(
+        &self,
+        element: Node<'a, 'a>,
+        mass: f64,
+        principal: &Mat3,
+        frame: &Transform,
+    ) -> Result<Inertia> {
+        let rotation = frame.rotation.transpose();
+        let inertia_com = rotation * principal * rotation.transpose();
+        check_mass_and_inertia(mass, &inertia_com)
+            .and_then(|_| check_positive_semidefinite(&inertia_com))
+            .map_err(|m| self.error(element, m))?;
+        Ok(Inertia::from_com(mass, &frame.translation, &inertia_com))
+    }
+
+    /// The inertia of a primitive `<geom>` of uniform density, in the body's frame.
+    pub(super) fn geom_inertia(&self, geom: Node<'a, 'a>, class: &str) -> Result<Inertia> {
+        let class = self.declared_class(geom, "class", class)?;
+        let text = |name: &str| self.attribute(geom, class, name);
+        let group = match text("group") {
+            None => 0,
+            Some(g) => g.trim().parse::<i64>().map_err(|_| {
+                self.error(
+                    geom,
+                    format!("attribute 'group': expected an integer, got '{g}'"),
+                )
+            })?,
+        };
+        if group < self.inertia_groups.0 || group > self.inertia_groups.1 {
+            return Ok(Inertia::ZERO);
+        }
+        let given_mass = self.numbers::<1>(geom, class, "mass")?.map(|[m]| m);
+        if given_mass == Some(0.0) {
+            return Ok(Inertia::ZERO);
+        }
+        let kind = text("type").unwrap_or_else(|| "sphere".to_string());
+        let mut size = match text("size") {
+            Some(t) => parse_number_list(&t, "size").map_err(|m| self.error(geom, m))?,
+            None => Vec::new(),
+        };
+        // `fromto`: the geom spans the segment; its axis is z, its half-length the last size
+        let mut frame = self.placement(geom, class)?;
+        if let Some((segment, half_length)) = self.segment(geom, class, &kind)? {
+            let radius = size.first().copied().unwrap_or(0.0);
+            // a box or ellipsoid along the segment has a square or round section of size[0]
+            size = if matches!(kind.as_str(), "box" | "ellipsoid") {
+                vec![radius, radius, half_length]
+            } else {
+                vec![radius, half_length]
+            };
+            frame = segment;
+        }
+        let needed = match kind.as_str() {
+            "sphere" => 1,
+            "capsule" | "cylinder" => 2,
+            "ellipsoid" | "box" => 3,
+            "mesh" | "sdf" => {
+                return Err(self.error(
+                    geom,
+                    format!("the inertia of a {kind} geom needs its file, which robodyn does not read: give the body an <inertial>"),
+                ))
+            }
+            other => {
+                return Err(self.error(
+                    geom,
+                    format!("a '{other}' geom has no volume to give the body an inertia: give the body an <inertial>"),
+                ))
+            }
+        };
+        if size.len() < needed || size[..needed].iter().any(|x| *x <= 0.0) {
+            return Err(self.error(
+                geom,
+                format!("attribute 'size': a {kind} needs {needed} positive numbers, got {size:?}"),
+            ));
+        }
+        // volume, and the principal moments per unit mass about the centre
+        let (volume, per_mass) = match kind.as_str() {
+            "sphere" => {
+                let r = size[0];
+                (4.0 / 3.0 * PI * r.powi(3), Vec3::repeat(0.4 * r * r))
+            }
+            "ellipsoid" => {
+                let (a, b, c) = (size[0], size[1], size[2]);
+                let moments = Vec3::new(b * b + c * c, a * a + c * c, a * a + b * b) / 5.0;
+                (4.0 / 3.0 * PI * a * b * c, moments)
+            }
+            "box" => {
+                let (a, b, c) = (size[0], size[1], size[2]);
+                let moments = Vec3::new(b * b + c * c, a * a + c * c, a * a + b * b) / 3.0;
+                (8.0 * a * b * c, moments)
+            }
+            "cylinder" => {
+                let (r, length) = (size[0], 2.0 * size[1]);
+                let across = (3.0 * r * r + length * length) / 12.0;
+                (PI * r * r * length, Vec3::new(across, across, r * r / 2.0))
+            }
+            _ => {
+                // capsule: the mass splits between the cylinder and the two hemispheres by volume
+                let (r, length) = (size[0], 2.0 * size[1]);
+                let (cylinder, sphere) = (PI * r * r * length, 4.0 / 3.0 * PI * r.powi(3));
+                let volume = cylinder + sphere;
+                let (m_c, m_s) = (cylinder / volume, sphere / volume);
+                let across = m_c * (length * length / 12.0 + r * r / 4.0)
+                    + m_s * (0.4 * r * r + length * length / 4.0 + 3.0 * length * r / 8.0);
+                let along = m_c * r * r / 2.0 + m_s * 0.4 * r * r;
+                (volume, Vec3::new(across, across, along))
+            }
+        };
+        let mass = match given_mass {
+            Some(mass) => mass,
+            None => {
+                self.numbers::<1>(geom, class, "density")?
+                    .map_or(DEFAULT_DENSITY, |[d]| d)
+                    * volume
+            }
+        };
+        let moments = per_mass * mass;
+        self.inertia_in_body(geom, mass, &Mat3::from_diagonal(&moments), &frame)
+    }
+}
