@@ -13,7 +13,7 @@ import robodyn
 from robodyn.crosscheck import mujoco_discrepancies, rigid_body_only
 
 TEST_MJCF = REPOSITORY / "testdata" / "mjcf"
-FEATURE_MODELS = ["nested/scene.xml", "compiler_mass.xml", "free_armature.xml", "framed_joints.xml"]
+FEATURE_MODELS = ["nested/scene.xml", "compiler_mass.xml", "free_armature.xml", "framed_joints.xml", "mesh_inertia.xml"]
 
 
 def mujoco_and_robodyn(name):
@@ -85,3 +85,27 @@ def test_the_medium_is_switched_off_for_the_comparison():
     errors = mujoco_discrepancies(robodyn.load_mjcf_string(text), mj, seed=5, states=3)
     assert max(errors.values()) < CROSS_CHECK_TOLERANCE
     assert mj.opt.density == mj.opt.viscosity == 0.0 and not mj.opt.wind.any()
+
+
+def test_mesh_inertia_gives_mujocos_masses():
+    mj, model = mujoco_and_robodyn("mesh_inertia.xml")
+    np.testing.assert_allclose(model.body_masses, mj.body_mass[1:], rtol=1e-13)
+
+
+MESH_ERRORS = [
+    ('<mesh name="m" file="missing.stl"/>', r"mesh file 'missing.stl' not found; tried .*meshes/missing.stl"),
+    ('<mesh name="m" file="box.stl" inertia="convex"/>', "inertia='convex' needs the mesh's convex hull"),
+    ('<mesh name="m" file="box.stl" inertia="solid"/>', "attribute 'inertia': expected legacy, exact, shell or convex, got 'solid'"),
+    ('<mesh name="m" file="make_meshes.py"/>', r"expected a mesh file ending in \.stl, \.obj or \.msh"),
+]
+
+
+@pytest.mark.parametrize(("mesh", "message"), MESH_ERRORS, ids=[m for m, _ in MESH_ERRORS])
+def test_mesh_errors_name_the_mesh(mesh, message, tmp_path):
+    text = f"""<mujoco><compiler meshdir="{REPOSITORY / 'testdata' / 'meshes'}"/><asset>{mesh}</asset>
+      <worldbody><body name="b"><joint/><geom type="mesh" mesh="m"/></body></worldbody></mujoco>"""
+    path = tmp_path / "model.xml"
+    path.write_text(text)
+    with pytest.raises(ValueError, match=message) as error:
+        robodyn.load(path)
+    assert "<mesh name='m'>" in str(error.value) and "model.xml" in str(error.value)

@@ -86,7 +86,7 @@ fn tree_classes_and_degrees() {
 #[test]
 fn errors_name_element_and_line() {
     let cases = [
-        ("<mujoco><worldbody>\n<body name='x'><geom type='mesh' mesh='m'/></body></worldbody></mujoco>", "<body name='x'>/<geom> (line 2): the inertia of a mesh geom needs its file"),
+        ("<mujoco><worldbody>\n<body name='x'><geom type='mesh' mesh='m'/></body></worldbody></mujoco>", "<body name='x'>/<geom> (line 2): attribute 'mesh': no <mesh name='m'> in the <asset>s"),
         ("<mujoco><compiler angle='grad'/></mujoco>", "attribute 'angle'"),
         ("<mujoco><worldbody><body name='x'><body name='y'><freejoint/><inertial mass='1' diaginertia='1 1 1'/></body></body></worldbody></mujoco>", "a free joint must be"),
         ("<mujoco><worldbody><body name='x'><inertial mass='-1' diaginertia='1 1 1'/></body></worldbody></mujoco>", "mass >= 0"),

@@ -14,10 +14,10 @@
 //! Every element and attribute is first checked against MuJoCo's schema (`schema_table.rs`): an
 //! unknown name is an error, as in MuJoCo.
 //! Not read (a warning each): actuators, sensors, contacts, equality constraints, tendons,
-//! keyframes, assets. A mesh geom cannot give a body its inertia here (the mesh file is not read):
-//! such a body needs an `<inertial>`, and the error says so.
+//! keyframes. Of the assets, the meshes are read, for the inertia of mesh geoms (`mjcf/meshes.rs`).
 
 use crate::error::{Error, Result};
+use crate::io::mesh::MeshMassProperties;
 use crate::io::read_model_file;
 use crate::io::schema;
 use crate::io::xml::{check_nesting, location, parse_numbers};
@@ -25,13 +25,14 @@ use crate::model::{Model, ModelBuilder};
 use crate::spatial::{Mat3, Transform, Vec3};
 use nalgebra::{Rotation3, Unit, UnitQuaternion};
 use roxmltree::{Document, Node};
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 mod bodies;
 mod inertia;
 mod mass;
+mod meshes;
 mod schema_table;
 
 use inertia::InertiaFromGeoms;
@@ -39,14 +40,13 @@ use mass::MassRules;
 use schema_table::MJCF_SCHEMA;
 
 /// Sections of an MJCF file that do not describe the tree.
-const IGNORED_SECTIONS: [&str; 9] = [
+const IGNORED_SECTIONS: [&str; 8] = [
     "actuator",
     "sensor",
     "contact",
     "equality",
     "tendon",
     "keyframe",
-    "asset",
     "visual",
     "statistic",
 ];
@@ -153,6 +153,9 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         defaults: HashMap::new(),
         mass_rules: MassRules::default(),
         total_mass: Cell::new(0.0),
+        meshes: HashMap::new(),
+        mesh_directory: None,
+        mesh_cache: RefCell::new(HashMap::new()),
     };
     if !root.has_tag_name("mujoco") {
         return Err(reader.error(root, "expected the root element <mujoco>"));
@@ -171,6 +174,9 @@ fn load_sources(sources: &Sources) -> Result<Model> {
     }
     for default in sections.iter().filter(|c| c.has_tag_name("default")) {
         reader.read_defaults(*default, None)?;
+    }
+    for asset in sections.iter().filter(|c| c.has_tag_name("asset")) {
+        reader.read_mesh_assets(*asset)?;
     }
     let mut builder = ModelBuilder::new(root.attribute("model").unwrap_or("mjcf"), "world");
     builder.add_frame("world", 0, Transform::IDENTITY);
@@ -212,6 +218,11 @@ struct Reader<'a> {
     mass_rules: MassRules,
     /// the mass of every body read so far, those welded to the world included
     total_mass: Cell<f64>,
+    /// `<asset><mesh>` elements by name, `<compiler meshdir>` (or `assetdir`), and each mesh's
+    /// mass properties once computed
+    meshes: HashMap<String, Node<'a, 'a>>,
+    mesh_directory: Option<String>,
+    mesh_cache: RefCell<HashMap<String, MeshMassProperties>>,
 }
 
 impl<'a> Reader<'a> {
@@ -293,7 +304,14 @@ impl<'a> Reader<'a> {
                 .map_err(|m| self.error(compiler, m))?;
             self.inertia_groups = (low as i64, high as i64);
         }
-        // the options that rewrite masses and inertias (mjcf_mass.rs)
+        // where mesh files are: meshdir, else assetdir
+        if let Some(folder) = compiler
+            .attribute("meshdir")
+            .or(compiler.attribute("assetdir"))
+        {
+            self.mesh_directory = Some(folder.to_string());
+        }
+        // the options that rewrite masses and inertias (mjcf/mass.rs)
         let number = |name: &str| -> Result<Option<f64>> {
             compiler
                 .attribute(name)

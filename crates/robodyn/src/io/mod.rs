@@ -3,6 +3,7 @@
 
 pub mod bundled;
 pub mod dh;
+pub mod mesh;
 pub mod mjcf;
 mod schema;
 pub mod urdf;

@@ -187,10 +187,14 @@ impl<'a> Reader<'a> {
             "sphere" => 1,
             "capsule" | "cylinder" => 2,
             "ellipsoid" | "box" => 3,
-            "mesh" | "sdf" => {
+            "mesh" => {
+                let density = self.numbers::<1>(geom, class, "density")?.map_or(DEFAULT_DENSITY, |[d]| d);
+                return self.mesh_geom_inertia(geom, class, &frame, given_mass, density);
+            }
+            "sdf" => {
                 return Err(self.error(
                     geom,
-                    format!("the inertia of a {kind} geom needs its file, which robodyn does not read: give the body an <inertial>"),
+                    "an sdf geom's inertia comes from its plugin, which robodyn does not run: give the body an <inertial>",
                 ))
             }
             other => {
@@ -200,6 +204,18 @@ impl<'a> Reader<'a> {
                 ))
             }
         };
+        if text("shellinertia").as_deref() == Some("true") {
+            return Err(self.error(
+                geom,
+                format!("attribute 'shellinertia': a hollow {kind} is not supported (only a mesh's shell): give the body an <inertial>"),
+            ));
+        }
+        if text("mesh").is_some() {
+            return Err(self.error(
+                geom,
+                format!("a {kind} fitted to a mesh is not supported: give the body an <inertial>"),
+            ));
+        }
         if size.len() < needed || size[..needed].iter().any(|x| *x <= 0.0) {
             return Err(self.error(
                 geom,

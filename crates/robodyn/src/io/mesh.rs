@@ -1,0 +1,441 @@
+//! Triangle meshes: reading STL (binary or ASCII, with `stl_io`), Wavefront OBJ (with `tobj`) and
+//! MuJoCo's binary `.msh`, and their mass properties as MuJoCo's compiler computes them
+//! (MJCF reference, `<mesh inertia>`):
+//!
+//! - vertex coordinates are read as the files store them (float32) and then transformed in double
+//!   precision: moved by −`refpos`, rotated by `refquat`ᵀ, scaled by `scale` (a left-handed
+//!   scale reverses every face, so that normals keep pointing out);
+//! - c_f, the area-weighted centroid of the faces, is the apex of one pyramid per face;
+//! - volume V = Σ_f (c_t − c_f)·n_t A_t / 3 over the triangles t (n_t the unit normal, A_t the
+//!   area, c_t the centroid), and the centre of mass Σ V_t (¾ c_t + ¼ c_f) / V;
+//! - about the centre of mass, with D, E, F a triangle's corners relative to it, the second
+//!   moments P_jk = Σ_t V_t / C (2(D_j D_k + E_j E_k + F_j F_k) + D_j E_k + D_k E_j + D_j F_k + D_k F_j
+//!   + E_j F_k + E_k F_j), C = 20 (solid) or 12 (shell), and I = tr(P) 1 − P (unit density).
+//!
+//! The `inertia` modes: `legacy` (MuJoCo's default) takes |V_t|, so a mesh with flipped faces still
+//! counts them; `exact` takes the signed V_t and refuses faces of inconsistent orientation; `shell`
+//! puts the mass on the surface (V_t = A_t); `convex` needs the convex hull, which robodyn does not
+//! build, and is refused by name.
+
+use crate::spatial::{Mat3, Vec3};
+use nalgebra::UnitQuaternion;
+use std::io::Cursor;
+
+/// Below this an area or volume is zero (MuJoCo's mjMINVAL).
+const MIN_VALUE: f64 = 1e-15;
+
+/// A mesh as read from its file: vertices and triangles (indices into the vertices).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TriangleMesh {
+    pub vertices: Vec<Vec3>,
+    pub faces: Vec<[usize; 3]>,
+}
+
+/// How a mesh's inertia is computed (`<mesh inertia>`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshInertia {
+    Legacy,
+    Exact,
+    Shell,
+    Convex,
+}
+
+impl MeshInertia {
+    /// From the attribute's value.
+    pub fn from_name(name: &str) -> Result<Self, String> {
+        match name {
+            "legacy" => Ok(MeshInertia::Legacy),
+            "exact" => Ok(MeshInertia::Exact),
+            "shell" => Ok(MeshInertia::Shell),
+            "convex" => Ok(MeshInertia::Convex),
+            other => Err(format!(
+                "attribute 'inertia': expected legacy, exact, shell or convex, got '{other}'"
+            )),
+        }
+    }
+}
+
+/// A mesh's mass properties at unit density: its volume (or area, for a shell), centre of mass
+/// and rotational inertia about the centre of mass, in the mesh's (transformed) frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MeshMassProperties {
+    pub volume: f64,
+    pub com: Vec3,
+    pub inertia: Mat3,
+}
+
+/// Reads a mesh file by its extension: `.stl`, `.obj` or `.msh`.
+pub fn read_mesh(bytes: &[u8], extension: &str) -> Result<TriangleMesh, String> {
+    match extension.to_ascii_lowercase().as_str() {
+        "stl" => read_stl(bytes),
+        "obj" => read_obj(bytes),
+        "msh" => read_msh(bytes),
+        other => Err(format!(
+            "expected a mesh file ending in .stl, .obj or .msh, got '.{other}'"
+        )),
+    }
+}
+
+fn read_stl(bytes: &[u8]) -> Result<TriangleMesh, String> {
+    let stl = stl_io::read_stl(&mut Cursor::new(bytes))
+        .map_err(|e| format!("not a readable STL file: {e}"))?;
+    let vertices = stl
+        .vertices
+        .iter()
+        .map(|v| Vec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2])))
+        .collect();
+    let faces = stl.faces.iter().map(|f| f.vertices).collect();
+    Ok(TriangleMesh { vertices, faces })
+}
+
+fn read_obj(bytes: &[u8]) -> Result<TriangleMesh, String> {
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ..tobj::LoadOptions::default()
+    };
+    let (models, _) = tobj::load_obj_buf(&mut Cursor::new(bytes), &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| format!("not a readable OBJ file: {e}"))?;
+    let mut mesh = TriangleMesh {
+        vertices: Vec::new(),
+        faces: Vec::new(),
+    };
+    for model in models {
+        let offset = mesh.vertices.len();
+        let positions = &model.mesh.positions;
+        mesh.vertices.extend(
+            positions
+                .chunks_exact(3)
+                .map(|p| Vec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))),
+        );
+        mesh.faces
+            .extend(model.mesh.indices.chunks_exact(3).map(|t| {
+                [
+                    offset + t[0] as usize,
+                    offset + t[1] as usize,
+                    offset + t[2] as usize,
+                ]
+            }));
+    }
+    Ok(mesh)
+}
+
+/// MuJoCo's `.msh`: four int32 counts (vertices, normals, texture coordinates, faces), then the
+/// vertices (3 float32 each), normals, texture coordinates (2 float32 each) and faces (3 int32).
+fn read_msh(bytes: &[u8]) -> Result<TriangleMesh, String> {
+    let int = |k: usize| -> Option<i32> {
+        bytes
+            .get(4 * k..4 * k + 4)
+            .map(|b| i32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    };
+    let header: Option<Vec<i32>> = (0..4).map(int).collect();
+    let Some([nv, nn, nt, nf]) = header.and_then(|h| <[i32; 4]>::try_from(h).ok()) else {
+        return Err("not a MSH file: the header of four counts is missing".into());
+    };
+    let counts_fit = nv >= 4 && nf >= 0 && (nn == 0 || nn == nv) && (nt == 0 || nt == nv);
+    let [nv, nn, nt, nf] = [nv, nn, nt, nf].map(|n| n.max(0) as usize);
+    let expected = 16 + 12 * nv + 12 * nn + 8 * nt + 12 * nf;
+    if !counts_fit || bytes.len() != expected {
+        return Err(format!(
+            "not a MSH file: its header gives {nv} vertices, {nn} normals, {nt} texture \
+             coordinates and {nf} faces, which needs {expected} bytes, and the file has {}",
+            bytes.len()
+        ));
+    }
+    let float = |k: usize| {
+        let b = &bytes[4 * k..4 * k + 4];
+        f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    };
+    let vertices = (0..nv)
+        .map(|i| Vec3::new(float(4 + 3 * i), float(5 + 3 * i), float(6 + 3 * i)))
+        .collect();
+    let start = 4 + 3 * nv + 3 * nn + 2 * nt;
+    let faces = (0..nf)
+        .map(|i| {
+            let index = |j: usize| int(start + 3 * i + j).unwrap_or(-1) as usize;
+            [index(0), index(1), index(2)]
+        })
+        .collect();
+    if nf == 0 {
+        return Err(
+            "a MSH file without faces needs its convex hull, which robodyn does not build".into(),
+        );
+    }
+    Ok(TriangleMesh { vertices, faces })
+}
+
+impl TriangleMesh {
+    /// Checks the indices and the size MuJoCo asks for (at least 4 vertices and one face).
+    pub fn check(&self) -> Result<(), String> {
+        if self.vertices.len() < 4 {
+            return Err(format!(
+                "expected at least 4 vertices, got {}",
+                self.vertices.len()
+            ));
+        }
+        if self.faces.is_empty() {
+            return Err("expected at least one face, got none".into());
+        }
+        if let Some((k, face)) = self
+            .faces
+            .iter()
+            .enumerate()
+            .find(|(_, f)| f.iter().any(|&v| v >= self.vertices.len()))
+        {
+            return Err(format!(
+                "face {k} names vertex {:?}, but the mesh has {} vertices",
+                face,
+                self.vertices.len()
+            ));
+        }
+        if let Some(k) = self
+            .vertices
+            .iter()
+            .position(|v| !v.iter().all(|x| x.is_finite()))
+        {
+            return Err(format!("vertex {k} is not finite"));
+        }
+        Ok(())
+    }
+
+    /// The mesh moved by −`refpos`, rotated into the frame `refquat` (w, x, y, z) describes, and
+    /// scaled, as MuJoCo applies `refpos`, `refquat` and `scale`.
+    pub fn transformed(mut self, refpos: Vec3, refquat: [f64; 4], scale: Vec3) -> Self {
+        let [w, x, y, z] = refquat;
+        let rotation = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z));
+        let rotation = rotation.to_rotation_matrix().into_inner().transpose();
+        for vertex in &mut self.vertices {
+            *vertex = (rotation * (*vertex - refpos)).component_mul(&scale);
+        }
+        // a left-handed scale turns the faces inside out: reverse them
+        if scale.x * scale.y * scale.z < 0.0 {
+            for face in &mut self.faces {
+                face.swap(1, 2);
+            }
+        }
+        self
+    }
+
+    /// Area, unit normal and centroid of face `f`.
+    fn triangle(&self, f: &[usize; 3], origin: &Vec3) -> (f64, Vec3, Vec3) {
+        let [a, b, c] = f.map(|k| self.vertices[k] - origin);
+        let cross = (b - a).cross(&(c - a));
+        let norm = cross.norm();
+        let normal = if norm > 0.0 {
+            cross / norm
+        } else {
+            Vec3::zeros()
+        };
+        (norm / 2.0, normal, (a + b + c) / 3.0)
+    }
+
+    /// Volume (area for a shell), centre of mass and inertia about it, at unit density.
+    pub fn mass_properties(&self, mode: MeshInertia) -> Result<MeshMassProperties, String> {
+        if mode == MeshInertia::Convex {
+            return Err(
+                "inertia='convex' needs the mesh's convex hull, which robodyn does not build: use \
+                 legacy, exact or shell, or give the body an <inertial>"
+                    .into(),
+            );
+        }
+        if mode == MeshInertia::Exact {
+            self.check_orientation()?;
+        }
+        // c_f: the faces' centroid, weighted by area
+        let origin = Vec3::zeros();
+        let (mut area, mut face_centre) = (0.0, Vec3::zeros());
+        for face in &self.faces {
+            let (a, _, centre) = self.triangle(face, &origin);
+            area += a;
+            face_centre += centre * a;
+        }
+        if area < MIN_VALUE {
+            return Err("the mesh's surface area is too small".into());
+        }
+        face_centre /= area;
+        // V and the centre of mass: one pyramid per face with its apex at c_f
+        let (mut volume, mut com) = (0.0, Vec3::zeros());
+        for face in &self.faces {
+            let (a, normal, centre) = self.triangle(face, &face_centre);
+            let v = match mode {
+                MeshInertia::Shell => a,
+                MeshInertia::Legacy => (centre.dot(&normal) * a / 3.0).abs(),
+                _ => centre.dot(&normal) * a / 3.0,
+            };
+            volume += v;
+            // ¾ c_t + ¼ c_f, with c_t relative to c_f here
+            com += (centre * 0.75 + face_centre) * v;
+        }
+        if volume < MIN_VALUE {
+            return Err(if volume < 0.0 {
+                "the mesh's volume is negative (its triangles point inwards)".into()
+            } else {
+                "the mesh's volume is too small: try inertia='shell'".into()
+            });
+        }
+        com /= volume;
+        // P about the centre of mass; the volumes again, from the centre of mass
+        let denominator = if mode == MeshInertia::Shell {
+            12.0
+        } else {
+            20.0
+        };
+        let (mut p, mut total) = (Mat3::zeros(), 0.0);
+        for face in &self.faces {
+            let (a, normal, centre) = self.triangle(face, &com);
+            let v = match mode {
+                MeshInertia::Shell => a,
+                MeshInertia::Legacy => (centre.dot(&normal) * a / 3.0).abs(),
+                _ => centre.dot(&normal) * a / 3.0,
+            };
+            total += v;
+            let [d, e, f] = face.map(|k| self.vertices[k] - com);
+            // 2(D Dᵀ + E Eᵀ + F Fᵀ) + D Eᵀ + E Dᵀ + D Fᵀ + F Dᵀ + E Fᵀ + F Eᵀ
+            let products = (d * d.transpose() + e * e.transpose() + f * f.transpose()) * 2.0
+                + d * e.transpose()
+                + e * d.transpose()
+                + d * f.transpose()
+                + f * d.transpose()
+                + e * f.transpose()
+                + f * e.transpose();
+            p += products * (v / denominator);
+        }
+        // I = tr(P) 1 − P
+        let inertia = Mat3::identity() * p.trace() - p;
+        Ok(MeshMassProperties {
+            volume: total,
+            com,
+            inertia,
+        })
+    }
+
+    /// `exact` needs every edge to be walked once each way: no two faces may share a directed
+    /// edge (as MuJoCo checks it).
+    fn check_orientation(&self) -> Result<(), String> {
+        let mut edges: Vec<(usize, usize)> = self
+            .faces
+            .iter()
+            .filter(|f| self.triangle(f, &Vec3::zeros()).0 > MIN_VALUE.sqrt())
+            .flat_map(|&[a, b, c]| [(a, b), (b, c), (c, a)])
+            .collect();
+        edges.sort_unstable();
+        match edges.windows(2).find(|w| w[0] == w[1]) {
+            Some(w) => Err(format!(
+                "the faces have inconsistent orientation (two faces walk from vertex {} to vertex \
+                 {}): inertia='exact' needs a consistently oriented mesh",
+                w[0].0 + 1,
+                w[0].1 + 1
+            )),
+            None => Ok(()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The unit cube [0, 1]³, faces pointing out.
+    fn cube() -> TriangleMesh {
+        let vertices = (0..8)
+            .map(|k| Vec3::new((k >> 2 & 1) as f64, (k >> 1 & 1) as f64, (k & 1) as f64))
+            .collect();
+        let faces = vec![
+            [0, 1, 3],
+            [0, 3, 2],
+            [4, 6, 7],
+            [4, 7, 5],
+            [0, 4, 5],
+            [0, 5, 1],
+            [2, 3, 7],
+            [2, 7, 6],
+            [0, 2, 6],
+            [0, 6, 4],
+            [1, 5, 7],
+            [1, 7, 3],
+        ];
+        TriangleMesh { vertices, faces }
+    }
+
+    #[test]
+    fn a_unit_cube_has_the_closed_form_volume_centre_and_inertia() {
+        for mode in [MeshInertia::Legacy, MeshInertia::Exact] {
+            let properties = cube().mass_properties(mode).unwrap();
+            assert!((properties.volume - 1.0).abs() < 1e-15);
+            assert!((properties.com - Vec3::repeat(0.5)).norm() < 1e-15);
+            // a cube of side 1 and mass 1: 1/6 about each axis through its centre
+            assert!((properties.inertia - Mat3::identity() / 6.0).abs().max() < 1e-15);
+        }
+        // a shell of six unit squares: area 6, and 5/3 about each axis at unit areal density (5/18 per
+        // unit mass)
+        let shell = cube().mass_properties(MeshInertia::Shell).unwrap();
+        assert!((shell.volume - 6.0).abs() < 1e-15);
+        assert!((shell.inertia - Mat3::identity() * (5.0 / 3.0)).abs().max() < 1e-14);
+    }
+
+    #[test]
+    fn inverted_or_inconsistent_faces_behave_as_in_mujoco() {
+        let mut inverted = cube();
+        for face in &mut inverted.faces {
+            face.swap(1, 2);
+        }
+        // legacy counts each pyramid's volume positive; exact refuses a negative volume
+        assert!(
+            (inverted
+                .mass_properties(MeshInertia::Legacy)
+                .unwrap()
+                .volume
+                - 1.0)
+                .abs()
+                < 1e-15
+        );
+        assert!(inverted
+            .mass_properties(MeshInertia::Exact)
+            .unwrap_err()
+            .contains("negative"));
+        let mut mixed = cube();
+        mixed.faces[0].swap(1, 2);
+        assert!(mixed
+            .mass_properties(MeshInertia::Exact)
+            .unwrap_err()
+            .contains("inconsistent orientation"));
+        assert!(mixed
+            .mass_properties(MeshInertia::Convex)
+            .unwrap_err()
+            .contains("convex hull"));
+    }
+
+    #[test]
+    fn transforms_move_rotate_and_scale_the_vertices() {
+        let moved = cube().transformed(
+            Vec3::new(0.5, 0.5, 0.5),
+            [1.0, 0.0, 0.0, 0.0],
+            Vec3::new(2.0, 1.0, 1.0),
+        );
+        let properties = moved.mass_properties(MeshInertia::Exact).unwrap();
+        assert!((properties.volume - 2.0).abs() < 1e-14 && properties.com.norm() < 1e-15);
+        // a mirror turns the faces inside out; they are reversed, so the volume stays positive
+        let mirrored = cube().transformed(
+            Vec3::zeros(),
+            [1.0, 0.0, 0.0, 0.0],
+            Vec3::new(-1.0, 1.0, 1.0),
+        );
+        assert!((mirrored.mass_properties(MeshInertia::Exact).unwrap().volume - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn malformed_files_are_errors() {
+        assert!(
+            read_mesh(b"solid nothing", "stl").is_err()
+                || read_mesh(b"solid nothing", "stl").unwrap().check().is_err()
+        );
+        assert!(read_mesh(&[0u8; 10], "msh").unwrap_err().contains("header"));
+        assert!(read_mesh(b"", "ply")
+            .unwrap_err()
+            .contains(".stl, .obj or .msh"));
+        let obj = read_mesh(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "obj").unwrap();
+        assert!(obj.check().unwrap_err().contains("at least 4 vertices"));
+    }
+}

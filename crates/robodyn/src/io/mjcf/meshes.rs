@@ -1,0 +1,161 @@
+//! Mesh geoms: the `<asset><mesh>` they name, its file found as MuJoCo finds it (`<compiler
+//! meshdir>` or `assetdir`, relative to the main file's folder, or to the folder of the file that
+//! names the mesh), read and turned into mass properties once (`io/mesh.rs`), and the geom's
+//! inertia: mass = density · volume (or the geom's `mass`), I = mass/volume · I_unit, about the
+//! mesh's centre of mass, placed by the geom's pose.
+
+use super::Reader;
+use crate::error::Result;
+use crate::io::mesh::{read_mesh, MeshInertia, MeshMassProperties, TriangleMesh};
+use crate::io::xml::parse_number_list;
+use crate::spatial::{Inertia, Transform, Vec3};
+use roxmltree::Node;
+use std::path::PathBuf;
+
+impl<'a> Reader<'a> {
+    /// Remembers every `<mesh>` of an `<asset>` section by name (its `name`, else its file's stem).
+    pub(super) fn read_mesh_assets(&mut self, asset: Node<'a, 'a>) -> Result<()> {
+        for mesh in self
+            .children(asset)?
+            .into_iter()
+            .filter(|c| c.has_tag_name("mesh"))
+        {
+            let name = match (mesh.attribute("name"), mesh.attribute("file")) {
+                (Some(name), _) => name.to_string(),
+                (None, Some(file)) => std::path::Path::new(file)
+                    .file_stem()
+                    .map_or_else(String::new, |s| s.to_string_lossy().into_owned()),
+                (None, None) => continue,
+            };
+            self.meshes.insert(name, mesh);
+        }
+        Ok(())
+    }
+
+    /// The mass properties (unit density) of the mesh named `name`, read once.
+    fn mesh_properties(&self, geom: Node<'a, 'a>, name: &str) -> Result<MeshMassProperties> {
+        if let Some(properties) = self.mesh_cache.borrow().get(name) {
+            return Ok(*properties);
+        }
+        let mesh = *self.meshes.get(name).ok_or_else(|| {
+            self.error(
+                geom,
+                format!("attribute 'mesh': no <mesh name='{name}'> in the <asset>s"),
+            )
+        })?;
+        let class = self.declared_class(mesh, "class", "main")?;
+        let error = |message: String| self.error(mesh, message);
+        let triangles = match mesh.attribute("file") {
+            Some(file) => {
+                let path = self.find_mesh_file(mesh, file)?;
+                let bytes = std::fs::read(&path)
+                    .map_err(|e| error(format!("cannot read '{}': {e}", path.display())))?;
+                let extension = path
+                    .extension()
+                    .map_or_else(String::new, |e| e.to_string_lossy().into_owned());
+                read_mesh(&bytes, &extension)
+                    .map_err(|m| error(format!("{}: {m}", path.display())))?
+            }
+            None => self.inline_mesh(mesh)?,
+        };
+        triangles.check().map_err(&error)?;
+        let vector = |attribute: &str, default: [f64; 3]| -> Result<Vec3> {
+            Ok(Vec3::from(
+                self.numbers::<3>(mesh, class, attribute)?
+                    .unwrap_or(default),
+            ))
+        };
+        let refquat = self
+            .numbers::<4>(mesh, class, "refquat")?
+            .unwrap_or([1.0, 0.0, 0.0, 0.0]);
+        let triangles = triangles.transformed(
+            vector("refpos", [0.0; 3])?,
+            refquat,
+            vector("scale", [1.0; 3])?,
+        );
+        let mode = match self.attribute(mesh, class, "inertia") {
+            None => MeshInertia::Legacy,
+            Some(name) => MeshInertia::from_name(&name).map_err(&error)?,
+        };
+        let properties = triangles.mass_properties(mode).map_err(&error)?;
+        self.mesh_cache
+            .borrow_mut()
+            .insert(name.to_string(), properties);
+        Ok(properties)
+    }
+
+    /// A mesh given in the XML by `vertex` (and `face`) instead of a file.
+    fn inline_mesh(&self, mesh: Node<'a, 'a>) -> Result<TriangleMesh> {
+        let numbers = |name: &str| -> Result<Vec<f64>> {
+            let text = mesh.attribute(name).ok_or_else(|| {
+                self.error(
+                    mesh,
+                    format!("expected 'file', or 'vertex' and 'face', got no '{name}'"),
+                )
+            })?;
+            parse_number_list(text, name).map_err(|m| self.error(mesh, m))
+        };
+        // the vertices are float32 in MuJoCo, as in a file
+        let vertices = numbers("vertex")?
+            .chunks_exact(3)
+            .map(|v| Vec3::new(v[0] as f32 as f64, v[1] as f32 as f64, v[2] as f32 as f64))
+            .collect();
+        let faces = numbers("face")?
+            .chunks_exact(3)
+            .map(|f| [f[0] as usize, f[1] as usize, f[2] as usize])
+            .collect();
+        Ok(TriangleMesh { vertices, faces })
+    }
+
+    /// Where a mesh file is: relative to `<compiler meshdir>` (or `assetdir`), itself relative to
+    /// the main file's folder, else to the folder of the file holding the `<mesh>`.
+    fn find_mesh_file(&self, mesh: Node<'a, 'a>, file: &str) -> Result<PathBuf> {
+        let directory = self.mesh_directory.as_deref().unwrap_or("");
+        let main = self.sources.files[0].folder.clone();
+        let own = self.sources.files[self.file_index(mesh)].folder.clone();
+        let mut tried = Vec::new();
+        for folder in [main, own].into_iter().flatten() {
+            let path = folder.join(directory).join(file);
+            if path.is_file() {
+                return Ok(path);
+            }
+            if !tried.contains(&path) {
+                tried.push(path);
+            }
+        }
+        if tried.is_empty() {
+            return Err(self.error(mesh, format!("the mesh file '{file}' is resolved against the model's folder: load the model from its file")));
+        }
+        let places: Vec<String> = tried.iter().map(|p| p.display().to_string()).collect();
+        Err(self.error(
+            mesh,
+            format!("mesh file '{file}' not found; tried {}", places.join(", ")),
+        ))
+    }
+
+    /// The inertia of a mesh geom in the body's frame (`frame`: X_{geom←body}).
+    pub(super) fn mesh_geom_inertia(
+        &self,
+        geom: Node<'a, 'a>,
+        class: &str,
+        frame: &Transform,
+        given_mass: Option<f64>,
+        density: f64,
+    ) -> Result<Inertia> {
+        let name = self
+            .attribute(geom, class, "mesh")
+            .ok_or_else(|| self.error(geom, "a mesh geom needs a 'mesh' attribute"))?;
+        if self.attribute(geom, class, "shellinertia").as_deref() == Some("true") {
+            return Err(self.error(
+                geom,
+                "for mesh geoms, inertia is set on the mesh asset (<mesh inertia='shell'>), as in MuJoCo",
+            ));
+        }
+        let properties = self.mesh_properties(geom, &name)?;
+        let mass = given_mass.unwrap_or(density * properties.volume);
+        // X_{com←body}: the centre of mass, in the geom's axes
+        let at_com = Transform::from_translation(&properties.com) * *frame;
+        let inertia = properties.inertia * (mass / properties.volume);
+        self.inertia_in_body(geom, mass, &inertia, &at_com)
+    }
+}
