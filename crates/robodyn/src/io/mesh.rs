@@ -55,6 +55,19 @@ impl MeshInertia {
     }
 }
 
+impl MeshInertia {
+    /// What a triangle of area `a`, unit normal `n` and centroid `c` (relative to the apex)
+    /// contributes: the pyramid's volume c·n a / 3 (its magnitude for `legacy`), or its area for a
+    /// shell.
+    fn pyramid(self, a: f64, n: &Vec3, c: &Vec3) -> f64 {
+        match self {
+            MeshInertia::Shell => a,
+            MeshInertia::Legacy => (c.dot(n) * a / 3.0).abs(),
+            MeshInertia::Exact | MeshInertia::Convex => c.dot(n) * a / 3.0,
+        }
+    }
+}
+
 /// A mesh's mass properties at unit density: its volume (or area, for a shell), centre of mass
 /// and rotational inertia about the centre of mass, in the mesh's (transformed) frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -259,11 +272,7 @@ impl TriangleMesh {
         let (mut volume, mut com) = (0.0, Vec3::zeros());
         for face in &self.faces {
             let (a, normal, centre) = self.triangle(face, &face_centre);
-            let v = match mode {
-                MeshInertia::Shell => a,
-                MeshInertia::Legacy => (centre.dot(&normal) * a / 3.0).abs(),
-                _ => centre.dot(&normal) * a / 3.0,
-            };
+            let v = mode.pyramid(a, &normal, &centre);
             volume += v;
             // ¾ c_t + ¼ c_f, with c_t relative to c_f here
             com += (centre * 0.75 + face_centre) * v;
@@ -285,11 +294,7 @@ impl TriangleMesh {
         let (mut p, mut total) = (Mat3::zeros(), 0.0);
         for face in &self.faces {
             let (a, normal, centre) = self.triangle(face, &com);
-            let v = match mode {
-                MeshInertia::Shell => a,
-                MeshInertia::Legacy => (centre.dot(&normal) * a / 3.0).abs(),
-                _ => centre.dot(&normal) * a / 3.0,
-            };
+            let v = mode.pyramid(a, &normal, &centre);
             total += v;
             let [d, e, f] = face.map(|k| self.vertices[k] - com);
             // 2(D Dᵀ + E Eᵀ + F Fᵀ) + D Eᵀ + E Dᵀ + D Fᵀ + F Dᵀ + E Fᵀ + F Eᵀ
