@@ -94,7 +94,7 @@ def test_mesh_inertia_gives_mujocos_masses():
 
 MESH_ERRORS = [
     ('<mesh name="m" file="missing.stl"/>', r"mesh file 'missing.stl' not found; tried .*meshes/missing.stl"),
-    ('<mesh name="m" file="box.stl" inertia="convex"/>', "inertia='convex' needs the mesh's convex hull"),
+    ('<mesh name="m" file="box.stl" inertia="convex" maxhullvert="6"/>', "inertia='convex' with 'maxhullvert'"),
     ('<mesh name="m" file="box.stl" inertia="solid"/>', "attribute 'inertia': expected legacy, exact, shell or convex, got 'solid'"),
     ('<mesh name="m" file="make_meshes.py"/>', r"expected a mesh file ending in \.stl, \.obj or \.msh"),
 ]

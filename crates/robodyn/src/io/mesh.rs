@@ -14,8 +14,8 @@
 //!
 //! The `inertia` modes: `legacy` (MuJoCo's default) takes |V_t|, so a mesh with flipped faces still
 //! counts them; `exact` takes the signed V_t and refuses faces of inconsistent orientation; `shell`
-//! puts the mass on the surface (V_t = A_t); `convex` needs the convex hull, which robodyn does not
-//! build, and is refused by name.
+//! puts the mass on the surface (V_t = A_t); `convex` takes the convex hull (parry3d's: a
+//! well-kept implementation of the algorithm MuJoCo takes from qhull) as an exact mesh.
 
 use crate::spatial::{Mat3, Vec3};
 use nalgebra::UnitQuaternion;
@@ -247,11 +247,7 @@ impl TriangleMesh {
     /// Volume (area for a shell), centre of mass and inertia about it, at unit density.
     pub fn mass_properties(&self, mode: MeshInertia) -> Result<MeshMassProperties, String> {
         if mode == MeshInertia::Convex {
-            return Err(
-                "inertia='convex' needs the mesh's convex hull, which robodyn does not build: use \
-                 legacy, exact or shell, or give the body an <inertial>"
-                    .into(),
-            );
+            return self.convex_hull()?.mass_properties(MeshInertia::Exact);
         }
         if mode == MeshInertia::Exact {
             self.check_orientation()?;
@@ -313,6 +309,24 @@ impl TriangleMesh {
             volume: total,
             com,
             inertia,
+        })
+    }
+
+    /// The convex hull of the vertices (parry3d's), its triangles pointing out.
+    pub fn convex_hull(&self) -> Result<TriangleMesh, String> {
+        use parry3d_f64::math::Vector3;
+        let points: Vec<Vector3> = self
+            .vertices
+            .iter()
+            .map(|v| Vector3::new(v.x, v.y, v.z))
+            .collect();
+        let (vertices, faces) =
+            parry3d_f64::transformation::try_convex_hull(&points).map_err(|e| {
+                format!("the mesh has no convex hull ({e:?}): are its vertices coplanar?")
+            })?;
+        Ok(TriangleMesh {
+            vertices: vertices.iter().map(|v| Vec3::new(v.x, v.y, v.z)).collect(),
+            faces: faces.iter().map(|f| f.map(|k| k as usize)).collect(),
         })
     }
 
@@ -406,10 +420,10 @@ mod tests {
             .mass_properties(MeshInertia::Exact)
             .unwrap_err()
             .contains("inconsistent orientation"));
-        assert!(mixed
-            .mass_properties(MeshInertia::Convex)
-            .unwrap_err()
-            .contains("convex hull"));
+        // the convex hull ignores the faces: the cube's hull is the cube
+        let hull = mixed.mass_properties(MeshInertia::Convex).unwrap();
+        assert!((hull.volume - 1.0).abs() < 1e-14);
+        assert!((hull.com - Vec3::repeat(0.5)).norm() < 1e-14);
     }
 
     #[test]

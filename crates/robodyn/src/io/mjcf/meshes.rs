@@ -77,6 +77,13 @@ impl<'a> Reader<'a> {
             None => MeshInertia::Legacy,
             Some(name) => MeshInertia::from_name(&name).map_err(&error)?,
         };
+        // MuJoCo's hull with a vertex limit is qhull's approximation, which robodyn cannot repeat
+        let limited = self
+            .numbers::<1>(mesh, class, "maxhullvert")?
+            .is_some_and(|[n]| n > -1.0);
+        if mode == MeshInertia::Convex && limited {
+            return Err(error("inertia='convex' with 'maxhullvert' (qhull's approximate hull) is not supported: leave maxhullvert out or use another inertia".into()));
+        }
         let properties = triangles.mass_properties(mode).map_err(&error)?;
         self.mesh_cache
             .borrow_mut()
