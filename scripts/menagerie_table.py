@@ -23,6 +23,9 @@ from robodyn.crosscheck import mujoco_discrepancies
 
 #: The agreement the cross-check tests ask for.
 TOLERANCE = 1e-9
+#: MuJoCo's principal axes of a mesh's inertia come from an iterative eigen-solver good to about
+#: 1e-7 rad; robodyn keeps the exact tensor (python/tests/test_mjcf_features.py measures it).
+MESH_AXES_TOLERANCE = 1e-6
 
 
 def model_files(paths: list[str]) -> list[Path]:
@@ -58,7 +61,12 @@ def row(path: Path, root: Path | None = None) -> str:
     except ValueError as error:
         return f"| `{name}` | yes | not compared: {first_line(error)} |"
     worst = max(errors.values())
-    verdict = "matches" if worst <= TOLERANCE else "DIFFERS"
+    if worst <= TOLERANCE:
+        verdict = "matches"
+    elif mj_model.nmesh and worst <= MESH_AXES_TOLERANCE:
+        verdict = "matches, to the accuracy of MuJoCo's mesh principal axes"
+    else:
+        verdict = "DIFFERS"
     note = f"nq = {model.nq}; not read: {', '.join(f'<{t}>' for t in ignored)}" if ignored else f"nq = {model.nq}"
     return f"| `{name}` | yes | {verdict} (largest relative error {worst:.1e}); {note} |"
 

@@ -14,8 +14,8 @@ max(1, max|mujoco|)``), after converting MuJoCo's conventions with
 - ``"jacobian"``: every body's world-aligned Jacobian (``mj_jacBody``);
 - ``"jacobian_dot_v"``: every body's J̇v, the classical acceleration at q̈ = 0 (``mj_jacDot``).
 
-MuJoCo is made a rigid-body model first: damping, friction loss, springs, fluid forces, constraints
-and actuators are switched off on the ``mj_model`` passed in (its armature stays: robodyn models it too).
+MuJoCo is made a rigid-body model first: damping, friction loss, springs, gravity compensation,
+fluid forces, constraints and actuators are switched off on the ``mj_model`` passed in (its armature stays: robodyn models it too).
 ``mujoco`` is imported only when this is called.
 """
 
@@ -30,13 +30,17 @@ __all__ = ["mujoco_discrepancies", "rigid_body_only"]
 
 def rigid_body_only(mj_model):
     """Switches off what robodyn's dynamics calls leave out: joint damping, friction loss and
-    springs, the medium's forces (density, viscosity, wind), constraints (limits, contacts,
-    equalities) and actuators. Returns ``mj_model``."""
+    springs, tendon springs and dampers, gravity compensation (``gravcomp``), the medium's forces
+    (density, viscosity, wind), constraints (limits, contacts, equalities) and actuators. Returns
+    ``mj_model``."""
     import mujoco
 
     mj_model.opt.density = 0.0
     mj_model.opt.viscosity = 0.0
     mj_model.opt.wind[:] = 0.0
+    mj_model.body_gravcomp[:] = 0.0
+    mj_model.tendon_stiffness[:] = 0.0
+    mj_model.tendon_damping[:] = 0.0
     mj_model.dof_damping[:] = 0.0
     mj_model.dof_frictionloss[:] = 0.0
     mj_model.jnt_stiffness[:] = 0.0

@@ -21,13 +21,20 @@ def mujoco_and_robodyn(name):
     return rigid_body_only(mujoco.MjModel.from_xml_path(str(path))), robodyn.load(path)
 
 
+#: MuJoCo turns a mesh's inertia into principal axes with an iterative eigen-solver whose axes are
+#: good to about 1e-7 rad (measured on warped_box.obj: moments equal to 2e-14, axes apart by 1.1e-7),
+#: where robodyn keeps the exact tensor; forward dynamics of light links amplify that a little.
+MESH_AXES_TOLERANCE = 1e-7
+
+
 @pytest.mark.parametrize("name", FEATURE_MODELS)
 def test_feature_models_agree_with_mujoco(name):
     mj, model = mujoco_and_robodyn(name)
     errors = mujoco_discrepancies(model, mj, seed=3, states=4)
     assert {"M", "bias", "forward_dynamics", "body_pose"} <= set(errors)
     assert ("site_pose" in errors) == (mj.nsite > 0)
-    too_large = {k: v for k, v in errors.items() if v > CROSS_CHECK_TOLERANCE}
+    tolerance = MESH_AXES_TOLERANCE if mj.nmesh else CROSS_CHECK_TOLERANCE
+    too_large = {k: v for k, v in errors.items() if v > tolerance}
     assert not too_large, too_large
 
 

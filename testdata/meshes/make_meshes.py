@@ -50,6 +50,12 @@ def main() -> None:
     faces += [(n + 0, n + 1, n + 2, n + 3), (n + 0, n + 3, n + 4, n + 5)]  # top, facing +z
     faces += [(k, (k + 1) % n, n + (k + 1) % n, n + k) for k in range(n)]  # sides
     write_obj(HERE / "l_prism.obj", bottom + top, faces, "a non-convex L-shaped prism")
+    # a box with one corner pulled out, written with quads: four of its quads are not planar, so
+    # how a quad is cut into triangles changes the numbers
+    warped = box((0.2, 0.1, 0.1), (0, 0, 0))
+    warped[7] = (0.26, 0.13, 0.14)
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    write_obj(HERE / "warped_box.obj", warped, quads, "a box with one corner pulled out, as quads")
     # an open box (no lid): a surface, for shell inertia
     corners = box((0.2, 0.2, 0.1), (-0.1, -0.1, 0))
     write_obj(HERE / "open_box.obj", corners, [f for f in BOX_FACES if f not in [(1, 5, 7), (1, 7, 3)]], "a box without its lid")

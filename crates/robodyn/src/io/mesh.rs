@@ -101,9 +101,13 @@ fn read_stl(bytes: &[u8]) -> Result<TriangleMesh, String> {
     Ok(TriangleMesh { vertices, faces })
 }
 
+/// OBJ polygons become triangles as MuJoCo's reader (tinyobjloader) makes them for triangles and
+/// quads (a quad is split along its shorter diagonal); a polygon of five or more corners is split
+/// as a fan from its first corner, where MuJoCo's reader clips ears: on a non-planar polygon the
+/// two can differ (Menagerie's ms_human_700 ribs differ by up to 2 % in mass).
 fn read_obj(bytes: &[u8]) -> Result<TriangleMesh, String> {
     let options = tobj::LoadOptions {
-        triangulate: true,
+        triangulate: false,
         single_index: false,
         ..tobj::LoadOptions::default()
     };
@@ -123,14 +127,40 @@ fn read_obj(bytes: &[u8]) -> Result<TriangleMesh, String> {
                 .chunks_exact(3)
                 .map(|p| Vec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))),
         );
-        mesh.faces
-            .extend(model.mesh.indices.chunks_exact(3).map(|t| {
-                [
-                    offset + t[0] as usize,
-                    offset + t[1] as usize,
-                    offset + t[2] as usize,
-                ]
-            }));
+        let indices = &model.mesh.indices;
+        // polygon sizes; none listed means triangles only
+        let arities: Vec<usize> = if model.mesh.face_arities.is_empty() {
+            vec![3; indices.len() / 3]
+        } else {
+            model
+                .mesh
+                .face_arities
+                .iter()
+                .map(|&n| n as usize)
+                .collect()
+        };
+        let mut start = 0;
+        for n in arities {
+            let corner = |k: usize| offset + indices[start + k] as usize;
+            if n == 4 {
+                // the shorter diagonal: 0–2, or 1–3
+                let length = |a: usize, b: usize| {
+                    (mesh.vertices[corner(a)] - mesh.vertices[corner(b)]).norm()
+                };
+                if length(1, 3) < length(0, 2) {
+                    mesh.faces.push([corner(1), corner(2), corner(3)]);
+                    mesh.faces.push([corner(1), corner(3), corner(0)]);
+                } else {
+                    mesh.faces.push([corner(0), corner(1), corner(2)]);
+                    mesh.faces.push([corner(0), corner(2), corner(3)]);
+                }
+            } else {
+                for k in 1..n.saturating_sub(1) {
+                    mesh.faces.push([corner(0), corner(k), corner(k + 1)]);
+                }
+            }
+            start += n;
+        }
     }
     Ok(mesh)
 }
