@@ -155,6 +155,7 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         total_mass: Cell::new(0.0),
         meshes: HashMap::new(),
         mesh_directory: None,
+        fit_aabb: false,
         mesh_cache: RefCell::new(HashMap::new()),
     };
     if !root.has_tag_name("mujoco") {
@@ -222,6 +223,8 @@ struct Reader<'a> {
     /// mass properties once computed
     meshes: HashMap<String, Node<'a, 'a>>,
     mesh_directory: Option<String>,
+    /// `<compiler fitaabb>`: primitives fitted to a mesh's bounding box rather than its inertia
+    fit_aabb: bool,
     mesh_cache: RefCell<HashMap<String, MeshMassProperties>>,
 }
 
@@ -310,6 +313,9 @@ impl<'a> Reader<'a> {
             .or(compiler.attribute("assetdir"))
         {
             self.mesh_directory = Some(folder.to_string());
+        }
+        if let Some(value) = compiler.attribute("fitaabb") {
+            self.fit_aabb = value == "true";
         }
         // the options that rewrite masses and inertias (mjcf/mass.rs)
         let number = |name: &str| -> Result<Option<f64>> {

@@ -183,6 +183,10 @@ impl<'a> Reader<'a> {
             };
             frame = segment;
         }
+        // a primitive with a `mesh` is fitted to it, as MuJoCo sizes and places it
+        if let (Some(mesh), true) = (text("mesh"), kind != "mesh") {
+            (size, frame) = self.fitted_primitive(geom, class, &mesh, &kind, &frame)?;
+        }
         let needed = match kind.as_str() {
             "sphere" => 1,
             "capsule" | "cylinder" => 2,
@@ -208,12 +212,6 @@ impl<'a> Reader<'a> {
             return Err(self.error(
                 geom,
                 format!("attribute 'shellinertia': a hollow {kind} is not supported (only a mesh's shell): give the body an <inertial>"),
-            ));
-        }
-        if text("mesh").is_some() {
-            return Err(self.error(
-                geom,
-                format!("a {kind} fitted to a mesh is not supported: give the body an <inertial>"),
             ));
         }
         if size.len() < needed || size[..needed].iter().any(|x| *x <= 0.0) {

@@ -8,7 +8,7 @@ use super::Reader;
 use crate::error::Result;
 use crate::io::mesh::{read_mesh, MeshInertia, MeshMassProperties, TriangleMesh};
 use crate::io::xml::parse_number_list;
-use crate::spatial::{Inertia, Transform, Vec3};
+use crate::spatial::{Inertia, Mat3, Transform, Vec3};
 use roxmltree::Node;
 use std::path::PathBuf;
 
@@ -138,6 +138,62 @@ impl<'a> Reader<'a> {
             mesh,
             format!("mesh file '{file}' not found; tried {}", places.join(", ")),
         ))
+    }
+
+    /// A primitive fitted to the mesh `mesh` (MuJoCo's `FitGeom` with the inertia box): its size and
+    /// X_{primitive←body}. The mesh's principal moments A ≥ B ≥ C (unit density, volume V) give
+    /// the equivalent box's half-sizes b₀ = ½√(6(B + C − A)/V), b₁ = ½√(6(A + C − B)/V),
+    /// b₂ = ½√(6(A + B − C)/V) along the principal axes, and: sphere r = (b₀ + b₁ + b₂)/3; capsule
+    /// r = (b₀ + b₁)/2, half-length max(0, b₂ − r/2); cylinder r = (b₀ + b₁)/2, half-length b₂;
+    /// box and ellipsoid (b₀, b₁, b₂); each times the geom's `fitscale`. The primitive sits at the
+    /// mesh's centre of mass, along its principal axes.
+    pub(super) fn fitted_primitive(
+        &self,
+        geom: Node<'a, 'a>,
+        class: &str,
+        mesh: &str,
+        kind: &str,
+        frame: &Transform,
+    ) -> Result<(Vec<f64>, Transform)> {
+        if self.fit_aabb {
+            return Err(self.error(
+                geom,
+                format!("a {kind} fitted to a mesh's bounding box (<compiler fitaabb='true'>) is not supported: give the body an <inertial>"),
+            ));
+        }
+        let properties = self.mesh_properties(geom, mesh)?;
+        // principal moments, largest first, and their axes as the columns of a rotation
+        let eigen = properties.inertia.symmetric_eigen();
+        let mut order = [0, 1, 2];
+        order.sort_by(|&i, &j| eigen.eigenvalues[j].total_cmp(&eigen.eigenvalues[i]));
+        let [a, b, c] = order.map(|k| eigen.eigenvalues[k]);
+        let mut axes =
+            Mat3::from_columns(&order.map(|k| eigen.eigenvectors.column(k).into_owned()));
+        if axes.determinant() < 0.0 {
+            axes.set_column(2, &(-axes.column(2)));
+        }
+        let volume = properties.volume;
+        let half = |x: f64| 0.5 * (6.0 * x.max(0.0) / volume).sqrt();
+        let (b0, b1, b2) = (half(b + c - a), half(a + c - b), half(a + b - c));
+        let mut size = match kind {
+            "sphere" => vec![(b0 + b1 + b2) / 3.0],
+            "capsule" => {
+                let radius = (b0 + b1) / 2.0;
+                vec![radius, (b2 - radius / 2.0).max(0.0)]
+            }
+            "cylinder" => vec![(b0 + b1) / 2.0, b2],
+            "box" | "ellipsoid" => vec![b0, b1, b2],
+            other => {
+                return Err(self.error(geom, format!("a '{other}' geom cannot be fitted to a mesh")))
+            }
+        };
+        let scale = self
+            .numbers::<1>(geom, class, "fitscale")?
+            .map_or(1.0, |[s]| s);
+        for x in &mut size {
+            *x *= scale;
+        }
+        Ok((size, Transform::from_pose(&axes, &properties.com) * *frame))
     }
 
     /// The inertia of a mesh geom in the body's frame (`frame`: X_{geom←body}).
