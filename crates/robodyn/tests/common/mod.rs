@@ -1,9 +1,11 @@
 //! Shared helpers of the integration tests: the models they run on and the tolerances.
 #![allow(dead_code)]
 
+use nalgebra::{DMatrix, DVector};
 use rand::{rngs::StdRng, Rng, SeedableRng};
+use robodyn::algo::{jacobian, Reference};
 use robodyn::io::{bundled_model, load_urdf_str, LoadOptions};
-use robodyn::Model;
+use robodyn::{Data, Model};
 
 /// Identities between exact algorithms (M from RNEA, ABA∘RNEA, ...), relative to the magnitude.
 pub const IDENTITY_TOLERANCE: f64 = 1e-10;
@@ -91,4 +93,46 @@ pub fn assert_close(label: &str, a: &[f64], b: &[f64], tol: f64) {
             tol * scale
         );
     }
+}
+
+/// J at q ⊕ h q̇, for finite differences along a motion.
+pub fn jacobian_along(
+    model: &Model,
+    data: &mut Data,
+    q: &DVector<f64>,
+    v: &DVector<f64>,
+    h: f64,
+    frame: usize,
+    reference: Reference,
+) -> DMatrix<f64> {
+    let moved = displaced(model, q, &(v * h));
+    jacobian(model, data, moved.as_slice(), frame, reference)
+        .unwrap()
+        .clone()
+}
+
+/// q ⊕ step, on the joints' Lie groups.
+pub fn displaced(model: &Model, q: &DVector<f64>, step: &DVector<f64>) -> DVector<f64> {
+    let mut moved = DVector::zeros(model.nq);
+    model
+        .integrate(q.as_slice(), step.as_slice(), moved.as_mut_slice())
+        .unwrap();
+    moved
+}
+
+/// h times the k-th unit vector of length n.
+pub fn unit_step(n: usize, k: usize, h: f64) -> DVector<f64> {
+    DVector::from_fn(n, |i, _| if i == k { h } else { 0.0 })
+}
+
+/// Random (q, v, a) for a model.
+pub fn state(
+    model: &Model,
+    rng: &mut rand::rngs::StdRng,
+) -> (DVector<f64>, DVector<f64>, DVector<f64>) {
+    (
+        model.random_configuration(rng),
+        random_vector(rng, model.nv),
+        random_vector(rng, model.nv),
+    )
 }
