@@ -5,6 +5,9 @@
 //! panic, a hang or unbounded memory. A model that loads is also run through RNEA and ABA at its
 //! neutral configuration, which must return too.
 //!
+//! The mesh readers get the same treatment on mutated STL and OBJ files of `testdata/meshes/`,
+//! through every inertia mode.
+//!
 //! `cargo test --test fuzz` runs `DEFAULT_CASES` cases from a fixed seed (a few seconds);
 //! `scripts/fuzz --minutes 60` runs it longer with fresh seeds (`ROBODYN_FUZZ_SECONDS`,
 //! `ROBODYN_FUZZ_SEED`).
@@ -291,4 +294,58 @@ fn a_chain_nested_to_the_limit_loads_and_one_deeper_is_refused() {
         })
         .unwrap();
     worker.join().unwrap();
+}
+
+#[test]
+fn mutated_mesh_files_end_in_ok_or_err() {
+    use robodyn::io::mesh::{read_mesh, MeshInertia};
+    let folder = repository().join("testdata/meshes");
+    let mut meshes: Vec<(String, Vec<u8>)> = std::fs::read_dir(&folder)
+        .unwrap()
+        .map(|entry| entry.unwrap().path())
+        .filter_map(|path| {
+            let extension = path.extension()?.to_str()?.to_string();
+            matches!(extension.as_str(), "stl" | "obj")
+                .then(|| (extension, std::fs::read(&path).unwrap()))
+        })
+        .collect();
+    meshes.sort();
+    assert!(meshes.len() >= 4);
+    let mut rng = StdRng::seed_from_u64(7);
+    for case in 0..DEFAULT_CASES / 4 {
+        let (extension, bytes) = &meshes[rng.random_range(0..meshes.len())];
+        let mut mutated = bytes.clone();
+        for _ in 0..rng.random_range(1..6) {
+            match rng.random_range(0..3) {
+                0 if !mutated.is_empty() => {
+                    let k = rng.random_range(0..mutated.len());
+                    mutated[k] ^= 1 << rng.random_range(0..8);
+                }
+                1 => mutated.truncate(rng.random_range(0..=mutated.len())),
+                _ => {
+                    let k = rng.random_range(0..=mutated.len());
+                    mutated.insert(k, rng.random());
+                }
+            }
+        }
+        let extension = extension.clone();
+        let outcome = std::panic::catch_unwind(move || {
+            if let Ok(mesh) = read_mesh(&mutated, &extension) {
+                if mesh.check().is_ok() {
+                    for mode in [
+                        MeshInertia::Legacy,
+                        MeshInertia::Exact,
+                        MeshInertia::Shell,
+                        MeshInertia::Convex,
+                    ] {
+                        let _ = mesh.mass_properties(mode);
+                    }
+                }
+            }
+        });
+        assert!(
+            outcome.is_ok(),
+            "case {case}: reading a mutated mesh panicked"
+        );
+    }
 }
