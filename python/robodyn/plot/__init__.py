@@ -16,6 +16,8 @@ __all__ = ["animate_trajectory", "check_animation_path", "check_figure_path", "p
 
 #: At most this many legend entries per panel; beyond it, the panel says how many it left out.
 MAX_LEGEND_ENTRIES = 12
+#: Lines of the animation's ground grid in each direction.
+GROUND_GRID_LINES = 11
 
 
 def _matplotlib() -> None:
@@ -205,7 +207,13 @@ def animate_trajectory(trajectory, path: str | os.PathLike[str], fps: int = 30, 
     centre, half = (low + high) / 2, max(float(np.max(high - low)) / 2, 0.1) * 1.1
     for setter, c in zip((axis.set_xlim, axis.set_ylim, axis.set_zlim), centre):
         setter(c - half, c + half)
+    # equal axes, and a ground grid at z = 0 (or under the robot, when it is all above or below)
     axis.set_box_aspect((1, 1, 1))
+    ground = 0.0 if low[2] - 1e-9 <= 0.0 <= high[2] + 1e-9 else centre[2] - half
+    ticks = np.linspace(-half, half, GROUND_GRID_LINES)
+    for offset in ticks:
+        axis.plot(centre[0] + ticks[[0, -1]], [centre[1] + offset] * 2, [ground] * 2, color="0.85", linewidth=0.6)
+        axis.plot([centre[0] + offset] * 2, centre[1] + ticks[[0, -1]], [ground] * 2, color="0.85", linewidth=0.6)
     axis.set_xlabel("x [m]")
     axis.set_ylabel("y [m]")
     axis.set_zlabel("z [m]")
