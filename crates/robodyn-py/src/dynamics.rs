@@ -3,7 +3,7 @@
 
 use crate::args::*;
 use crate::model::*;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 use pyo3::prelude::*;
 use robodyn::algo;
 use robodyn::{Data, Model};
@@ -95,18 +95,13 @@ impl PyModel {
         q: &Bound<'py, PyAny>,
         #[pyo3(from_py_with = named::method)] method: String,
     ) -> PyResult<Bound<'py, PyAny>> {
-        type Method = for<'d> fn(&Model, &'d mut Data, &[f64]) -> robodyn::Result<&'d DMatrix<f64>>;
-        let algorithm: Method = match method.as_str() {
+        let algorithm: MatrixOfQ = match method.as_str() {
             "crba" => algo::crba,
             "rnea" => algo::mass_matrix_by_rnea,
             "jacobians" => algo::mass_matrix_by_jacobians,
             other => return Err(unknown_method(other, "crba, rnea or jacobians")),
         };
-        let nv = self.model.nv;
-        self.evaluate(py, &[self.q_arg("q", q)?], &[nv, nv], &|m, w, i, out| {
-            write_row_major(algorithm(m, &mut w.data, i[0])?, m.nv, out);
-            Ok(())
-        })
+        self.matrix_of_q(py, q, self.model.nv, algorithm)
     }
 
     /// M(q)⁻¹. (nv, nv).
@@ -115,11 +110,7 @@ impl PyModel {
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let nv = self.model.nv;
-        self.evaluate(py, &[self.q_arg("q", q)?], &[nv, nv], &|m, w, i, out| {
-            write_row_major(algo::inverse_mass_matrix(m, &mut w.data, i[0])?, m.nv, out);
-            Ok(())
-        })
+        self.matrix_of_q(py, q, self.model.nv, algo::inverse_mass_matrix)
     }
 
     /// Bias forces C(q, v) v + g(q) (RNEA with a = 0). (nv,).
@@ -311,19 +302,7 @@ impl PyModel {
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.evaluate(
-            py,
-            &[self.q_arg("q", q)?],
-            &[6, self.model.nv],
-            &|m, w, i, out| {
-                write_row_major(
-                    algo::centroidal_momentum_matrix(m, &mut w.data, i[0])?,
-                    6,
-                    out,
-                );
-                Ok(())
-            },
-        )
+        self.matrix_of_q(py, q, 6, algo::centroidal_momentum_matrix)
     }
 
     /// Centroidal momentum h_G = A_G(q) v, (6,): [linear momentum m ċ; angular momentum about the
@@ -334,18 +313,6 @@ impl PyModel {
         q: &Bound<'py, PyAny>,
         v: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.evaluate(
-            py,
-            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
-            &[6],
-            &|m, w, i, out| {
-                matrix_times(
-                    algo::centroidal_momentum_matrix(m, &mut w.data, i[0])?,
-                    i[1],
-                    out,
-                );
-                Ok(())
-            },
-        )
+        self.matrix_of_q_times_v(py, q, v, 6, algo::centroidal_momentum_matrix)
     }
 }

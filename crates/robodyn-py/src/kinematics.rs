@@ -187,15 +187,7 @@ impl PyModel {
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.evaluate(
-            py,
-            &[self.q_arg("q", q)?],
-            &[3, self.model.nv],
-            &|m, w, i, out| {
-                write_row_major(algo::center_of_mass_jacobian(m, &mut w.data, i[0])?, 3, out);
-                Ok(())
-            },
-        )
+        self.matrix_of_q(py, q, 3, algo::center_of_mass_jacobian)
     }
 
     /// Velocity of the centre of mass ċ = J_com(q) v, (3,), world axes.
@@ -205,19 +197,7 @@ impl PyModel {
         q: &Bound<'py, PyAny>,
         v: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.evaluate(
-            py,
-            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
-            &[3],
-            &|m, w, i, out| {
-                matrix_times(
-                    algo::center_of_mass_jacobian(m, &mut w.data, i[0])?,
-                    i[1],
-                    out,
-                );
-                Ok(())
-            },
-        )
+        self.matrix_of_q_times_v(py, q, v, 3, algo::center_of_mass_jacobian)
     }
 
     /// Yoshikawa's manipulability √det(J Jᵀ) of a frame for a task: "full" (6 rows), "position",

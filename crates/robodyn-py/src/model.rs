@@ -226,6 +226,47 @@ impl PyModel {
     }
 }
 
+/// A core algorithm giving a matrix of the configuration (M, M⁻¹, A_G, J_com) in `Data`.
+pub(crate) type MatrixOfQ =
+    for<'d> fn(&Model, &'d mut Data, &[f64]) -> robodyn::Result<&'d DMatrix<f64>>;
+
+impl PyModel {
+    /// The first `rows` rows of `algorithm`'s matrix (rows × nv), per state.
+    pub(crate) fn matrix_of_q<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        rows: usize,
+        algorithm: MatrixOfQ,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let nv = self.model.nv;
+        self.evaluate(py, &[self.q_arg("q", q)?], &[rows, nv], &|m, w, i, out| {
+            write_row_major(algorithm(m, &mut w.data, i[0])?, rows, out);
+            Ok(())
+        })
+    }
+
+    /// `algorithm`'s matrix times v (rows,), per state: a momentum or a velocity.
+    pub(crate) fn matrix_of_q_times_v<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        rows: usize,
+        algorithm: MatrixOfQ,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?, self.v_arg("v", v)?],
+            &[rows],
+            &|m, w, i, out| {
+                matrix_times(algorithm(m, &mut w.data, i[0])?, i[1], out);
+                Ok(())
+            },
+        )
+    }
+}
+
 /// Writes the first `rows` rows of a matrix (column-major in nalgebra) into a row-major output.
 pub(crate) fn write_row_major(matrix: &nalgebra::DMatrix<f64>, rows: usize, out: &mut [f64]) {
     let columns = matrix.ncols();
