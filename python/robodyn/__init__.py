@@ -39,6 +39,28 @@ from robodyn.simulation import PD, ComputedTorque, GravityCompensation, Trajecto
 # methods composed in NumPy from the core's batched calls
 Model.operational_space = _operational_space
 
+
+def _view(self, q=None, **options):
+    """The robot in a browser page at ``q`` (default: neutral), served from this machine: a
+    :class:`robodyn.viewer.Viewer` (``viewer.show(q)`` poses it, ``viewer.close()`` stops it).
+    Options: ``frames``, ``com``, ``ground`` (overlays), ``groups`` (MJCF geom groups drawn),
+    ``host``, ``port``, ``open_browser``."""
+    from robodyn.viewer import Viewer
+
+    return Viewer(self, q, **options)
+
+
+def _to_html(self, path, q=None, **options):
+    """Writes one self-contained HTML file showing the robot at ``q`` (default: neutral) that
+    opens offline in any browser. Options: ``frames``, ``com``, ``ground``, ``groups``."""
+    from robodyn.viewer import model_html
+
+    return model_html(self, path, q, **options)
+
+
+Model.view = _view
+Model.to_html = _to_html
+
 __all__ = [
     "ComputedTorque",
     "GravityCompensation",

@@ -3,9 +3,12 @@ shape (nq,)) or a batch (shape (N, nq)) and returns one result or a stack of N; 
 numbers is accepted; results are float64."""
 
 from os import PathLike
-from typing import Callable, overload
+from pathlib import Path
+from typing import Any, Callable, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from robodyn.viewer import Viewer
 
 FloatArray = NDArray[np.float64]
 #: one configuration (nq,) and a batch of them (N, nq): the shapes simulate's overloads tell apart
@@ -13,6 +16,8 @@ Vector = np.ndarray[tuple[int], np.dtype[np.float64]]
 Matrix = np.ndarray[tuple[int, int], np.dtype[np.float64]]
 
 class SimulationError(ValueError): ...
+
+def read_mesh_file(path: str | PathLike[str]) -> tuple[FloatArray, NDArray[np.int64]]: ...
 
 class Model:
     @property
@@ -100,6 +105,18 @@ class Model:
     def centrifugal_matrix(self, q: ArrayLike) -> FloatArray: ...
     def coriolis_pairs_matrix(self, q: ArrayLike) -> FloatArray: ...
     def frame_pose(self, q: ArrayLike, frame: str | int) -> FloatArray: ...
+    def body_poses(self, q: ArrayLike) -> FloatArray: ...
+    @property
+    def visuals(self) -> list[dict[str, Any]]: ...
+    def view(
+        self, q: ArrayLike | None = None, *, frames: bool = False, com: bool = False, ground: bool = True,
+        groups: tuple[int, ...] | None = (0, 1, 2), host: str = "127.0.0.1", port: int = 8080,
+        open_browser: bool | None = None, camera: tuple[ArrayLike, ArrayLike] | None = None,
+    ) -> Viewer: ...
+    def to_html(
+        self, path: str | PathLike[str], q: ArrayLike | None = None, *, frames: bool = False, com: bool = False,
+        ground: bool = True, groups: tuple[int, ...] | None = (0, 1, 2), camera: tuple[ArrayLike, ArrayLike] | None = None,
+    ) -> Path: ...
     def jacobian(self, q: ArrayLike, frame: str | int, reference: str = "world") -> FloatArray: ...
     def jacobian_time_variation(self, q: ArrayLike, v: ArrayLike, frame: str | int, reference: str = "world") -> FloatArray: ...
     def frame_velocity(self, q: ArrayLike, v: ArrayLike, frame: str | int, reference: str = "world") -> FloatArray: ...

@@ -309,15 +309,19 @@ def _check_writable(path: str, option: str) -> None:
         raise UsageError(f"argument {option}: the folder {folder} is not writable")
 
 
-def _check_outputs(plot: str | None, animate: str | None, csv: str | None, npz: str | None) -> None:
+def _check_outputs(plot: str | None, animate: str | None, csv: str | None, npz: str | None,
+                   html: str | None = None) -> None:
     """Everything the outputs need, checked before simulating rather than after."""
     from robodyn.plot import check_animation_path, check_figure_path
+    from robodyn.viewer import check_html_path
 
     try:
         if plot:
             check_figure_path(plot, "--plot")
         if animate:
             check_animation_path(animate, "--animate")
+        if html:
+            check_html_path(html, "--html")
     except ImportError as error:
         raise UsageError(str(error)) from None
     except ValueError as error:
@@ -329,9 +333,10 @@ def _check_outputs(plot: str | None, animate: str | None, csv: str | None, npz: 
 
 def simulate(model: str, t_end: float, dt: float, integrator: str, q0: Sequence[float] | None, controller: str,
              target: Sequence[float] | None, plot: str | None, animate: str | None, csv: str | None,
-             npz: str | None, show_progress: bool | None = None) -> int:
-    """Simulate a model from rest and report the run; optionally save a plot, an animation and data."""
-    _check_outputs(plot, animate, csv, npz)
+             npz: str | None, show_progress: bool | None = None, html: str | None = None) -> int:
+    """Simulate a model from rest and report the run; optionally save a plot, an animation, a page
+    that plays it and data."""
+    _check_outputs(plot, animate, csv, npz, html)
     m = _load(model)
     start_q = _configuration(m, q0, "--q0", m.neutral())
     if target is not None and controller != "pd":
@@ -367,12 +372,42 @@ def simulate(model: str, t_end: float, dt: float, integrator: str, q0: Sequence[
     if animate:
         trajectory.animate(animate, progress=_progress_bar("writing frames") if terminal else None)
         print(f"wrote {animate}")
+    if html:
+        trajectory.to_html(html)
+        print(f"wrote {html} (opens offline in any browser)")
     if csv:
         trajectory.to_csv(csv)
         print(f"wrote {csv}")
     if npz:
         trajectory.to_npz(npz)
         print(f"wrote {npz}")
+    return 0
+
+
+# ---------------------------------------------------------------------------------------------------
+# robodyn view
+
+
+def view(model: str, q: Sequence[float] | None, html: str | None, port: int, frames: bool, com: bool,
+         open_browser: bool | None) -> int:
+    """Shows a model in the browser until interrupted, or writes it to one offline HTML file."""
+    from robodyn.viewer import check_html_path
+
+    if html:
+        check_html_path(html, "--html")
+    m = _load(model)
+    configuration = _configuration(m, q, "--q", m.neutral())
+    if html:
+        m.to_html(html, configuration, frames=frames, com=com)
+        print(f"wrote {html} (opens offline in any browser)")
+        return 0
+    with m.view(configuration, port=port, frames=frames, com=com, open_browser=open_browser) as viewer:
+        print(f"{m.name}: {viewer.url} (Ctrl-C stops)", flush=True)
+        try:
+            while True:
+                time.sleep(1.0)
+        except KeyboardInterrupt:
+            print()
     return 0
 
 
@@ -422,10 +457,20 @@ def _parser() -> _Parser:
                                  help="the configuration the pd controller drives to, nq numbers (default: q0)")
     simulate_parser.add_argument("--plot", help="save q, v, τ and energy over time (PNG, PDF or SVG)")
     simulate_parser.add_argument("--animate", help="save a stick-figure animation (.gif, or .mp4 with ffmpeg)")
+    simulate_parser.add_argument("--html", help="save a page that plays the motion with the robot's meshes, offline")
     simulate_parser.add_argument("--csv", help="save the trajectory as CSV")
     simulate_parser.add_argument("--npz", help="save the trajectory as NumPy .npz")
     simulate_parser.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                                  help="show a progress bar (default: for long runs on a terminal)")
+    view_parser = commands.add_parser("view", help="show a model in the browser, or save it as an offline page")
+    view_parser.add_argument("model", help=MODEL_HELP)
+    view_parser.add_argument("--q", type=float, nargs="+", help="the configuration, nq numbers (default: neutral)")
+    view_parser.add_argument("--html", help="write one self-contained page instead of serving")
+    view_parser.add_argument("--port", type=_positive_int, default=8080, help="port tried first (default 8080)")
+    view_parser.add_argument("--frames", action="store_true", help="draw every body's frame")
+    view_parser.add_argument("--com", action="store_true", help="mark the centre of mass")
+    view_parser.add_argument("--browser", action=argparse.BooleanOptionalAction, default=None,
+                             help="open the page in a browser (default: when a desktop session is there)")
     return parser
 
 
@@ -440,14 +485,16 @@ def _run(args: argparse.Namespace) -> int:
     if args.command == "derive":
         return derive(args.model, args.rods, args.latex, args.codegen, args.symbolic_params, args.newton_euler,
                       args.output)
+    if args.command == "view":
+        return view(args.model, args.q, args.html, args.port, args.frames, args.com, args.browser)
     return simulate(args.model, args.t_end, args.dt, args.integrator, args.q0, args.controller, args.target,
-                    args.plot, args.animate, args.csv, args.npz, args.progress)
+                    args.plot, args.animate, args.csv, args.npz, args.progress, args.html)
 
 
 def main(argv: list[str] | None = None) -> int:
     arguments = sys.argv[1:] if argv is None else argv
     command = next((a for a in arguments if not a.startswith("-")), "")
-    prefix = f"robodyn {command}".strip() if command in ("demo", "info", "models", "derive", "simulate") else "robodyn"
+    prefix = f"robodyn {command}".strip() if command in ("demo", "info", "models", "derive", "simulate", "view") else "robodyn"
     try:
         return _run(_parser().parse_args(arguments))
     except (UsageError, ValueError, FileNotFoundError) as error:

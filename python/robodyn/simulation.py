@@ -25,9 +25,13 @@ from __future__ import annotations
 import csv
 import os
 from dataclasses import dataclass, field
-from typing import Any, Callable, Sequence, Union, overload
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable, Sequence, Union, overload
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from robodyn.viewer import TrajectoryViewer
 from numpy.typing import ArrayLike
 
 from robodyn import _core
@@ -259,6 +263,22 @@ class Trajectory:
         from robodyn.plot import animate_trajectory
 
         return animate_trajectory(self, path, fps=fps, speed=speed, progress=progress)
+
+    def view(self, **options: Any) -> TrajectoryViewer:
+        """Plays the trajectory in a browser page served from this machine: play/pause, time
+        slider, speed, and the overlays (body frames, centre of mass, ground). Returns the
+        :class:`robodyn.viewer.TrajectoryViewer` (``close()`` stops it). Options: ``speed``,
+        ``frames``, ``com``, ``ground``, ``groups``, ``host``, ``port``, ``open_browser``."""
+        from robodyn.viewer import TrajectoryViewer
+
+        return TrajectoryViewer(self, **options)
+
+    def to_html(self, path: str | os.PathLike[str], **options: Any) -> Path:
+        """Writes one self-contained HTML file that plays the trajectory offline, in any browser,
+        at 60 frames per second. Options: ``frames``, ``com``, ``ground``, ``groups``."""
+        from robodyn.viewer import trajectory_html
+
+        return trajectory_html(self, path, **options)
 
 
 def _joint_of_q(model, k: int) -> str:

@@ -40,14 +40,32 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let frame = self.frame_index(frame)?;
         self.evaluate(py, &[self.q_arg("q", q)?], &[4, 4], &|m, w, i, out| {
-            let pose = algo::frame_pose(m, &mut w.data, i[0], frame)?.to_homogeneous();
-            for (r, row) in out.chunks_exact_mut(4).enumerate() {
-                for (c, value) in row.iter_mut().enumerate() {
-                    *value = pose[(r, c)];
-                }
-            }
+            let pose = algo::frame_pose(m, &mut w.data, i[0], frame)?;
+            write_pose(&pose, out);
             Ok(())
         })
+    }
+
+    /// The pose in the world of every body, the world first: (nbodies, 4, 4) homogeneous
+    /// matrices, in the order of `["world"] + body_names`. What a viewer needs for each frame.
+    fn body_poses<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let bodies = self.model.nbodies();
+        self.evaluate(
+            py,
+            &[self.q_arg("q", q)?],
+            &[bodies, 4, 4],
+            &|m, w, i, out| {
+                let placements = algo::forward_kinematics(m, &mut w.data, i[0])?;
+                for (placement, pose) in placements.iter().zip(out.chunks_exact_mut(16)) {
+                    write_pose(placement, pose);
+                }
+                Ok(())
+            },
+        )
     }
 
     /// Jacobian of a frame, (6, nv), rows [linear; angular]. `reference`: "world" (velocity of the
@@ -357,5 +375,15 @@ impl PyModel {
         )?;
         result.set_item("residual", packed.get_item(column(nq + 2))?)?;
         Ok(result)
+    }
+}
+
+/// Writes the pose a placement `X_{B←A}` describes (B in A) as a row-major 4x4 matrix.
+fn write_pose(placement: &robodyn::spatial::Transform, out: &mut [f64]) {
+    let pose = placement.to_homogeneous();
+    for (r, row) in out.chunks_exact_mut(4).enumerate() {
+        for (c, value) in row.iter_mut().enumerate() {
+            *value = pose[(r, c)];
+        }
     }
 }

@@ -12,6 +12,7 @@ mod loaders;
 mod model;
 mod properties;
 mod simulation;
+mod visuals;
 
 use loaders::*;
 use model::PyModel;
@@ -49,5 +50,6 @@ fn _core(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(bundled_names, module)?)?;
     module.add_function(wrap_pyfunction!(bundled_urdf, module)?)?;
     module.add_function(wrap_pyfunction!(simulation::simulate, module)?)?;
+    module.add_function(wrap_pyfunction!(visuals::read_mesh_file, module)?)?;
     Ok(())
 }

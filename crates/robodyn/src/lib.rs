@@ -17,6 +17,7 @@ pub mod io;
 pub mod joint;
 pub mod model;
 pub mod spatial;
+pub mod visual;
 
 pub use data::Data;
 pub use error::{Error, Result};

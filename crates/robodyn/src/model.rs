@@ -4,6 +4,7 @@
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::joint::Joint;
 use crate::spatial::{Inertia, Mat3, Transform, Vec3};
+use crate::visual::Visual;
 use nalgebra::DVector;
 use rand::Rng;
 
@@ -124,6 +125,8 @@ pub struct Model {
     pub mimics: Vec<Mimic>,
     /// What the loader accepted but the user should know (ignored tags, unchecked inertias).
     pub warnings: Vec<String>,
+    /// What the links look like (URDF `<visual>`, MJCF geoms); only the viewer reads it.
+    pub visuals: Vec<Visual>,
 }
 
 impl Model {
@@ -344,6 +347,7 @@ impl ModelBuilder {
                 gravity: Vec3::new(0.0, 0.0, -STANDARD_GRAVITY),
                 mimics: Vec::new(),
                 warnings: Vec::new(),
+                visuals: Vec::new(),
             },
         }
     }
@@ -438,6 +442,11 @@ impl ModelBuilder {
             inertia.first_moment *= factor;
             inertia.rotational *= factor;
         }
+    }
+
+    /// Adds a piece of visual geometry.
+    pub fn add_visual(&mut self, visual: Visual) {
+        self.model.visuals.push(visual);
     }
 
     /// Adds a named frame on `body` at `placement` (`X_{frame←body}`).

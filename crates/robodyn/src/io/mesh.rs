@@ -18,7 +18,7 @@
 //! well-kept implementation of the algorithm MuJoCo takes from qhull) as an exact mesh.
 
 use crate::spatial::{Mat3, Vec3};
-use nalgebra::UnitQuaternion;
+use nalgebra::{Isometry3, Matrix4, Translation3, UnitQuaternion};
 use std::io::Cursor;
 
 /// Below this an area or volume is zero (MuJoCo's mjMINVAL).
@@ -75,6 +75,16 @@ pub struct MeshMassProperties {
     pub volume: f64,
     pub com: Vec3,
     pub inertia: Mat3,
+}
+
+/// MuJoCo's map from a mesh file's coordinates to the mesh's: p ↦ S Rᵀ (p − refpos), with R the
+/// rotation of `refquat` (w, x, y, z) and S = diag(`scale`), as a homogeneous 4x4 matrix.
+pub fn reference_map(refpos: Vec3, refquat: [f64; 4], scale: Vec3) -> Matrix4<f64> {
+    let [w, x, y, z] = refquat;
+    let rotation = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z));
+    let rotated = Isometry3::from_parts(Translation3::identity(), rotation.inverse())
+        * Translation3::from(-refpos);
+    Matrix4::new_nonuniform_scaling(&scale) * rotated.to_homogeneous()
 }
 
 /// Reads a mesh file by its extension: `.stl`, `.obj` or `.msh`.
@@ -244,13 +254,11 @@ impl TriangleMesh {
     }
 
     /// The mesh moved by −`refpos`, rotated into the frame `refquat` (w, x, y, z) describes, and
-    /// scaled, as MuJoCo applies `refpos`, `refquat` and `scale`.
+    /// scaled, as MuJoCo applies `refpos`, `refquat` and `scale` (see [`reference_map`]).
     pub fn transformed(mut self, refpos: Vec3, refquat: [f64; 4], scale: Vec3) -> Self {
-        let [w, x, y, z] = refquat;
-        let rotation = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z));
-        let rotation = rotation.to_rotation_matrix().into_inner().transpose();
+        let map = reference_map(refpos, refquat, scale);
         for vertex in &mut self.vertices {
-            *vertex = (rotation * (*vertex - refpos)).component_mul(&scale);
+            *vertex = map.transform_point(&(*vertex).into()).coords;
         }
         // a left-handed scale turns the faces inside out: reverse them
         if scale.x * scale.y * scale.z < 0.0 {

@@ -34,6 +34,7 @@ mod inertia;
 mod mass;
 mod meshes;
 mod schema_table;
+mod visuals;
 
 use inertia::InertiaFromGeoms;
 use mass::MassRules;
@@ -154,6 +155,7 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         mass_rules: MassRules::default(),
         total_mass: Cell::new(0.0),
         meshes: HashMap::new(),
+        materials: HashMap::new(),
         mesh_directory: None,
         fit_aabb: false,
         mesh_cache: RefCell::new(HashMap::new()),
@@ -177,7 +179,7 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         reader.read_defaults(*default, None)?;
     }
     for asset in sections.iter().filter(|c| c.has_tag_name("asset")) {
-        reader.read_mesh_assets(*asset)?;
+        reader.read_assets(*asset)?;
     }
     let mut builder = ModelBuilder::new(root.attribute("model").unwrap_or("mjcf"), "world");
     builder.add_frame("world", 0, Transform::IDENTITY);
@@ -197,6 +199,13 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         }
     }
     for world in sections.iter().filter(|c| c.has_tag_name("worldbody")) {
+        reader.add_visuals(
+            &mut builder,
+            &reader.children(*world)?,
+            "main",
+            0,
+            Transform::IDENTITY,
+        )?;
         reader.read_children(&mut builder, *world, 0, Transform::IDENTITY, "main")?;
     }
     if let Some(factor) = reader.mass_rules.total_mass_scale(reader.total_mass.get()) {
@@ -222,6 +231,8 @@ struct Reader<'a> {
     /// `<asset><mesh>` elements by name, `<compiler meshdir>` (or `assetdir`), and each mesh's
     /// mass properties once computed
     meshes: HashMap<String, Node<'a, 'a>>,
+    /// `<asset><material>` elements by name
+    materials: HashMap<String, Node<'a, 'a>>,
     mesh_directory: Option<String>,
     /// `<compiler fitaabb>`: primitives fitted to a mesh's bounding box rather than its inertia
     fit_aabb: bool,

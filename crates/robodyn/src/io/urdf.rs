@@ -8,7 +8,8 @@
 //! An inertia that is not positive semi-definite is an error unless `check_inertia` is off, when
 //! it becomes a warning on the model. A mimic tag on a fixed joint, or naming a joint that does not
 //! move, is ignored with a warning.
-//! Visual, collision, transmission and gazebo elements are ignored.
+//! Visuals are read for the viewer (`urdf/visuals.rs`); collision, transmission and gazebo
+//! elements are ignored.
 
 use crate::error::{Error, Result};
 use crate::io::schema;
@@ -24,6 +25,8 @@ use crate::spatial::{rotation_from_rpy, Inertia, Mat3, Transform, Vec3};
 use roxmltree::{Document, Node};
 use std::collections::HashMap;
 use std::path::Path;
+
+mod visuals;
 
 /// Loads a URDF file.
 pub fn load_urdf_file(path: &Path, options: LoadOptions) -> Result<Model> {
@@ -344,7 +347,12 @@ impl<'a> Parser<'a> {
     }
 
     /// Checks that links and joints form one tree and builds the model depth-first.
-    fn build(&self, robot: Node, links: &[Link<'a>], joints: &[UrdfJoint<'a>]) -> Result<Model> {
+    fn build(
+        &self,
+        robot: Node<'a, 'a>,
+        links: &[Link<'a>],
+        joints: &[UrdfJoint<'a>],
+    ) -> Result<Model> {
         // the tree: one parent joint per link, exactly one root
         let mut parent_joint: Vec<Option<usize>> = vec![None; links.len()];
         for (j, joint) in joints.iter().enumerate() {
@@ -485,6 +493,7 @@ impl<'a> Parser<'a> {
                 ignored.join(", ")
             ));
         }
+        self.add_visuals(&mut builder, robot, links, &placement)?;
         Ok(builder.build())
     }
 }

@@ -130,6 +130,7 @@ impl<'a> Reader<'a> {
         if joints.is_empty() {
             // no joint: merged into the parent, kept as a frame
             builder.add_fixed_link(parent, to_body, inertia, &name);
+            self.add_visuals(builder, &elements, child_class, parent, to_body)?;
             return self.read_children(builder, node, parent, to_body, child_class);
         }
         let mut body = parent;
@@ -278,6 +279,7 @@ impl<'a> Reader<'a> {
         if to_body != Transform::IDENTITY {
             builder.add_frame(&name, body, to_body);
         }
+        self.add_visuals(builder, &elements, child_class, body, to_body)?;
         self.read_children(builder, node, body, to_body, child_class)
     }
 }

@@ -66,6 +66,54 @@ impl<'a> Reader<'a> {
         )))
     }
 
+    /// A geom's `group` (0 unless given).
+    pub(super) fn geom_group(&self, geom: Node<'a, 'a>, class: &str) -> Result<i64> {
+        match self.attribute(geom, class, "group") {
+            None => Ok(0),
+            Some(g) => g.trim().parse::<i64>().map_err(|_| {
+                self.error(
+                    geom,
+                    format!("attribute 'group': expected an integer, got '{g}'"),
+                )
+            }),
+        }
+    }
+
+    /// A geom's `type` (MuJoCo's default: a sphere).
+    pub(super) fn geom_type(&self, geom: Node<'a, 'a>, class: &str) -> String {
+        self.attribute(geom, class, "type")
+            .unwrap_or_else(|| "sphere".to_string())
+    }
+
+    /// A geom's `size` and `X_{geom←element}`, as MuJoCo sizes and places it: along its `fromto`
+    /// segment (z the segment, the last size its half-length; a box or ellipsoid on it has a
+    /// square or round section of `size[0]`), or fitted to its `mesh` when a primitive names one.
+    pub(super) fn geom_size_and_frame(
+        &self,
+        geom: Node<'a, 'a>,
+        class: &str,
+        kind: &str,
+    ) -> Result<(Vec<f64>, Transform)> {
+        let mut size = match self.attribute(geom, class, "size") {
+            Some(t) => parse_number_list(&t, "size").map_err(|m| self.error(geom, m))?,
+            None => Vec::new(),
+        };
+        let mut frame = self.placement(geom, class)?;
+        if let Some((segment, half_length)) = self.segment(geom, class, kind)? {
+            let radius = size.first().copied().unwrap_or(0.0);
+            size = if matches!(kind, "box" | "ellipsoid") {
+                vec![radius, radius, half_length]
+            } else {
+                vec![radius, half_length]
+            };
+            frame = segment;
+        }
+        if let (Some(mesh), true) = (self.attribute(geom, class, "mesh"), kind != "mesh") {
+            (size, frame) = self.fitted_primitive(geom, class, &mesh, kind, &frame)?;
+        }
+        Ok((size, frame))
+    }
+
     /// The spatial inertia of a body, in its frame: from `<inertial>` or from its geoms, as
     /// `<compiler inertiafromgeom>` says.
     pub(super) fn body_inertia(&self, elements: &[Node<'a, 'a>], class: &str) -> Result<Inertia> {
@@ -150,15 +198,7 @@ impl<'a> Reader<'a> {
     pub(super) fn geom_inertia(&self, geom: Node<'a, 'a>, class: &str) -> Result<Inertia> {
         let class = self.declared_class(geom, "class", class)?;
         let text = |name: &str| self.attribute(geom, class, name);
-        let group = match text("group") {
-            None => 0,
-            Some(g) => g.trim().parse::<i64>().map_err(|_| {
-                self.error(
-                    geom,
-                    format!("attribute 'group': expected an integer, got '{g}'"),
-                )
-            })?,
-        };
+        let group = self.geom_group(geom, class)?;
         if group < self.inertia_groups.0 || group > self.inertia_groups.1 {
             return Ok(Inertia::ZERO);
         }
@@ -166,27 +206,8 @@ impl<'a> Reader<'a> {
         if given_mass == Some(0.0) {
             return Ok(Inertia::ZERO);
         }
-        let kind = text("type").unwrap_or_else(|| "sphere".to_string());
-        let mut size = match text("size") {
-            Some(t) => parse_number_list(&t, "size").map_err(|m| self.error(geom, m))?,
-            None => Vec::new(),
-        };
-        // `fromto`: the geom spans the segment; its axis is z, its half-length the last size
-        let mut frame = self.placement(geom, class)?;
-        if let Some((segment, half_length)) = self.segment(geom, class, &kind)? {
-            let radius = size.first().copied().unwrap_or(0.0);
-            // a box or ellipsoid along the segment has a square or round section of size[0]
-            size = if matches!(kind.as_str(), "box" | "ellipsoid") {
-                vec![radius, radius, half_length]
-            } else {
-                vec![radius, half_length]
-            };
-            frame = segment;
-        }
-        // a primitive with a `mesh` is fitted to it, as MuJoCo sizes and places it
-        if let (Some(mesh), true) = (text("mesh"), kind != "mesh") {
-            (size, frame) = self.fitted_primitive(geom, class, &mesh, &kind, &frame)?;
-        }
+        let kind = self.geom_type(geom, class);
+        let (size, frame) = self.geom_size_and_frame(geom, class, &kind)?;
         let needed = match kind.as_str() {
             "sphere" => 1,
             "capsule" | "cylinder" => 2,

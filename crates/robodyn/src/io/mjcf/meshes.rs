@@ -6,20 +6,24 @@
 
 use super::Reader;
 use crate::error::Result;
-use crate::io::mesh::{read_mesh, MeshInertia, MeshMassProperties, TriangleMesh};
+use crate::io::mesh::{read_mesh, reference_map, MeshInertia, MeshMassProperties, TriangleMesh};
 use crate::io::xml::parse_number_list;
 use crate::spatial::{Inertia, Mat3, Transform, Vec3};
+use crate::visual::{MeshSource, Shape};
 use roxmltree::Node;
 use std::path::PathBuf;
 
 impl<'a> Reader<'a> {
-    /// Remembers every `<mesh>` of an `<asset>` section by name (its `name`, else its file's stem).
-    pub(super) fn read_mesh_assets(&mut self, asset: Node<'a, 'a>) -> Result<()> {
-        for mesh in self
-            .children(asset)?
-            .into_iter()
-            .filter(|c| c.has_tag_name("mesh"))
-        {
+    /// Remembers every `<mesh>` of an `<asset>` section by name (its `name`, else its file's stem),
+    /// and every `<material>` by name.
+    pub(super) fn read_assets(&mut self, asset: Node<'a, 'a>) -> Result<()> {
+        let children = self.children(asset)?;
+        for material in children.iter().filter(|c| c.has_tag_name("material")) {
+            if let Some(name) = material.attribute("name") {
+                self.materials.insert(name.to_string(), *material);
+            }
+        }
+        for mesh in children.into_iter().filter(|c| c.has_tag_name("mesh")) {
             let name = match (mesh.attribute("name"), mesh.attribute("file")) {
                 (Some(name), _) => name.to_string(),
                 (None, Some(file)) => std::path::Path::new(file)
@@ -37,12 +41,7 @@ impl<'a> Reader<'a> {
         if let Some(properties) = self.mesh_cache.borrow().get(name) {
             return Ok(*properties);
         }
-        let mesh = *self.meshes.get(name).ok_or_else(|| {
-            self.error(
-                geom,
-                format!("attribute 'mesh': no <mesh name='{name}'> in the <asset>s"),
-            )
-        })?;
+        let mesh = self.mesh_asset(geom, name)?;
         let class = self.declared_class(mesh, "class", "main")?;
         let error = |message: String| self.error(mesh, message);
         let triangles = match mesh.attribute("file") {
@@ -59,20 +58,8 @@ impl<'a> Reader<'a> {
             None => self.inline_mesh(mesh)?,
         };
         triangles.check().map_err(&error)?;
-        let vector = |attribute: &str, default: [f64; 3]| -> Result<Vec3> {
-            Ok(Vec3::from(
-                self.numbers::<3>(mesh, class, attribute)?
-                    .unwrap_or(default),
-            ))
-        };
-        let refquat = self
-            .numbers::<4>(mesh, class, "refquat")?
-            .unwrap_or([1.0, 0.0, 0.0, 0.0]);
-        let triangles = triangles.transformed(
-            vector("refpos", [0.0; 3])?,
-            refquat,
-            vector("scale", [1.0; 3])?,
-        );
+        let (refpos, refquat, scale) = self.mesh_reference(mesh, class)?;
+        let triangles = triangles.transformed(refpos, refquat, scale);
         let mode = match self.attribute(mesh, class, "inertia") {
             None => MeshInertia::Legacy,
             Some(name) => MeshInertia::from_name(&name).map_err(&error)?,
@@ -89,6 +76,54 @@ impl<'a> Reader<'a> {
             .borrow_mut()
             .insert(name.to_string(), properties);
         Ok(properties)
+    }
+
+    /// The `<mesh>` named `name`, for `geom`'s messages.
+    fn mesh_asset(&self, geom: Node<'a, 'a>, name: &str) -> Result<Node<'a, 'a>> {
+        self.meshes.get(name).copied().ok_or_else(|| {
+            self.error(
+                geom,
+                format!("attribute 'mesh': no <mesh name='{name}'> in the <asset>s"),
+            )
+        })
+    }
+
+    /// A mesh's `refpos`, `refquat` and `scale`.
+    fn mesh_reference(&self, mesh: Node<'a, 'a>, class: &str) -> Result<(Vec3, [f64; 4], Vec3)> {
+        let vector = |attribute: &str, default: [f64; 3]| -> Result<Vec3> {
+            Ok(Vec3::from(
+                self.numbers::<3>(mesh, class, attribute)?
+                    .unwrap_or(default),
+            ))
+        };
+        let refquat = self
+            .numbers::<4>(mesh, class, "refquat")?
+            .unwrap_or([1.0, 0.0, 0.0, 0.0]);
+        Ok((
+            vector("refpos", [0.0; 3])?,
+            refquat,
+            vector("scale", [1.0; 3])?,
+        ))
+    }
+
+    /// The mesh named `name` as a visual shape: its file (or the reason it was not found) or
+    /// its inline vertices, and the map from their coordinates into the geom's frame. The file
+    /// is drawn as written: MuJoCo's re-centring moves the mesh and the geom frame together.
+    pub(super) fn visual_mesh(&self, geom: Node<'a, 'a>, name: &str) -> Result<Shape> {
+        let mesh = self.mesh_asset(geom, name)?;
+        let class = self.declared_class(mesh, "class", "main")?;
+        let source = match mesh.attribute("file") {
+            Some(file) => match self.find_mesh_file(mesh, file) {
+                Ok(path) => MeshSource::File(path),
+                Err(missing) => MeshSource::Missing(missing.to_string()),
+            },
+            None => MeshSource::Inline(self.inline_mesh(mesh)?),
+        };
+        let (refpos, refquat, scale) = self.mesh_reference(mesh, class)?;
+        Ok(Shape::Mesh {
+            source,
+            file_to_visual: reference_map(refpos, refquat, scale),
+        })
     }
 
     /// A mesh given in the XML by `vertex` (and `face`) instead of a file.

@@ -1,0 +1,131 @@
+//! What an MJCF body looks like: each of its geoms (those in its `<frame>`s too) as a visual, sized
+//! and placed as MuJoCo places it (`fromto`, a primitive fitted to a mesh), coloured as MuJoCo
+//! colours it: the geom's `rgba` when it differs from MuJoCo's default, else its `material`'s,
+//! else the default grey. Height fields and SDF geoms are not drawn.
+
+use super::Reader;
+use crate::error::Result;
+use crate::model::ModelBuilder;
+use crate::spatial::{Transform, Vec3};
+use crate::visual::{Shape, Visual, DEFAULT_RGBA};
+use roxmltree::Node;
+
+/// A material's colour when it gives none (MuJoCo's default).
+const MATERIAL_RGBA: [f64; 4] = [1.0, 1.0, 1.0, 1.0];
+
+impl<'a> Reader<'a> {
+    /// Adds the geoms among a body's `elements` as visuals of model body `body`, where the body
+    /// element's frame is at `to_element` (`X_{element←body}`).
+    pub(super) fn add_visuals(
+        &self,
+        builder: &mut ModelBuilder,
+        elements: &[Node<'a, 'a>],
+        class: &str,
+        body: usize,
+        to_element: Transform,
+    ) -> Result<()> {
+        let mut geoms = Vec::new();
+        self.framed_elements(elements, class, &["geom"], Transform::IDENTITY, &mut geoms)?;
+        for (geom, to_frame, frame_class) in geoms {
+            let class = self.declared_class(geom, "class", frame_class)?;
+            let kind = self.geom_type(geom, class);
+            if matches!(kind.as_str(), "hfield" | "sdf") {
+                continue;
+            }
+            let (size, frame) = self.geom_size_and_frame(geom, class, &kind)?;
+            let shape = self.geom_shape(geom, class, &kind, &size)?;
+            builder.add_visual(Visual {
+                name: geom
+                    .attribute("name")
+                    .map_or_else(|| format!("geom{}", geom.range().start), str::to_string),
+                body,
+                // X_{geom←body} = X_{geom←frame} X_{frame←element} X_{element←body}
+                placement: frame * to_frame * to_element,
+                shape,
+                rgba: self.geom_rgba(geom, class)?,
+                group: self.geom_group(geom, class)?,
+                element: self.location(geom),
+            });
+        }
+        Ok(())
+    }
+
+    /// The shape of a geom of type `kind` and `size`.
+    fn geom_shape(
+        &self,
+        geom: Node<'a, 'a>,
+        class: &str,
+        kind: &str,
+        size: &[f64],
+    ) -> Result<Shape> {
+        let needed = match kind {
+            "sphere" => 1,
+            "capsule" | "cylinder" | "plane" => 2,
+            "box" | "ellipsoid" => 3,
+            "mesh" => {
+                let name = self
+                    .attribute(geom, class, "mesh")
+                    .ok_or_else(|| self.error(geom, "a mesh geom needs a 'mesh' attribute"))?;
+                return self.visual_mesh(geom, &name);
+            }
+            other => {
+                return Err(self.error(
+                    geom,
+                    format!("unknown geom type '{other}': expected plane, sphere, capsule, ellipsoid, cylinder, box, mesh, hfield or sdf"),
+                ))
+            }
+        };
+        // a plane may be unbounded (size 0); every other size is positive
+        let valid = |x: &f64| x.is_finite() && (*x > 0.0 || (kind == "plane" && *x >= 0.0));
+        if size.len() < needed || !size[..needed].iter().all(valid) {
+            return Err(self.error(
+                geom,
+                format!("attribute 'size': a {kind} needs {needed} positive numbers, got {size:?}"),
+            ));
+        }
+        Ok(match kind {
+            "sphere" => Shape::Sphere { radius: size[0] },
+            "capsule" => Shape::Capsule {
+                radius: size[0],
+                half_length: size[1],
+            },
+            "cylinder" => Shape::Cylinder {
+                radius: size[0],
+                half_length: size[1],
+            },
+            "plane" => Shape::Plane {
+                half_extents: [size[0], size[1]],
+            },
+            "box" => Shape::Box {
+                half_extents: Vec3::new(size[0], size[1], size[2]),
+            },
+            _ => Shape::Ellipsoid {
+                radii: Vec3::new(size[0], size[1], size[2]),
+            },
+        })
+    }
+
+    /// A geom's colour: its `rgba` unless that is MuJoCo's default and it names a material.
+    fn geom_rgba(&self, geom: Node<'a, 'a>, class: &str) -> Result<[f64; 4]> {
+        let own = self.numbers::<4>(geom, class, "rgba")?;
+        let material = match self.attribute(geom, class, "material") {
+            None => None,
+            Some(name) => Some(*self.materials.get(&name).ok_or_else(|| {
+                self.error(
+                    geom,
+                    format!("attribute 'material': no <material name='{name}'> in the <asset>s"),
+                )
+            })?),
+        };
+        let rgba = match (own, material) {
+            (Some(rgba), Some(_)) if rgba != DEFAULT_RGBA => rgba,
+            (_, Some(material)) => {
+                let class = self.declared_class(material, "class", "main")?;
+                self.numbers::<4>(material, class, "rgba")?
+                    .unwrap_or(MATERIAL_RGBA)
+            }
+            (own, None) => own.unwrap_or(DEFAULT_RGBA),
+        };
+        Ok(rgba)
+    }
+}

@@ -1,0 +1,260 @@
+"""A 3-D viewer in the browser: the robot's meshes and primitives, posed by robodyn's forward
+kinematics, with a trajectory player and overlays (body frames, centre of mass, ground grid).
+
+Built on viser, whose web client ships inside its wheel as one HTML file: the live viewer is a
+server on this machine (loopback unless told otherwise) that any browser opens, and
+:func:`trajectory_html` writes one self-contained file that plays with no server and no network.
+
+- ``Model.view(q)`` / :class:`Viewer`: one configuration, updated with ``viewer.show(q)``.
+- ``Trajectory.view()`` / :class:`TrajectoryViewer`: play/pause, time slider, speed, overlays,
+  at :data:`PLAYBACK_RATE` frames per second.
+- ``Trajectory.to_html(path)`` / ``Model.to_html(path, q)``: the same as one offline file.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import os
+import sys
+import threading
+import time
+import webbrowser
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from robodyn.viewer.geometry import MUJOCO_VISIBLE_GROUPS, stick_pieces, visual_pieces
+from robodyn.viewer.scene import RobotScene
+
+__all__ = ["PLAYBACK_RATE", "TrajectoryViewer", "Viewer", "check_html_path", "model_html", "trajectory_html"]
+
+#: Frames per second of the trajectory player and of the HTML export.
+PLAYBACK_RATE = 60
+#: Playback speeds offered by the player.
+SPEEDS = ("0.1x", "0.25x", "0.5x", "1x", "2x", "4x")
+#: The address the viewer listens on unless told otherwise: this machine only.
+LOOPBACK = "127.0.0.1"
+#: viser's own port; the next free one is taken when it is busy.
+DEFAULT_PORT = 8080
+
+
+def _server(host: str, port: int):
+    """A viser server without its banner."""
+    try:
+        import viser
+    except ImportError as error:  # pragma: no cover - viser is a dependency
+        raise ImportError("the viewer needs viser, a dependency of robodyn: pip install viser") from error
+    with contextlib.redirect_stdout(io.StringIO()):
+        return viser.ViserServer(host=host, port=port, verbose=False)
+
+
+def _stop(server) -> None:
+    """Stops a viser server without its farewell line."""
+    with contextlib.redirect_stdout(io.StringIO()):
+        server.stop()
+
+
+def _pieces(model, groups: tuple[int, ...] | None):
+    """What is drawn: the model's visuals, or its stick figure when it has none."""
+    return visual_pieces(model, groups) if model.visuals else stick_pieces(model)
+
+
+def _configuration(model, q, argument: str = "q") -> np.ndarray:
+    """``q`` (default: the neutral configuration) as a checked configuration."""
+    if q is None:
+        return np.asarray(model.neutral(), dtype=float)
+    q = np.asarray(q, dtype=float)
+    if q.shape != (model.nq,):
+        raise ValueError(f"argument '{argument}': expected one configuration of shape ({model.nq},), got shape {q.shape}")
+    return q
+
+
+def _browser_available() -> bool:
+    """Whether a browser can likely be opened here (a desktop session)."""
+    return sys.platform in ("darwin", "win32") or bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def check_html_path(path: str | os.PathLike[str], argument: str = "path") -> Path:
+    """``path`` as a writable ``.html`` file path, or a ValueError naming the argument."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise ValueError(f"argument '{argument}': expected a file path ending in .html, got {type(path).__name__}")
+    target = Path(path)
+    if target.suffix.lower() not in (".html", ".htm"):
+        raise ValueError(f"argument '{argument}': expected a file name ending in .html, got '{target}'")
+    folder = target.parent.resolve()
+    if not folder.is_dir():
+        raise ValueError(f"argument '{argument}': the folder '{target.parent}' does not exist")
+    if not os.access(folder, os.W_OK):
+        raise ValueError(f"argument '{argument}': the folder '{target.parent}' is not writable")
+    return target
+
+
+class Viewer:
+    """The robot in a browser page, served from this machine at :attr:`url`.
+
+    ``q``: the configuration shown first (default: neutral). ``frames``, ``com`` and ``ground``
+    show the body frames, the centre of mass and a ground grid. ``groups``: the MJCF geom groups
+    drawn (MuJoCo's default 0, 1, 2; None for all). ``host`` is the loopback address unless you
+    want other machines to connect; ``port`` is tried first, then the next free one.
+    ``open_browser``: open the page (default: when a desktop session is there). ``camera``:
+    (position, point looked at) of the first view, in world coordinates (default: the whole robot
+    from the front right and above).
+    Use :meth:`show` to pose the robot, :meth:`close` (or a ``with`` block) to stop the server.
+    """
+
+    def __init__(self, model: Any, q: ArrayLike | None = None, *, frames: bool = False, com: bool = False, ground: bool = True,
+                 groups: tuple[int, ...] | None = MUJOCO_VISIBLE_GROUPS, host: str = LOOPBACK,
+                 port: int = DEFAULT_PORT, open_browser: bool | None = None, camera: tuple[Any, Any] | None = None,
+                 _extent_q: np.ndarray | None = None) -> None:
+        self.model = model
+        q = _configuration(model, q)
+        pieces = _pieces(model, groups)
+        self.server = _server(host, port)
+        extent = None if _extent_q is None else np.asarray(model.body_poses(_extent_q))
+        self.scene = RobotScene(self.server, pieces, np.asarray(model.body_poses(q)), np.asarray(model.center_of_mass(q)),
+                                frames=frames, com_marker=com, ground=ground, extent_poses=extent, camera=camera)
+        self.url = f"http://{host}:{self.server.get_port()}"
+        if open_browser if open_browser is not None else _browser_available():
+            webbrowser.open(self.url)
+
+    def show(self, q: ArrayLike) -> None:
+        """Poses the robot at configuration ``q`` in every open page."""
+        q = _configuration(self.model, q)
+        self.scene.show(np.asarray(self.model.body_poses(q)), np.asarray(self.model.center_of_mass(q)))
+
+    def close(self) -> None:
+        """Stops the server; open pages stop updating."""
+        _stop(self.server)
+
+    def __enter__(self) -> Viewer:
+        return self
+
+    def __exit__(self, *exception: Any) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        return f"<robodyn Viewer of '{self.model.name}' at {self.url}>"
+
+
+def _samples(trajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Times, body poses (T, nbodies, 4, 4) and centres of mass (T, 3) of a trajectory."""
+    q = np.asarray(trajectory.q, dtype=float)
+    model = trajectory.model
+    return np.asarray(trajectory.t, dtype=float), np.asarray(model.body_poses(q)).reshape(len(q), -1, 4, 4), \
+        np.asarray(model.center_of_mass(q)).reshape(len(q), 3)
+
+
+def _sample_at(times: np.ndarray, t: float) -> int:
+    """The last sample at or before time ``t``."""
+    return int(np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 1))
+
+
+class TrajectoryViewer(Viewer):
+    """A trajectory played in the browser at :data:`PLAYBACK_RATE` frames per second: play/pause,
+    a time slider, the playback speed and the overlays in the page's panel. Arguments as
+    :class:`Viewer`; ``speed`` is the initial playback speed (one of :data:`SPEEDS`)."""
+
+    def __init__(self, trajectory: Any, *, speed: str = "1x", frames: bool = False, com: bool = False, ground: bool = True,
+                 groups: tuple[int, ...] | None = MUJOCO_VISIBLE_GROUPS, host: str = LOOPBACK,
+                 port: int = DEFAULT_PORT, open_browser: bool | None = None, camera: tuple[Any, Any] | None = None) -> None:
+        if speed not in SPEEDS:
+            raise ValueError(f"argument 'speed': expected one of {', '.join(SPEEDS)}, got {speed!r}")
+        self.times, self.poses, self.coms = _samples(trajectory)
+        stride = max(1, len(self.times) // 50)
+        super().__init__(trajectory.model, trajectory.q[0], frames=frames, com=com, ground=ground, groups=groups,
+                         host=host, port=port, open_browser=False, camera=camera, _extent_q=np.asarray(trajectory.q)[::stride])
+        gui = self.server.gui
+        duration = float(self.times[-1] - self.times[0])
+        self.playing = gui.add_checkbox("Play", True)
+        self.time = gui.add_slider("Time (s)", min=float(self.times[0]), max=float(self.times[-1]),
+                                   step=max(duration / 1000, 1e-6), initial_value=float(self.times[0]))
+        self.speed = gui.add_dropdown("Speed", SPEEDS, initial_value=speed)
+        frames_box = gui.add_checkbox("Body frames", frames)
+        com_box = gui.add_checkbox("Centre of mass", com)
+        ground_box = gui.add_checkbox("Ground", ground)
+        frames_box.on_update(lambda _: self.scene.overlays(frames=frames_box.value))
+        com_box.on_update(lambda _: self.scene.overlays(com_marker=com_box.value))
+        ground_box.on_update(lambda _: self.scene.overlays(ground=ground_box.value))
+        self.time.on_update(lambda _: self._draw(self.time.value))
+        self._stop = threading.Event()
+        self._player = threading.Thread(target=self._play, name="robodyn-player", daemon=True)
+        self._player.start()
+        if open_browser if open_browser is not None else _browser_available():
+            webbrowser.open(self.url)
+
+    def _draw(self, t: float) -> None:
+        k = _sample_at(self.times, t)
+        self.scene.show(self.poses[k], self.coms[k])
+
+    def _play(self) -> None:
+        """Advances the time slider at the playback rate while playing, looping at the end."""
+        period = 1.0 / PLAYBACK_RATE
+        start, end = float(self.times[0]), float(self.times[-1])
+        next_tick = time.perf_counter()
+        while not self._stop.is_set():
+            next_tick += period
+            if self.playing.value and end > start:
+                t = self.time.value + period * float(self.speed.value.rstrip("x"))
+                self.time.value = start + (t - start) % (end - start) if t > end else t
+                self._draw(self.time.value)
+            self._stop.wait(max(0.0, next_tick - time.perf_counter()))
+
+    def close(self) -> None:
+        """Stops the player and the server."""
+        self._stop.set()
+        self._player.join()
+        super().close()
+
+
+def _write_html(server, serializer_steps, path: Path) -> Path:
+    """Runs ``serializer_steps(serializer)`` on a recording of ``server``'s scene and writes the
+    self-contained page it makes."""
+    try:
+        serializer = server.get_scene_serializer()
+        serializer_steps(serializer)
+        path.write_text(serializer.as_html(), encoding="utf-8")
+    finally:
+        _stop(server)
+    return path
+
+
+def model_html(model, path: str | os.PathLike[str], q=None, *, frames: bool = False, com: bool = False,
+               ground: bool = True, groups: tuple[int, ...] | None = MUJOCO_VISIBLE_GROUPS,
+               camera: tuple[Any, Any] | None = None) -> Path:
+    """Writes one self-contained HTML file showing ``model`` at ``q`` (default: neutral), which
+    opens offline in any browser (no server, no network). Returns the path."""
+    target = check_html_path(path)
+    q = _configuration(model, q)
+    pieces = _pieces(model, groups)
+    server = _server(LOOPBACK, 0)
+    RobotScene(server, pieces, np.asarray(model.body_poses(q)), np.asarray(model.center_of_mass(q)),
+               frames=frames, com_marker=com, ground=ground, camera=camera)
+    return _write_html(server, lambda serializer: None, target)
+
+
+def trajectory_html(trajectory, path: str | os.PathLike[str], *, frames: bool = False, com: bool = False,
+                    ground: bool = True, groups: tuple[int, ...] | None = MUJOCO_VISIBLE_GROUPS,
+                    camera: tuple[Any, Any] | None = None) -> Path:
+    """Writes one self-contained HTML file that plays ``trajectory`` at :data:`PLAYBACK_RATE`
+    frames per second (play/pause, time slider and speed in the page), offline in any browser.
+    Returns the path."""
+    target = check_html_path(path)
+    times, poses, coms = _samples(trajectory)
+    pieces = _pieces(trajectory.model, groups)
+    server = _server(LOOPBACK, 0)
+    stride = max(1, len(times) // 50)
+    scene = RobotScene(server, pieces, poses[0], coms[0], frames=frames, com_marker=com, ground=ground,
+                       extent_poses=poses[::stride], camera=camera)
+    frame_times = np.arange(times[0], times[-1] + 0.5 / PLAYBACK_RATE, 1.0 / PLAYBACK_RATE)
+
+    def record(serializer) -> None:
+        for k, t in enumerate(frame_times):
+            sample = _sample_at(times, t)
+            scene.show(poses[sample], coms[sample])
+            if k + 1 < len(frame_times):
+                serializer.insert_sleep(1.0 / PLAYBACK_RATE)
+
+    return _write_html(server, record, target)

@@ -1,0 +1,120 @@
+"""The robot in a viser scene: one node per body, posed by robodyn's forward kinematics, the
+visuals fixed under it, and the overlays (body frames, centre of mass, ground grid)."""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+import numpy as np
+
+from robodyn.viewer.geometry import Piece
+
+__all__ = ["RobotScene", "camera_for", "poses_to_wxyz_position"]
+
+#: Vertical field of view of the initial camera, radians.
+CAMERA_FOV = np.radians(50.0)
+#: Direction from the robot's centre to the initial camera (normalised when used).
+CAMERA_DIRECTION = np.array([1.0, 0.8, 0.6])
+#: Margin around the robot's bounding sphere in the initial view.
+CAMERA_MARGIN = 1.15
+#: Body-frame axes and the centre-of-mass marker, as fractions of the robot's size.
+AXES_FRACTION = 0.08
+COM_FRACTION = 0.02
+COM_RGB = (230, 40, 40)
+#: Side of the ground grid's cells, metres, and how far the grid reaches beyond the robot.
+GRID_CELL = 0.1
+GRID_REACH = 2.0
+
+
+def poses_to_wxyz_position(poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Quaternions (w, x, y, z) and positions of 4x4 poses (..., 4, 4)."""
+    from viser.transforms import SO3
+
+    return SO3.from_matrix(poses[..., :3, :3]).wxyz, poses[..., :3, 3].copy()
+
+
+def _bounds(pieces: list[Piece], poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The world bounding box of the pieces (and body origins) at body poses ``poses``."""
+    points = [poses[:, :3, 3]]
+    for piece in pieces:
+        low, high = piece.vertices.min(axis=0), piece.vertices.max(axis=0)
+        corners = np.array([[x, y, z] for x in (low[0], high[0]) for y in (low[1], high[1]) for z in (low[2], high[2])])
+        pose = poses[piece.body]
+        points.append(corners @ pose[:3, :3].T + pose[:3, 3])
+    every = np.concatenate(points)
+    return every.min(axis=0), every.max(axis=0)
+
+
+def camera_for(low: np.ndarray, high: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A camera position and the point it looks at that show the box [low, high] whole."""
+    centre = (low + high) / 2
+    radius = max(np.linalg.norm(high - low) / 2, 1e-3)
+    distance = CAMERA_MARGIN * radius / np.sin(CAMERA_FOV / 2)
+    direction = CAMERA_DIRECTION / np.linalg.norm(CAMERA_DIRECTION)
+    return centre + distance * direction, centre
+
+
+def _node_name(text: str) -> str:
+    """A scene-node name part: letters, digits, '_' and '-' only."""
+    return re.sub(r"[^A-Za-z0-9_-]", "_", text)
+
+
+class RobotScene:
+    """The robot's nodes in ``server``'s scene, set up for body poses ``poses`` (nbodies, 4, 4)
+    and centre of mass ``com``; ``frames``, ``com_marker`` and ``ground`` switch the overlays.
+    The initial camera shows the robot whole (at every pose of ``extent_poses`` when given), from
+    the front right and above, unless ``camera`` gives its (position, point looked at)."""
+
+    def __init__(self, server, pieces: list[Piece], poses: np.ndarray, com: np.ndarray, *,
+                 frames: bool = False, com_marker: bool = False, ground: bool = True,
+                 extent_poses: np.ndarray | None = None, camera: tuple[Any, Any] | None = None) -> None:
+        self.server = server
+        scene = server.scene
+        scene.set_up_direction("+z")
+        every_pose = poses[None] if extent_poses is None else extent_poses
+        lows, highs = zip(*(_bounds(pieces, p) for p in every_pose))
+        low, high = np.min(lows, axis=0), np.max(highs, axis=0)
+        size = max(float(np.linalg.norm(high - low)), 1e-3)
+        position, look_at = camera_for(low, high) if camera is None else (np.asarray(camera[0], float), np.asarray(camera[1], float))
+        server.initial_camera.fov = float(CAMERA_FOV)
+        server.initial_camera.up = (0.0, 0.0, 1.0)
+        server.initial_camera.position = tuple(position)
+        server.initial_camera.look_at = tuple(look_at)
+        self.bounds = (low, high)
+        self.camera = (position, look_at)
+
+        grid_side = 2 * GRID_REACH + float(max(high[0] - low[0], high[1] - low[1]))
+        self.ground = scene.add_grid("/ground", width=grid_side, height=grid_side, cell_size=GRID_CELL,
+                                     position=(float((low[0] + high[0]) / 2), float((low[1] + high[1]) / 2), min(0.0, float(low[2]))),
+                                     visible=ground)
+        self.bodies = []
+        for body in range(len(poses)):
+            self.bodies.append(scene.add_frame(f"/robot/body{body}", show_axes=frames, axes_length=AXES_FRACTION * size,
+                                               axes_radius=AXES_FRACTION * size / 20))
+        for index, piece in enumerate(pieces):
+            rgb = tuple(int(round(255 * c)) for c in piece.rgba[:3])
+            scene.add_mesh_simple(f"/robot/body{piece.body}/{index}_{_node_name(piece.name)}",
+                                  vertices=piece.vertices.astype(np.float32), faces=piece.faces.astype(np.uint32),
+                                  color=rgb, opacity=piece.rgba[3] if piece.rgba[3] < 1 else None, side="double")
+        self.com = scene.add_icosphere("/com", radius=COM_FRACTION * size, color=COM_RGB, visible=com_marker)
+        self.show(poses, com)
+
+    def show(self, poses: np.ndarray, com: np.ndarray) -> None:
+        """Moves every body to ``poses`` (nbodies, 4, 4) and the marker to ``com``."""
+        wxyz, position = poses_to_wxyz_position(poses)
+        with self.server.atomic():
+            for node, w, p in zip(self.bodies, wxyz, position):
+                node.wxyz = w
+                node.position = p
+            self.com.position = np.asarray(com, dtype=float)
+
+    def overlays(self, *, frames: bool | None = None, com_marker: bool | None = None, ground: bool | None = None) -> None:
+        """Switches the overlays given."""
+        if frames is not None:
+            for node in self.bodies:
+                node.show_axes = frames
+        if com_marker is not None:
+            self.com.visible = com_marker
+        if ground is not None:
+            self.ground.visible = ground
