@@ -80,8 +80,8 @@ def test_mjcf_visuals_are_placed_sized_and_coloured_as_mujoco_does(path: Path) -
         start, count = mj.mesh_vertadr[mesh], mj.mesh_vertnum[mesh]
         theirs = mj.mesh_vert[start:start + count] @ data.geom_xmat[g].reshape(3, 3).T + data.geom_xpos[g]
         (piece,) = [p for p in visual_pieces(model, None) if p.name.startswith(visual["name"] + "/")]
-        ours = piece.vertices @ np.asarray(model.body_poses(q))[visual["body"]][:3, :3].T \
-            + np.asarray(model.body_poses(q))[visual["body"]][:3, 3]
+        body = np.asarray(model.body_poses(q))[visual["body"]]
+        ours = piece.vertices @ body[:3, :3].T + body[:3, 3]
         distance = np.linalg.norm(theirs[:, None, :] - ours[None, :, :], axis=2)
         assert distance.min(axis=1).max() < VERTEX_TOLERANCE and distance.min(axis=0).max() < VERTEX_TOLERANCE
 
@@ -244,8 +244,7 @@ def test_trajectory_player_and_its_offline_page(tmp_path: Path) -> None:
         assert viewer.time.max == pytest.approx(trajectory.t[-1]) and viewer.speed.value == "1x"
         viewer.playing.value = False
         k = len(trajectory.t) * 3 // 4
-        viewer.time.value = float(trajectory.t[k])
-        viewer._draw(viewer.time.value)
+        viewer.time.value = float(trajectory.t[k])  # the slider poses the robot
         pixels, _ = screenshot(viewer.url, tmp_path, "player")
         check_arm_drawn(pixels, model, trajectory.q[k])
     finally:

@@ -35,6 +35,8 @@ __all__ = ["PLAYBACK_RATE", "TrajectoryViewer", "Viewer", "check_html_path", "mo
 PLAYBACK_RATE = 60
 #: Playback speeds offered by the player.
 SPEEDS = ("0.1x", "0.25x", "0.5x", "1x", "2x", "4x")
+#: How many of a trajectory's samples the first view frames (spread over it).
+EXTENT_SAMPLES = 50
 #: The address the viewer listens on unless told otherwise: this machine only.
 LOOPBACK = "127.0.0.1"
 #: viser's own port; the next free one is taken when it is busy.
@@ -107,16 +109,24 @@ class Viewer:
 
     def __init__(self, model: Any, q: ArrayLike | None = None, *, frames: bool = False, com: bool = False, ground: bool = True,
                  groups: tuple[int, ...] | None = MUJOCO_VISIBLE_GROUPS, host: str = LOOPBACK,
-                 port: int = DEFAULT_PORT, open_browser: bool | None = None, camera: tuple[Any, Any] | None = None,
-                 _extent_q: np.ndarray | None = None) -> None:
-        self.model = model
+                 port: int = DEFAULT_PORT, open_browser: bool | None = None, camera: tuple[Any, Any] | None = None) -> None:
         q = _configuration(model, q)
+        self._serve(model, np.asarray(model.body_poses(q)), np.asarray(model.center_of_mass(q)), None,
+                    dict(frames=frames, com_marker=com, ground=ground, camera=camera), groups, host, port)
+        self._open(open_browser)
+
+    def _serve(self, model: Any, poses: np.ndarray, com: np.ndarray, extent_poses: np.ndarray | None,
+               options: dict[str, Any], groups: tuple[int, ...] | None, host: str, port: int) -> None:
+        """Starts the server with the robot at body poses ``poses`` (the pieces are read first,
+        so that a missing mesh starts nothing)."""
+        self.model = model
         pieces = _pieces(model, groups)
         self.server = _server(host, port)
-        extent = None if _extent_q is None else np.asarray(model.body_poses(_extent_q))
-        self.scene = RobotScene(self.server, pieces, np.asarray(model.body_poses(q)), np.asarray(model.center_of_mass(q)),
-                                frames=frames, com_marker=com, ground=ground, extent_poses=extent, camera=camera)
+        self.scene = RobotScene(self.server, pieces, poses, com, extent_poses=extent_poses, **options)
         self.url = f"http://{host}:{self.server.get_port()}"
+
+    def _open(self, open_browser: bool | None) -> None:
+        """Opens the page in a browser when asked, or by default when a desktop session is there."""
         if open_browser if open_browser is not None else _browser_available():
             webbrowser.open(self.url)
 
@@ -147,6 +157,12 @@ def _samples(trajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         np.asarray(model.center_of_mass(q)).reshape(len(q), 3)
 
 
+def _spread(poses: np.ndarray) -> np.ndarray:
+    """About :data:`EXTENT_SAMPLES` of a trajectory's poses, spread over it: what the first view
+    frames."""
+    return poses[::max(1, len(poses) // EXTENT_SAMPLES)]
+
+
 def _sample_at(times: np.ndarray, t: float) -> int:
     """The last sample at or before time ``t``."""
     return int(np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 1))
@@ -163,9 +179,8 @@ class TrajectoryViewer(Viewer):
         if speed not in SPEEDS:
             raise ValueError(f"argument 'speed': expected one of {', '.join(SPEEDS)}, got {speed!r}")
         self.times, self.poses, self.coms = _samples(trajectory)
-        stride = max(1, len(self.times) // 50)
-        super().__init__(trajectory.model, trajectory.q[0], frames=frames, com=com, ground=ground, groups=groups,
-                         host=host, port=port, open_browser=False, camera=camera, _extent_q=np.asarray(trajectory.q)[::stride])
+        self._serve(trajectory.model, self.poses[0], self.coms[0], _spread(self.poses),
+                    dict(frames=frames, com_marker=com, ground=ground, camera=camera), groups, host, port)
         gui = self.server.gui
         duration = float(self.times[-1] - self.times[0])
         self.playing = gui.add_checkbox("Play", True)
@@ -178,12 +193,12 @@ class TrajectoryViewer(Viewer):
         frames_box.on_update(lambda _: self.scene.overlays(frames=frames_box.value))
         com_box.on_update(lambda _: self.scene.overlays(com_marker=com_box.value))
         ground_box.on_update(lambda _: self.scene.overlays(ground=ground_box.value))
+        # the slider draws: moved in the page, or by the player below (viser calls back on both)
         self.time.on_update(lambda _: self._draw(self.time.value))
         self._stop = threading.Event()
         self._player = threading.Thread(target=self._play, name="robodyn-player", daemon=True)
         self._player.start()
-        if open_browser if open_browser is not None else _browser_available():
-            webbrowser.open(self.url)
+        self._open(open_browser)
 
     def _draw(self, t: float) -> None:
         k = _sample_at(self.times, t)
@@ -199,7 +214,6 @@ class TrajectoryViewer(Viewer):
             if self.playing.value and end > start:
                 t = self.time.value + period * float(self.speed.value.rstrip("x"))
                 self.time.value = start + (t - start) % (end - start) if t > end else t
-                self._draw(self.time.value)
             self._stop.wait(max(0.0, next_tick - time.perf_counter()))
 
     def close(self) -> None:
@@ -245,9 +259,8 @@ def trajectory_html(trajectory, path: str | os.PathLike[str], *, frames: bool = 
     times, poses, coms = _samples(trajectory)
     pieces = _pieces(trajectory.model, groups)
     server = _server(LOOPBACK, 0)
-    stride = max(1, len(times) // 50)
     scene = RobotScene(server, pieces, poses[0], coms[0], frames=frames, com_marker=com, ground=ground,
-                       extent_poses=poses[::stride], camera=camera)
+                       extent_poses=_spread(poses), camera=camera)
     frame_times = np.arange(times[0], times[-1] + 0.5 / PLAYBACK_RATE, 1.0 / PLAYBACK_RATE)
 
     def record(serializer) -> None:

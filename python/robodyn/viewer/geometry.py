@@ -121,6 +121,8 @@ def visual_pieces(model, groups: tuple[int, ...] | None = MUJOCO_VISIBLE_GROUPS)
     bodies' frames. A mesh file that is missing raises ``FileNotFoundError``, one that cannot be
     read ``ValueError``, both naming the file and the element that names it."""
     pieces = []
+    # a file named by several visuals (a hand's fingers) is read once
+    files: dict[str, list[tuple[np.ndarray, np.ndarray, tuple[float, ...] | None]]] = {}
     for visual in model.visuals:
         if groups is not None and visual["group"] not in groups:
             continue
@@ -130,7 +132,10 @@ def visual_pieces(model, groups: tuple[int, ...] | None = MUJOCO_VISIBLE_GROUPS)
             to_body = placement @ np.asarray(visual["file_to_visual"])
             # a mirroring scale turns the faces inside out: turn them back
             flip = np.linalg.det(to_body[:3, :3]) < 0
-            for k, (vertices, faces, own) in enumerate(_mesh_file_parts(visual)):
+            key = visual.get("mesh_file") or f"inline:{visual['element']}"
+            if key not in files:
+                files[key] = _mesh_file_parts(visual)
+            for k, (vertices, faces, own) in enumerate(files[key]):
                 faces = np.asarray(faces, dtype=np.int64)
                 color = own if (own is not None and rgba == DEFAULT_RGBA) else rgba
                 pieces.append(Piece(f"{visual['name']}/{k}", visual["body"], _affine(to_body, np.asarray(vertices, dtype=float)),

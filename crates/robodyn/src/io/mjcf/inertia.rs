@@ -17,6 +17,7 @@ use crate::error::Result;
 use crate::io::xml::parse_number_list;
 use crate::model::{check_mass_and_inertia, check_positive_semidefinite};
 use crate::spatial::{Inertia, Mat3, Transform, Vec3};
+use crate::visual::Shape;
 use nalgebra::Rotation3;
 use roxmltree::Node;
 use std::f64::consts::PI;
@@ -208,10 +209,13 @@ impl<'a> Reader<'a> {
         }
         let kind = self.geom_type(geom, class);
         let (size, frame) = self.geom_size_and_frame(geom, class, &kind)?;
-        let needed = match kind.as_str() {
-            "sphere" => 1,
-            "capsule" | "cylinder" => 2,
-            "ellipsoid" | "box" => 3,
+        let no_volume = || {
+            self.error(
+                geom,
+                format!("a '{kind}' geom has no volume to give the body an inertia: give the body an <inertial>"),
+            )
+        };
+        match kind.as_str() {
             "mesh" => {
                 let density = self.numbers::<1>(geom, class, "density")?.map_or(DEFAULT_DENSITY, |[d]| d);
                 return self.mesh_geom_inertia(geom, class, &frame, given_mass, density);
@@ -222,49 +226,44 @@ impl<'a> Reader<'a> {
                     "an sdf geom's inertia comes from its plugin, which robodyn does not run: give the body an <inertial>",
                 ))
             }
-            other => {
-                return Err(self.error(
-                    geom,
-                    format!("a '{other}' geom has no volume to give the body an inertia: give the body an <inertial>"),
-                ))
-            }
-        };
+            "plane" | "hfield" => return Err(no_volume()),
+            _ => {}
+        }
+        // the shape checks the size, as the viewer reads it
+        let shape = self.geom_shape(geom, class, &kind, &size)?;
         if text("shellinertia").as_deref() == Some("true") {
             return Err(self.error(
                 geom,
                 format!("attribute 'shellinertia': a hollow {kind} is not supported (only a mesh's shell): give the body an <inertial>"),
             ));
         }
-        if size.len() < needed || size[..needed].iter().any(|x| *x <= 0.0) {
-            return Err(self.error(
-                geom,
-                format!("attribute 'size': a {kind} needs {needed} positive numbers, got {size:?}"),
-            ));
-        }
         // volume, and the principal moments per unit mass about the centre
-        let (volume, per_mass) = match kind.as_str() {
-            "sphere" => {
-                let r = size[0];
-                (4.0 / 3.0 * PI * r.powi(3), Vec3::repeat(0.4 * r * r))
-            }
-            "ellipsoid" => {
-                let (a, b, c) = (size[0], size[1], size[2]);
+        let (volume, per_mass) = match shape {
+            Shape::Sphere { radius: r } => (4.0 / 3.0 * PI * r.powi(3), Vec3::repeat(0.4 * r * r)),
+            Shape::Ellipsoid { radii } => {
+                let (a, b, c) = (radii.x, radii.y, radii.z);
                 let moments = Vec3::new(b * b + c * c, a * a + c * c, a * a + b * b) / 5.0;
                 (4.0 / 3.0 * PI * a * b * c, moments)
             }
-            "box" => {
-                let (a, b, c) = (size[0], size[1], size[2]);
+            Shape::Box { half_extents } => {
+                let (a, b, c) = (half_extents.x, half_extents.y, half_extents.z);
                 let moments = Vec3::new(b * b + c * c, a * a + c * c, a * a + b * b) / 3.0;
                 (8.0 * a * b * c, moments)
             }
-            "cylinder" => {
-                let (r, length) = (size[0], 2.0 * size[1]);
+            Shape::Cylinder {
+                radius: r,
+                half_length,
+            } => {
+                let length = 2.0 * half_length;
                 let across = (3.0 * r * r + length * length) / 12.0;
                 (PI * r * r * length, Vec3::new(across, across, r * r / 2.0))
             }
-            _ => {
-                // capsule: the mass splits between the cylinder and the two hemispheres by volume
-                let (r, length) = (size[0], 2.0 * size[1]);
+            Shape::Capsule {
+                radius: r,
+                half_length,
+            } => {
+                // the mass splits between the cylinder and the two hemispheres by volume
+                let length = 2.0 * half_length;
                 let (cylinder, sphere) = (PI * r * r * length, 4.0 / 3.0 * PI * r.powi(3));
                 let volume = cylinder + sphere;
                 let (m_c, m_s) = (cylinder / volume, sphere / volume);
@@ -273,6 +272,7 @@ impl<'a> Reader<'a> {
                 let along = m_c * r * r / 2.0 + m_s * 0.4 * r * r;
                 (volume, Vec3::new(across, across, along))
             }
+            Shape::Plane { .. } | Shape::Mesh { .. } => return Err(no_volume()),
         };
         let mass = match given_mass {
             Some(mass) => mass,

@@ -50,8 +50,9 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
-    /// The shape of a geom of type `kind` and `size`.
-    fn geom_shape(
+    /// The shape of a geom of type `kind` and `size` (every size positive and finite; a plane's
+    /// may be 0, unbounded).
+    pub(super) fn geom_shape(
         &self,
         geom: Node<'a, 'a>,
         class: &str,
