@@ -13,7 +13,7 @@ import robodyn
 from robodyn.crosscheck import mujoco_discrepancies, rigid_body_only
 
 TEST_MJCF = REPOSITORY / "testdata" / "mjcf"
-FEATURE_MODELS = ["nested/scene.xml", "compiler_mass.xml", "free_armature.xml", "framed_joints.xml", "mesh_inertia.xml"]
+FEATURE_MODELS = ["nested/scene.xml", "compiler_mass.xml", "free_armature.xml", "framed_joints.xml", "mesh_inertia.xml", "mesh_fitaabb.xml"]
 
 
 def mujoco_and_robodyn(name):
@@ -101,7 +101,7 @@ def test_mesh_inertia_gives_mujocos_masses():
 
 MESH_ERRORS = [
     ('<mesh name="m" file="missing.stl"/>', r"mesh file 'missing.stl' not found; tried .*meshes/missing.stl"),
-    ('<mesh name="m" file="box.stl" inertia="convex" maxhullvert="6"/>', "inertia='convex' with 'maxhullvert'"),
+    ('<mesh name="m" file="box.stl" inertia="convex" maxhullvert="6"/>', "inertia='convex' with maxhullvert='6': the mesh's convex hull has 8 vertices"),
     ('<mesh name="m" file="box.stl" inertia="solid"/>', "attribute 'inertia': expected legacy, exact, shell or convex, got 'solid'"),
     ('<mesh name="m" file="make_meshes.py"/>', r"expected a mesh file ending in \.stl, \.obj or \.msh"),
 ]

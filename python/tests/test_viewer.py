@@ -21,6 +21,7 @@ from robodyn.viewer.scene import CAMERA_FOV
 ROOT = Path(__file__).resolve().parents[2]
 ARM = ROOT / "testdata" / "mjcf" / "viewer_arm.xml"
 MESH_INERTIA = ROOT / "testdata" / "mjcf" / "mesh_inertia.xml"
+MESH_FITAABB = ROOT / "testdata" / "mjcf" / "mesh_fitaabb.xml"
 BOX_STL = ROOT / "testdata" / "meshes" / "box.stl"
 #: Poses agree with MuJoCo's to round-off; mesh vertices to MuJoCo's float32 storage.
 POSE_TOLERANCE = 1e-9
@@ -28,6 +29,10 @@ VERTEX_TOLERANCE = 1e-6
 #: A primitive fitted to a mesh lies along the mesh's principal axes, which MuJoCo's eigensolver
 #: finds to about 1e-7 when two principal moments are close.
 AXES_TOLERANCE = 1e-6
+#: Sizes agree to round-off; a primitive fitted to a mesh's bounding box (fitaabb) takes that box
+#: along those axes, so its size moves with them: 1e-7 rad times the mesh's extent.
+SIZE_TOLERANCE = 1e-9
+FITTED_BOX_SIZE_TOLERANCE = 1e-7
 #: The arm's configurations in the screenshots, and the camera that looks at them.
 ARM_CONFIGURATIONS = {"upright": [0.0, 0.0], "bent": [1.0, 0.8]}
 ARM_CAMERA = (np.array([1.6, 1.2, 0.9]), np.array([0.0, 0.0, 0.4]))
@@ -52,7 +57,7 @@ def mujoco_colour(mj, g) -> np.ndarray:
     return mj.geom_rgba[g]
 
 
-@pytest.mark.parametrize("path", [ARM, MESH_INERTIA], ids=["viewer_arm", "mesh_inertia"])
+@pytest.mark.parametrize("path", [ARM, MESH_INERTIA, MESH_FITAABB], ids=["viewer_arm", "mesh_inertia", "mesh_fitaabb"])
 def test_mjcf_visuals_are_placed_sized_and_coloured_as_mujoco_does(path: Path) -> None:
     model = robodyn.load(path)
     mj = mujoco.MjModel.from_xml_path(str(path))
@@ -73,7 +78,8 @@ def test_mjcf_visuals_are_placed_sized_and_coloured_as_mujoco_does(path: Path) -
             # principal axes' signs are free), which leaves every primitive unchanged
             alignment = pose[:3, :3].T @ data.geom_xmat[g].reshape(3, 3)
             np.testing.assert_allclose(np.abs(alignment), np.eye(3), atol=AXES_TOLERANCE)
-            np.testing.assert_allclose(visual["size"], mj.geom_size[g][: len(visual["size"])], rtol=1e-9)
+            size_tolerance = FITTED_BOX_SIZE_TOLERANCE if path == MESH_FITAABB else SIZE_TOLERANCE
+            np.testing.assert_allclose(visual["size"], mj.geom_size[g][: len(visual["size"])], rtol=size_tolerance)
             continue
         # a mesh: the same vertices in the world, whatever frame MuJoCo re-centred it in
         mesh = mj.geom_dataid[g]

@@ -3,6 +3,7 @@ mesh inertia with MuJoCo's in every mode. BSD-3-Clause, as robodyn."""
 
 from __future__ import annotations
 
+import math
 import struct
 from pathlib import Path
 
@@ -56,6 +57,23 @@ def main() -> None:
     warped[7] = (0.26, 0.13, 0.14)
     quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
     write_obj(HERE / "warped_box.obj", warped, quads, "a box with one corner pulled out, as quads")
+    # a prism on a concave heptagon whose caps are not planar, written as two heptagons and
+    # quads: how a polygon of five or more corners is cut into triangles changes the numbers;
+    # a second object follows whose faces MuJoCo's reader ignores (it reads the first object's)
+    radii = [0.10, 0.05, 0.11, 0.09, 0.04, 0.12, 0.10]
+    ring = [(r * math.cos(2 * math.pi * k / 7), r * math.sin(2 * math.pi * k / 7)) for k, r in enumerate(radii)]
+    n = len(ring)
+    bottom = [(x, y, 0.01 * (k % 3)) for k, (x, y) in enumerate(ring)]
+    top = [(0.8 * x, y, 0.15 + 0.02 * (k % 2)) for k, (x, y) in enumerate(ring)]
+    caps = [tuple(reversed(range(n))), tuple(range(n, 2 * n))]
+    sides = [(k, (k + 1) % n, n + (k + 1) % n, n + k) for k in range(n)]
+    ignored = box((0.05, 0.05, 0.05), (0.3, 0, 0))
+    lines = ["# a prism on a concave heptagon, caps not planar, then an object MuJoCo ignores", "o prism"]
+    lines += [f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in bottom + top]
+    lines += ["f " + " ".join(str(k + 1) for k in face) for face in caps + sides]
+    lines += ["o ignored"] + [f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in ignored]
+    lines += ["f " + " ".join(str(2 * n + k + 1) for k in face) for face in BOX_FACES]
+    (HERE / "warped_prism.obj").write_text("\n".join(lines) + "\n")
     # an open box (no lid): a surface, for shell inertia
     corners = box((0.2, 0.2, 0.1), (-0.1, -0.1, 0))
     write_obj(HERE / "open_box.obj", corners, [f for f in BOX_FACES if f not in [(1, 5, 7), (1, 7, 3)]], "a box without its lid")

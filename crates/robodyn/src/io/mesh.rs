@@ -21,6 +21,8 @@ use crate::spatial::{Mat3, Vec3};
 use nalgebra::{Isometry3, Matrix4, Translation3, UnitQuaternion};
 use std::io::Cursor;
 
+mod polygon;
+
 /// Below this an area or volume is zero (MuJoCo's mjMINVAL).
 const MIN_VALUE: f64 = 1e-15;
 
@@ -111,10 +113,9 @@ fn read_stl(bytes: &[u8]) -> Result<TriangleMesh, String> {
     Ok(TriangleMesh { vertices, faces })
 }
 
-/// OBJ polygons become triangles as MuJoCo's reader (tinyobjloader) makes them for triangles and
-/// quads (a quad is split along its shorter diagonal); a polygon of five or more corners is split
-/// as a fan from its first corner, where MuJoCo's reader clips ears: on a non-planar polygon the
-/// two can differ (Menagerie's ms_human_700 ribs differ by up to 2 % in mass).
+/// OBJ as MuJoCo reads it: every vertex of the file, and the faces of its first object (`o`/`g`
+/// group; MuJoCo ignores the rest), polygons cut into triangles as its reader cuts them
+/// ([`polygon::triangulate`]).
 fn read_obj(bytes: &[u8]) -> Result<TriangleMesh, String> {
     let options = tobj::LoadOptions {
         triangulate: false,
@@ -125,54 +126,30 @@ fn read_obj(bytes: &[u8]) -> Result<TriangleMesh, String> {
         Err(tobj::LoadError::OpenFileFailed)
     })
     .map_err(|e| format!("not a readable OBJ file: {e}"))?;
-    let mut mesh = TriangleMesh {
-        vertices: Vec::new(),
-        faces: Vec::new(),
-    };
-    for model in models {
-        let offset = mesh.vertices.len();
-        let positions = &model.mesh.positions;
-        mesh.vertices.extend(
-            positions
-                .chunks_exact(3)
-                .map(|p| Vec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))),
-        );
-        let indices = &model.mesh.indices;
+    // the first object's vertices come first, so its indices need no offset
+    let vertices = models
+        .iter()
+        .flat_map(|model| model.mesh.positions.chunks_exact(3))
+        .map(|p| Vec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])))
+        .collect();
+    let mut triangles = Vec::new();
+    if let Some(first) = models.first() {
+        let (indices, arities) = (&first.mesh.indices, &first.mesh.face_arities);
         // polygon sizes; none listed means triangles only
-        let arities: Vec<usize> = if model.mesh.face_arities.is_empty() {
+        let sizes: Vec<usize> = if arities.is_empty() {
             vec![3; indices.len() / 3]
         } else {
-            model
-                .mesh
-                .face_arities
-                .iter()
-                .map(|&n| n as usize)
-                .collect()
+            arities.iter().map(|&n| n as usize).collect()
         };
         let mut start = 0;
-        for n in arities {
-            let corner = |k: usize| offset + indices[start + k] as usize;
-            if n == 4 {
-                // the shorter diagonal: 0–2, or 1–3
-                let length = |a: usize, b: usize| {
-                    (mesh.vertices[corner(a)] - mesh.vertices[corner(b)]).norm()
-                };
-                if length(1, 3) < length(0, 2) {
-                    mesh.faces.push([corner(1), corner(2), corner(3)]);
-                    mesh.faces.push([corner(1), corner(3), corner(0)]);
-                } else {
-                    mesh.faces.push([corner(0), corner(1), corner(2)]);
-                    mesh.faces.push([corner(0), corner(2), corner(3)]);
-                }
-            } else {
-                for k in 1..n.saturating_sub(1) {
-                    mesh.faces.push([corner(0), corner(k), corner(k + 1)]);
-                }
-            }
+        for n in sizes {
+            let corners = &indices[start..start + n];
+            polygon::triangulate(&first.mesh.positions, corners, &mut triangles);
             start += n;
         }
     }
-    Ok(mesh)
+    let faces = triangles.iter().map(|t| t.map(|v| v as usize)).collect();
+    Ok(TriangleMesh { vertices, faces })
 }
 
 /// MuJoCo's `.msh`: four int32 counts (vertices, normals, texture coordinates, faces), then the

@@ -17,7 +17,6 @@
 //! keyframes. Of the assets, the meshes are read, for the inertia of mesh geoms (`mjcf/meshes.rs`).
 
 use crate::error::{Error, Result};
-use crate::io::mesh::MeshMassProperties;
 use crate::io::read_model_file;
 use crate::io::schema;
 use crate::io::xml::{check_nesting, location, parse_numbers};
@@ -236,7 +235,7 @@ struct Reader<'a> {
     mesh_directory: Option<String>,
     /// `<compiler fitaabb>`: primitives fitted to a mesh's bounding box rather than its inertia
     fit_aabb: bool,
-    mesh_cache: RefCell<HashMap<String, MeshMassProperties>>,
+    mesh_cache: RefCell<HashMap<String, meshes::CompiledMesh>>,
 }
 
 impl<'a> Reader<'a> {

@@ -36,10 +36,11 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
-    /// The mass properties (unit density) of the mesh named `name`, read once.
-    fn mesh_properties(&self, geom: Node<'a, 'a>, name: &str) -> Result<MeshMassProperties> {
-        if let Some(properties) = self.mesh_cache.borrow().get(name) {
-            return Ok(*properties);
+    /// The mesh named `name` as the compiler uses it (mass properties at unit density, principal
+    /// frame, bounding box), read once.
+    fn compiled_mesh(&self, geom: Node<'a, 'a>, name: &str) -> Result<CompiledMesh> {
+        if let Some(compiled) = self.mesh_cache.borrow().get(name) {
+            return Ok(*compiled);
         }
         let mesh = self.mesh_asset(geom, name)?;
         let class = self.declared_class(mesh, "class", "main")?;
@@ -64,18 +65,38 @@ impl<'a> Reader<'a> {
             None => MeshInertia::Legacy,
             Some(name) => MeshInertia::from_name(&name).map_err(&error)?,
         };
-        // MuJoCo's hull with a vertex limit is qhull's approximation, which robodyn cannot repeat
-        let limited = self
+        // with a vertex limit MuJoCo's hull is qhull's, stopped after that many vertices: the
+        // exact hull when it has no more, an approximation robodyn cannot repeat otherwise
+        let limit = self
             .numbers::<1>(mesh, class, "maxhullvert")?
-            .is_some_and(|[n]| n > -1.0);
-        if mode == MeshInertia::Convex && limited {
-            return Err(error("inertia='convex' with 'maxhullvert' (qhull's approximate hull) is not supported: leave maxhullvert out or use another inertia".into()));
+            .map(|[n]| n)
+            .filter(|&n| n > -1.0);
+        if let (MeshInertia::Convex, Some(limit)) = (mode, limit) {
+            let corners = triangles.convex_hull().map_err(&error)?.vertices.len();
+            if corners as f64 > limit {
+                return Err(error(format!(
+                    "inertia='convex' with maxhullvert='{limit}': the mesh's convex hull has {corners} vertices, and MuJoCo then takes qhull's hull stopped at {limit}, which robodyn does not repeat: raise maxhullvert to {corners} or more, leave it out, or use another inertia"
+                )));
+            }
         }
         let properties = triangles.mass_properties(mode).map_err(&error)?;
+        let (moments, axes) = principal_frame(&properties.inertia);
+        // the vertices' bounding box in the principal frame, about the centre of mass
+        let mut aabb = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
+        for vertex in &triangles.vertices {
+            let local = axes.transpose() * (vertex - properties.com);
+            aabb = (aabb.0.inf(&local), aabb.1.sup(&local));
+        }
+        let compiled = CompiledMesh {
+            properties,
+            moments,
+            axes,
+            aabb,
+        };
         self.mesh_cache
             .borrow_mut()
-            .insert(name.to_string(), properties);
-        Ok(properties)
+            .insert(name.to_string(), compiled);
+        Ok(compiled)
     }
 
     /// The `<mesh>` named `name`, for `geom`'s messages.
@@ -175,13 +196,16 @@ impl<'a> Reader<'a> {
         ))
     }
 
-    /// A primitive fitted to the mesh `mesh` (MuJoCo's `FitGeom` with the inertia box): its size and
-    /// X_{primitive←body}. The mesh's principal moments A ≥ B ≥ C (unit density, volume V) give
-    /// the equivalent box's half-sizes b₀ = ½√(6(B + C − A)/V), b₁ = ½√(6(A + C − B)/V),
-    /// b₂ = ½√(6(A + B − C)/V) along the principal axes, and: sphere r = (b₀ + b₁ + b₂)/3; capsule
-    /// r = (b₀ + b₁)/2, half-length max(0, b₂ − r/2); cylinder r = (b₀ + b₁)/2, half-length b₂;
-    /// box and ellipsoid (b₀, b₁, b₂); each times the geom's `fitscale`. The primitive sits at the
-    /// mesh's centre of mass, along its principal axes.
+    /// A primitive fitted to the mesh `mesh` (MuJoCo's `FitGeom`): its size and
+    /// X_{primitive←body}. The primitive lies along the mesh's principal axes. By default it fits
+    /// the equivalent inertia box: with the principal moments A ≥ B ≥ C (unit density, volume V),
+    /// half-sizes b₀ = ½√(6(B + C − A)/V), b₁ = ½√(6(A + C − B)/V), b₂ = ½√(6(A + B − C)/V); sphere
+    /// r = (b₀ + b₁ + b₂)/3; capsule r = (b₀ + b₁)/2, half-length max(0, b₂ − r/2); cylinder
+    /// r = (b₀ + b₁)/2, half-length b₂; box and ellipsoid (b₀, b₁, b₂); centred on the centre of
+    /// mass. With `<compiler fitaabb="true">` it fits the vertices' bounding box in that frame
+    /// (half-sizes h, centre c): sphere r = max h; cylinder r = max(h₀, h₁), half-length h₂;
+    /// capsule the same less r from the half-length; box and ellipsoid h; centred on c. Each size
+    /// is then times the geom's `fitscale`.
     pub(super) fn fitted_primitive(
         &self,
         geom: Node<'a, 'a>,
@@ -190,37 +214,38 @@ impl<'a> Reader<'a> {
         kind: &str,
         frame: &Transform,
     ) -> Result<(Vec<f64>, Transform)> {
-        if self.fit_aabb {
-            return Err(self.error(
-                geom,
-                format!("a {kind} fitted to a mesh's bounding box (<compiler fitaabb='true'>) is not supported: give the body an <inertial>"),
-            ));
+        if !matches!(
+            kind,
+            "sphere" | "capsule" | "cylinder" | "box" | "ellipsoid"
+        ) {
+            return Err(self.error(geom, format!("a '{kind}' geom cannot be fitted to a mesh")));
         }
-        let properties = self.mesh_properties(geom, mesh)?;
-        // principal moments, largest first, and their axes as the columns of a rotation
-        let eigen = properties.inertia.symmetric_eigen();
-        let mut order = [0, 1, 2];
-        order.sort_by(|&i, &j| eigen.eigenvalues[j].total_cmp(&eigen.eigenvalues[i]));
-        let [a, b, c] = order.map(|k| eigen.eigenvalues[k]);
-        let mut axes =
-            Mat3::from_columns(&order.map(|k| eigen.eigenvectors.column(k).into_owned()));
-        if axes.determinant() < 0.0 {
-            axes.set_column(2, &(-axes.column(2)));
-        }
-        let volume = properties.volume;
-        let half = |x: f64| 0.5 * (6.0 * x.max(0.0) / volume).sqrt();
-        let (b0, b1, b2) = (half(b + c - a), half(a + c - b), half(a + b - c));
-        let mut size = match kind {
-            "sphere" => vec![(b0 + b1 + b2) / 3.0],
-            "capsule" => {
-                let radius = (b0 + b1) / 2.0;
-                vec![radius, (b2 - radius / 2.0).max(0.0)]
-            }
-            "cylinder" => vec![(b0 + b1) / 2.0, b2],
-            "box" | "ellipsoid" => vec![b0, b1, b2],
-            other => {
-                return Err(self.error(geom, format!("a '{other}' geom cannot be fitted to a mesh")))
-            }
+        let compiled = self.compiled_mesh(geom, mesh)?;
+        let (mut size, centre) = if self.fit_aabb {
+            let (low, high) = compiled.aabb;
+            let h = (high - low) / 2.0;
+            let size = match kind {
+                "sphere" => vec![h.max()],
+                "cylinder" => vec![h.x.max(h.y), h.z],
+                "capsule" => vec![h.x.max(h.y), h.z - h.x.max(h.y)],
+                _ => vec![h.x, h.y, h.z],
+            };
+            (size, (low + high) / 2.0)
+        } else {
+            let [a, b, c] = compiled.moments;
+            let volume = compiled.properties.volume;
+            let half = |x: f64| 0.5 * (6.0 * x.max(0.0) / volume).sqrt();
+            let (b0, b1, b2) = (half(b + c - a), half(a + c - b), half(a + b - c));
+            let size = match kind {
+                "sphere" => vec![(b0 + b1 + b2) / 3.0],
+                "capsule" => {
+                    let radius = (b0 + b1) / 2.0;
+                    vec![radius, (b2 - radius / 2.0).max(0.0)]
+                }
+                "cylinder" => vec![(b0 + b1) / 2.0, b2],
+                _ => vec![b0, b1, b2],
+            };
+            (size, Vec3::zeros())
         };
         let scale = self
             .numbers::<1>(geom, class, "fitscale")?
@@ -228,7 +253,8 @@ impl<'a> Reader<'a> {
         for x in &mut size {
             *x *= scale;
         }
-        Ok((size, Transform::from_pose(&axes, &properties.com) * *frame))
+        let origin = compiled.properties.com + compiled.axes * centre;
+        Ok((size, Transform::from_pose(&compiled.axes, &origin) * *frame))
     }
 
     /// The inertia of a mesh geom in the body's frame (`frame`: X_{geom←body}).
@@ -249,11 +275,38 @@ impl<'a> Reader<'a> {
                 "for mesh geoms, inertia is set on the mesh asset (<mesh inertia='shell'>), as in MuJoCo",
             ));
         }
-        let properties = self.mesh_properties(geom, &name)?;
+        let properties = self.compiled_mesh(geom, &name)?.properties;
         let mass = given_mass.unwrap_or(density * properties.volume);
         // X_{com←body}: the centre of mass, in the geom's axes
         let at_com = Transform::from_translation(&properties.com) * *frame;
         let inertia = properties.inertia * (mass / properties.volume);
         self.inertia_in_body(geom, mass, &inertia, &at_com)
     }
+}
+
+/// A mesh asset as the compiler uses it.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct CompiledMesh {
+    /// Volume (area for a shell), centre of mass and inertia at unit density.
+    properties: MeshMassProperties,
+    /// Principal moments, largest first.
+    moments: [f64; 3],
+    /// The principal axes as the columns of a rotation, in the order of `moments`.
+    axes: Mat3,
+    /// The vertices' bounding box (lowest, highest corner) in the principal frame at the centre
+    /// of mass.
+    aabb: (Vec3, Vec3),
+}
+
+/// Principal moments of a rotational inertia, largest first, and their axes as the columns of a
+/// rotation (the third axis flipped if needed to make it right-handed).
+fn principal_frame(inertia: &Mat3) -> ([f64; 3], Mat3) {
+    let eigen = inertia.symmetric_eigen();
+    let mut order = [0, 1, 2];
+    order.sort_by(|&i, &j| eigen.eigenvalues[j].total_cmp(&eigen.eigenvalues[i]));
+    let mut axes = Mat3::from_columns(&order.map(|k| eigen.eigenvectors.column(k).into_owned()));
+    if axes.determinant() < 0.0 {
+        axes.set_column(2, &(-axes.column(2)));
+    }
+    (order.map(|k| eigen.eigenvalues[k]), axes)
 }
