@@ -1,4 +1,4 @@
-//! Triangle meshes: reading STL (binary or ASCII, with `stl_io`), Wavefront OBJ (with `tobj`) and
+//! Triangle meshes: reading STL (binary directly, ASCII with `stl_io`), Wavefront OBJ (with `tobj`) and
 //! MuJoCo's binary `.msh`, and their mass properties as MuJoCo's compiler computes them
 //! (MJCF reference, `<mesh inertia>`):
 //!
@@ -6,11 +6,13 @@
 //!   precision: moved by −`refpos`, rotated by `refquat`ᵀ, scaled by `scale` (a left-handed
 //!   scale reverses every face, so that normals keep pointing out);
 //! - c_f, the area-weighted centroid of the faces, is the apex of one pyramid per face;
-//! - volume V = Σ_f (c_t − c_f)·n_t A_t / 3 over the triangles t (n_t the unit normal, A_t the
-//!   area, c_t the centroid), and the centre of mass Σ V_t (¾ c_t + ¼ c_f) / V;
+//! - volume V = Σ_t V_t, V_t = (c_t − c_f)·n_t A_t / 3 = (c_t − c_f)·w_t / 6 over the triangles t
+//!   (n_t the unit normal, A_t the area, c_t the centroid, w_t = (b − a) × (c − a) = 2 A_t n_t),
+//!   and the centre of mass Σ V_t (¾ c_t + ¼ c_f) / V;
 //! - about the centre of mass, with D, E, F a triangle's corners relative to it, the second
-//!   moments P_jk = Σ_t V_t / C (2(D_j D_k + E_j E_k + F_j F_k) + D_j E_k + D_k E_j + D_j F_k + D_k F_j
-//!   + E_j F_k + E_k F_j), C = 20 (solid) or 12 (shell), and I = tr(P) 1 − P (unit density).
+//!   moments P = Σ_t V_t / C (2(D Dᵀ + E Eᵀ + F Fᵀ) + D Eᵀ + E Dᵀ + D Fᵀ + F Dᵀ + E Fᵀ + F Eᵀ)
+//!   = Σ_t V_t / C (D Dᵀ + E Eᵀ + F Fᵀ + S Sᵀ) with S = D + E + F, C = 20 (solid) or 12
+//!   (shell), and I = tr(P) 1 − P (unit density).
 //!
 //! The `inertia` modes: `legacy` (MuJoCo's default) takes |V_t|, so a mesh with flipped faces still
 //! counts them; `exact` takes the signed V_t and refuses faces of inconsistent orientation; `shell`
@@ -19,6 +21,7 @@
 
 use crate::spatial::{Mat3, Vec3};
 use nalgebra::{Isometry3, Matrix4, Translation3, UnitQuaternion};
+use rustc_hash::FxHashMap;
 use std::io::Cursor;
 
 mod polygon;
@@ -58,14 +61,14 @@ impl MeshInertia {
 }
 
 impl MeshInertia {
-    /// What a triangle of area `a`, unit normal `n` and centroid `c` (relative to the apex)
-    /// contributes: the pyramid's volume c·n a / 3 (its magnitude for `legacy`), or its area for a
-    /// shell.
-    fn pyramid(self, a: f64, n: &Vec3, c: &Vec3) -> f64 {
+    /// What a triangle with area vector `w` = (b − a) × (c − a) (along its normal n, twice its
+    /// area A long) and centroid `c` (relative to the apex) contributes: the pyramid's volume
+    /// c·n A / 3 = c·w / 6 (its magnitude for `legacy`), or its area for a shell.
+    fn pyramid(self, w: &Vec3, c: &Vec3) -> f64 {
         match self {
-            MeshInertia::Shell => a,
-            MeshInertia::Legacy => (c.dot(n) * a / 3.0).abs(),
-            MeshInertia::Exact | MeshInertia::Convex => c.dot(n) * a / 3.0,
+            MeshInertia::Shell => w.norm() / 2.0,
+            MeshInertia::Legacy => (c.dot(w) / 6.0).abs(),
+            MeshInertia::Exact | MeshInertia::Convex => c.dot(w) / 6.0,
         }
     }
 }
@@ -101,15 +104,43 @@ pub fn read_mesh(bytes: &[u8], extension: &str) -> Result<TriangleMesh, String> 
     }
 }
 
+/// STL: a binary file (80-byte header, a u32 triangle count, then 50 bytes per triangle: a normal
+/// and three corners as float32, and a u16) is read directly, its corners merged by exact value;
+/// anything else goes to `stl_io` (ASCII STL, and the error for what is neither).
 fn read_stl(bytes: &[u8]) -> Result<TriangleMesh, String> {
-    let stl = stl_io::read_stl(&mut Cursor::new(bytes))
-        .map_err(|e| format!("not a readable STL file: {e}"))?;
-    let vertices = stl
-        .vertices
-        .iter()
-        .map(|v| Vec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2])))
-        .collect();
-    let faces = stl.faces.iter().map(|f| f.vertices).collect();
+    const HEADER: usize = 84;
+    const RECORD: usize = 50;
+    let count = bytes
+        .get(80..HEADER)
+        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]) as usize);
+    let Some(count) = count.filter(|&n| bytes.len() == HEADER + RECORD * n) else {
+        let stl = stl_io::read_stl(&mut Cursor::new(bytes))
+            .map_err(|e| format!("not a readable STL file: {e}"))?;
+        let vertices = stl
+            .vertices
+            .iter()
+            .map(|v| Vec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2])))
+            .collect();
+        let faces = stl.faces.iter().map(|f| f.vertices).collect();
+        return Ok(TriangleMesh { vertices, faces });
+    };
+    // a corner's index by its coordinates' bits (−0 counted as +0)
+    let mut index: FxHashMap<[u32; 3], usize> = FxHashMap::default();
+    index.reserve(count);
+    let mut vertices = Vec::with_capacity(count);
+    let mut faces = Vec::with_capacity(count);
+    for record in bytes[HEADER..].chunks_exact(RECORD) {
+        let float = |at: usize| {
+            f32::from_le_bytes([record[at], record[at + 1], record[at + 2], record[at + 3]]) + 0.0
+        };
+        faces.push([12, 24, 36].map(|at| {
+            let corner = [float(at), float(at + 4), float(at + 8)];
+            *index.entry(corner.map(f32::to_bits)).or_insert_with(|| {
+                vertices.push(Vec3::from(corner.map(f64::from)));
+                vertices.len() - 1
+            })
+        }));
+    }
     Ok(TriangleMesh { vertices, faces })
 }
 
@@ -246,17 +277,10 @@ impl TriangleMesh {
         self
     }
 
-    /// Area, unit normal and centroid of face `f`.
-    fn triangle(&self, f: &[usize; 3], origin: &Vec3) -> (f64, Vec3, Vec3) {
+    /// Area vector (b − a) × (c − a) and centroid (relative to `origin`) of face `f`.
+    fn triangle(&self, f: &[usize; 3], origin: &Vec3) -> (Vec3, Vec3) {
         let [a, b, c] = f.map(|k| self.vertices[k] - origin);
-        let cross = (b - a).cross(&(c - a));
-        let norm = cross.norm();
-        let normal = if norm > 0.0 {
-            cross / norm
-        } else {
-            Vec3::zeros()
-        };
-        (norm / 2.0, normal, (a + b + c) / 3.0)
+        ((b - a).cross(&(c - a)), (a + b + c) / 3.0)
     }
 
     /// Volume (area for a shell), centre of mass and inertia about it, at unit density.
@@ -271,7 +295,8 @@ impl TriangleMesh {
         let origin = Vec3::zeros();
         let (mut area, mut face_centre) = (0.0, Vec3::zeros());
         for face in &self.faces {
-            let (a, _, centre) = self.triangle(face, &origin);
+            let (w, centre) = self.triangle(face, &origin);
+            let a = w.norm() / 2.0;
             area += a;
             face_centre += centre * a;
         }
@@ -282,8 +307,8 @@ impl TriangleMesh {
         // V and the centre of mass: one pyramid per face with its apex at c_f
         let (mut volume, mut com) = (0.0, Vec3::zeros());
         for face in &self.faces {
-            let (a, normal, centre) = self.triangle(face, &face_centre);
-            let v = mode.pyramid(a, &normal, &centre);
+            let (w, centre) = self.triangle(face, &face_centre);
+            let v = mode.pyramid(&w, &centre);
             volume += v;
             // ¾ c_t + ¼ c_f, with c_t relative to c_f here
             com += (centre * 0.75 + face_centre) * v;
@@ -304,18 +329,15 @@ impl TriangleMesh {
         };
         let (mut p, mut total) = (Mat3::zeros(), 0.0);
         for face in &self.faces {
-            let (a, normal, centre) = self.triangle(face, &com);
-            let v = mode.pyramid(a, &normal, &centre);
+            let (w, centre) = self.triangle(face, &com);
+            let v = mode.pyramid(&w, &centre);
             total += v;
             let [d, e, f] = face.map(|k| self.vertices[k] - com);
             // 2(D Dᵀ + E Eᵀ + F Fᵀ) + D Eᵀ + E Dᵀ + D Fᵀ + F Dᵀ + E Fᵀ + F Eᵀ
-            let products = (d * d.transpose() + e * e.transpose() + f * f.transpose()) * 2.0
-                + d * e.transpose()
-                + e * d.transpose()
-                + d * f.transpose()
-                + f * d.transpose()
-                + e * f.transpose()
-                + f * e.transpose();
+            //   = D Dᵀ + E Eᵀ + F Fᵀ + S Sᵀ, with S = D + E + F
+            let s = d + e + f;
+            let products =
+                d * d.transpose() + e * e.transpose() + f * f.transpose() + s * s.transpose();
             p += products * (v / denominator);
         }
         // I = tr(P) 1 − P
@@ -351,7 +373,7 @@ impl TriangleMesh {
         let mut edges: Vec<(usize, usize)> = self
             .faces
             .iter()
-            .filter(|f| self.triangle(f, &Vec3::zeros()).0 > MIN_VALUE.sqrt())
+            .filter(|f| self.triangle(f, &Vec3::zeros()).0.norm() / 2.0 > MIN_VALUE.sqrt())
             .flat_map(|&[a, b, c]| [(a, b), (b, c), (c, a)])
             .collect();
         edges.sort_unstable();
@@ -370,6 +392,48 @@ impl TriangleMesh {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The corners of every face, by value.
+    fn corners(mesh: &TriangleMesh) -> Vec<[Vec3; 3]> {
+        mesh.faces
+            .iter()
+            .map(|f| f.map(|k| mesh.vertices[k]))
+            .collect()
+    }
+
+    #[test]
+    fn binary_and_ascii_stl_give_the_same_mesh() {
+        let cube = cube();
+        let mut triangles = Vec::new();
+        for face in &cube.faces {
+            let [a, b, c] = face.map(|k| {
+                let v = cube.vertices[k].map(|x| x as f32);
+                stl_io::Vector::new([v.x, v.y, v.z])
+            });
+            triangles.push(stl_io::Triangle {
+                normal: stl_io::Vector::new([0.0; 3]),
+                vertices: [a, b, c],
+            });
+        }
+        let mut binary = Vec::new();
+        stl_io::write_stl(&mut binary, triangles.iter()).unwrap();
+        // a binary header may begin with "solid", as an ASCII file does
+        binary[..5].copy_from_slice(b"solid");
+        let mut ascii = String::from("solid cube\n");
+        for t in &triangles {
+            ascii += "facet normal 0 0 0\nouter loop\n";
+            for v in t.vertices {
+                ascii += &format!("vertex {} {} {}\n", v[0], v[1], v[2]);
+            }
+            ascii += "endloop\nendfacet\n";
+        }
+        ascii += "endsolid cube\n";
+        let from_binary = read_stl(&binary).unwrap();
+        let from_ascii = read_stl(ascii.as_bytes()).unwrap();
+        assert_eq!(from_binary.vertices.len(), 8);
+        assert_eq!(corners(&from_binary), corners(&cube));
+        assert_eq!(corners(&from_ascii), corners(&cube));
+    }
 
     /// The unit cube [0, 1]³, faces pointing out.
     fn cube() -> TriangleMesh {
