@@ -57,6 +57,8 @@ class PinocchioLayout:
             continuous = joint.nq == 2 and joint.nv == 1
             self._joints.append((iq, joint.idx_q, joint.nq, continuous))
             self.v_index[iv : iv + joint.nv] = np.arange(joint.idx_v, joint.idx_v + joint.nv)
+        # joint_ids[k]: Pinocchio's joint id of robodyn's moving body k (the joint's child)
+        self.joint_ids = np.array([pin_model.getJointId(name) for name in model.joint_names], dtype=int)
 
     def q_to_pinocchio(self, q) -> np.ndarray:
         q = np.asarray(q, dtype=float)
@@ -95,6 +97,18 @@ class PinocchioLayout:
         out = np.zeros((self.nv, self.nv))
         out[np.ix_(self.v_index, self.v_index)] = matrix
         return out
+
+    def inertial_parameters_from_pinocchio(self) -> np.ndarray:
+        """Pinocchio's `inertias[j].toDynamicParameters()` as robodyn's `inertial_parameters`
+        (nbodies, 10): the same ten parameters in the same order, rows in robodyn's body order."""
+        return np.array([self.pin_model.inertias[int(j)].toDynamicParameters() for j in self.joint_ids])
+
+    def regressor_from_pinocchio(self, regressor) -> np.ndarray:
+        """Pinocchio's joint-torque regressor (nv × 10 njoints) as robodyn's `torque_regressor`:
+        rows in robodyn's v order, column blocks in its body order."""
+        regressor = np.asarray(regressor, dtype=float)[self.v_index]
+        columns = np.concatenate([np.arange(10 * (j - 1), 10 * j) for j in self.joint_ids])
+        return regressor[:, columns]
 
     def jacobian_from_pinocchio(self, jacobian) -> np.ndarray:
         """A k x nv matrix (Jacobian); Pinocchio returns a one-column Jacobian as a vector."""

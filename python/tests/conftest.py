@@ -44,5 +44,25 @@ def robots_dir() -> Path:
     return folder
 
 
+def pinocchio_model(path, floating_base: bool):
+    """Pinocchio's model of a URDF, on a free-flyer root joint when `floating_base`."""
+    import pinocchio as pin
+
+    if floating_base:
+        return pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    return pin.buildModelFromUrdf(str(path))
+
+
+@pytest.fixture(scope="module", params=sorted(ROBOTS))
+def pinocchio_robot(request, robots_dir):
+    """(name, robodyn model, Pinocchio model, PinocchioLayout) for each example-robot-data robot."""
+    from robodyn.convert import PinocchioLayout
+
+    path, floating_base = ROBOTS[request.param]
+    model = robodyn.load(robots_dir / path, floating_base=floating_base)
+    pin_model = pinocchio_model(robots_dir / path, floating_base)
+    return request.param, model, pin_model, PinocchioLayout(model, pin_model)
+
+
 def load_reference(name: str) -> dict:
     return json.loads((REFERENCE_DIR / f"{name}.json").read_text())

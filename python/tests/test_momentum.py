@@ -6,27 +6,18 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import CROSS_CHECK_TOLERANCE, IDENTITY_TOLERANCE, ROBOTS, assert_close
+from conftest import CROSS_CHECK_TOLERANCE, IDENTITY_TOLERANCE, assert_close
 
 import robodyn
-from robodyn.convert import PinocchioLayout
 
 #: A central difference in time with step TIME_STEP is good to about this (relative).
 FD_TOLERANCE = 1e-6
 TIME_STEP = 1e-6
 
 
-@pytest.fixture(scope="module", params=sorted(ROBOTS))
-def robot(request, robots_dir):
-    path, floating_base = ROBOTS[request.param]
-    model = robodyn.load(robots_dir / path, floating_base=floating_base)
-    pin_model = pin.buildModelFromUrdf(str(robots_dir / path), pin.JointModelFreeFlyer()) if floating_base else pin.buildModelFromUrdf(str(robots_dir / path))
-    return request.param, model, pin_model, PinocchioLayout(model, pin_model)
-
-
-def test_energy_rate_is_the_power_of_the_joint_forces(robot):
+def test_energy_rate_is_the_power_of_the_joint_forces(pinocchio_robot):
     """Along the motion q̈ = FD(q, q̇, τ): d(T + V)/dt = q̇ᵀ τ (no damping or friction applied)."""
-    name, model, _, _ = robot
+    name, model, _, _ = pinocchio_robot
     rng = np.random.default_rng(1)
     q, v, tau = model.random_configuration(seed=1), rng.uniform(-1, 1, model.nv), rng.uniform(-5, 5, model.nv)
     qdd = model.forward_dynamics(q, v, tau)
@@ -40,8 +31,8 @@ def test_energy_rate_is_the_power_of_the_joint_forces(robot):
     assert_close(model.lagrangian(q, v), model.kinetic_energy(q, v) - model.potential_energy(q), IDENTITY_TOLERANCE, f"{name} L")
 
 
-def test_centroidal_momentum_agrees_with_pinocchio(robot):
-    name, model, pin_model, layout = robot
+def test_centroidal_momentum_agrees_with_pinocchio(pinocchio_robot):
+    name, model, pin_model, layout = pinocchio_robot
     data = pin_model.createData()
     rng = np.random.default_rng(2)
     for seed in range(3):

@@ -9,28 +9,14 @@ import warnings
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import CROSS_CHECK_TOLERANCE, REPOSITORY, ROBOTS, assert_close, load_reference
+from conftest import CROSS_CHECK_TOLERANCE, REPOSITORY, ROBOTS, assert_close, load_reference, pinocchio_model
 
 import robodyn
 from robodyn.convert import PinocchioLayout
 
 
-def pinocchio_model(path, floating_base):
-    if floating_base:
-        return pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
-    return pin.buildModelFromUrdf(str(path))
-
-
-@pytest.fixture(scope="module", params=sorted(ROBOTS))
-def robot(request, robots_dir):
-    path, floating_base = ROBOTS[request.param]
-    model = robodyn.load(robots_dir / path, floating_base=floating_base)
-    pin_model = pinocchio_model(robots_dir / path, floating_base)
-    return request.param, model, pin_model, PinocchioLayout(model, pin_model)
-
-
-def test_dynamics_agree_with_pinocchio(robot):
-    name, model, pin_model, mapping = robot
+def test_dynamics_agree_with_pinocchio(pinocchio_robot):
+    name, model, pin_model, mapping = pinocchio_robot
     data = pin_model.createData()
     rng = np.random.default_rng(7)
     for seed in range(5):
@@ -72,8 +58,8 @@ def test_dynamics_agree_with_pinocchio(robot):
         )
 
 
-def test_external_forces_agree_with_pinocchio(robot):
-    name, model, pin_model, mapping = robot
+def test_external_forces_agree_with_pinocchio(pinocchio_robot):
+    name, model, pin_model, mapping = pinocchio_robot
     data = pin_model.createData()
     rng = np.random.default_rng(8)
     q = model.random_configuration(seed=11)
@@ -88,8 +74,8 @@ def test_external_forces_agree_with_pinocchio(robot):
     assert_close(model.forward_dynamics(q, v, tau, f_ext=f_ext), a, CROSS_CHECK_TOLERANCE, f"{name} aba with f_ext")
 
 
-def test_kinematics_agree_with_pinocchio(robot):
-    name, model, pin_model, mapping = robot
+def test_kinematics_agree_with_pinocchio(pinocchio_robot):
+    name, model, pin_model, mapping = pinocchio_robot
     data = pin_model.createData()
     for seed in range(3):
         q = model.random_configuration(seed=20 + seed)
@@ -104,9 +90,9 @@ def test_kinematics_agree_with_pinocchio(robot):
                 assert_close(model.jacobian(q, frame, reference), expected, CROSS_CHECK_TOLERANCE, f"{name} J {reference} {frame}")
 
 
-def test_frame_velocity_and_acceleration_agree_with_pinocchio(robot):
+def test_frame_velocity_and_acceleration_agree_with_pinocchio(pinocchio_robot):
     """Frame velocity, classical acceleration (J a + J̇ v) and spatial acceleration."""
-    name, model, pin_model, mapping = robot
+    name, model, pin_model, mapping = pinocchio_robot
     data = pin_model.createData()
     rng = np.random.default_rng(12)
     for seed in range(3):

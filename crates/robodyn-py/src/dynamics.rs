@@ -71,6 +71,34 @@ impl PyModel {
         self.with_external_forces(py, q, v, ("a", a), f_ext, algo::rnea)
     }
 
+    /// The joint-torque regressor Y(q, v, a), shape (nv, 10 nbodies): τ = Y π with π =
+    /// `inertial_parameters.ravel()` (each body's ten parameters in turn). Armature adds
+    /// armature · a (and the ball joints' rotor terms) to τ; it is not a body's parameter.
+    fn torque_regressor<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        a: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let columns = 10 * (self.model.nbodies() - 1);
+        let arguments = [
+            self.q_arg("q", q)?,
+            self.v_arg("v", v)?,
+            self.v_arg("a", a)?,
+        ];
+        self.evaluate(
+            py,
+            &arguments,
+            &[self.model.nv, columns],
+            &|m, w, i, out| {
+                let y = algo::torque_regressor(m, &mut w.data, i[0], i[1], i[2])?;
+                write_row_major(y, m.nv, out);
+                Ok(())
+            },
+        )
+    }
+
     /// Forward dynamics by ABA: a = M(q)⁻¹ (τ - C(q, v) v - g(q) + Σ J_iᵀ f_ext_i).
     #[pyo3(signature = (q, v, tau, f_ext=None))]
     fn forward_dynamics<'py>(

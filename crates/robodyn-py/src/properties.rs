@@ -228,6 +228,38 @@ impl PyModel {
         self.model.inertias[1..].iter().map(|i| i.mass).collect()
     }
 
+    /// The ten standard inertial parameters of each moving body, shape (nbodies, 10), rows as
+    /// body_names: [m, m c_x, m c_y, m c_z, I_xx, I_xy, I_yy, I_xz, I_yz, I_zz], c the centre of
+    /// mass and I the rotational inertia about the body's origin, in the body's axes (the
+    /// regressor's order, as Pinocchio's dynamic parameters). Settable: every algorithm then
+    /// uses the new values; each row must be a physical body (m >= 0, the inertia about the
+    /// centre of mass positive semi-definite with principal moments obeying the triangle
+    /// inequalities), else ValueError naming the row and body, and nothing changes.
+    #[getter]
+    fn get_inertial_parameters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let rows = self.model.nbodies() - 1;
+        let flat: Vec<f64> = self
+            .model
+            .inertial_parameters()
+            .into_iter()
+            .flatten()
+            .collect();
+        Ok(PyArray1::from_vec(py, flat).reshape([rows, 10])?.into_any())
+    }
+
+    #[setter]
+    fn set_inertial_parameters(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        let rows = self.model.nbodies() - 1;
+        let flat = read_sample("inertial_parameters", value, SampleShape::matrix(rows, 10))?;
+        let parameters: Vec<[f64; 10]> = flat
+            .chunks_exact(10)
+            .map(|row| <[f64; 10]>::try_from(row).expect("rows of ten"))
+            .collect();
+        self.model
+            .set_inertial_parameters(&parameters)
+            .map_err(to_py_err)
+    }
+
     /// Total mass (kg).
     #[getter]
     fn total_mass(&self) -> f64 {

@@ -77,6 +77,9 @@ pub struct Data {
     /// Time derivative J̇ of a frame Jacobian, 6 x nv, rows `[linear; angular]`. Written by
     /// `jacobian_time_variation`.
     pub jacobian_dot: DMatrix<f64>,
+    /// Joint-torque regressor Y(q, q̇, q̈), τ = Y π; nv x 10 (nbodies − 1). Written by
+    /// `torque_regressor`.
+    pub regressor: DMatrix<f64>,
     /// The bodies from a frame's body down to the world's child (its support), in that order.
     /// Written by `jacobian` and `frame_pose`.
     pub support: Vec<usize>,
@@ -115,6 +118,7 @@ impl Data {
             qdd: DVector::zeros(nv),
             jacobian: DMatrix::zeros(6, nv),
             jacobian_dot: DMatrix::zeros(6, nv),
+            regressor: DMatrix::zeros(nv, 10 * (nb - 1)),
             support: Vec::with_capacity(nb),
         }
     }

@@ -259,6 +259,31 @@ impl Model {
         Ok(())
     }
 
+    /// The ten standard inertial parameters [m, m c, Ī_O] of every moving body, in body order
+    /// (see [`Inertia::to_parameters`]).
+    pub fn inertial_parameters(&self) -> Vec<[f64; 10]> {
+        self.inertias[1..]
+            .iter()
+            .map(Inertia::to_parameters)
+            .collect()
+    }
+
+    /// Replaces the inertia of every moving body by its ten parameters, after checking that each
+    /// body is physical (see [`check_physical_parameters`]); on an error nothing changes.
+    pub fn set_inertial_parameters(&mut self, parameters: &[[f64; 10]]) -> Result<()> {
+        check_length("inertial_parameters", parameters.len(), self.nbodies() - 1)?;
+        for (k, p) in parameters.iter().enumerate() {
+            check_physical_parameters(p).map_err(|message| Error::InvalidValue {
+                argument: "inertial_parameters".into(),
+                message: format!("row {k} (body '{}'): {message}", self.body_names[k + 1]),
+            })?;
+        }
+        for (inertia, p) in self.inertias[1..].iter_mut().zip(parameters) {
+            *inertia = Inertia::from_parameters(p);
+        }
+        Ok(())
+    }
+
     /// Total mass.
     pub fn total_mass(&self) -> f64 {
         self.inertias.iter().skip(1).map(|i| i.mass).sum()
@@ -292,6 +317,48 @@ pub fn check_positive_semidefinite(inertia_com: &Mat3) -> std::result::Result<()
             "expected a positive semi-definite inertia tensor, got principal moments [{:.6e}, {:.6e}, {:.6e}]",
             eigenvalues[0], eigenvalues[1], eigenvalues[2]
         ));
+    }
+    Ok(())
+}
+
+/// Checks that ten inertial parameters [m, h, Ī_O] describe a rigid body: finite, m ≥ 0, and the
+/// rotational inertia about the centre of mass I_C = Ī_O − (h·h 1 − h hᵀ)/m positive
+/// semi-definite with principal moments obeying the triangle inequalities λ_a + λ_b ≥ λ_c (a
+/// massless body has h = 0 and I_C = Ī_O).
+pub fn check_physical_parameters(p: &[f64; 10]) -> std::result::Result<(), String> {
+    if let Some(k) = p.iter().position(|x| !x.is_finite()) {
+        return Err(format!(
+            "expected finite parameters, got {} at index {k}",
+            p[k]
+        ));
+    }
+    let inertia = Inertia::from_parameters(p);
+    let (mass, h) = (inertia.mass, inertia.first_moment);
+    if mass < 0.0 {
+        return Err(format!("expected a mass >= 0, got {mass}"));
+    }
+    let scale = inertia.rotational.abs().max();
+    let tolerance = (INERTIA_EIGENVALUE_TOLERANCE * scale).max(INERTIA_ABSOLUTE_TOLERANCE);
+    let inertia_com = if mass > 0.0 {
+        inertia.rotational - (Mat3::identity() * h.norm_squared() - h * h.transpose()) / mass
+    } else if h.norm() > INERTIA_ABSOLUTE_TOLERANCE {
+        return Err(format!(
+            "a massless body has no first moment, got m c = [{}, {}, {}]",
+            h.x, h.y, h.z
+        ));
+    } else {
+        inertia.rotational
+    };
+    check_positive_semidefinite(&inertia_com)?;
+    let moments = inertia_com.symmetric_eigenvalues();
+    for c in 0..3 {
+        let (a, b) = (moments[(c + 1) % 3], moments[(c + 2) % 3]);
+        if a + b < moments[c] - tolerance {
+            return Err(format!(
+                "the principal moments about the centre of mass [{:.6e}, {:.6e}, {:.6e}] break the triangle inequality ({a:.6e} + {b:.6e} < {:.6e})",
+                moments[0], moments[1], moments[2], moments[c]
+            ));
+        }
     }
     Ok(())
 }

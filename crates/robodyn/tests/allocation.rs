@@ -83,6 +83,12 @@ fn algorithms_allocate_nothing_after_data_new() {
                 }),
             ),
             (
+                "torque_regressor",
+                allocations(|| {
+                    torque_regressor(&model, &mut data, q, v, a).unwrap();
+                }),
+            ),
+            (
                 "bias_forces",
                 allocations(|| {
                     bias_forces(&model, &mut data, q, v).unwrap();

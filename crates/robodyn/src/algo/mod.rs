@@ -17,6 +17,7 @@ pub mod jacobian;
 pub mod kinematics;
 pub mod manipulability;
 pub mod minv;
+pub mod regressor;
 pub mod rnea;
 pub mod textbook_forms;
 
@@ -31,6 +32,7 @@ pub use jacobian::{jacobian, Reference};
 pub use kinematics::{forward_kinematics, frame_placement, frame_pose};
 pub use manipulability::manipulability;
 pub use minv::inverse_mass_matrix;
+pub use regressor::torque_regressor;
 pub use rnea::{bias_forces, generalized_gravity, rnea};
 pub use textbook_forms::{
     generalized_gravity_by_jacobians, mass_matrix_by_jacobians, mass_matrix_by_rnea,

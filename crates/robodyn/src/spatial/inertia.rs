@@ -75,6 +75,66 @@ impl Inertia {
 }
 
 impl Inertia {
+    /// The ten standard inertial parameters π = [m, h_x, h_y, h_z, Ī_xx, Ī_xy, Ī_yy, Ī_xz, Ī_yz,
+    /// Ī_zz] (h = m c, Ī about the frame's origin), the order of Atkeson, An and Hollerbach (1986)
+    /// that Pinocchio's dynamic parameters also use.
+    pub fn to_parameters(&self) -> [f64; 10] {
+        let (h, i) = (&self.first_moment, &self.rotational);
+        [
+            self.mass,
+            h.x,
+            h.y,
+            h.z,
+            i[(0, 0)],
+            i[(0, 1)],
+            i[(1, 1)],
+            i[(0, 2)],
+            i[(1, 2)],
+            i[(2, 2)],
+        ]
+    }
+
+    /// The inertia of the ten standard parameters (see [`Inertia::to_parameters`]).
+    pub fn from_parameters(p: &[f64; 10]) -> Self {
+        Inertia {
+            mass: p[0],
+            first_moment: Vec3::new(p[1], p[2], p[3]),
+            rotational: Mat3::new(p[4], p[5], p[7], p[5], p[6], p[8], p[7], p[8], p[9]),
+        }
+    }
+
+    /// The columns of f = I a + v ×* I v as a linear map of the ten parameters: f = Σ_k π_k
+    /// F_k(v, a). With v = (ω, u), a = (ω̇, u̇) on `[angular; linear]` (Atkeson, An and
+    /// Hollerbach 1986, with the Jacobi identity [u]×[ω]× − [ω]×[u]× = [u × ω]×):
+    /// - m: n = 0, f = u̇ + ω × u;
+    /// - h: n = −[u̇ + ω × u]× h, f = ([ω̇]× + [ω]×[ω]×) h;
+    /// - Ī: n = L(ω̇) + [ω]× L(ω), f = 0, with Ī w = L(w) [Ī_xx, Ī_xy, Ī_yy, Ī_xz, Ī_yz, Ī_zz].
+    pub fn force_regressor(v: &Motion, a: &Motion) -> [Force; 10] {
+        let (w, u) = (&v.angular, &v.linear);
+        let linear_acceleration = a.linear + w.cross(u);
+        let mut columns = [Force::ZERO; 10];
+        columns[0].linear = linear_acceleration;
+        for (k, e) in [Vec3::x(), Vec3::y(), Vec3::z()].iter().enumerate() {
+            columns[1 + k] = Force {
+                angular: -linear_acceleration.cross(e),
+                linear: a.angular.cross(e) + w.cross(&w.cross(e)),
+            };
+        }
+        // L(w) column by column: the unit tensors of Ī_xx, Ī_xy, Ī_yy, Ī_xz, Ī_yz, Ī_zz
+        for (k, (r, c)) in [(0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)]
+            .into_iter()
+            .enumerate()
+        {
+            let mut unit = Mat3::zeros();
+            unit[(r, c)] = 1.0;
+            unit[(c, r)] = 1.0;
+            columns[4 + k].angular = unit * a.angular + w.cross(&(unit * w));
+        }
+        columns
+    }
+}
+
+impl Inertia {
     /// The body's Coriolis factor `B(I, v) = ½[(v×*) I + (I v)×̄ − I (v×)]` (Echeandia & Wensing
     /// 2021, eq. 19) on `[angular; linear]`: `B v = v ×* I v` gives the body's velocity-product
     /// force, and `İ − 2B = −(I v)×̄` is skew-symmetric, so the joint-space C it assembles makes
