@@ -4,11 +4,14 @@
 use crate::args::*;
 use crate::model::*;
 use crate::to_py_err;
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use rand::{rngs::StdRng, SeedableRng};
+use robodyn::integrate::lie_group::{difference_jacobians, integrate_jacobians};
+use robodyn::Model;
 
 #[pymethods]
 impl PyModel {
@@ -338,6 +341,34 @@ impl PyModel {
         )
     }
 
+    /// Jacobians of q ⊕ v in the tangent spaces (right perturbations q ⊕ δ, Pinocchio's
+    /// `dIntegrate` convention): dict of `dq` = ∂(q ⊕ v)/∂q = Ad(exp(v))⁻¹ and `dv` =
+    /// ∂(q ⊕ v)/∂v = J_r(v), each (nv, nv), block-diagonal by joint; identity blocks on revolute
+    /// and prismatic joints.
+    fn integrate_jacobians<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let arguments = [self.q_arg("q", q)?, self.v_arg("v", v)?];
+        let pair = self.jacobian_pair(py, &arguments, integrate_jacobians)?;
+        split_pair(py, &pair, ["dq", "dv"])
+    }
+
+    /// Jacobians of q1 ⊖ q0 in the tangent spaces: dict of `dq0` = −J_l(v)⁻¹ and `dq1` =
+    /// J_r(v)⁻¹ with v = q1 ⊖ q0, each (nv, nv), block-diagonal by joint.
+    fn difference_jacobians<'py>(
+        &self,
+        py: Python<'py>,
+        q0: &Bound<'py, PyAny>,
+        q1: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let arguments = [self.q_arg("q0", q0)?, self.q_arg("q1", q1)?];
+        let pair = self.jacobian_pair(py, &arguments, difference_jacobians)?;
+        split_pair(py, &pair, ["dq0", "dq1"])
+    }
+
     /// q1 ⊖ q0: the velocity that moves q0 to q1 in unit time. (nv,).
     fn difference<'py>(
         &self,
@@ -352,4 +383,43 @@ impl PyModel {
             &|m, _, i, out| m.difference(i[0], i[1], out),
         )
     }
+}
+
+/// A pair of nv × nv Jacobians of two inputs.
+type JacobianPair =
+    fn(&Model, &[f64], &[f64], &mut DMatrix<f64>, &mut DMatrix<f64>) -> robodyn::Result<()>;
+
+impl PyModel {
+    /// `algorithm`'s two Jacobians per sample, as one (…, 2, nv, nv) array.
+    fn jacobian_pair<'py>(
+        &self,
+        py: Python<'py>,
+        arguments: &[Argument<'py>],
+        algorithm: JacobianPair,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let nv = self.model.nv;
+        self.evaluate(py, arguments, &[2, nv, nv], &|m, _, i, out| {
+            let (mut first, mut second) = (DMatrix::zeros(nv, nv), DMatrix::zeros(nv, nv));
+            algorithm(m, i[0], i[1], &mut first, &mut second)?;
+            let (top, bottom) = out.split_at_mut(nv * nv);
+            write_row_major(&first, nv, top);
+            write_row_major(&second, nv, bottom);
+            Ok(())
+        })
+    }
+}
+
+/// {names[0]: pair[..., 0, :, :], names[1]: pair[..., 1, :, :]}.
+fn split_pair<'py>(
+    py: Python<'py>,
+    pair: &Bound<'py, PyAny>,
+    names: [&str; 2],
+) -> PyResult<Bound<'py, PyAny>> {
+    let out = PyDict::new(py);
+    for (k, name) in names.into_iter().enumerate() {
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("axis", -3)?;
+        out.set_item(name, pair.call_method("take", (k,), Some(&kwargs))?)?;
+    }
+    Ok(out.into_any())
 }

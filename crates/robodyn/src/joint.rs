@@ -7,9 +7,11 @@
 //! differences act on the joint's Lie group (quaternions for the spherical and free joints), so
 //! `difference(q, integrate(q, v)) = v`.
 
-use crate::spatial::{log_rotation, skew, Force, Mat3, Motion, Transform, Vec3};
+use crate::spatial::{log_rotation, skew, Force, Mat3, Mat6, Motion, Transform, Vec3};
 use nalgebra::{Quaternion, UnitQuaternion};
 use rand::Rng;
+
+mod jacobians;
 
 /// Below this rotation angle the SE(3)/SO(3) exponential and logarithm use their Taylor series.
 const SMALL_ANGLE: f64 = 1e-6;
@@ -230,6 +232,61 @@ impl Joint {
             }
         }
     }
+    /// ∂(q ⊕ v)/∂q = Ad(exp(v))⁻¹ and ∂(q ⊕ v)/∂v = J_r(v), tangent to tangent (see
+    /// [`jacobians`]), written into the leading nv × nv blocks of `d_q` and `d_v`.
+    pub fn integrate_jacobians(&self, v: &[f64], d_q: &mut Mat6, d_v: &mut Mat6) {
+        match self {
+            Joint::Fixed => {}
+            Joint::Revolute { .. } | Joint::Prismatic { .. } => {
+                d_q[(0, 0)] = 1.0;
+                d_v[(0, 0)] = 1.0;
+            }
+            Joint::Spherical => {
+                let w = Vec3::new(v[0], v[1], v[2]);
+                let back = exp_so3(&-w).to_rotation_matrix();
+                d_q.fixed_view_mut::<3, 3>(0, 0).copy_from(back.matrix());
+                // J_r(w) = J_l(−w)
+                d_v.fixed_view_mut::<3, 3>(0, 0)
+                    .copy_from(&left_jacobian_so3(&-w));
+            }
+            Joint::Free => {
+                let (linear, angular) = (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5]));
+                let (rotation, position) = exp_se3(&-linear, &-angular);
+                *d_q = jacobians::adjoint_se3(&rotation, &position);
+                *d_v = jacobians::left_jacobian_se3(&-linear, &-angular);
+            }
+        }
+    }
+
+    /// ∂(q₁ ⊖ q₀)/∂q₀ = −J_l(v)⁻¹ and ∂(q₁ ⊖ q₀)/∂q₁ = J_r(v)⁻¹ with v = q₁ ⊖ q₀, written into the
+    /// leading nv × nv blocks of `d_q0` and `d_q1`.
+    pub fn difference_jacobians(&self, q0: &[f64], q1: &[f64], d_q0: &mut Mat6, d_q1: &mut Mat6) {
+        let mut v = [0.0; 6];
+        let nv = self.nv();
+        self.difference(q0, q1, &mut v[..nv]);
+        match self {
+            Joint::Fixed => {}
+            Joint::Revolute { .. } | Joint::Prismatic { .. } => {
+                d_q0[(0, 0)] = -1.0;
+                d_q1[(0, 0)] = 1.0;
+            }
+            Joint::Spherical => {
+                let w = Vec3::new(v[0], v[1], v[2]);
+                let inverse = |j: Mat3| j.try_inverse().unwrap_or_else(Mat3::zeros);
+                d_q0.fixed_view_mut::<3, 3>(0, 0)
+                    .copy_from(&-inverse(left_jacobian_so3(&w)));
+                d_q1.fixed_view_mut::<3, 3>(0, 0)
+                    .copy_from(&inverse(left_jacobian_so3(&-w)));
+            }
+            Joint::Free => {
+                let (linear, angular) = (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5]));
+                let inverse = |j: Mat6| j.try_inverse().unwrap_or_else(Mat6::zeros);
+                *d_q0 = -inverse(jacobians::left_jacobian_se3(&linear, &angular));
+                *d_q1 = inverse(jacobians::left_jacobian_se3(&-linear, &-angular));
+            }
+        }
+    }
+
     /// The rate `ξ̇` of the tangent coordinates `ξ` in `q(t) = q₀ ⊕ ξ(t)` when the joint moves
     /// with body velocity `v`: `ξ̇ = dexp⁻¹_{-ξ}(v) = v + ½ ad_ξ v + ¹⁄₁₂ ad_ξ² v − ¹⁄₇₂₀ ad_ξ⁴ v`
     /// (the Bernoulli series, truncated after the term that a fifth-order Runge–Kutta–Munthe-Kaas

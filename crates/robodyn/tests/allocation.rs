@@ -63,6 +63,10 @@ fn algorithms_allocate_nothing_after_data_new() {
         let (q, v, a) = (q.as_slice(), v.as_slice(), a.as_slice());
         let frame = model.frames.len() - 1;
         let mut gamma = vec![0.0; model.nv.pow(3)];
+        let mut jacobians = (
+            nalgebra::DMatrix::zeros(model.nv, model.nv),
+            nalgebra::DMatrix::zeros(model.nv, model.nv),
+        );
         let counts = [
             (
                 "forward_kinematics",
@@ -80,6 +84,19 @@ fn algorithms_allocate_nothing_after_data_new() {
                 "rnea",
                 allocations(|| {
                     rnea(&model, &mut data, q, v, a, Some(&f_ext)).unwrap();
+                }),
+            ),
+            (
+                "integrate_jacobians",
+                allocations(|| {
+                    robodyn::integrate::lie_group::integrate_jacobians(
+                        &model,
+                        q,
+                        v,
+                        &mut jacobians.0,
+                        &mut jacobians.1,
+                    )
+                    .unwrap();
                 }),
             ),
             (
