@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import time
 from pathlib import Path
 
 import mujoco
@@ -248,9 +249,10 @@ def test_trajectory_player_and_its_offline_page(tmp_path: Path) -> None:
     viewer = trajectory.view(open_browser=False, port=0, camera=ARM_CAMERA)
     try:
         assert viewer.time.max == pytest.approx(trajectory.t[-1]) and viewer.speed.value == "1x"
-        viewer.playing.value = False
         k = len(trajectory.t) * 3 // 4
-        viewer.time.value = float(trajectory.t[k])  # the slider poses the robot
+        viewer.seek(trajectory.t[k])  # pauses; the slider poses the robot
+        time.sleep(0.2)
+        assert viewer.time.value == float(trajectory.t[k]) and not viewer.playing.value
         pixels, _ = screenshot(viewer.url, tmp_path, "player")
         check_arm_drawn(pixels, model, trajectory.q[k])
     finally:

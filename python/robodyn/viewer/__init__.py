@@ -196,6 +196,8 @@ class TrajectoryViewer(Viewer):
         # the slider draws: moved in the page, or by the player below (viser calls back on both)
         self.time.on_update(lambda _: self._draw(self.time.value))
         self._stop = threading.Event()
+        # one tick of the player, or a seek, at a time: a seek is never overwritten by a tick
+        self._tick = threading.Lock()
         self._player = threading.Thread(target=self._play, name="robodyn-player", daemon=True)
         self._player.start()
         self._open(open_browser)
@@ -211,10 +213,17 @@ class TrajectoryViewer(Viewer):
         next_tick = time.perf_counter()
         while not self._stop.is_set():
             next_tick += period
-            if self.playing.value and end > start:
-                t = self.time.value + period * float(self.speed.value.rstrip("x"))
-                self.time.value = start + (t - start) % (end - start) if t > end else t
+            with self._tick:
+                if self.playing.value and end > start:
+                    t = self.time.value + period * float(self.speed.value.rstrip("x"))
+                    self.time.value = start + (t - start) % (end - start) if t > end else t
             self._stop.wait(max(0.0, next_tick - time.perf_counter()))
+
+    def seek(self, t: float) -> None:
+        """Pauses the playback and shows the robot at time ``t`` (the sample at or before it)."""
+        with self._tick:
+            self.playing.value = False
+            self.time.value = float(t)
 
     def close(self) -> None:
         """Stops the player and the server."""
