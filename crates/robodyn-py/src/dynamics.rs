@@ -32,7 +32,7 @@ impl PyModel {
             )?);
         }
         self.evaluate(py, &arguments, &[self.model.nv], &|m, w, i, out| {
-            let Workspace { data, forces } = w;
+            let Workspace { data, forces, .. } = w;
             let forces = i.get(3).map(|flat| {
                 fill_forces(forces, flat);
                 &forces[..]

@@ -20,6 +20,8 @@ use std::sync::Mutex;
 pub(crate) struct Workspace {
     pub(crate) data: Data,
     pub(crate) forces: Vec<Force>,
+    /// Two nv × nv results of a pair of Jacobians (`integrate_jacobians`, ...).
+    pub(crate) jacobians: (DMatrix<f64>, DMatrix<f64>),
 }
 
 impl Workspace {
@@ -27,6 +29,10 @@ impl Workspace {
         Workspace {
             data: Data::new(model),
             forces: vec![Force::ZERO; model.nbodies() - 1],
+            jacobians: (
+                DMatrix::zeros(model.nv, model.nv),
+                DMatrix::zeros(model.nv, model.nv),
+            ),
         }
     }
 }

@@ -398,12 +398,12 @@ impl PyModel {
         algorithm: JacobianPair,
     ) -> PyResult<Bound<'py, PyAny>> {
         let nv = self.model.nv;
-        self.evaluate(py, arguments, &[2, nv, nv], &|m, _, i, out| {
-            let (mut first, mut second) = (DMatrix::zeros(nv, nv), DMatrix::zeros(nv, nv));
-            algorithm(m, i[0], i[1], &mut first, &mut second)?;
+        self.evaluate(py, arguments, &[2, nv, nv], &|m, w, i, out| {
+            let (first, second) = &mut w.jacobians;
+            algorithm(m, i[0], i[1], first, second)?;
             let (top, bottom) = out.split_at_mut(nv * nv);
-            write_row_major(&first, nv, top);
-            write_row_major(&second, nv, bottom);
+            write_row_major(first, nv, top);
+            write_row_major(second, nv, bottom);
             Ok(())
         })
     }

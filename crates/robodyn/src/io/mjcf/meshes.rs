@@ -71,15 +71,20 @@ impl<'a> Reader<'a> {
             .numbers::<1>(mesh, class, "maxhullvert")?
             .map(|[n]| n)
             .filter(|&n| n > -1.0);
-        if let (MeshInertia::Convex, Some(limit)) = (mode, limit) {
-            let corners = triangles.convex_hull().map_err(&error)?.vertices.len();
-            if corners as f64 > limit {
+        let properties = if mode == MeshInertia::Convex {
+            // the hull, once: its vertex count against the limit, then its exact inertia
+            let hull = triangles.convex_hull().map_err(&error)?;
+            let corners = hull.vertices.len();
+            if let Some(limit) = limit.filter(|&n| corners as f64 > n) {
                 return Err(error(format!(
                     "inertia='convex' with maxhullvert='{limit}': the mesh's convex hull has {corners} vertices, and MuJoCo then takes qhull's hull stopped at {limit}, which robodyn does not repeat: raise maxhullvert to {corners} or more, leave it out, or use another inertia"
                 )));
             }
+            hull.mass_properties(MeshInertia::Exact)
+        } else {
+            triangles.mass_properties(mode)
         }
-        let properties = triangles.mass_properties(mode).map_err(&error)?;
+        .map_err(&error)?;
         let (moments, axes) = principal_frame(&properties.inertia);
         // the vertices' bounding box in the principal frame, about the centre of mass
         let mut aabb = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
