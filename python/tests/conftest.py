@@ -53,6 +53,16 @@ def pinocchio_model(path, floating_base: bool):
     return pin.buildModelFromUrdf(str(path))
 
 
+def pinocchio_forces(model, pin_model, f_ext):
+    """robodyn's (nbodies, 6) body-frame wrenches as Pinocchio's per-joint forces."""
+    import pinocchio as pin
+
+    forces = [pin.Force.Zero() for _ in range(pin_model.njoints)]
+    for joint_name, wrench in zip(model.joint_names, f_ext):
+        forces[pin_model.getJointId(joint_name)] = pin.Force(wrench[:3], wrench[3:])
+    return forces
+
+
 @pytest.fixture(scope="module", params=sorted(ROBOTS))
 def pinocchio_robot(request, robots_dir):
     """(name, robodyn model, Pinocchio model, PinocchioLayout) for each example-robot-data robot."""

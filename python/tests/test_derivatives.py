@@ -1,18 +1,83 @@
-"""Derivatives: the Jacobians of integrate and difference on the joints' Lie groups, against
-Pinocchio's `dIntegrate` and `dDifference` on example-robot-data robots (free joints included) and
-against central finite differences, batched like every call."""
+"""Derivatives: of inverse and forward dynamics, and the Jacobians of integrate and difference on
+the joints' Lie groups, against Pinocchio (`computeRNEADerivatives`, `computeABADerivatives`,
+`dIntegrate`, `dDifference`) on example-robot-data robots (free joints included) and against
+central finite differences on the Lie group, batched like every call."""
 
 from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
-from conftest import CROSS_CHECK_TOLERANCE, assert_close
+from conftest import CROSS_CHECK_TOLERANCE, REPOSITORY, assert_close, pinocchio_forces
 
 import robodyn
 
 #: Central differences with step FD_STEP: truncation h² and round-off ε/h.
 FD_STEP = 1e-6
 FD_TOLERANCE = 1e-7
+#: Central differences of τ or q̈ (magnitudes up to ~1e3 on Talos): round-off ε |f| / h dominates.
+DYNAMICS_FD_TOLERANCE = 1e-6
+
+
+def test_dynamics_derivatives_agree_with_pinocchio(pinocchio_robot):
+    name, model, pin_model, mapping = pinocchio_robot
+    data = pin_model.createData()
+    rng = np.random.default_rng(6)
+    for seed in range(2):
+        q = model.random_configuration(seed=seed)
+        v, a = rng.uniform(-1, 1, model.nv), rng.uniform(-1, 1, model.nv)
+        f_ext = rng.uniform(-5, 5, (len(model.body_names), 6))
+        pq, pv, pa = mapping.q_to_pinocchio(q), mapping.v_to_pinocchio(v), mapping.v_to_pinocchio(a)
+        theirs = pin.computeRNEADerivatives(pin_model, data, pq, pv, pa, pinocchio_forces(model, pin_model, f_ext))
+        ours = model.inverse_dynamics_derivatives(q, v, a, f_ext=f_ext)
+        for key, expected in zip(["dtau_dq", "dtau_dv", "dtau_da"], theirs):
+            expected = np.triu(expected) + np.triu(expected, 1).T if key == "dtau_da" else expected
+            assert_close(ours[key], mapping.matrix_from_pinocchio(expected), CROSS_CHECK_TOLERANCE, f"{name} {key}")
+
+        tau = model.inverse_dynamics(q, v, a)
+        theirs = pin.computeABADerivatives(pin_model, data, pq, pv, mapping.v_to_pinocchio(tau))
+        ours = model.forward_dynamics_derivatives(q, v, tau)
+        for key, expected in zip(["dqdd_dq", "dqdd_dv", "dqdd_dtau"], theirs):
+            expected = np.triu(expected) + np.triu(expected, 1).T if key == "dqdd_dtau" else expected
+            assert_close(ours[key], mapping.matrix_from_pinocchio(expected), CROSS_CHECK_TOLERANCE, f"{name} {key}")
+
+
+def tangent_differences(model, q, f):
+    """Columns (f(q ⊕ h e_k) − f(q ⊕ −h e_k)) / 2h: ∂f/∂q in the tangent space, centrally."""
+    return np.column_stack([
+        (f(model.integrate(q, FD_STEP * e)) - f(model.integrate(q, -FD_STEP * e))) / (2 * FD_STEP) for e in np.eye(model.nv)
+    ])
+
+
+def test_dynamics_derivatives_are_finite_differences_on_the_bundled_models():
+    rng = np.random.default_rng(9)
+    free_armature = REPOSITORY / "testdata" / "mjcf" / "free_armature.xml"
+    for name in ["pendulum", "planar2", "ur5", free_armature]:
+        model = robodyn.load(name)
+        q = model.random_configuration(seed=3)
+        v, a = rng.uniform(-1, 1, model.nv), rng.uniform(-1, 1, model.nv)
+        ours = model.inverse_dynamics_derivatives(q, v, a)
+        fd = tangent_differences(model, q, lambda q: model.inverse_dynamics(q, v, a))
+        assert_close(ours["dtau_dq"], fd, DYNAMICS_FD_TOLERANCE, f"{name} dtau_dq")
+        assert_close(ours["dtau_da"], model.mass_matrix(q), 1e-12, f"{name} dtau_da = M")
+        tau = model.inverse_dynamics(q, v, a)
+        ours = model.forward_dynamics_derivatives(q, v, tau)
+        fd = tangent_differences(model, q, lambda q: model.forward_dynamics(q, v, tau))
+        assert_close(ours["dqdd_dq"], fd, DYNAMICS_FD_TOLERANCE, f"{name} dqdd_dq")
+        assert_close(ours["dqdd_dtau"], model.inverse_mass_matrix(q), 1e-12, f"{name} dqdd_dtau = M⁻¹")
+
+
+def test_dynamics_derivatives_are_batched():
+    model = robodyn.load("ur5")
+    rng = np.random.default_rng(3)
+    q = np.array([model.random_configuration(seed=s) for s in range(4)])
+    v, a = rng.uniform(-1, 1, (4, model.nv)), rng.uniform(-1, 1, (4, model.nv))
+    batch = model.inverse_dynamics_derivatives(q, v, a)
+    assert batch["dtau_dq"].shape == (4, model.nv, model.nv)
+    single = model.inverse_dynamics_derivatives(q[1], v[1], a[1])
+    for key in single:
+        np.testing.assert_array_equal(batch[key][1], single[key])
+    forward = model.forward_dynamics_derivatives(q, v, a)
+    assert forward["dqdd_dv"].shape == (4, model.nv, model.nv)
 
 
 def test_lie_group_jacobians_agree_with_pinocchio(pinocchio_robot):

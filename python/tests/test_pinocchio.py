@@ -9,7 +9,7 @@ import warnings
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import CROSS_CHECK_TOLERANCE, REPOSITORY, ROBOTS, assert_close, load_reference, pinocchio_model
+from conftest import CROSS_CHECK_TOLERANCE, REPOSITORY, ROBOTS, assert_close, load_reference, pinocchio_forces, pinocchio_model
 
 import robodyn
 from robodyn.convert import PinocchioLayout
@@ -65,9 +65,7 @@ def test_external_forces_agree_with_pinocchio(pinocchio_robot):
     q = model.random_configuration(seed=11)
     v, a = rng.uniform(-1, 1, model.nv), rng.uniform(-1, 1, model.nv)
     f_ext = rng.uniform(-5, 5, (len(model.body_names), 6))
-    pin_forces = [pin.Force.Zero() for _ in range(pin_model.njoints)]
-    for joint_name, wrench in zip(model.joint_names, f_ext):
-        pin_forces[pin_model.getJointId(joint_name)] = pin.Force(wrench[:3], wrench[3:])
+    pin_forces = pinocchio_forces(model, pin_model, f_ext)
     expected = mapping.v_from_pinocchio(pin.rnea(pin_model, data, mapping.q_to_pinocchio(q), mapping.v_to_pinocchio(v), mapping.v_to_pinocchio(a), pin_forces))
     tau = model.inverse_dynamics(q, v, a, f_ext=f_ext)
     assert_close(tau, expected, CROSS_CHECK_TOLERANCE, f"{name} tau with f_ext")

@@ -3,22 +3,21 @@
 
 use crate::args::*;
 use crate::model::*;
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 use pyo3::prelude::*;
 use robodyn::algo;
+use robodyn::spatial::Force;
 use robodyn::{Data, Model};
 
 impl PyModel {
-    /// Dynamics with optional external forces: `algorithm(q, v, x, f_ext)`.
-    pub(crate) fn with_external_forces<'py>(
+    /// The arguments (q, v, x[, f_ext]) of a dynamics algorithm with optional external forces.
+    fn dynamics_arguments<'py>(
         &self,
-        py: Python<'py>,
         q: &Bound<'py, PyAny>,
         v: &Bound<'py, PyAny>,
         x: (&'static str, &Bound<'py, PyAny>),
         f_ext: Option<&Bound<'py, PyAny>>,
-        algorithm: DynamicsAlgorithm,
-    ) -> PyResult<Bound<'py, PyAny>> {
+    ) -> PyResult<Vec<Argument<'py>>> {
         let mut arguments = vec![
             self.q_arg("q", q)?,
             self.v_arg("v", v)?,
@@ -31,16 +30,93 @@ impl PyModel {
                 SampleShape::matrix(self.model.nbodies() - 1, 6),
             )?);
         }
+        Ok(arguments)
+    }
+
+    /// Dynamics with optional external forces: `algorithm(q, v, x, f_ext)`.
+    pub(crate) fn with_external_forces<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        x: (&'static str, &Bound<'py, PyAny>),
+        f_ext: Option<&Bound<'py, PyAny>>,
+        algorithm: DynamicsAlgorithm,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let arguments = self.dynamics_arguments(q, v, x, f_ext)?;
         self.evaluate(py, &arguments, &[self.model.nv], &|m, w, i, out| {
             let Workspace { data, forces, .. } = w;
-            let forces = i.get(3).map(|flat| {
-                fill_forces(forces, flat);
-                &forces[..]
-            });
+            let forces = i.get(3).map(|flat| external_forces(forces, flat));
             out.copy_from_slice(algorithm(m, data, i[0], i[1], i[2], forces)?.as_slice());
             Ok(())
         })
     }
+
+    /// The three nv × nv derivatives of a dynamics algorithm with optional external forces, as a
+    /// dict of (…, nv, nv) arrays named `names`.
+    fn dynamics_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        arguments: &[Argument<'py>],
+        names: [&str; 3],
+        derivatives: DerivativesAlgorithm,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let nv = self.model.nv;
+        let stack = self.evaluate(py, arguments, &[3, nv, nv], &|m, w, i, out| {
+            let Workspace { data, forces, .. } = w;
+            let forces = i.get(3).map(|flat| external_forces(forces, flat));
+            for (matrix, block) in derivatives(m, data, i[0], i[1], i[2], forces)?
+                .into_iter()
+                .zip(out.chunks_exact_mut(nv * nv))
+            {
+                write_row_major(matrix, nv, block);
+            }
+            Ok(())
+        })?;
+        split_stack(py, &stack, &names)
+    }
+}
+
+/// A derivatives algorithm `(q, v, x, f_ext)` returning its three nv × nv results.
+type DerivativesAlgorithm = for<'d> fn(
+    &Model,
+    &'d mut Data,
+    &[f64],
+    &[f64],
+    &[f64],
+    Option<&[Force]>,
+) -> robodyn::Result<[&'d DMatrix<f64>; 3]>;
+
+/// `forces` filled from the flat (nbodies − 1) × 6 rows of an `f_ext` argument.
+fn external_forces<'w>(forces: &'w mut [Force], flat: &[f64]) -> &'w [Force] {
+    fill_forces(forces, flat);
+    forces
+}
+
+/// ∂τ/∂q, ∂τ/∂v, ∂τ/∂a = M.
+fn rnea_derivatives<'d>(
+    model: &Model,
+    data: &'d mut Data,
+    q: &[f64],
+    v: &[f64],
+    a: &[f64],
+    f_ext: Option<&[Force]>,
+) -> robodyn::Result<[&'d DMatrix<f64>; 3]> {
+    algo::rnea_derivatives(model, data, q, v, a, f_ext)?;
+    Ok([&data.dtau_dq, &data.dtau_dv, &data.mass_matrix])
+}
+
+/// ∂q̈/∂q, ∂q̈/∂v, ∂q̈/∂τ = M⁻¹.
+fn aba_derivatives<'d>(
+    model: &Model,
+    data: &'d mut Data,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    f_ext: Option<&[Force]>,
+) -> robodyn::Result<[&'d DMatrix<f64>; 3]> {
+    algo::aba_derivatives(model, data, q, v, tau, f_ext)?;
+    Ok([&data.dqdd_dq, &data.dqdd_dv, &data.mass_matrix_inverse])
 }
 
 /// The Christoffel symbols at q, row-major (i, j, k), in a new buffer.
@@ -110,6 +186,42 @@ impl PyModel {
         f_ext: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         self.with_external_forces(py, q, v, ("tau", tau), f_ext, algo::aba)
+    }
+
+    /// Derivatives of inverse dynamics τ = ID(q, v, a, f_ext): dict of `dtau_dq`, `dtau_dv` and
+    /// `dtau_da` (= M(q)), each (nv, nv). ∂/∂q is taken in the tangent space along right
+    /// perturbations q ⊕ δ (δ a velocity, in each joint's child frame: Pinocchio's convention);
+    /// on revolute and prismatic joints it is the ordinary partial derivative. `f_ext` as in
+    /// `inverse_dynamics`, held fixed in each body's frame.
+    #[pyo3(signature = (q, v, a, f_ext=None))]
+    fn inverse_dynamics_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        a: &Bound<'py, PyAny>,
+        f_ext: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let arguments = self.dynamics_arguments(q, v, ("a", a), f_ext)?;
+        let names = ["dtau_dq", "dtau_dv", "dtau_da"];
+        self.dynamics_derivatives(py, &arguments, names, rnea_derivatives)
+    }
+
+    /// Derivatives of forward dynamics a = FD(q, v, tau, f_ext): dict of `dqdd_dq`, `dqdd_dv`
+    /// and `dqdd_dtau` (= M(q)⁻¹), each (nv, nv); ∂/∂q as in `inverse_dynamics_derivatives`.
+    /// Computed as −M⁻¹ ∂τ/∂x at a = FD(q, v, tau).
+    #[pyo3(signature = (q, v, tau, f_ext=None))]
+    fn forward_dynamics_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        tau: &Bound<'py, PyAny>,
+        f_ext: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let arguments = self.dynamics_arguments(q, v, ("tau", tau), f_ext)?;
+        let names = ["dqdd_dq", "dqdd_dv", "dqdd_dtau"];
+        self.dynamics_derivatives(py, &arguments, names, aba_derivatives)
     }
 
     /// Joint-space inertia matrix M(q), full and symmetric, armature included. (nv, nv).

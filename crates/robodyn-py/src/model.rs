@@ -301,3 +301,18 @@ pub(crate) fn matrix_times(matrix: &DMatrix<f64>, vector: &[f64], out: &mut [f64
             .sum();
     }
 }
+
+/// {names[k]: stack[..., k, :, :]}: a stack of results along axis −3 as a dict.
+pub(crate) fn split_stack<'py>(
+    py: Python<'py>,
+    stack: &Bound<'py, PyAny>,
+    names: &[&str],
+) -> PyResult<Bound<'py, PyAny>> {
+    let out = pyo3::types::PyDict::new(py);
+    for (k, name) in names.iter().enumerate() {
+        let kwargs = pyo3::types::PyDict::new(py);
+        kwargs.set_item("axis", -3)?;
+        out.set_item(*name, stack.call_method("take", (k,), Some(&kwargs))?)?;
+    }
+    Ok(out.into_any())
+}

@@ -8,7 +8,6 @@ use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 use rand::{rngs::StdRng, SeedableRng};
 use robodyn::integrate::lie_group::{difference_jacobians, integrate_jacobians};
 use robodyn::Model;
@@ -353,7 +352,7 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let arguments = [self.q_arg("q", q)?, self.v_arg("v", v)?];
         let pair = self.jacobian_pair(py, &arguments, integrate_jacobians)?;
-        split_pair(py, &pair, ["dq", "dv"])
+        split_stack(py, &pair, &["dq", "dv"])
     }
 
     /// Jacobians of q1 ⊖ q0 in the tangent spaces: dict of `dq0` = −J_l(v)⁻¹ and `dq1` =
@@ -366,7 +365,7 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let arguments = [self.q_arg("q0", q0)?, self.q_arg("q1", q1)?];
         let pair = self.jacobian_pair(py, &arguments, difference_jacobians)?;
-        split_pair(py, &pair, ["dq0", "dq1"])
+        split_stack(py, &pair, &["dq0", "dq1"])
     }
 
     /// q1 ⊖ q0: the velocity that moves q0 to q1 in unit time. (nv,).
@@ -407,19 +406,4 @@ impl PyModel {
             Ok(())
         })
     }
-}
-
-/// {names[0]: pair[..., 0, :, :], names[1]: pair[..., 1, :, :]}.
-fn split_pair<'py>(
-    py: Python<'py>,
-    pair: &Bound<'py, PyAny>,
-    names: [&str; 2],
-) -> PyResult<Bound<'py, PyAny>> {
-    let out = PyDict::new(py);
-    for (k, name) in names.into_iter().enumerate() {
-        let kwargs = PyDict::new(py);
-        kwargs.set_item("axis", -3)?;
-        out.set_item(name, pair.call_method("take", (k,), Some(&kwargs))?)?;
-    }
-    Ok(out.into_any())
 }

@@ -80,6 +80,24 @@ pub struct Data {
     /// Joint-torque regressor Y(q, q̇, q̈), τ = Y π; nv x 10 (nbodies − 1). Written by
     /// `torque_regressor`.
     pub regressor: DMatrix<f64>,
+    /// Spatial acceleration of body i in world coordinates, gravity included as `a_0 = -g`;
+    /// nbodies. Written by `rnea_derivatives`.
+    pub a_world: Vec<Motion>,
+    /// Net spatial force transmitted across joint i (the forces of its whole subtree), in world
+    /// coordinates; nbodies. Written by `rnea_derivatives`.
+    pub f_world: Vec<Force>,
+    /// Per velocity coordinate k of body i (parent λ), world coordinates: `[S_k × v_λ, S_k × v_i,
+    /// S_k × a_λ − (S_k × v_λ) × v_λ]`, the terms by which v and a of i's subtree move when q_k or
+    /// q̇_k does; nv. Written by `rnea_derivatives`.
+    pub motion_terms: Vec<[Motion; 3]>,
+    /// ∂τ/∂q (tangent space, right perturbations q ⊕ δ); nv x nv. Written by `rnea_derivatives`.
+    pub dtau_dq: DMatrix<f64>,
+    /// ∂τ/∂q̇; nv x nv. Written by `rnea_derivatives`.
+    pub dtau_dv: DMatrix<f64>,
+    /// ∂q̈/∂q (tangent space); nv x nv. Written by `aba_derivatives`.
+    pub dqdd_dq: DMatrix<f64>,
+    /// ∂q̈/∂q̇; nv x nv. Written by `aba_derivatives`.
+    pub dqdd_dv: DMatrix<f64>,
     /// The bodies from a frame's body down to the world's child (its support), in that order.
     /// Written by `jacobian` and `frame_pose`.
     pub support: Vec<usize>,
@@ -119,6 +137,13 @@ impl Data {
             jacobian: DMatrix::zeros(6, nv),
             jacobian_dot: DMatrix::zeros(6, nv),
             regressor: DMatrix::zeros(nv, 10 * (nb - 1)),
+            a_world: vec![Motion::ZERO; nb],
+            f_world: vec![Force::ZERO; nb],
+            motion_terms: vec![[Motion::ZERO; 3]; nv],
+            dtau_dq: DMatrix::zeros(nv, nv),
+            dtau_dv: DMatrix::zeros(nv, nv),
+            dqdd_dq: DMatrix::zeros(nv, nv),
+            dqdd_dv: DMatrix::zeros(nv, nv),
             support: Vec::with_capacity(nb),
         }
     }

@@ -135,6 +135,17 @@ impl Joint {
         }
     }
 
+    /// Entry (r, c) of ∂(K(v) v)/∂v, the derivative of the rotor's velocity term above: on a free
+    /// joint (K v)_lin = ω × v_lin, so ∂/∂v_lin = [ω×] and ∂/∂ω = −[v_lin×].
+    #[inline]
+    pub fn rotor_velocity_jacobian(&self, r: usize, c: usize, v: &[f64]) -> f64 {
+        match self {
+            Joint::Free if r < 3 && c < 3 => skew(&Vec3::new(v[3], v[4], v[5]))[(r, c)],
+            Joint::Free if r < 3 => -skew(&Vec3::new(v[0], v[1], v[2]))[(r, c - 3)],
+            _ => 0.0,
+        }
+    }
+
     /// Checks the armature of this joint's velocity coordinates: a free joint's acts on its
     /// world-frame linear velocity, so it must be the same along the three linear coordinates.
     pub fn check_armature(&self, armature: &[f64]) -> Result<(), String> {

@@ -106,6 +106,18 @@ fn algorithms_allocate_nothing_after_data_new() {
                 }),
             ),
             (
+                "rnea_derivatives",
+                allocations(|| {
+                    rnea_derivatives(&model, &mut data, q, v, a, None).unwrap();
+                }),
+            ),
+            (
+                "aba_derivatives",
+                allocations(|| {
+                    aba_derivatives(&model, &mut data, q, v, a, None).unwrap();
+                }),
+            ),
+            (
                 "bias_forces",
                 allocations(|| {
                     bias_forces(&model, &mut data, q, v).unwrap();

@@ -19,6 +19,12 @@ pub fn inverse_mass_matrix<'d>(
     q: &[f64],
 ) -> Result<&'d DMatrix<f64>> {
     crba(model, data, q)?;
+    invert_mass_matrix(model, data)?;
+    Ok(&data.mass_matrix_inverse)
+}
+
+/// `data.mass_matrix_inverse` = `data.mass_matrix`⁻¹, by the Cholesky factor in `data.cholesky`.
+pub(crate) fn invert_mass_matrix(model: &Model, data: &mut Data) -> Result<()> {
     // factor a copy of M in the preallocated workspace: M = L Lᵀ
     let mut work = std::mem::replace(&mut data.cholesky, DMatrix::zeros(0, 0));
     work.copy_from(&data.mass_matrix);
@@ -48,5 +54,12 @@ pub fn inverse_mass_matrix<'d>(
     data.mass_matrix_inverse.fill_with_identity();
     factor.solve_mut(&mut data.mass_matrix_inverse);
     data.cholesky = factor.unpack_dirty();
-    Ok(&data.mass_matrix_inverse)
+    Ok(())
+}
+
+/// Solves `L Lᵀ X = B` in place (`rhs` holds B, then X), with L the lower triangle of `cholesky`
+/// (what [`invert_mass_matrix`] leaves in `data.cholesky`); allocates nothing.
+pub(crate) fn cholesky_solve_mut(cholesky: &DMatrix<f64>, rhs: &mut DMatrix<f64>) {
+    cholesky.solve_lower_triangular_unchecked_mut(rhs);
+    cholesky.tr_solve_lower_triangular_unchecked_mut(rhs);
 }
