@@ -34,7 +34,7 @@ from robodyn._core import (
     load_urdf_string,
 )
 from robodyn.operational_space import operational_space as _operational_space
-from robodyn.simulation import PD, ComputedTorque, GravityCompensation, Trajectory, simulate
+from robodyn.simulation import PD, ComputedTorque, GravityCompensation, Trajectory, simulate, step
 
 # methods composed in NumPy from the core's batched calls
 Model.operational_space = _operational_space
@@ -69,6 +69,7 @@ __all__ = [
     "SimulationError",
     "Trajectory",
     "simulate",
+    "step",
     "ModelWarning",
     "from_dh",
     "load",

@@ -184,3 +184,16 @@ def simulate(
     limit_damping: float = 1e2,
     progress: Callable[[float], object] | None = None,
 ) -> dict[str, FloatArray | list[int]]: ...
+def step(
+    model: Model,
+    q: ArrayLike,
+    v: ArrayLike,
+    tau: ArrayLike,
+    dt: float,
+    integrator: str,
+    derivatives: bool,
+    friction_velocity: float,
+    limits: str,
+    limit_stiffness: float,
+    limit_damping: float,
+) -> FloatArray: ...

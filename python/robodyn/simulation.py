@@ -43,6 +43,7 @@ __all__ = [
     "PD",
     "Trajectory",
     "simulate",
+    "step",
 ]
 
 #: The integrator names :func:`simulate` accepts.
@@ -396,3 +397,50 @@ def simulate(
         for k in range(len(result["steps"]))
     ]
     return runs if batch else runs[0]
+
+
+def step(
+    model: _core.Model,
+    q: ArrayLike,
+    v: ArrayLike,
+    tau: ArrayLike,
+    dt: float,
+    integrator: str = "rk4",
+    derivatives: bool = False,
+    *,
+    friction_velocity: float = 1e-2,
+    limits: str = "report",
+    limit_stiffness: float = 1e4,
+    limit_damping: float = 1e2,
+) -> Any:
+    """One step of size ``dt`` from (``q``, ``v``) with the torque ``tau`` held over it: the step
+    :func:`simulate` takes (``integrator`` ``"euler"``, ``"semi_implicit_euler"`` or ``"rk4"``, on the
+    joints' Lie groups, with the model's passive forces and the same ``friction_velocity`` and
+    ``limits`` options).
+
+    Returns ``x1`` = [q1, v1] (nq + nv values), and with ``derivatives=True`` the tuple
+    ``(x1, A, B)``: A = ∂x1/∂x0 (2nv × 2nv) and B = ∂x1/∂tau (2nv × nv), the exact Jacobians of this
+    discrete step (chain rule through its stages, from the analytical derivatives of forward
+    dynamics and of the passive forces). Rows and columns are [q; v] with q in the tangent space:
+    a change δ of q means ``m.integrate(q, δ)``, and x1's change is read as
+    ``m.difference(q1, q1')`` (as for every derivative in robodyn). Batched: (N, nq), (N, nv),
+    (N, nv) give (N, ...) results computed on all cores.
+    """
+    if integrator not in INTEGRATORS[:3]:
+        raise ValueError(f"argument 'integrator': expected one of {list(INTEGRATORS[:3])} (a single fixed step), got {integrator!r}")
+    if limits not in LIMIT_MODELS:
+        raise ValueError(f"argument 'limits': expected one of {list(LIMIT_MODELS)}, got {limits!r}")
+    if not isinstance(derivatives, (bool, np.bool_)):
+        raise TypeError(f"argument 'derivatives': expected True or False, got {derivatives!r}")
+    flat = _core.step(
+        model, q, v, tau, _real("dt", dt), integrator, bool(derivatives), _real("friction_velocity", friction_velocity),
+        limits, _real("limit_stiffness", limit_stiffness), _real("limit_damping", limit_damping),
+    )
+    nx, nv = model.nq + model.nv, model.nv
+    if not derivatives:
+        return flat
+    batch = flat.shape[:-1]
+    x1 = flat[..., :nx]
+    a = flat[..., nx : nx + 4 * nv * nv].reshape(batch + (2 * nv, 2 * nv))
+    b = flat[..., nx + 4 * nv * nv :].reshape(batch + (2 * nv, nv))
+    return x1, a, b

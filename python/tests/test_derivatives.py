@@ -119,3 +119,63 @@ def test_integrate_jacobians_are_finite_differences_and_batched():
     pair = model.difference_jacobians(q[0], model.integrate(q[0], v[0]))
     # ⊖ undoes ⊕: ∂(q1 ⊖ q0)/∂q1 is the inverse of ∂(q0 ⊕ v)/∂v
     assert_close(pair["dq1"] @ model.integrate_jacobians(q[0], v[0])["dv"], eye, 1e-12, "J_r⁻¹ J_r")
+
+
+#: Central differences of one step (smooth in x and tau): round-off ε |x| / h dominates.
+STEP_FD_TOLERANCE = 1e-6
+
+
+def step_differences(model, q, v, tau, dt, integrator):
+    """Columns of ∂x1/∂(q, v, tau) by central differences of `robodyn.step`, q on the Lie group."""
+    nq, nv = model.nq, model.nv
+    q1 = robodyn.step(model, q, v, tau, dt, integrator)[:nq]
+
+    def moved(k, h):
+        e = np.eye(nv)[k % nv] * h
+        inputs = [model.integrate(q, e) if k < nv else q, v + e if nv <= k < 2 * nv else v, tau + e if k >= 2 * nv else tau]
+        x = robodyn.step(model, *inputs, dt, integrator)
+        return np.concatenate([model.difference(q1, x[:nq]), x[nq:]])
+
+    return np.column_stack([(moved(k, FD_STEP) - moved(k, -FD_STEP)) / (2 * FD_STEP) for k in range(3 * nv)])
+
+
+def test_step_jacobians_are_finite_differences_of_the_step():
+    model = robodyn.load(REPOSITORY / "testdata" / "mjcf" / "free_armature.xml")
+    model.damping = np.full(model.nv, 0.3)
+    rng = np.random.default_rng(12)
+    q = model.random_configuration(seed=5)
+    v, tau = rng.uniform(-1, 1, model.nv), rng.uniform(-1, 1, model.nv)
+    for integrator in ["euler", "semi_implicit_euler", "rk4"]:
+        x1, a, b = robodyn.step(model, q, v, tau, 0.01, integrator, derivatives=True)
+        np.testing.assert_array_equal(x1, robodyn.step(model, q, v, tau, 0.01, integrator))
+        fd = step_differences(model, q, v, tau, 0.01, integrator)
+        assert_close(a, fd[:, : 2 * model.nv], STEP_FD_TOLERANCE, f"{integrator} A")
+        assert_close(b, fd[:, 2 * model.nv :], STEP_FD_TOLERANCE, f"{integrator} B")
+
+
+def test_step_is_one_step_of_simulate_and_is_batched():
+    model = robodyn.load("ur5")
+    q = model.random_configuration(2, seed=1)
+    v = np.zeros((2, model.nv))
+    tau = np.ones((2, model.nv))
+    x1, a, b = robodyn.step(model, q, v, tau, 1e-3, derivatives=True)
+    assert x1.shape == (2, model.nq + model.nv) and a.shape == (2, 12, 12) and b.shape == (2, 12, 6)
+    run = robodyn.simulate(model, q[1], v[1], t_end=1e-3, dt=1e-3, controller=tau[1])
+    assert_close(x1[1], np.concatenate([run.q[-1], run.v[-1]]), 1e-14, "step = simulate")
+
+
+def test_step_refuses_bad_arguments():
+    model = robodyn.load("pendulum")
+    for kwargs, words in [
+        ({"integrator": "rk45"}, ["integrator", "rk45"]),
+        ({"dt": -1.0}, ["dt", "-1"]),
+        ({"limits": "hard"}, ["limits", "hard"]),
+        ({"friction_velocity": 0.0}, ["friction_velocity"]),
+    ]:
+        arguments = {"dt": 0.01, **kwargs}
+        try:
+            robodyn.step(model, [0.1], [0.0], [0.0], **arguments)
+        except ValueError as error:
+            assert all(word in str(error) for word in words), str(error)
+        else:
+            raise AssertionError(f"{kwargs} accepted")

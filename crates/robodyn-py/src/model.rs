@@ -10,6 +10,7 @@ use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
 use pyo3::prelude::*;
 use rayon::prelude::*;
+use robodyn::integrate::StepWorkspace;
 use robodyn::spatial::Force;
 use robodyn::{Data, Error, Model};
 use std::borrow::Cow;
@@ -22,6 +23,8 @@ pub(crate) struct Workspace {
     pub(crate) forces: Vec<Force>,
     /// Two nv × nv results of a pair of Jacobians (`integrate_jacobians`, ...).
     pub(crate) jacobians: (DMatrix<f64>, DMatrix<f64>),
+    /// The stages of a simulation step, made on the first `step` call.
+    pub(crate) step: Option<Box<StepWorkspace>>,
 }
 
 impl Workspace {
@@ -33,6 +36,7 @@ impl Workspace {
                 DMatrix::zeros(model.nv, model.nv),
                 DMatrix::zeros(model.nv, model.nv),
             ),
+            step: None,
         }
     }
 }

@@ -2,7 +2,7 @@
 //! with the GIL released (batches on all cores); Python callables are called back with the GIL.
 
 use crate::args::{read_property, read_sample, single_sample, Argument, SampleShape};
-use crate::model::{fill_forces, PyModel};
+use crate::model::{fill_forces, write_row_major, PyModel};
 use crate::to_py_err;
 use nalgebra::DVector;
 use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
@@ -12,7 +12,7 @@ use pyo3::types::PyDict;
 use rayon::prelude::*;
 use robodyn::integrate::{
     simulate as run, ControlLaw, Controller, DesiredMotion, ExternalWrenches, Integrator,
-    LimitModel, NativeController, PassiveForces, SimulationOptions, Trajectory,
+    LimitModel, NativeController, PassiveForces, SimulationOptions, StepWorkspace, Trajectory,
 };
 use robodyn::spatial::Force;
 use robodyn::{Error, Model};
@@ -246,28 +246,14 @@ pub fn simulate<'py>(
     progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &model.model;
-    let limits = match limits {
-        "report" => LimitModel::Report,
-        "penalty" => LimitModel::Penalty {
-            stiffness: limit_stiffness,
-            damping: limit_damping,
-        },
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "argument 'limits': expected 'report' or 'penalty', got '{other}'"
-            )))
-        }
-    };
+    let passive = passive_forces(friction_velocity, limits, limit_stiffness, limit_damping)?;
     let mut options = SimulationOptions::new(
         Integrator::from_name(integrator, rtol, atol).map_err(to_py_err)?,
         dt,
         t_end,
     );
     options.max_step = max_step;
-    options.passive = PassiveForces {
-        friction_velocity,
-        limits,
-    };
+    options.passive = passive;
     options.check().map_err(to_py_err)?;
 
     let q0 = model.q_arg("q0", q0)?;
@@ -415,4 +401,76 @@ fn batch_error(batch: Option<usize>, k: usize, error: Error) -> Error {
         },
         (_, error) => error,
     }
+}
+
+/// The passive-force model from the Python arguments.
+fn passive_forces(
+    friction_velocity: f64,
+    limits: &str,
+    limit_stiffness: f64,
+    limit_damping: f64,
+) -> PyResult<PassiveForces> {
+    let limits = match limits {
+        "report" => LimitModel::Report,
+        "penalty" => LimitModel::Penalty {
+            stiffness: limit_stiffness,
+            damping: limit_damping,
+        },
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "argument 'limits': expected 'report' or 'penalty', got '{other}'"
+            )))
+        }
+    };
+    let passive = PassiveForces {
+        friction_velocity,
+        limits,
+    };
+    passive.check().map_err(to_py_err)?;
+    Ok(passive)
+}
+
+/// One step of each state: per sample the flat [q₁, v₁] and, with `derivatives`, A (2nv × 2nv)
+/// and B (2nv × nv) row-major after it. The Python `robodyn.step` splits them.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub fn step<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: &Bound<'py, PyAny>,
+    v: &Bound<'py, PyAny>,
+    tau: &Bound<'py, PyAny>,
+    dt: f64,
+    integrator: &str,
+    derivatives: bool,
+    friction_velocity: f64,
+    limits: &str,
+    limit_stiffness: f64,
+    limit_damping: f64,
+) -> PyResult<Bound<'py, PyAny>> {
+    let m = &model.model;
+    let passive = passive_forces(friction_velocity, limits, limit_stiffness, limit_damping)?;
+    let integrator = Integrator::from_name(integrator, 0.0, 0.0).map_err(to_py_err)?;
+    let arguments = [
+        model.q_arg("q", q)?,
+        model.v_arg("v", v)?,
+        model.v_arg("tau", tau)?,
+    ];
+    let (nq, nv) = (m.nq, m.nv);
+    let size = nq + nv + if derivatives { 6 * nv * nv } else { 0 };
+    model.evaluate(py, &arguments, &[size], &|m, w, i, out| {
+        let stepper = w
+            .step
+            .get_or_insert_with(|| Box::new(StepWorkspace::new(m)));
+        stepper.step(m, i[0], i[1], i[2], dt, integrator, &passive, derivatives)?;
+        let (state, jacobians) = out.split_at_mut(nq + nv);
+        state[..nq].copy_from_slice(&stepper.q_end);
+        state[nq..].copy_from_slice(&stepper.v_end);
+        if derivatives {
+            let (a, b) = jacobians.split_at_mut(4 * nv * nv);
+            write_row_major(&stepper.a, 2 * nv, a);
+            write_row_major(&stepper.b, 2 * nv, b);
+        }
+        Ok(())
+    })
 }

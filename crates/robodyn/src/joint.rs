@@ -8,7 +8,7 @@
 //! `difference(q, integrate(q, v)) = v`.
 
 use crate::spatial::{log_rotation, skew, Force, Mat3, Mat6, Motion, Transform, Vec3};
-use nalgebra::{Quaternion, UnitQuaternion};
+use nalgebra::{Quaternion, UnitQuaternion, Vector6};
 use rand::Rng;
 
 mod jacobians;
@@ -323,6 +323,31 @@ impl Joint {
                 let rate = bernoulli_series(v, |m| xi.cross_motion(&m));
                 out[0..3].copy_from_slice(rate.linear.as_slice());
                 out[3..6].copy_from_slice(rate.angular.as_slice());
+            }
+        }
+    }
+
+    /// ∂ξ̇/∂ξ and ∂ξ̇/∂v of [`Joint::tangent_rate`] (see [`jacobians`]), written into the leading
+    /// nv × nv blocks of `d_xi` and `d_v`; identity and zero on revolute and prismatic joints.
+    pub fn tangent_rate_jacobians(&self, xi: &[f64], v: &[f64], d_xi: &mut Mat6, d_v: &mut Mat6) {
+        match self {
+            Joint::Fixed => {}
+            Joint::Revolute { .. } | Joint::Prismatic { .. } => {
+                d_xi[(0, 0)] = 0.0;
+                d_v[(0, 0)] = 1.0;
+            }
+            Joint::Spherical => {
+                let (xi, v) = (Vec3::new(xi[0], xi[1], xi[2]), Vec3::new(v[0], v[1], v[2]));
+                let (a, b) = jacobians::tangent_rate_jacobians(&xi, &v, skew);
+                d_xi.fixed_view_mut::<3, 3>(0, 0).copy_from(&a);
+                d_v.fixed_view_mut::<3, 3>(0, 0).copy_from(&b);
+            }
+            Joint::Free => {
+                let (xi, v) = (
+                    Vector6::from_column_slice(xi),
+                    Vector6::from_column_slice(v),
+                );
+                (*d_xi, *d_v) = jacobians::tangent_rate_jacobians(&xi, &v, jacobians::ad_se3);
             }
         }
     }

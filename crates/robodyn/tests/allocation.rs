@@ -5,7 +5,8 @@ mod common;
 use nalgebra::DVector;
 use robodyn::algo::*;
 use robodyn::integrate::{
-    simulate, ControlLaw, DesiredMotion, Integrator, NativeController, SimulationOptions,
+    simulate, ControlLaw, DesiredMotion, Integrator, NativeController, PassiveForces,
+    SimulationOptions, StepWorkspace,
 };
 use robodyn::Data;
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -67,7 +68,17 @@ fn algorithms_allocate_nothing_after_data_new() {
             nalgebra::DMatrix::zeros(model.nv, model.nv),
             nalgebra::DMatrix::zeros(model.nv, model.nv),
         );
+        let mut stepper = StepWorkspace::new(&model);
+        let passive = PassiveForces::default();
         let counts = [
+            (
+                "step with derivatives (rk4)",
+                allocations(|| {
+                    stepper
+                        .step(&model, q, v, a, 1e-3, Integrator::Rk4, &passive, true)
+                        .unwrap();
+                }),
+            ),
             (
                 "forward_kinematics",
                 allocations(|| {

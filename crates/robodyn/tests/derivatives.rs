@@ -50,11 +50,14 @@ struct Linearised {
     derivatives: [DMatrix<f64>; 3],
 }
 
+/// A dynamics function (q, v, x, f_ext) of a model in its workspace.
+type DynamicsFunction<T> = fn(&Model, &mut Data, &[f64], &[f64], &[f64], Option<&[Force]>) -> T;
+
 /// Checks `linearise(q, v, x)` against `f` at random states, with and without external forces.
 fn check_against_differences(
     what: [&str; 4],
-    linearise: fn(&Model, &mut Data, &[f64], &[f64], &[f64], Option<&[Force]>) -> Linearised,
-    f: fn(&Model, &mut Data, &[f64], &[f64], &[f64], Option<&[Force]>) -> DVector<f64>,
+    linearise: DynamicsFunction<Linearised>,
+    f: DynamicsFunction<DVector<f64>>,
 ) {
     let mut rng = rng();
     for (name, model) in models() {

@@ -17,7 +17,11 @@
 //!   back towards the allowed range. It applies to revolute and prismatic joints with finite
 //!   limits; it is a penalty, so a joint driven hard into its limit goes past it by about τ/k_l.
 
+use crate::error::Result;
+use crate::integrate::simulator::{invalid, positive};
 use crate::model::Model;
+use crate::spatial::Mat6;
+use nalgebra::DMatrix;
 
 /// Default smoothing speed v_s of Coulomb friction (rad/s or m/s).
 pub const DEFAULT_FRICTION_VELOCITY: f64 = 1e-2;
@@ -53,6 +57,22 @@ impl Default for PassiveForces {
 }
 
 impl PassiveForces {
+    /// Checks the numbers: a friction velocity > 0, limit stiffness and damping >= 0.
+    pub fn check(&self) -> Result<()> {
+        positive("friction_velocity", self.friction_velocity, false)?;
+        if let LimitModel::Penalty { stiffness, damping } = self.limits {
+            for (name, value) in [("limit_stiffness", stiffness), ("limit_damping", damping)] {
+                if !value.is_finite() || value < 0.0 {
+                    return Err(invalid(
+                        name,
+                        format!("expected a finite value >= 0, got {value}"),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// τ_passive(q, q̇) into `tau` (nv). `q` must be a valid configuration.
     pub fn torque(&self, model: &Model, q: &[f64], v: &[f64], tau: &mut [f64]) {
         // springs: −K (q ⊖ q_ref), with q ⊖ q_ref written into tau first
@@ -64,27 +84,81 @@ impl PassiveForces {
                 - model.friction[k] * (v[k] / self.friction_velocity).tanh();
         }
         if let LimitModel::Penalty { stiffness, damping } = self.limits {
-            for i in 1..model.nbodies() {
-                if model.joints[i].nq() != 1 || model.joints[i].nv() != 1 {
-                    continue;
-                }
-                let (index_q, index_v) = (model.idx_q[i], model.idx_v[i]);
-                let position = q[index_q];
-                let (lower, upper) = (
-                    model.lower_position_limit[index_q],
-                    model.upper_position_limit[index_q],
-                );
-                // τ_limit = −k δ − b q̇, pushing back only
-                if position > upper {
-                    tau[index_v] +=
-                        (-stiffness * (position - upper) - damping * v[index_v]).min(0.0);
-                } else if position < lower {
-                    tau[index_v] +=
-                        (-stiffness * (position - lower) - damping * v[index_v]).max(0.0);
-                }
+            for (dof, push) in limit_penalties(model, (stiffness, damping), q, v) {
+                tau[dof] += push;
             }
         }
     }
+
+    /// ∂τ_passive/∂q (tangent space, right perturbations) and ∂τ_passive/∂q̇ into `d_q` and `d_v`
+    /// (nv × nv; block-diagonal by joint). Springs: −K ∂(q ⊖ q_ref)/∂q; damping −D; friction
+    /// −F_c sech²(q̇/v_s)/v_s; the limit penalty −k_l and −b_l where it pushes (zero where clipped).
+    pub fn jacobians(
+        &self,
+        model: &Model,
+        q: &[f64],
+        v: &[f64],
+        d_q: &mut DMatrix<f64>,
+        d_v: &mut DMatrix<f64>,
+    ) {
+        d_q.fill(0.0);
+        d_v.fill(0.0);
+        for i in 1..model.nbodies() {
+            let (configuration, dofs) = (model.q_range(i), model.v_range(i));
+            // ∂(q ⊖ q_ref)/∂q, the joint's block
+            let (mut d_reference, mut d_displacement) = (Mat6::zeros(), Mat6::zeros());
+            model.joints[i].difference_jacobians(
+                &model.spring_reference.as_slice()[configuration.clone()],
+                &q[configuration],
+                &mut d_reference,
+                &mut d_displacement,
+            );
+            for (r, row) in dofs.clone().enumerate() {
+                for (c, column) in dofs.clone().enumerate() {
+                    d_q[(row, column)] = -model.stiffness[row] * d_displacement[(r, c)];
+                }
+                // d/dq̇ [−d q̇ − f_c tanh(q̇ / v_s)]
+                let slope = (v[row] / self.friction_velocity).tanh();
+                d_v[(row, row)] = -model.damping[row]
+                    - model.friction[row] * (1.0 - slope * slope) / self.friction_velocity;
+            }
+        }
+        if let LimitModel::Penalty { stiffness, damping } = self.limits {
+            // where −k δ − b q̇ pushes back (not clipped to zero), its slopes −k and −b
+            for (dof, _) in limit_penalties(model, (stiffness, damping), q, v) {
+                d_q[(dof, dof)] -= stiffness;
+                d_v[(dof, dof)] -= damping;
+            }
+        }
+    }
+}
+
+/// The limit penalty τ_limit = −k δ − b q̇ of each revolute or prismatic joint past a finite
+/// limit, as (velocity index, τ_limit) where it pushes back towards the range (elsewhere it is
+/// clipped to zero and left out).
+fn limit_penalties<'a>(
+    model: &'a Model,
+    (stiffness, damping): (f64, f64),
+    q: &'a [f64],
+    v: &'a [f64],
+) -> impl Iterator<Item = (usize, f64)> + 'a {
+    (1..model.nbodies())
+        .filter(|&i| model.joints[i].nq() == 1 && model.joints[i].nv() == 1)
+        .filter_map(move |i| {
+            let (index_q, index_v) = (model.idx_q[i], model.idx_v[i]);
+            let position = q[index_q];
+            let (lower, upper) = (
+                model.lower_position_limit[index_q],
+                model.upper_position_limit[index_q],
+            );
+            let push = |delta: f64| -stiffness * delta - damping * v[index_v];
+            match position {
+                p if p > upper => Some(push(p - upper)).filter(|&t| t < 0.0),
+                p if p < lower => Some(push(p - lower)).filter(|&t| t > 0.0),
+                _ => None,
+            }
+            .map(|t| (index_v, t))
+        })
 }
 
 /// The energy stored in the joint springs, ½ Σ k (q ⊖ q_ref)²; `scratch` (nv) holds q ⊖ q_ref.

@@ -58,6 +58,23 @@ pub fn difference_jacobians(
     })
 }
 
+/// ∂ξ̇/∂ξ and ∂ξ̇/∂v of [`tangent_rate`] (nv × nv each, block-diagonal), for the derivatives of
+/// a Runge–Kutta–Munthe-Kaas step.
+pub fn tangent_rate_jacobians(
+    model: &Model,
+    xi: &[f64],
+    v: &[f64],
+    d_xi: &mut DMatrix<f64>,
+    d_v: &mut DMatrix<f64>,
+) -> Result<()> {
+    check_vector("xi", xi, model.nv)?;
+    check_vector("v", v, model.nv)?;
+    joint_blocks(model, d_xi, d_v, |i, a, b| {
+        let dofs = model.v_range(i);
+        model.joints[i].tangent_rate_jacobians(&xi[dofs.clone()], &v[dofs], a, b)
+    })
+}
+
 /// Fills two block-diagonal nv × nv matrices from each joint's pair of blocks.
 fn joint_blocks(
     model: &Model,

@@ -14,6 +14,7 @@
 //! - [`control`]: the [`Controller`] trait and the native controllers (constant torque, PD,
 //!   gravity compensation, computed torque) with their reference motions.
 //! - [`schemes`]: the Butcher tableaus and the Runge–Kutta–Munthe-Kaas step.
+//! - [`step`]: one fixed step and its Jacobians A = ∂x₁/∂x₀, B = ∂x₁/∂τ (trajectory optimisation).
 //! - [`simulator`]: the loop, fixed-step or adaptive with dense output, recording a [`Trajectory`].
 //!
 //! Forward dynamics is [`crate::algo::aba`]; armature is part of the model's M there.
@@ -23,8 +24,10 @@ pub mod forces;
 pub mod lie_group;
 pub mod schemes;
 pub mod simulator;
+pub mod step;
 
 pub use control::{ControlLaw, Controller, DesiredMotion, ExternalWrenches, NativeController};
 pub use forces::{LimitModel, PassiveForces};
 pub use schemes::Integrator;
 pub use simulator::{simulate, SimulationOptions, Statistics, Trajectory};
+pub use step::StepWorkspace;

@@ -10,7 +10,7 @@
 use crate::algo::aba;
 use crate::error::{check_vector, Error, Result};
 use crate::integrate::control::{Controller, ExternalWrenches};
-use crate::integrate::forces::{LimitModel, PassiveForces};
+use crate::integrate::forces::PassiveForces;
 use crate::integrate::schemes::{Integrator, State, Stepper};
 use crate::model::Model;
 use crate::spatial::Force;
@@ -64,21 +64,11 @@ impl SimulationOptions {
             ));
         }
         positive("max_step", self.max_step, true)?;
-        positive("friction_velocity", self.passive.friction_velocity, false)?;
         if let Integrator::Rk45 { rtol, atol } = self.integrator {
             positive("rtol", rtol, false)?;
             positive("atol", atol, false)?;
         }
-        if let LimitModel::Penalty { stiffness, damping } = self.passive.limits {
-            for (name, value) in [("limit_stiffness", stiffness), ("limit_damping", damping)] {
-                if !value.is_finite() || value < 0.0 {
-                    return Err(invalid(
-                        name,
-                        format!("expected a finite value >= 0, got {value}"),
-                    ));
-                }
-            }
-        }
+        self.passive.check()?;
         let steps = (self.t_end / self.dt - 1e-9).ceil().max(0.0);
         if steps >= MAX_SAMPLES as f64 {
             return Err(invalid(
@@ -509,7 +499,7 @@ impl Simulation<'_> {
     }
 }
 
-fn positive(argument: &str, value: f64, infinity_allowed: bool) -> Result<()> {
+pub(crate) fn positive(argument: &str, value: f64, infinity_allowed: bool) -> Result<()> {
     if value > 0.0 && (value.is_finite() || infinity_allowed) {
         return Ok(());
     }
@@ -519,7 +509,7 @@ fn positive(argument: &str, value: f64, infinity_allowed: bool) -> Result<()> {
     ))
 }
 
-fn invalid(argument: &str, message: String) -> Error {
+pub(crate) fn invalid(argument: &str, message: String) -> Error {
     Error::InvalidValue {
         argument: argument.into(),
         message,
