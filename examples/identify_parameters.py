@@ -47,7 +47,7 @@ print(f"{len(Q)} samples, {W.shape[0]} equations, {W.shape[1]} standard paramete
 _, singular, rows = np.linalg.svd(W, full_matrices=False)
 rank = int(np.sum(singular > singular[0] * 1e-9))
 basis = rows[:rank]
-estimate, *_ = np.linalg.lstsq(W, measured.ravel(), rcond=None)
+estimate = np.linalg.lstsq(W, measured.ravel(), rcond=None)[0]
 print(f"{rank} base parameters are identifiable (the other {pi.size - rank} combinations never move τ)")
 
 # least squares: error covariance σ² (WᵀW)⁻¹ on the base parameters, so their error is about

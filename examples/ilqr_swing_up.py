@@ -11,13 +11,17 @@ the same code serves floating robots. The cost printed per iteration decreases m
     python examples/ilqr_swing_up.py
 """
 
+from typing import Any
+
 import numpy as np
 from _compare import show
 
 import robodyn
 
+Array = np.ndarray[Any, np.dtype[np.float64]]
 
-def rollout(m, q0, controls, dt, feedback=None):
+
+def rollout(m: robodyn.Model, q0: Any, controls: Array, dt: float, feedback: tuple[Array, Array, Array, float, Array] | None = None) -> tuple[Array, Array, Array]:
     """States (q, v) from q0 at rest under `controls`; with `feedback` = (Q, V, K, alpha, k) the
     controls become U + α k + K (x ⊖ x̄) along the way."""
     q, v = [np.asarray(q0, dtype=float)], [np.zeros(m.nv)]
@@ -33,20 +37,21 @@ def rollout(m, q0, controls, dt, feedback=None):
     return np.array(q), np.array(v), applied
 
 
-def cost(m, Q, V, U, goal, weights, dt):
+def cost(m: robodyn.Model, states: tuple[Array, Array, Array], goal: Array, weights: tuple[Array, Array], dt: float) -> float:
     """½ Σ uᵀ R u dt + ½ eᵀ W e with e = [q_N ⊖ q_goal; v_N]."""
+    Q, V, U = states
     control_weight, final_weight = weights
     error = np.concatenate([m.difference(goal, Q[-1]), V[-1]])
-    return 0.5 * dt * np.einsum("ti,ij,tj->", U, control_weight, U) + 0.5 * error @ final_weight @ error
+    return float(0.5 * dt * np.einsum("ti,ij,tj->", U, control_weight, U) + 0.5 * error @ final_weight @ error)
 
 
-def ilqr(m, q0, goal, controls, dt, weights, iterations=100, label=""):
+def ilqr(m: robodyn.Model, q0: Any, goal: Array, controls: Array, dt: float, weights: tuple[Array, Array], iterations: int = 100, label: str = "") -> tuple[Array, Array, Array, Array]:
     """Optimises `controls` (T, nv) from q0 at rest towards `goal` at rest; returns the states, the
     controls and the cost of every iteration."""
     control_weight, final_weight = weights
     nv = m.nv
     Q, V, U = rollout(m, q0, controls, dt)
-    costs = [cost(m, Q, V, U, goal, weights, dt)]
+    costs = [cost(m, (Q, V, U), goal, weights, dt)]
     mu = 1e-6
     print(f"{label}: iteration 0, cost {costs[-1]:.6g}")
     for iteration in range(1, iterations + 1):
@@ -77,7 +82,7 @@ def ilqr(m, q0, goal, controls, dt, weights, iterations=100, label=""):
                 candidate = rollout(m, q0, U, dt, feedback=(Q, V, K, alpha, k))
             except ValueError:
                 continue  # the step blew up (robodyn refuses non-finite states): shorten it
-            new_cost = cost(m, *candidate, goal, weights, dt)
+            new_cost = cost(m, candidate, goal, weights, dt)
             if new_cost < costs[-1]:
                 break
         else:

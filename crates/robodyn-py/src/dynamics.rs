@@ -65,12 +65,7 @@ impl PyModel {
         let stack = self.evaluate(py, arguments, &[3, nv, nv], &|m, w, i, out| {
             let Workspace { data, forces, .. } = w;
             let forces = i.get(3).map(|flat| external_forces(forces, flat));
-            for (matrix, block) in derivatives(m, data, i[0], i[1], i[2], forces)?
-                .into_iter()
-                .zip(out.chunks_exact_mut(nv * nv))
-            {
-                write_row_major(matrix, nv, block);
-            }
+            write_stack(&derivatives(m, data, i[0], i[1], i[2], forces)?, nv, out);
             Ok(())
         })?;
         split_stack(py, &stack, &names)

@@ -123,6 +123,83 @@ impl PyModel {
         )
     }
 
+    /// Derivatives of a frame's velocity (`frame_velocity`, same `reference`): dict of `dv_dq`
+    /// (tangent space, right perturbations q ⊕ δ) and `dv_dv` (= J), each (6, nv).
+    #[pyo3(signature = (q, v, frame, reference="world".to_string()), text_signature = "($self, q, v, frame, reference='world')")]
+    fn frame_velocity_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = named::reference)] reference: String,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (frame, reference) = (self.frame_index(frame)?, parse_reference(&reference)?);
+        let zeros = vec![0.0; self.model.nv];
+        let arguments = [self.q_arg("q", q)?, self.v_arg("v", v)?];
+        let stack = self.evaluate(py, &arguments, &[2, 6, self.model.nv], &|m, w, i, out| {
+            let data = &mut w.data;
+            algo::frame_motion_derivatives(m, data, i[0], i[1], &zeros, frame, reference)?;
+            write_stack(&[&data.frame_velocity_dq, &data.jacobian], 6, out);
+            Ok(())
+        })?;
+        split_stack(py, &stack, &["dv_dq", "dv_dv"])
+    }
+
+    /// Derivatives of a frame's velocity and classical acceleration (`frame_acceleration`, same
+    /// `reference`): dict of `dv_dq`, `dv_dv` (= J), `da_dq`, `da_dv`, `da_da` (= J), each
+    /// (6, nv), q in the tangent space.
+    #[pyo3(signature = (q, v, a, frame, reference="world".to_string()), text_signature = "($self, q, v, a, frame, reference='world')")]
+    fn frame_acceleration_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        a: &Bound<'py, PyAny>,
+        frame: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = named::reference)] reference: String,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (frame, reference) = (self.frame_index(frame)?, parse_reference(&reference)?);
+        let arguments = [
+            self.q_arg("q", q)?,
+            self.v_arg("v", v)?,
+            self.v_arg("a", a)?,
+        ];
+        let stack = self.evaluate(py, &arguments, &[5, 6, self.model.nv], &|m, w, i, out| {
+            let data = &mut w.data;
+            algo::frame_motion_derivatives(m, data, i[0], i[1], i[2], frame, reference)?;
+            let matrices = [
+                &data.frame_velocity_dq,
+                &data.jacobian,
+                &data.frame_acceleration_dq,
+                &data.frame_acceleration_dv,
+                &data.jacobian,
+            ];
+            write_stack(&matrices, 6, out);
+            Ok(())
+        })?;
+        split_stack(py, &stack, &["dv_dq", "dv_dv", "da_dq", "da_dv", "da_da"])
+    }
+
+    /// Derivatives of the centre of mass's velocity ċ = J_com v (world axes): dict of `dv_dq`
+    /// (tangent space) and `dv_dv` (= J_com), each (3, nv).
+    fn center_of_mass_velocity_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let arguments = [self.q_arg("q", q)?, self.v_arg("v", v)?];
+        let stack = self.evaluate(py, &arguments, &[2, 3, self.model.nv], &|m, w, i, out| {
+            let data = &mut w.data;
+            algo::center_of_mass_velocity_derivatives(m, data, i[0], i[1])?;
+            // J_com: the first three rows of `data.jacobian`
+            write_stack(&[&data.com_velocity_dq, &data.jacobian], 3, out);
+            Ok(())
+        })?;
+        split_stack(py, &stack, &["dv_dq", "dv_dv"])
+    }
+
     /// Velocity of a frame, (6,) [linear; angular] = J(q) v: "world" (its origin's velocity and
     /// angular velocity in world axes), "local" (the same in its axes) or "spatial".
     #[pyo3(signature = (q, v, frame, reference="world".to_string()), text_signature = "($self, q, v, frame, reference='world')")]

@@ -320,3 +320,11 @@ pub(crate) fn split_stack<'py>(
     }
     Ok(out.into_any())
 }
+
+/// Matrices of `rows` rows each, one after the other, row-major, into `out`.
+pub(crate) fn write_stack(matrices: &[&DMatrix<f64>], rows: usize, out: &mut [f64]) {
+    let size = out.len() / matrices.len();
+    for (matrix, block) in matrices.iter().zip(out.chunks_exact_mut(size)) {
+        write_row_major(matrix, rows, block);
+    }
+}

@@ -84,7 +84,8 @@ pub struct Data {
     /// nbodies. Written by `rnea_derivatives`.
     pub a_world: Vec<Motion>,
     /// Net spatial force transmitted across joint i (the forces of its whole subtree), in world
-    /// coordinates; nbodies. Written by `rnea_derivatives`.
+    /// coordinates; nbodies. Written by `rnea_derivatives` (`center_of_mass_velocity_derivatives`
+    /// writes the subtrees' momenta Σ I ν here).
     pub f_world: Vec<Force>,
     /// Per velocity coordinate k of body i (parent λ), world coordinates: `[S_k × v_λ, S_k × v_i,
     /// S_k × a_λ − (S_k × v_λ) × v_λ]`, the terms by which v and a of i's subtree move when q_k or
@@ -98,6 +99,15 @@ pub struct Data {
     pub dqdd_dq: DMatrix<f64>,
     /// ∂q̈/∂q̇; nv x nv. Written by `aba_derivatives`.
     pub dqdd_dv: DMatrix<f64>,
+    /// ∂(frame velocity)/∂q (tangent space); 6 x nv. Written by `frame_motion_derivatives`.
+    pub frame_velocity_dq: DMatrix<f64>,
+    /// ∂(frame classical acceleration)/∂q; 6 x nv. Written by `frame_motion_derivatives`.
+    pub frame_acceleration_dq: DMatrix<f64>,
+    /// ∂(frame classical acceleration)/∂q̇; 6 x nv. Written by `frame_motion_derivatives`.
+    pub frame_acceleration_dv: DMatrix<f64>,
+    /// ∂ċ/∂q of the centre of mass's velocity (tangent space); 3 x nv. Written by
+    /// `center_of_mass_velocity_derivatives`.
+    pub com_velocity_dq: DMatrix<f64>,
     /// The bodies from a frame's body down to the world's child (its support), in that order.
     /// Written by `jacobian` and `frame_pose`.
     pub support: Vec<usize>,
@@ -144,6 +154,10 @@ impl Data {
             dtau_dv: DMatrix::zeros(nv, nv),
             dqdd_dq: DMatrix::zeros(nv, nv),
             dqdd_dv: DMatrix::zeros(nv, nv),
+            frame_velocity_dq: DMatrix::zeros(6, nv),
+            frame_acceleration_dq: DMatrix::zeros(6, nv),
+            frame_acceleration_dv: DMatrix::zeros(6, nv),
+            com_velocity_dq: DMatrix::zeros(3, nv),
             support: Vec::with_capacity(nb),
         }
     }

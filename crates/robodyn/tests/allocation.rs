@@ -117,6 +117,19 @@ fn algorithms_allocate_nothing_after_data_new() {
                 }),
             ),
             (
+                "frame_motion_derivatives",
+                allocations(|| {
+                    frame_motion_derivatives(&model, &mut data, q, v, a, frame, Reference::Local)
+                        .unwrap();
+                }),
+            ),
+            (
+                "center_of_mass_velocity_derivatives",
+                allocations(|| {
+                    center_of_mass_velocity_derivatives(&model, &mut data, q, v).unwrap();
+                }),
+            ),
+            (
                 "rnea_derivatives",
                 allocations(|| {
                     rnea_derivatives(&model, &mut data, q, v, a, None).unwrap();

@@ -5,7 +5,11 @@ mod common;
 
 use common::*;
 use nalgebra::{DMatrix, DVector};
-use robodyn::algo::{aba, aba_derivatives, inverse_mass_matrix, rnea, rnea_derivatives};
+use robodyn::algo::{
+    aba, aba_derivatives, center_of_mass_jacobian, center_of_mass_velocity_derivatives,
+    frame_acceleration, frame_motion_derivatives, frame_velocity, inverse_mass_matrix, rnea,
+    rnea_derivatives, Reference,
+};
 use robodyn::spatial::{Force, Vec3};
 use robodyn::{Data, Model};
 
@@ -161,4 +165,128 @@ fn aba_derivatives_are_finite_differences() {
         },
         |model, data, q, v, tau, f_ext| aba(model, data, q, v, tau, f_ext).unwrap().clone(),
     );
+}
+
+#[test]
+fn frame_motion_derivatives_are_finite_differences() {
+    let mut rng = rng();
+    for (name, model) in models() {
+        let mut data = Data::new(&model);
+        let nv = model.nv;
+        let (q, v, a) = state(&model, &mut rng);
+        for frame in [model.frames.len() - 1, model.frames.len() / 2] {
+            for reference in [Reference::World, Reference::Local, Reference::Spatial] {
+                frame_motion_derivatives(
+                    &model,
+                    &mut data,
+                    q.as_slice(),
+                    v.as_slice(),
+                    a.as_slice(),
+                    frame,
+                    reference,
+                )
+                .unwrap();
+                let ours = [
+                    data.frame_velocity_dq.clone(),
+                    data.jacobian.clone(),
+                    data.frame_acceleration_dq.clone(),
+                    data.frame_acceleration_dv.clone(),
+                    data.jacobian.clone(),
+                ];
+                let mut motion = |q: &DVector<f64>, v: &DVector<f64>, a: &DVector<f64>| {
+                    let (q, v, a) = (q.as_slice(), v.as_slice(), a.as_slice());
+                    let velocity =
+                        frame_velocity(&model, &mut data, q, v, frame, reference).unwrap();
+                    let acceleration =
+                        frame_acceleration(&model, &mut data, q, v, a, frame, reference).unwrap();
+                    (
+                        DVector::from_row_slice(&velocity),
+                        DVector::from_row_slice(&acceleration),
+                    )
+                };
+                let mut differences = |moved: &dyn Fn(usize, f64) -> [DVector<f64>; 3]| {
+                    let mut jacobians = (DMatrix::zeros(6, nv), DMatrix::zeros(6, nv));
+                    for k in 0..nv {
+                        let [q1, v1, a1] = moved(k, FD_STEP);
+                        let [q0, v0, a0] = moved(k, -FD_STEP);
+                        let (plus, minus) = (motion(&q1, &v1, &a1), motion(&q0, &v0, &a0));
+                        jacobians
+                            .0
+                            .set_column(k, &((plus.0 - minus.0) / (2.0 * FD_STEP)));
+                        jacobians
+                            .1
+                            .set_column(k, &((plus.1 - minus.1) / (2.0 * FD_STEP)));
+                    }
+                    jacobians
+                };
+                let by_q = differences(&|k, h| {
+                    [
+                        displaced(&model, &q, &unit_step(nv, k, h)),
+                        v.clone(),
+                        a.clone(),
+                    ]
+                });
+                let by_v = differences(&|k, h| [q.clone(), &v + unit_step(nv, k, h), a.clone()]);
+                let by_a = differences(&|k, h| [q.clone(), v.clone(), &a + unit_step(nv, k, h)]);
+                let expected = [by_q.0, by_v.0, by_q.1, by_v.1, by_a.1];
+                let what = ["dv/dq", "dv/dv", "da/dq", "da/dv", "da/da"];
+                for ((what, ours), expected) in what.iter().zip(&ours).zip(&expected) {
+                    assert_close(
+                        &format!("{name} frame {frame} {reference:?}: {what}"),
+                        ours.as_slice(),
+                        expected.as_slice(),
+                        DYNAMICS_FD_TOLERANCE,
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn center_of_mass_velocity_derivatives_are_finite_differences() {
+    let mut rng = rng();
+    for (name, model) in models() {
+        let mut data = Data::new(&model);
+        let nv = model.nv;
+        let (q, v, _) = state(&model, &mut rng);
+        center_of_mass_velocity_derivatives(&model, &mut data, q.as_slice(), v.as_slice()).unwrap();
+        let (ours_q, ours_v) = (
+            data.com_velocity_dq.clone(),
+            data.jacobian.rows(0, 3).into_owned(),
+        );
+        let mut com_velocity = |q: &DVector<f64>, v: &DVector<f64>| {
+            center_of_mass_jacobian(&model, &mut data, q.as_slice())
+                .unwrap()
+                .rows(0, 3)
+                * v
+        };
+        let mut by_q = DMatrix::zeros(3, nv);
+        let mut by_v = DMatrix::zeros(3, nv);
+        for k in 0..nv {
+            let step = unit_step(nv, k, FD_STEP);
+            let (plus, minus) = (displaced(&model, &q, &step), displaced(&model, &q, &-&step));
+            by_q.set_column(
+                k,
+                &((com_velocity(&plus, &v) - com_velocity(&minus, &v)) / (2.0 * FD_STEP)),
+            );
+            by_v.set_column(
+                k,
+                &((com_velocity(&q, &(&v + &step)) - com_velocity(&q, &(&v - &step)))
+                    / (2.0 * FD_STEP)),
+            );
+        }
+        assert_close(
+            &format!("{name}: dcom/dq"),
+            ours_q.as_slice(),
+            by_q.as_slice(),
+            DYNAMICS_FD_TOLERANCE,
+        );
+        assert_close(
+            &format!("{name}: dcom/dv"),
+            ours_v.as_slice(),
+            by_v.as_slice(),
+            DYNAMICS_FD_TOLERANCE,
+        );
+    }
 }
