@@ -71,6 +71,8 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
         "gravity": (lambda: m.generalized_gravity(q), lambda: pin.computeGeneralizedGravity(pm, pd, pq)),
         "frame_pose": (lambda: m.frame_pose(q, frame), pin_frame_pose),
         "jacobian": (lambda: m.jacobian(q, frame), pin_jacobian),
+        "rnea_derivatives": (lambda: m.inverse_dynamics_derivatives(q, v, a), lambda: pin.computeRNEADerivatives(pm, pd, pq, pv, pa)),
+        "aba_derivatives": (lambda: m.forward_dynamics_derivatives(q, v, a), lambda: pin.computeABADerivatives(pm, pd, pq, pv, pa)),
     }
     rows = [(f"{name} {algorithm} (one call)", *best_times(ours, theirs, 2000)) for algorithm, (ours, theirs) in single.items()]
 
@@ -91,10 +93,15 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
         for x in pin_states:
             pin.crba(pm, pd, x)
 
+    def pin_rnea_derivatives_loop():
+        for x, w in zip(pin_states, pin_velocities):
+            pin.computeRNEADerivatives(pm, pd, x, w, w)
+
     batches = {
         "gravity": (lambda: m.generalized_gravity(states), pin_gravity_loop),
         "rnea": (lambda: m.inverse_dynamics(states, velocities, velocities), pin_rnea_loop),
         "crba": (lambda: m.mass_matrix(states), pin_crba_loop),
+        "rnea_derivatives": (lambda: m.inverse_dynamics_derivatives(states, velocities, velocities), pin_rnea_derivatives_loop),
     }
     rows += [(f"{name} {algorithm} ({batch} states)", *best_times(ours, theirs, 1, 5)) for algorithm, (ours, theirs) in batches.items()]
     return rows

@@ -2,12 +2,14 @@
 // Built and run by benchmarks/pinocchio_native.sh against the headers and libraries of the `pin`
 // wheel. Prints nanoseconds per call (best of 5 rounds) for each robot given on the command line
 // as `name path floating(0|1) frame`; the Jacobian is that frame's.
+#include <pinocchio/algorithm/aba-derivatives.hpp>
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/frames.hpp>
 #include <pinocchio/algorithm/jacobian.hpp>
 #include <pinocchio/algorithm/joint-configuration.hpp>
 #include <pinocchio/algorithm/kinematics.hpp>
+#include <pinocchio/algorithm/rnea-derivatives.hpp>
 #include <pinocchio/algorithm/rnea.hpp>
 #include <pinocchio/parsers/urdf.hpp>
 
@@ -53,6 +55,10 @@ int main(int argc, char** argv) {
     std::printf("%s rnea %.1f\n", name.c_str(), best_ns([&] { pinocchio::rnea(model, data, q, v, a); }, calls));
     std::printf("%s crba %.1f\n", name.c_str(), best_ns([&] { pinocchio::crba(model, data, q); }, calls));
     std::printf("%s aba %.1f\n", name.c_str(), best_ns([&] { pinocchio::aba(model, data, q, v, a); }, calls));
+    std::printf("%s rnea_derivatives %.1f\n", name.c_str(),
+                best_ns([&] { pinocchio::computeRNEADerivatives(model, data, q, v, a); }, calls / 4));
+    std::printf("%s aba_derivatives %.1f\n", name.c_str(),
+                best_ns([&] { pinocchio::computeABADerivatives(model, data, q, v, a); }, calls / 4));
   }
   return 0;
 }

@@ -5,8 +5,8 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::{rngs::StdRng, SeedableRng};
 use robodyn::algo::{
-    aba, centroidal_momentum_matrix, coriolis_matrix, crba, forward_kinematics, frame_pose,
-    jacobian, rnea, Reference,
+    aba, aba_derivatives, centroidal_momentum_matrix, coriolis_matrix, crba, forward_kinematics,
+    frame_pose, jacobian, rnea, rnea_derivatives, Reference,
 };
 use robodyn::io::{bundled_model, load_urdf_file, LoadOptions};
 use robodyn::{Data, Model};
@@ -107,6 +107,32 @@ fn benchmarks(c: &mut Criterion) {
                     None,
                 )
                 .map(|t| t[0])
+            })
+        });
+        c.bench_function(&format!("{name}/rnea_derivatives"), |b| {
+            b.iter(|| {
+                rnea_derivatives(
+                    &model,
+                    &mut data,
+                    black_box(q),
+                    v.as_slice(),
+                    a.as_slice(),
+                    None,
+                )
+                .map(|()| data.dtau_dq[0])
+            })
+        });
+        c.bench_function(&format!("{name}/aba_derivatives"), |b| {
+            b.iter(|| {
+                aba_derivatives(
+                    &model,
+                    &mut data,
+                    black_box(q),
+                    v.as_slice(),
+                    a.as_slice(),
+                    None,
+                )
+                .map(|()| data.dqdd_dq[0])
             })
         });
     }
