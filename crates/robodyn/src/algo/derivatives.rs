@@ -27,8 +27,9 @@
 //! ```
 //! (I^C_k: the composite of k's body). ABA's derivatives follow from τ(q, q̇, FD(q, q̇, τ)) = τ:
 //! ∂q̈/∂x = −M⁻¹ ∂τ/∂x at q̈ = FD(q, q̇, τ), and ∂q̈/∂τ = M⁻¹, solved with the Cholesky factor of
-//! the M that the RNEA derivatives build anyway (no second recursion to maintain; benchmarks/README
-//! gives its time against Pinocchio's dedicated recursion).
+//! the M that the RNEA derivatives build anyway (no second recursion to maintain). Measured against
+//! Pinocchio's dedicated recursion (benchmarks/README, "Derivatives") this O(n³) route is slower on
+//! large trees: a direct recursion is the next step.
 //! Cost: O(n · depth) for RNEA's, plus O(n³) for ABA's products with M⁻¹.
 
 use crate::algo::aba::aba;
