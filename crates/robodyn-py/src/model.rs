@@ -5,7 +5,7 @@
 use crate::args::*;
 use crate::to_py_err;
 use nalgebra::DMatrix;
-use numpy::ndarray::IxDyn;
+use numpy::ndarray::{Axis, IxDyn};
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
 use pyo3::prelude::*;
@@ -306,17 +306,23 @@ pub(crate) fn matrix_times(matrix: &DMatrix<f64>, vector: &[f64], out: &mut [f64
     }
 }
 
-/// {names[k]: stack[..., k, :, :]}: a stack of results along axis −3 as a dict.
+/// {names[k]: stack[..., k, :, :]}: a stack of results along axis −3 as a dict of views into it
+/// (made without a Python call: contiguous for one sample, strided over a batch).
 pub(crate) fn split_stack<'py>(
     py: Python<'py>,
     stack: &Bound<'py, PyAny>,
     names: &[&str],
 ) -> PyResult<Bound<'py, PyAny>> {
+    let array = stack.cast::<PyArrayDyn<f64>>()?;
+    let axis = Axis(array.ndim() - 3);
+    // SAFETY: the array was just made by `evaluate` and nothing else refers to it yet; each view
+    // keeps it alive as its base and none outlives it.
+    let whole = unsafe { array.as_array() };
     let out = pyo3::types::PyDict::new(py);
     for (k, name) in names.iter().enumerate() {
-        let kwargs = pyo3::types::PyDict::new(py);
-        kwargs.set_item("axis", -3)?;
-        out.set_item(*name, stack.call_method("take", (k,), Some(&kwargs))?)?;
+        let part = whole.index_axis(axis, k);
+        let view = unsafe { PyArrayDyn::borrow_from_array(&part, stack.clone()) };
+        out.set_item(*name, view)?;
     }
     Ok(out.into_any())
 }

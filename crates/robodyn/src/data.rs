@@ -2,7 +2,7 @@
 //! After that, the algorithms in [`crate::algo`] allocate nothing.
 
 use crate::model::Model;
-use crate::spatial::{Force, Inertia, Mat6, Motion, Transform};
+use crate::spatial::{CoriolisFactor, Force, Inertia, Mat6, Motion, Transform};
 use nalgebra::{DMatrix, DVector};
 
 /// Results and intermediates of the algorithms, indexed like the model's bodies (0 = world).
@@ -87,10 +87,13 @@ pub struct Data {
     /// coordinates; nbodies. Written by `rnea_derivatives` (`center_of_mass_velocity_derivatives`
     /// writes the subtrees' momenta Σ I ν here).
     pub f_world: Vec<Force>,
-    /// Per velocity coordinate k of body i (parent λ), world coordinates: `[S_k × v_λ, S_k × v_i,
-    /// S_k × a_λ − (S_k × v_λ) × v_λ]`, the terms by which v and a of i's subtree move when q_k or
+    /// Per velocity coordinate k of body i (parent λ), world coordinates: `[u_k, u_k + u'_k, z_k]`
+    /// with `u_k = S_k × v_λ`, `u'_k = S_k × v_i`, `z_k = S_k × a_λ − u_k × v_λ`, the terms by which v and a of i's subtree move when q_k or
     /// q̇_k does; nv. Written by `rnea_derivatives`.
     pub motion_terms: Vec<[Motion; 3]>,
+    /// `H = 2B(I, v)` of the subtree rooted at body i, world coordinates, factored; nbodies.
+    /// Written by `rnea_derivatives`.
+    pub coriolis_factors: Vec<CoriolisFactor>,
     /// ∂τ/∂q (tangent space, right perturbations q ⊕ δ); nv x nv. Written by `rnea_derivatives`.
     pub dtau_dq: DMatrix<f64>,
     /// ∂τ/∂q̇; nv x nv. Written by `rnea_derivatives`.
@@ -150,6 +153,7 @@ impl Data {
             a_world: vec![Motion::ZERO; nb],
             f_world: vec![Force::ZERO; nb],
             motion_terms: vec![[Motion::ZERO; 3]; nv],
+            coriolis_factors: vec![CoriolisFactor::ZERO; nb],
             dtau_dq: DMatrix::zeros(nv, nv),
             dtau_dv: DMatrix::zeros(nv, nv),
             dqdd_dq: DMatrix::zeros(nv, nv),

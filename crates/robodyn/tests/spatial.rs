@@ -1,7 +1,9 @@
 //! Spatial algebra identities, as property tests over random transforms and vectors.
 
 use proptest::prelude::*;
-use robodyn::spatial::{rotation_from_rpy, Force, Inertia, Mat3, Motion, Transform, Vec3};
+use robodyn::spatial::{
+    rotation_from_rpy, CoriolisFactor, Force, Inertia, Mat3, Motion, Transform, Vec3,
+};
 
 const TOLERANCE: f64 = 1e-12;
 
@@ -67,6 +69,17 @@ proptest! {
         let (m, other, force) = (Motion::new(w, v), Motion::new(w2, v2), Force::new(n, f));
         // (m ×* f) · other = -(m × other) · f
         prop_assert!((other.dot(&m.cross_force(&force)) + m.cross_motion(&other).dot(&force)).abs() < 1e-10);
+    }
+
+    #[test]
+    fn factored_coriolis_is_twice_the_coriolis_factor(i in inertia(), w in vec3(), v in vec3(), w2 in vec3(), v2 in vec3(), j in inertia(), w3 in vec3(), v3 in vec3()) {
+        let (velocity, s, other_velocity) = (Motion::new(w, v), Motion::new(w2, v2), Motion::new(w3, v3));
+        // a subtree's H is the sum of its bodies'
+        let mut factored = CoriolisFactor::new(&i, &velocity);
+        factored += CoriolisFactor::new(&j, &other_velocity);
+        let h = (i.coriolis_factor(&velocity) + j.coriolis_factor(&other_velocity)) * 2.0;
+        prop_assert!((factored.mul_motion(&s).to_vector() - h * s.to_vector()).norm() < 1e-10);
+        prop_assert!((factored.tr_mul_motion(&s).to_vector() - h.transpose() * s.to_vector()).norm() < 1e-10);
     }
 }
 

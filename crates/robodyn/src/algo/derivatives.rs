@@ -18,7 +18,8 @@
 //! ```
 //! for i in the subtree of b. With f_i = I_i a_i + v_i ×* I_i v_i and H(I, v) s = I (s × v) +
 //! v ×* I s + s ×* I v = 2 B(I, v) s (B the Coriolis factor of `coriolis_matrix`), summing over a
-//! subtree gives its composites I^C, H^C = 2 B^C and F (all world coordinates):
+//! subtree gives its composites I^C, H^C = 2 B^C (in the factored form of `CoriolisFactor`: no
+//! 6×6 products) and F (all world coordinates):
 //! ```text
 //!   k in the subtree of b:   ∂τ_k/∂δ_j = −S_kᵀ (I^C_k z_j + H^C_k u_j)
 //!                            ∂τ_k/∂q̇_j = S_kᵀ (H^C_k S_j − I^C_k (u_j + u'_j))
@@ -38,14 +39,14 @@ use crate::algo::minv::{cholesky_solve_mut, invert_mass_matrix};
 use crate::algo::rnea::check_external_forces;
 use crate::error::{check_vector, Result};
 use crate::model::Model;
-use crate::spatial::{mat6_mul_motion, Force, Motion, Vec3};
+use crate::spatial::{CoriolisFactor, Force, Motion, Vec3};
 use crate::Data;
 
 /// ∂τ/∂q, ∂τ/∂q̇ and ∂τ/∂q̈ = M of τ = ID(q, q̇, q̈, f_ext), with τ itself: written into
 /// `data.dtau_dq`, `data.dtau_dv`, `data.mass_matrix` and `data.tau`. `f_ext` as in `rnea` (one
 /// force per moving body, in its frame; held fixed in the body as q moves). Also writes
 /// `data.x_up`, `data.x_world`, `data.i_c`, `data.s_world`, `data.v_world`, `data.a_world`,
-/// `data.f_world`, `data.b_c`, `data.motion_terms`.
+/// `data.f_world`, `data.coriolis_factors`, `data.motion_terms`.
 pub fn rnea_derivatives(
     model: &Model,
     data: &mut Data,
@@ -81,27 +82,28 @@ pub fn rnea_derivatives(
             let u = s.cross_motion(&v_parent);
             data.motion_terms[dof] = [
                 u,
-                s.cross_motion(&v_i),
+                u + s.cross_motion(&v_i),
                 s.cross_motion(&a_parent) - u.cross_motion(&v_parent),
             ];
         }
         // f_i = I_i a_i + v_i ×* I_i v_i − f_ext_i
         let inertia = data.i_c[i];
-        let mut f_i = inertia.mul_motion(&a_i) + v_i.cross_force(&inertia.mul_motion(&v_i));
+        let coriolis = CoriolisFactor::new(&inertia, &v_i);
+        let mut f_i = inertia.mul_motion(&a_i) + v_i.cross_force(&coriolis.momentum);
         if let Some(forces) = f_ext {
             f_i -= data.x_world[i].transpose_apply_force(&forces[i - 1]);
         }
-        data.b_c[i] = inertia.coriolis_factor(&v_i);
+        data.coriolis_factors[i] = coriolis;
         (data.v_world[i], data.a_world[i], data.f_world[i]) = (v_i, a_i, f_i);
     }
 
-    // composites, leaves to root: I^C, B^C and F of each subtree
+    // composites, leaves to root: I^C, H^C and F of each subtree
     add_composite_inertias(model, data);
     for i in (1..model.nbodies()).rev() {
         let parent = model.parent[i];
         if parent != 0 {
-            let (b, f) = (data.b_c[i], data.f_world[i]);
-            data.b_c[parent] += b;
+            let (h, f) = (data.coriolis_factors[i], data.f_world[i]);
+            data.coriolis_factors[parent] += h;
             data.f_world[parent] += f;
         }
     }
@@ -111,29 +113,28 @@ pub fn rnea_derivatives(
     data.dtau_dv.fill(0.0);
     data.mass_matrix.fill(0.0);
     for i in 1..model.nbodies() {
-        let (composite, h_composite) = (data.i_c[i], data.b_c[i] * 2.0);
+        let (composite, h_composite, f_i) =
+            (data.i_c[i], data.coriolis_factors[i], data.f_world[i]);
         for k in model.v_range(i) {
             let s_k = data.s_world[k];
-            let [u_k, u_body_k, z_k] = data.motion_terms[k];
-            data.tau[k] = s_k.dot(&data.f_world[i]);
+            let [u_k, w_k, z_k] = data.motion_terms[k];
+            data.tau[k] = s_k.dot(&f_i);
             // I^C_i S_k and H^C_iᵀ S_k, for the rows of k
             let inertia_s = composite.mul_motion(&s_k);
-            let h_transpose_s = Force::from_vector(&h_composite.tr_mul(&s_k.to_vector()));
+            let h_transpose_s = h_composite.tr_mul_motion(&s_k);
             // S_k ×* F_i − I^C_i z_k − H^C_i u_k and H^C_i S_k − I^C_i (u_k + u'_k), for k's column
-            let position_force = s_k.cross_force(&data.f_world[i])
+            let position_force = s_k.cross_force(&f_i)
                 - composite.mul_motion(&z_k)
-                - mat6_mul_motion(&h_composite, &u_k);
-            let velocity_force =
-                mat6_mul_motion(&h_composite, &s_k) - composite.mul_motion(&(u_k + u_body_k));
+                - h_composite.mul_motion(&u_k);
+            let velocity_force = h_composite.mul_motion(&s_k) - composite.mul_motion(&w_k);
             let mut j = i;
             while j != 0 {
                 for c in model.v_range(j) {
                     let s_c = data.s_world[c];
-                    let [u_c, u_body_c, z_c] = data.motion_terms[c];
+                    let [u_c, w_c, z_c] = data.motion_terms[c];
                     // row k: i lies in the subtree of c's body
                     data.dtau_dq[(k, c)] = -(z_c.dot(&inertia_s) + u_c.dot(&h_transpose_s));
-                    data.dtau_dv[(k, c)] =
-                        s_c.dot(&h_transpose_s) - (u_c + u_body_c).dot(&inertia_s);
+                    data.dtau_dv[(k, c)] = s_c.dot(&h_transpose_s) - w_c.dot(&inertia_s);
                     let m = s_c.dot(&inertia_s);
                     data.mass_matrix[(k, c)] = m;
                     data.mass_matrix[(c, k)] = m;

@@ -148,6 +148,81 @@ impl Inertia {
     }
 }
 
+/// `H(I, v) = 2 B(I, v)` of one body, or summed over a subtree, in the fifteen numbers it takes.
+/// With `A = (v×*) I`, `2B = A + Aᵀ + (I v)×̄`; writing `v = (ω, u)` and `h = m c` (same axes),
+/// ```text
+///   A + Aᵀ = [S  p×; −p×  0],   S = ω×Ī − Īω× − (h uᵀ + u hᵀ) + 2 (u·h) 1,   p = ω × h + m u
+/// ```
+/// (the block algebra of Featherstone §2.13 with `a×b× = b aᵀ − (a·b) 1` and
+/// `ω×h× − h×ω× = (ω × h)×`), so `H s = (A + Aᵀ) s + s ×* I v` and, `(I v)×̄` being skew,
+/// `Hᵀ s = (A + Aᵀ) s − s ×* I v`. Every part is linear in the body, so a subtree's H is the sum.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CoriolisFactor {
+    /// `S`, symmetric.
+    pub rotational: Mat3,
+    /// `p = ω × h + m u`.
+    pub coupling: Vec3,
+    /// `I v`, the momentum.
+    pub momentum: Force,
+}
+
+impl CoriolisFactor {
+    pub const ZERO: CoriolisFactor = CoriolisFactor {
+        rotational: Mat3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+        coupling: Vec3::new(0.0, 0.0, 0.0),
+        momentum: Force::ZERO,
+    };
+
+    /// `H(I, v)` of a body of inertia `inertia` moving with `v` (both in the same coordinates).
+    #[inline]
+    pub fn new(inertia: &Inertia, v: &Motion) -> Self {
+        let (w, u, h) = (&v.angular, &v.linear, &inertia.first_moment);
+        // ω×Ī column by column; ω×Ī − Īω× = C + Cᵀ
+        let c = Mat3::from_columns(&[
+            w.cross(&inertia.rotational.column(0).into_owned()),
+            w.cross(&inertia.rotational.column(1).into_owned()),
+            w.cross(&inertia.rotational.column(2).into_owned()),
+        ]);
+        let h_u = h * u.transpose();
+        CoriolisFactor {
+            rotational: c + c.transpose() - h_u - h_u.transpose()
+                + Mat3::identity() * (2.0 * u.dot(h)),
+            coupling: w.cross(h) + u * inertia.mass,
+            momentum: inertia.mul_motion(v),
+        }
+    }
+
+    /// `(A + Aᵀ) s = [S s_ω + p × s_u; −p × s_ω]`.
+    #[inline]
+    fn symmetric_mul_motion(&self, s: &Motion) -> Force {
+        Force {
+            angular: self.rotational * s.angular + self.coupling.cross(&s.linear),
+            linear: s.angular.cross(&self.coupling),
+        }
+    }
+
+    /// `H s`.
+    #[inline]
+    pub fn mul_motion(&self, s: &Motion) -> Force {
+        self.symmetric_mul_motion(s) + s.cross_force(&self.momentum)
+    }
+
+    /// `Hᵀ s`.
+    #[inline]
+    pub fn tr_mul_motion(&self, s: &Motion) -> Force {
+        self.symmetric_mul_motion(s) - s.cross_force(&self.momentum)
+    }
+}
+
+impl AddAssign for CoriolisFactor {
+    #[inline]
+    fn add_assign(&mut self, rhs: CoriolisFactor) {
+        self.rotational += rhs.rotational;
+        self.coupling += rhs.coupling;
+        self.momentum += rhs.momentum;
+    }
+}
+
 impl Add for Inertia {
     type Output = Inertia;
     #[inline]

@@ -12,7 +12,7 @@ mod motion;
 mod transform;
 
 pub use force::Force;
-pub use inertia::{mat6_mul_motion, Inertia};
+pub use inertia::{mat6_mul_motion, CoriolisFactor, Inertia};
 pub use motion::Motion;
 pub use transform::Transform;
 
