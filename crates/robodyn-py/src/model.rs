@@ -6,7 +6,9 @@ use crate::args::*;
 use crate::to_py_err;
 use nalgebra::DMatrix;
 use numpy::ndarray::{Axis, IxDyn};
-use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{
+    PyArray1, PyArray2, PyArray3, PyArray4, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods,
+};
 use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
 use pyo3::prelude::*;
 use rayon::prelude::*;
@@ -313,16 +315,26 @@ pub(crate) fn split_stack<'py>(
     stack: &Bound<'py, PyAny>,
     names: &[&str],
 ) -> PyResult<Bound<'py, PyAny>> {
-    let array = stack.cast::<PyArrayDyn<f64>>()?;
-    let axis = Axis(array.ndim() - 3);
-    // SAFETY: the array was just made by `evaluate` and nothing else refers to it yet; each view
-    // keeps it alive as its base and none outlives it.
-    let whole = unsafe { array.as_array() };
     let out = pyo3::types::PyDict::new(py);
-    for (k, name) in names.iter().enumerate() {
-        let part = whole.index_axis(axis, k);
-        let view = unsafe { PyArrayDyn::borrow_from_array(&part, stack.clone()) };
-        out.set_item(*name, view)?;
+    // SAFETY (both arms): the array was just made by `evaluate` and nothing else refers to it
+    // yet; each view keeps it alive as its base.
+    if let Ok(single) = stack.cast::<PyArray3<f64>>() {
+        let whole = unsafe { single.as_array() };
+        for (k, name) in names.iter().enumerate() {
+            let part = whole.index_axis(Axis(0), k);
+            out.set_item(*name, unsafe {
+                PyArray2::borrow_from_array(&part, stack.clone())
+            })?;
+        }
+    } else {
+        let batch = stack.cast::<PyArray4<f64>>()?;
+        let whole = unsafe { batch.as_array() };
+        for (k, name) in names.iter().enumerate() {
+            let part = whole.index_axis(Axis(1), k);
+            out.set_item(*name, unsafe {
+                PyArray3::borrow_from_array(&part, stack.clone())
+            })?;
+        }
     }
     Ok(out.into_any())
 }

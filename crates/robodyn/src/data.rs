@@ -52,8 +52,9 @@ pub struct Data {
     pub mass_matrix: DMatrix<f64>,
     /// M(q)⁻¹; nv x nv. Written by `inverse_mass_matrix`.
     pub mass_matrix_inverse: DMatrix<f64>,
-    /// Cholesky factor workspace for `inverse_mass_matrix`; nv x nv.
-    pub cholesky: DMatrix<f64>,
+    /// M's tree-sparse factors M = Lᵀ D L: D on the diagonal, L strictly below (see
+    /// `algo::ltdl`); nv x nv. Written by `inverse_mass_matrix` and `aba_derivatives`.
+    pub mass_matrix_factor: DMatrix<f64>,
     /// Velocity-product acceleration `c_i = v_i × v_J` of body i, own frame; nbodies.
     /// Written by `aba`.
     pub c: Vec<Motion>,
@@ -94,6 +95,12 @@ pub struct Data {
     /// `H = 2B(I, v)` of the subtree rooted at body i, world coordinates, factored; nbodies.
     /// Written by `rnea_derivatives`.
     pub coriolis_factors: Vec<CoriolisFactor>,
+    /// Each body's own spatial inertia in world coordinates; nbodies. Written by
+    /// `rnea_derivatives`.
+    pub i_world: Vec<Inertia>,
+    /// Each body's velocity-product force v ×* I v less its external force, world coordinates;
+    /// nbodies. Written by `rnea_derivatives`.
+    pub f_velocity: Vec<Force>,
     /// ∂τ/∂q (tangent space, right perturbations q ⊕ δ); nv x nv. Written by `rnea_derivatives`.
     pub dtau_dq: DMatrix<f64>,
     /// ∂τ/∂q̇; nv x nv. Written by `rnea_derivatives`.
@@ -102,6 +109,9 @@ pub struct Data {
     pub dqdd_dq: DMatrix<f64>,
     /// ∂q̈/∂q̇; nv x nv. Written by `aba_derivatives`.
     pub dqdd_dv: DMatrix<f64>,
+    /// Row i of [−∂τ/∂q, −∂τ/∂q̇, 1], then of M⁻¹ times it, row-major (nv rows of 3 nv).
+    /// Written by `aba_derivatives`.
+    pub derivative_rows: Vec<f64>,
     /// ∂(frame velocity)/∂q (tangent space); 6 x nv. Written by `frame_motion_derivatives`.
     pub frame_velocity_dq: DMatrix<f64>,
     /// ∂(frame classical acceleration)/∂q; 6 x nv. Written by `frame_motion_derivatives`.
@@ -139,7 +149,8 @@ impl Data {
             centroidal_matrix: DMatrix::zeros(6, nv),
             mass_matrix: DMatrix::zeros(nv, nv),
             mass_matrix_inverse: DMatrix::zeros(nv, nv),
-            cholesky: DMatrix::zeros(nv, nv),
+            mass_matrix_factor: DMatrix::zeros(nv, nv),
+            derivative_rows: vec![0.0; 3 * nv * nv],
             c: vec![Motion::ZERO; nb],
             i_a: vec![Mat6::zeros(); nb],
             p_a: vec![Force::ZERO; nb],
@@ -154,6 +165,8 @@ impl Data {
             f_world: vec![Force::ZERO; nb],
             motion_terms: vec![[Motion::ZERO; 3]; nv],
             coriolis_factors: vec![CoriolisFactor::ZERO; nb],
+            i_world: vec![Inertia::ZERO; nb],
+            f_velocity: vec![Force::ZERO; nb],
             dtau_dq: DMatrix::zeros(nv, nv),
             dtau_dv: DMatrix::zeros(nv, nv),
             dqdd_dq: DMatrix::zeros(nv, nv),

@@ -100,6 +100,9 @@ pub struct Model {
     pub idx_q: Vec<usize>,
     /// First index of body i's joint in v.
     pub idx_v: Vec<usize>,
+    /// The parent of each velocity coordinate: the one before it in its joint, or the last of the
+    /// nearest ancestor body's joint (`None` at a root); nv. M_ij ≠ 0 only along these chains.
+    pub dof_parent: Vec<Option<usize>>,
     /// Position limits, length nq (±inf where none).
     pub lower_position_limit: DVector<f64>,
     pub upper_position_limit: DVector<f64>,
@@ -401,6 +404,7 @@ impl ModelBuilder {
                 inertias: vec![Inertia::ZERO],
                 idx_q: vec![0],
                 idx_v: vec![0],
+                dof_parent: Vec::new(),
                 lower_position_limit: DVector::zeros(0),
                 upper_position_limit: DVector::zeros(0),
                 velocity_limit: DVector::zeros(0),
@@ -453,6 +457,16 @@ impl ModelBuilder {
         m.idx_q.push(m.nq);
         m.idx_v.push(m.nv);
         let (nq, nv) = (joint.nq(), joint.nv());
+        // the first coordinate hangs from the last of the nearest ancestor joint that moves
+        let mut ancestor = parent;
+        while ancestor != 0 && m.joints[ancestor].nv() == 0 {
+            ancestor = m.parent[ancestor];
+        }
+        let mut previous = (ancestor != 0).then(|| m.idx_v[ancestor] + m.joints[ancestor].nv() - 1);
+        for k in m.nv..m.nv + nv {
+            m.dof_parent.push(previous);
+            previous = Some(k);
+        }
         m.nq += nq;
         m.nv += nv;
         // quaternion coordinates carry no limits

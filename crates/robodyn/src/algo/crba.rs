@@ -21,7 +21,13 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMat
     model.check_configuration(q)?;
     world_inertias_and_subspaces(model, data, q);
     add_composite_inertias(model, data);
+    composite_mass_matrix(model, data);
+    Ok(&data.mass_matrix)
+}
 
+/// M from the world-frame composites in `data.i_c` and subspaces in `data.s_world`, armature on
+/// the diagonal.
+pub(crate) fn composite_mass_matrix(model: &Model, data: &mut Data) {
     // H_ij = ⁰S_jᵀ (I^c_i ⁰S_i) for j on the path from i to the root; other entries are zero
     let nv = model.nv;
     let mass_matrix = data.mass_matrix.as_mut_slice();
@@ -43,7 +49,6 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMat
             mass_matrix[row + row * nv] += model.armature[row];
         }
     }
-    Ok(&data.mass_matrix)
 }
 
 /// Poses, then each body's own inertia in world coordinates in `data.i_c` and the motion subspace

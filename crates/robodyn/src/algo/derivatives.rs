@@ -27,15 +27,16 @@
 //!                            ∂τ_k/∂q̇_j = S_kᵀ (H^C_b S_j − I^C_b (u_j + u'_j))
 //! ```
 //! (I^C_k: the composite of k's body). ABA's derivatives follow from τ(q, q̇, FD(q, q̇, τ)) = τ:
-//! ∂q̈/∂x = −M⁻¹ ∂τ/∂x at q̈ = FD(q, q̇, τ), and ∂q̈/∂τ = M⁻¹, solved with the Cholesky factor of
-//! the M that the RNEA derivatives build anyway (no second recursion to maintain). Measured against
-//! Pinocchio's dedicated recursion (benchmarks/README, "Derivatives") this O(n³) route is slower on
-//! large trees: a direct recursion is the next step.
-//! Cost: O(n · depth) for RNEA's, plus O(n³) for ABA's products with M⁻¹.
+//! ∂q̈/∂x = −M⁻¹ ∂τ/∂x at q̈ = FD(q, q̇, τ), and ∂q̈/∂τ = M⁻¹. The same passes give q̈ itself: the
+//! velocity terms do not depend on q̈, the composites give M, the acceleration terms at q̈ = 0
+//! give the bias b, and q̈ = M⁻¹ (τ − b) with M's tree-sparse factors (`ltdl`), which then solve
+//! for all 3n columns of [−∂τ/∂q, −∂τ/∂q̇, 1] at once, a row update at a time.
+//! Cost: O(n · depth) for RNEA's; ABA's add O(n Σ depth) for the solves.
 
-use crate::algo::aba::aba;
-use crate::algo::crba::{add_composite_inertias, world_inertias_and_subspaces};
-use crate::algo::minv::{cholesky_solve_mut, invert_mass_matrix};
+use crate::algo::crba::{
+    add_composite_inertias, composite_mass_matrix, world_inertias_and_subspaces,
+};
+use crate::algo::ltdl::{factor_mass_matrix, solve_rows};
 use crate::algo::rnea::check_external_forces;
 use crate::error::{check_vector, Result};
 use crate::model::Model;
@@ -46,7 +47,8 @@ use crate::Data;
 /// `data.dtau_dq`, `data.dtau_dv`, `data.mass_matrix` and `data.tau`. `f_ext` as in `rnea` (one
 /// force per moving body, in its frame; held fixed in the body as q moves). Also writes
 /// `data.x_up`, `data.x_world`, `data.i_c`, `data.s_world`, `data.v_world`, `data.a_world`,
-/// `data.f_world`, `data.coriolis_factors`, `data.motion_terms`.
+/// `data.i_world`, `data.f_velocity`, `data.f_world`, `data.coriolis_factors`,
+/// `data.motion_terms`.
 pub fn rnea_derivatives(
     model: &Model,
     data: &mut Data,
@@ -55,60 +57,177 @@ pub fn rnea_derivatives(
     a: &[f64],
     f_ext: Option<&[Force]>,
 ) -> Result<()> {
+    check_arguments(model, q, v, ("a", a), f_ext)?;
+    velocity_terms(model, data, q, v, f_ext);
+    acceleration_terms(model, data, Some(a));
+    derivative_products(model, data);
+    add_rotor_terms(model, data, v, Some(a), true);
+    Ok(())
+}
+
+/// ∂q̈/∂q, ∂q̈/∂q̇ and ∂q̈/∂τ = M⁻¹ of q̈ = FD(q, q̇, τ, f_ext), with q̈ itself: written into
+/// `data.dqdd_dq`, `data.dqdd_dv`, `data.mass_matrix_inverse` and `data.qdd`. Also writes what
+/// `rnea_derivatives` writes (at q̈), `data.mass_matrix_factor` and `data.derivative_rows`.
+pub fn aba_derivatives(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    f_ext: Option<&[Force]>,
+) -> Result<()> {
+    check_arguments(model, q, v, ("tau", tau), f_ext)?;
+    velocity_terms(model, data, q, v, f_ext);
+
+    // q̈ = M⁻¹ (τ − b), b = ID(q, q̇, 0)
+    acceleration_terms(model, data, None);
+    for i in 1..model.nbodies() {
+        for k in model.v_range(i) {
+            data.tau[k] = data.s_world[k].dot(&data.f_world[i]);
+        }
+    }
+    add_rotor_terms(model, data, v, None, false);
+    composite_mass_matrix(model, data);
+    factor_mass_matrix(model, data)?;
+    for (qdd, (applied, bias)) in data.qdd.iter_mut().zip(tau.iter().zip(data.tau.iter())) {
+        *qdd = applied - bias;
+    }
+    let mut qdd = std::mem::take(&mut data.qdd);
+    solve_rows(model, data, qdd.as_mut_slice());
+
+    // ∂τ/∂x at q̈
+    acceleration_terms(model, data, Some(qdd.as_slice()));
+    derivative_products(model, data);
+    add_rotor_terms(model, data, v, Some(qdd.as_slice()), true);
+    data.qdd = qdd;
+
+    // [∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂τ] = M⁻¹ [−∂τ/∂q, −∂τ/∂q̇, 1], row by row
+    let nv = model.nv;
+    let mut rows = std::mem::take(&mut data.derivative_rows);
+    let width = 3 * nv;
+    rows.fill(0.0);
+    // column by column, as the matrices are stored
+    for j in 0..nv {
+        let (by_q, by_v) = (data.dtau_dq.column(j), data.dtau_dv.column(j));
+        for i in 0..nv {
+            rows[i * width + j] = -by_q[i];
+            rows[i * width + nv + j] = -by_v[i];
+        }
+        rows[j * width + 2 * nv + j] = 1.0;
+    }
+    solve_rows(model, data, &mut rows);
+    for j in 0..nv {
+        let (mut by_q, mut by_v) = (data.dqdd_dq.column_mut(j), data.dqdd_dv.column_mut(j));
+        for i in 0..nv {
+            by_q[i] = rows[i * width + j];
+            by_v[i] = rows[i * width + nv + j];
+        }
+        let mut inverse = data.mass_matrix_inverse.column_mut(j);
+        for i in 0..nv {
+            inverse[i] = rows[i * width + 2 * nv + j];
+        }
+    }
+    data.derivative_rows = rows;
+    Ok(())
+}
+
+/// Shapes and finiteness of (q, v, a or τ, f_ext).
+fn check_arguments(
+    model: &Model,
+    q: &[f64],
+    v: &[f64],
+    (name, x): (&str, &[f64]),
+    f_ext: Option<&[Force]>,
+) -> Result<()> {
     model.check_configuration(q)?;
     check_vector("v", v, model.nv)?;
-    check_vector("a", a, model.nv)?;
+    check_vector(name, x, model.nv)?;
     if let Some(forces) = f_ext {
         check_external_forces(model, forces)?;
     }
-    world_inertias_and_subspaces(model, data, q);
+    Ok(())
+}
 
-    // outward: world velocities and accelerations, the terms u, u', z, each body's force and B
+/// What does not depend on q̈: poses, world inertias (each body's in `data.i_world`, the
+/// subtrees' in `data.i_c`) and subspaces, velocities, the terms u and u + u', each body's
+/// velocity-product force less its external force, and the subtrees' H^C.
+fn velocity_terms(model: &Model, data: &mut Data, q: &[f64], v: &[f64], f_ext: Option<&[Force]>) {
+    world_inertias_and_subspaces(model, data, q);
     data.v_world[0] = Motion::ZERO;
-    data.a_world[0] = Motion::new(Vec3::zeros(), -model.gravity);
     for i in 1..model.nbodies() {
-        let parent = model.parent[i];
-        let (v_parent, a_parent) = (data.v_world[parent], data.a_world[parent]);
-        let (mut v_joint, mut a_joint) = (Motion::ZERO, Motion::ZERO);
+        let v_parent = data.v_world[model.parent[i]];
+        let mut v_joint = Motion::ZERO;
         for dof in model.v_range(i) {
             v_joint += data.s_world[dof] * v[dof];
-            a_joint += data.s_world[dof] * a[dof];
         }
-        // v_i = v_λ + S q̇;  a_i = a_λ + S q̈ + v_i × S q̇
+        // v_i = v_λ + S q̇
         let v_i = v_parent + v_joint;
-        let a_i = a_parent + a_joint + v_i.cross_motion(&v_joint);
         for dof in model.v_range(i) {
             let s = data.s_world[dof];
             let u = s.cross_motion(&v_parent);
-            data.motion_terms[dof] = [
-                u,
-                u + s.cross_motion(&v_i),
-                s.cross_motion(&a_parent) - u.cross_motion(&v_parent),
-            ];
+            data.motion_terms[dof][0] = u;
+            data.motion_terms[dof][1] = u + s.cross_motion(&v_i);
         }
-        // f_i = I_i a_i + v_i ×* I_i v_i − f_ext_i
+        // v_i ×* I_i v_i − f_ext_i
         let inertia = data.i_c[i];
         let coriolis = CoriolisFactor::new(&inertia, &v_i);
-        let mut f_i = inertia.mul_motion(&a_i) + v_i.cross_force(&coriolis.momentum);
+        let mut f_velocity = v_i.cross_force(&coriolis.momentum);
         if let Some(forces) = f_ext {
-            f_i -= data.x_world[i].transpose_apply_force(&forces[i - 1]);
+            f_velocity -= data.x_world[i].transpose_apply_force(&forces[i - 1]);
         }
+        data.i_world[i] = inertia;
+        data.f_velocity[i] = f_velocity;
         data.coriolis_factors[i] = coriolis;
-        (data.v_world[i], data.a_world[i], data.f_world[i]) = (v_i, a_i, f_i);
+        data.v_world[i] = v_i;
     }
-
-    // composites, leaves to root: I^C, H^C and F of each subtree
+    // composites, leaves to root
     add_composite_inertias(model, data);
     for i in (1..model.nbodies()).rev() {
         let parent = model.parent[i];
         if parent != 0 {
-            let (h, f) = (data.coriolis_factors[i], data.f_world[i]);
+            let h = data.coriolis_factors[i];
             data.coriolis_factors[parent] += h;
+        }
+    }
+}
+
+/// What q̈ (zero for `None`) adds: accelerations, the terms z, each body's force
+/// f_i = I_i a_i + v_i ×* I_i v_i − f_ext_i and the subtrees' sums F in `data.f_world`.
+fn acceleration_terms(model: &Model, data: &mut Data, a: Option<&[f64]>) {
+    data.a_world[0] = Motion::new(Vec3::zeros(), -model.gravity);
+    for i in 1..model.nbodies() {
+        let parent = model.parent[i];
+        let (v_parent, a_parent, v_i) =
+            (data.v_world[parent], data.a_world[parent], data.v_world[i]);
+        let mut a_joint = Motion::ZERO;
+        if let Some(a) = a {
+            for dof in model.v_range(i) {
+                a_joint += data.s_world[dof] * a[dof];
+            }
+        }
+        // a_i = a_λ + S q̈ + v_i × S q̇, with S q̇ = v_i − v_λ
+        let a_i = a_parent + a_joint + v_i.cross_motion(&(v_i - v_parent));
+        for dof in model.v_range(i) {
+            let [u, ..] = data.motion_terms[dof];
+            // z_k = S_k × a_λ − u_k × v_λ
+            data.motion_terms[dof][2] =
+                data.s_world[dof].cross_motion(&a_parent) - u.cross_motion(&v_parent);
+        }
+        data.a_world[i] = a_i;
+        data.f_world[i] = data.i_world[i].mul_motion(&a_i) + data.f_velocity[i];
+    }
+    for i in (1..model.nbodies()).rev() {
+        let parent = model.parent[i];
+        if parent != 0 {
+            let f = data.f_world[i];
             data.f_world[parent] += f;
         }
     }
+}
 
-    // τ, M and both derivatives, one coordinate k of body i against the coordinates on its path
+/// τ, M and both derivatives from the terms and composites above: one coordinate k of body i
+/// against the coordinates on its path to the root.
+fn derivative_products(model: &Model, data: &mut Data) {
     data.dtau_dq.fill(0.0);
     data.dtau_dv.fill(0.0);
     data.mass_matrix.fill(0.0);
@@ -123,9 +242,8 @@ pub fn rnea_derivatives(
             let inertia_s = composite.mul_motion(&s_k);
             let h_transpose_s = h_composite.tr_mul_motion(&s_k);
             // S_k ×* F_i − I^C_i z_k − H^C_i u_k and H^C_i S_k − I^C_i (u_k + u'_k), for k's column
-            let position_force = s_k.cross_force(&f_i)
-                - composite.mul_motion(&z_k)
-                - h_composite.mul_motion(&u_k);
+            let position_force =
+                s_k.cross_force(&f_i) - composite.mul_motion(&z_k) - h_composite.mul_motion(&u_k);
             let velocity_force = h_composite.mul_motion(&s_k) - composite.mul_motion(&w_k);
             let mut j = i;
             while j != 0 {
@@ -148,8 +266,17 @@ pub fn rnea_derivatives(
             }
         }
     }
+}
 
-    // the rotors: armature · (q̈ + K(q̇) q̇) on each joint's own block
+/// The rotors: armature · (q̈ + K(q̇) q̇) added to τ on each joint's own coordinates (q̈ = 0 for
+/// `None`); with `derivatives`, armature on M's diagonal and armature · ∂(K(q̇) q̇)/∂q̇ on ∂τ/∂q̇.
+fn add_rotor_terms(
+    model: &Model,
+    data: &mut Data,
+    v: &[f64],
+    a: Option<&[f64]>,
+    derivatives: bool,
+) {
     for i in 1..model.nbodies() {
         let (joint, dofs) = (&model.joints[i], model.v_range(i));
         let v_i = &v[dofs.clone()];
@@ -158,41 +285,14 @@ pub fn rnea_derivatives(
             let rotor_rate: f64 = (0..v_i.len())
                 .map(|c| joint.rotor_velocity_term(r, c, v_i) * v_i[c])
                 .sum();
-            data.tau[row] += armature * (a[row] + rotor_rate);
-            data.mass_matrix[(row, row)] += armature;
-            for (c, column) in dofs.clone().enumerate() {
-                data.dtau_dv[(row, column)] += armature * joint.rotor_velocity_jacobian(r, c, v_i);
+            data.tau[row] += armature * (a.map_or(0.0, |a| a[row]) + rotor_rate);
+            if derivatives {
+                data.mass_matrix[(row, row)] += armature;
+                for (c, column) in dofs.clone().enumerate() {
+                    data.dtau_dv[(row, column)] +=
+                        armature * joint.rotor_velocity_jacobian(r, c, v_i);
+                }
             }
         }
     }
-    Ok(())
-}
-
-/// ∂q̈/∂q, ∂q̈/∂q̇ and ∂q̈/∂τ = M⁻¹ of q̈ = FD(q, q̇, τ, f_ext), with q̈ itself: written into
-/// `data.dqdd_dq`, `data.dqdd_dv`, `data.mass_matrix_inverse` and `data.qdd`. Also writes what
-/// `aba` and `rnea_derivatives` write, and `data.cholesky`.
-pub fn aba_derivatives(
-    model: &Model,
-    data: &mut Data,
-    q: &[f64],
-    v: &[f64],
-    tau: &[f64],
-    f_ext: Option<&[Force]>,
-) -> Result<()> {
-    aba(model, data, q, v, tau, f_ext)?;
-    let qdd = std::mem::take(&mut data.qdd);
-    let linearised = rnea_derivatives(model, data, q, v, qdd.as_slice(), f_ext);
-    data.qdd = qdd;
-    linearised?;
-    invert_mass_matrix(model, data)?;
-    // ∂q̈/∂x = −M⁻¹ ∂τ/∂x, solved with M's Cholesky factor
-    for (derivative, tau_derivative) in [
-        (&mut data.dqdd_dq, &data.dtau_dq),
-        (&mut data.dqdd_dv, &data.dtau_dv),
-    ] {
-        derivative.copy_from(tau_derivative);
-        derivative.neg_mut();
-        cholesky_solve_mut(&data.cholesky, derivative);
-    }
-    Ok(())
 }

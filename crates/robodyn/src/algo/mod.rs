@@ -1,7 +1,7 @@
 //! One file per algorithm. Each is a free function `f(&Model, &mut Data, inputs) -> Result<..>`
 //! that validates its inputs, writes its results into [`crate::Data`] and allocates nothing.
 
-/// A pivot of M's Cholesky factorisation, or of an articulated inertia `D_i`, smaller than this
+/// A pivot of M's factorisation (`ltdl`), or of an articulated inertia `D_i`, smaller than this
 /// times the largest diagonal entry means the matrix is singular (a massless subtree without
 /// armature): forward dynamics and M⁻¹ are then refused rather than returned as huge numbers.
 pub const SINGULARITY_TOLERANCE: f64 = 1e-12;
@@ -17,6 +17,7 @@ pub mod frame_motion;
 pub mod inverse_kinematics;
 pub mod jacobian;
 pub mod kinematics;
+pub mod ltdl;
 pub mod manipulability;
 pub mod minv;
 pub mod regressor;

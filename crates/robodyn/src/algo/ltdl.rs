@@ -1,0 +1,125 @@
+//! The mass matrix's tree-sparse factorisation M = Lᵀ D L and the solves with it.
+//!
+//! Reference: Featherstone, "Efficient factorization of the joint-space inertia matrix for
+//! branched kinematic trees", IJRR 24(6), 2005, and *Rigid Body Dynamics Algorithms* (2008) §6.5.
+//! M_ij is zero unless one of i, j is an ancestor of the other (the parent of a velocity
+//! coordinate, `Model::dof_parent`, being the one before it in its joint or the last of the
+//! parent body's joint). Eliminating the coordinates from the leaves up keeps that pattern: L is
+//! unit lower triangular with L_ki ≠ 0 only for i an ancestor of k, D diagonal. In place, k from
+//! the last coordinate to the first:
+//! ```text
+//!   for each ancestor i of k:   a = M_ki / M_kk;   M_ij −= a M_kj for j = i and its ancestors;   M_ki = a
+//! ```
+//! after which D_k = M_kk and L_ki = M_ki. Solving M x = b is then two sweeps along the ancestor
+//! chains (Lᵀ from the leaves, L from the root) and a division by D. Cost: O(Σ depth²) to factor,
+//! O(Σ depth) per right-hand side, against O(n³) and O(n²) dense: on a floating humanoid, whose
+//! chains are short against its 50 coordinates, a fraction.
+
+use crate::algo::SINGULARITY_TOLERANCE;
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::Data;
+
+/// Factors `data.mass_matrix` into `data.mass_matrix_factor` (D on the diagonal, L strictly
+/// below it; nothing above is read). A pivot D_k not above [`SINGULARITY_TOLERANCE`] times M's
+/// largest diagonal entry is refused: M is then singular (a massless subtree without armature).
+pub fn factor_mass_matrix(model: &Model, data: &mut Data) -> Result<()> {
+    let factor = &mut data.mass_matrix_factor;
+    factor.copy_from(&data.mass_matrix);
+    let scale = (0..model.nv).map(|k| factor[(k, k)]).fold(0.0, f64::max);
+    for k in (0..model.nv).rev() {
+        let pivot = factor[(k, k)];
+        if pivot.is_nan() || pivot <= SINGULARITY_TOLERANCE * scale || pivot <= 0.0 {
+            return Err(Error::InvalidValue {
+                argument: "q".into(),
+                message: "the mass matrix is singular at this configuration (a massless \
+                          subtree without armature)"
+                    .into(),
+            });
+        }
+        let mut ancestor = model.dof_parent[k];
+        while let Some(i) = ancestor {
+            // eliminate coordinate k from row i and the rows of i's ancestors
+            let a = factor[(k, i)] / pivot;
+            let mut above = Some(i);
+            while let Some(j) = above {
+                factor[(i, j)] -= a * factor[(k, j)];
+                above = model.dof_parent[j];
+            }
+            factor[(k, i)] = a;
+            ancestor = model.dof_parent[i];
+        }
+    }
+    Ok(())
+}
+
+/// Solves M X = B in place for B stored row by row in `rows` (row i at `i * width..(i + 1) *
+/// width`, width = rows.len() / nv), with the factor of [`factor_mass_matrix`]. Each elimination
+/// step is one row update over all columns at once, vectorised: with AVX2 where the processor has
+/// it (checked at run time; the same operations in the same order, so the same result bit for
+/// bit), else with the baseline's SSE2.
+pub fn solve_rows(model: &Model, data: &Data, rows: &mut [f64]) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the processor has AVX2, just checked.
+        return unsafe { solve_rows_avx2(model, data, rows) };
+    }
+    solve_rows_generic(model, data, rows);
+}
+
+/// [`solve_rows_generic`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn solve_rows_avx2(model: &Model, data: &Data, rows: &mut [f64]) {
+    solve_rows_generic(model, data, rows);
+}
+
+#[inline(always)]
+fn solve_rows_generic(model: &Model, data: &Data, rows: &mut [f64]) {
+    let (factor, nv) = (&data.mass_matrix_factor, model.nv);
+    let width = rows.len() / nv.max(1);
+    // Lᵀ y = b: k from the leaves, y_k then leaves its share in the rows of its ancestors
+    for k in (0..nv).rev() {
+        let mut ancestor = model.dof_parent[k];
+        while let Some(i) = ancestor {
+            subtract_row(rows, width, (i, k), factor[(k, i)]);
+            ancestor = model.dof_parent[i];
+        }
+    }
+    // D z = y
+    for k in 0..nv {
+        let inverse_pivot = 1.0 / factor[(k, k)];
+        for value in &mut rows[k * width..(k + 1) * width] {
+            *value *= inverse_pivot;
+        }
+    }
+    // L x = z: from the root, x_k = z_k − Σ L_ki x_i over k's ancestors i
+    for k in 0..nv {
+        let mut ancestor = model.dof_parent[k];
+        while let Some(i) = ancestor {
+            subtract_row(rows, width, (k, i), factor[(k, i)]);
+            ancestor = model.dof_parent[i];
+        }
+    }
+}
+
+/// Row `target` −= `scale` · row `source` (two different rows of `width` values each).
+#[inline(always)]
+fn subtract_row(rows: &mut [f64], width: usize, (target, source): (usize, usize), scale: f64) {
+    let (target_row, source_row) = if target < source {
+        let (head, tail) = rows.split_at_mut(source * width);
+        (
+            &mut head[target * width..(target + 1) * width],
+            &tail[..width],
+        )
+    } else {
+        let (head, tail) = rows.split_at_mut(target * width);
+        (
+            &mut tail[..width],
+            &head[source * width..(source + 1) * width],
+        )
+    };
+    for (t, s) in target_row.iter_mut().zip(source_row) {
+        *t -= scale * s;
+    }
+}
