@@ -3,7 +3,7 @@
 
 use crate::args::*;
 use crate::model::*;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 use pyo3::prelude::*;
 use robodyn::algo;
 use robodyn::spatial::Force;
@@ -65,22 +65,23 @@ impl PyModel {
         let stack = self.evaluate(py, arguments, &[3, nv, nv], &|m, w, i, out| {
             let Workspace { data, forces, .. } = w;
             let forces = i.get(3).map(|flat| external_forces(forces, flat));
-            write_stack(&derivatives(m, data, i[0], i[1], i[2], forces)?, nv, out);
-            Ok(())
+            derivatives(m, data, i[0], i[1], i[2], forces, out)
         })?;
         split_stack(py, &stack, &names)
     }
 }
 
-/// A derivatives algorithm `(q, v, x, f_ext)` returning its three nv × nv results.
-type DerivativesAlgorithm = for<'d> fn(
+/// A derivatives algorithm `(q, v, x, f_ext)` writing its three nv × nv results row-major, one
+/// after the other.
+type DerivativesAlgorithm = fn(
     &Model,
-    &'d mut Data,
+    &mut Data,
     &[f64],
     &[f64],
     &[f64],
     Option<&[Force]>,
-) -> robodyn::Result<[&'d DMatrix<f64>; 3]>;
+    &mut [f64],
+) -> robodyn::Result<()>;
 
 /// `forces` filled from the flat (nbodies − 1) × 6 rows of an `f_ext` argument.
 fn external_forces<'w>(forces: &'w mut [Force], flat: &[f64]) -> &'w [Force] {
@@ -88,30 +89,44 @@ fn external_forces<'w>(forces: &'w mut [Force], flat: &[f64]) -> &'w [Force] {
     forces
 }
 
-/// ∂τ/∂q, ∂τ/∂v, ∂τ/∂a = M.
-fn rnea_derivatives<'d>(
+/// ∂τ/∂q, ∂τ/∂v, ∂τ/∂a = M (symmetric: its storage is already row-major).
+fn rnea_derivatives(
     model: &Model,
-    data: &'d mut Data,
+    data: &mut Data,
     q: &[f64],
     v: &[f64],
     a: &[f64],
     f_ext: Option<&[Force]>,
-) -> robodyn::Result<[&'d DMatrix<f64>; 3]> {
+    out: &mut [f64],
+) -> robodyn::Result<()> {
     algo::rnea_derivatives(model, data, q, v, a, f_ext)?;
-    Ok([&data.dtau_dq, &data.dtau_dv, &data.mass_matrix])
+    let nv = model.nv;
+    let (by_q, rest) = out.split_at_mut(nv * nv);
+    let (by_v, by_a) = rest.split_at_mut(nv * nv);
+    write_row_major(&data.dtau_dq, nv, by_q);
+    write_row_major(&data.dtau_dv, nv, by_v);
+    by_a.copy_from_slice(data.mass_matrix.as_slice());
+    Ok(())
 }
 
-/// ∂q̈/∂q, ∂q̈/∂v, ∂q̈/∂τ = M⁻¹.
-fn aba_derivatives<'d>(
+/// ∂q̈/∂q, ∂q̈/∂v, ∂q̈/∂τ = M⁻¹, from the rows [∂q̈/∂q, ∂q̈/∂v, M⁻¹] the algorithm solves.
+fn aba_derivatives(
     model: &Model,
-    data: &'d mut Data,
+    data: &mut Data,
     q: &[f64],
     v: &[f64],
     tau: &[f64],
     f_ext: Option<&[Force]>,
-) -> robodyn::Result<[&'d DMatrix<f64>; 3]> {
+    out: &mut [f64],
+) -> robodyn::Result<()> {
     algo::aba_derivatives(model, data, q, v, tau, f_ext)?;
-    Ok([&data.dqdd_dq, &data.dqdd_dv, &data.mass_matrix_inverse])
+    let nv = model.nv;
+    for (i, row) in data.derivative_rows.chunks_exact(3 * nv).enumerate() {
+        for (block, part) in row.chunks_exact(nv).enumerate() {
+            out[(block * nv + i) * nv..][..nv].copy_from_slice(part);
+        }
+    }
+    Ok(())
 }
 
 /// The Christoffel symbols at q, row-major (i, j, k), in a new buffer.

@@ -77,13 +77,15 @@ pub(crate) fn run_kernel(
     out: &mut [f64],
 ) -> robodyn::Result<()> {
     kernel(model, workspace, inputs, out)?;
-    match out.iter().position(|x| !x.is_finite()) {
-        None => Ok(()),
-        Some(index) => Err(Error::Overflow {
-            index,
-            value: out[index],
-        }),
+    // one pass without an early exit (it vectorises), then the first culprit if there is one
+    if out.iter().fold(true, |finite, x| finite & x.is_finite()) {
+        return Ok(());
     }
+    let index = out.iter().position(|x| !x.is_finite()).unwrap_or_default();
+    Err(Error::Overflow {
+        index,
+        value: out[index],
+    })
 }
 
 /// A robot model with its preallocated workspace. Every numeric method takes one state (q of
@@ -281,14 +283,12 @@ impl PyModel {
 
 /// Writes the first `rows` rows of a matrix (column-major in nalgebra) into a row-major output.
 pub(crate) fn write_row_major(matrix: &nalgebra::DMatrix<f64>, rows: usize, out: &mut [f64]) {
-    let columns = matrix.ncols();
-    for (c, column) in matrix
-        .as_slice()
-        .chunks_exact(matrix.nrows().max(1))
-        .enumerate()
-    {
-        for (r, value) in column.iter().take(rows).enumerate() {
-            out[r * columns + c] = *value;
+    let (stored_rows, columns) = matrix.shape();
+    // output row by row, reading along the matrix's row (a stride of its column length)
+    for (r, out_row) in out.chunks_exact_mut(columns.max(1)).take(rows).enumerate() {
+        let row = matrix.as_slice()[r..].iter().step_by(stored_rows);
+        for (target, value) in out_row.iter_mut().zip(row) {
+            *target = *value;
         }
     }
 }

@@ -66,7 +66,7 @@ fn fill_coriolis_matrix(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
 
     // the entries, one column of body i against every velocity coordinate on its path to the root
     let coriolis = &mut data.coriolis;
-    coriolis.fill(0.0);
+    coriolis.as_mut_slice().fill(0.0);
     for i in 1..model.nbodies() {
         for a in model.v_range(i) {
             let (s_a, s_dot_a) = (data.s_world[a], data.s_dot_world[a]);

@@ -42,6 +42,7 @@ use crate::error::{check_vector, Result};
 use crate::model::Model;
 use crate::spatial::{CoriolisFactor, Force, Motion, Vec3};
 use crate::Data;
+use nalgebra::DMatrix;
 
 /// ∂τ/∂q, ∂τ/∂q̇ and ∂τ/∂q̈ = M of τ = ID(q, q̇, q̈, f_ext), with τ itself: written into
 /// `data.dtau_dq`, `data.dtau_dv`, `data.mass_matrix` and `data.tau`. `f_ext` as in `rnea` (one
@@ -60,14 +61,22 @@ pub fn rnea_derivatives(
     check_arguments(model, q, v, ("a", a), f_ext)?;
     velocity_terms(model, data, q, v, f_ext);
     acceleration_terms(model, data, Some(a));
-    derivative_products(model, data);
-    add_rotor_terms(model, data, v, Some(a), true);
+    let mut matrices = Matrices(
+        std::mem::take(&mut data.dtau_dq),
+        std::mem::take(&mut data.dtau_dv),
+    );
+    matrices.0.as_mut_slice().fill(0.0);
+    matrices.1.as_mut_slice().fill(0.0);
+    derivative_products(model, data, v, &mut matrices);
+    add_rotor_torques(model, data, v, Some(a));
+    (data.dtau_dq, data.dtau_dv) = (matrices.0, matrices.1);
     Ok(())
 }
 
 /// ∂q̈/∂q, ∂q̈/∂q̇ and ∂q̈/∂τ = M⁻¹ of q̈ = FD(q, q̇, τ, f_ext), with q̈ itself: written into
-/// `data.dqdd_dq`, `data.dqdd_dv`, `data.mass_matrix_inverse` and `data.qdd`. Also writes what
-/// `rnea_derivatives` writes (at q̈), `data.mass_matrix_factor` and `data.derivative_rows`.
+/// `data.dqdd_dq`, `data.dqdd_dv`, `data.mass_matrix_inverse` and `data.qdd`, and row by row
+/// into `data.derivative_rows`. Also writes what `rnea_derivatives` writes (at q̈) except
+/// `data.dtau_dq` and `data.dtau_dv`, and `data.mass_matrix_factor`.
 pub fn aba_derivatives(
     model: &Model,
     data: &mut Data,
@@ -86,7 +95,7 @@ pub fn aba_derivatives(
             data.tau[k] = data.s_world[k].dot(&data.f_world[i]);
         }
     }
-    add_rotor_terms(model, data, v, None, false);
+    add_rotor_torques(model, data, v, None);
     composite_mass_matrix(model, data);
     factor_mass_matrix(model, data)?;
     for (qdd, (applied, bias)) in data.qdd.iter_mut().zip(tau.iter().zip(data.tau.iter())) {
@@ -95,27 +104,23 @@ pub fn aba_derivatives(
     let mut qdd = std::mem::take(&mut data.qdd);
     solve_rows(model, data, qdd.as_mut_slice());
 
-    // ∂τ/∂x at q̈
+    // [∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂τ] = M⁻¹ [−∂τ/∂q, −∂τ/∂q̇, 1] at q̈, solved row by row
     acceleration_terms(model, data, Some(qdd.as_slice()));
-    derivative_products(model, data);
-    add_rotor_terms(model, data, v, Some(qdd.as_slice()), true);
-    data.qdd = qdd;
-
-    // [∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂τ] = M⁻¹ [−∂τ/∂q, −∂τ/∂q̇, 1], row by row
     let nv = model.nv;
-    let mut rows = std::mem::take(&mut data.derivative_rows);
-    let width = 3 * nv;
-    rows.fill(0.0);
-    // column by column, as the matrices are stored
-    for j in 0..nv {
-        let (by_q, by_v) = (data.dtau_dq.column(j), data.dtau_dv.column(j));
-        for i in 0..nv {
-            rows[i * width + j] = -by_q[i];
-            rows[i * width + nv + j] = -by_v[i];
-        }
-        rows[j * width + 2 * nv + j] = 1.0;
+    let mut rows = NegatedRows {
+        rows: std::mem::take(&mut data.derivative_rows),
+        nv,
+    };
+    rows.rows.fill(0.0);
+    derivative_products(model, data, v, &mut rows);
+    add_rotor_torques(model, data, v, Some(qdd.as_slice()));
+    data.qdd = qdd;
+    let (mut rows, width) = (rows.rows, 3 * nv);
+    for k in 0..nv {
+        rows[k * width + 2 * nv + k] = 1.0;
     }
     solve_rows(model, data, &mut rows);
+    // into the matrices, column by column as they are stored
     for j in 0..nv {
         let (mut by_q, mut by_v) = (data.dqdd_dq.column_mut(j), data.dqdd_dv.column_mut(j));
         for i in 0..nv {
@@ -225,12 +230,48 @@ fn acceleration_terms(model: &Model, data: &mut Data, a: Option<&[f64]>) {
     }
 }
 
+/// Where the entries of ∂τ/∂q and ∂τ/∂q̇ go, added to a zeroed buffer (a joint's own block gets
+/// the recursion's term and its rotor's).
+trait TorqueDerivatives {
+    fn add(&mut self, row: usize, column: usize, by_q: f64, by_v: f64);
+}
+
+/// Into two nv × nv matrices: `data.dtau_dq`, `data.dtau_dv`.
+struct Matrices(DMatrix<f64>, DMatrix<f64>);
+
+impl TorqueDerivatives for Matrices {
+    #[inline(always)]
+    fn add(&mut self, row: usize, column: usize, by_q: f64, by_v: f64) {
+        self.0[(row, column)] += by_q;
+        self.1[(row, column)] += by_v;
+    }
+}
+
+/// Negated into the rows [−∂τ/∂q, −∂τ/∂q̇, ·] (nv rows of 3 nv) that the ABA derivatives solve.
+struct NegatedRows {
+    rows: Vec<f64>,
+    nv: usize,
+}
+
+impl TorqueDerivatives for NegatedRows {
+    #[inline(always)]
+    fn add(&mut self, row: usize, column: usize, by_q: f64, by_v: f64) {
+        let start = row * 3 * self.nv + column;
+        self.rows[start] -= by_q;
+        self.rows[start + self.nv] -= by_v;
+    }
+}
+
 /// τ, M and both derivatives from the terms and composites above: one coordinate k of body i
-/// against the coordinates on its path to the root.
-fn derivative_products(model: &Model, data: &mut Data) {
-    data.dtau_dq.fill(0.0);
-    data.dtau_dv.fill(0.0);
-    data.mass_matrix.fill(0.0);
+/// against the coordinates on its path to the root; then the rotors' armature on M and their
+/// velocity term's Jacobian on ∂τ/∂q̇.
+fn derivative_products(
+    model: &Model,
+    data: &mut Data,
+    v: &[f64],
+    out: &mut impl TorqueDerivatives,
+) {
+    data.mass_matrix.as_mut_slice().fill(0.0);
     for i in 1..model.nbodies() {
         let (composite, h_composite, f_i) =
             (data.i_c[i], data.coriolis_factors[i], data.f_world[i]);
@@ -251,48 +292,49 @@ fn derivative_products(model: &Model, data: &mut Data) {
                     let s_c = data.s_world[c];
                     let [u_c, w_c, z_c] = data.motion_terms[c];
                     // row k: i lies in the subtree of c's body
-                    data.dtau_dq[(k, c)] = -(z_c.dot(&inertia_s) + u_c.dot(&h_transpose_s));
-                    data.dtau_dv[(k, c)] = s_c.dot(&h_transpose_s) - w_c.dot(&inertia_s);
+                    out.add(
+                        k,
+                        c,
+                        -(z_c.dot(&inertia_s) + u_c.dot(&h_transpose_s)),
+                        s_c.dot(&h_transpose_s) - w_c.dot(&inertia_s),
+                    );
                     let m = s_c.dot(&inertia_s);
                     data.mass_matrix[(k, c)] = m;
                     data.mass_matrix[(c, k)] = m;
                     // column k: c's body lies strictly above i
                     if j != i {
-                        data.dtau_dq[(c, k)] = s_c.dot(&position_force);
-                        data.dtau_dv[(c, k)] = s_c.dot(&velocity_force);
+                        out.add(c, k, s_c.dot(&position_force), s_c.dot(&velocity_force));
                     }
                 }
                 j = model.parent[j];
             }
         }
     }
-}
-
-/// The rotors: armature · (q̈ + K(q̇) q̇) added to τ on each joint's own coordinates (q̈ = 0 for
-/// `None`); with `derivatives`, armature on M's diagonal and armature · ∂(K(q̇) q̇)/∂q̇ on ∂τ/∂q̇.
-fn add_rotor_terms(
-    model: &Model,
-    data: &mut Data,
-    v: &[f64],
-    a: Option<&[f64]>,
-    derivatives: bool,
-) {
     for i in 1..model.nbodies() {
         let (joint, dofs) = (&model.joints[i], model.v_range(i));
         let v_i = &v[dofs.clone()];
         for (r, row) in dofs.clone().enumerate() {
             let armature = model.armature[row];
+            data.mass_matrix[(row, row)] += armature;
+            for (c, column) in dofs.clone().enumerate() {
+                let by_v = armature * joint.rotor_velocity_jacobian(r, c, v_i);
+                out.add(row, column, 0.0, by_v);
+            }
+        }
+    }
+}
+
+/// The rotors' torque armature · (q̈ + K(q̇) q̇) added to τ on each joint's own coordinates (q̈ = 0
+/// for `None`).
+fn add_rotor_torques(model: &Model, data: &mut Data, v: &[f64], a: Option<&[f64]>) {
+    for i in 1..model.nbodies() {
+        let (joint, dofs) = (&model.joints[i], model.v_range(i));
+        let v_i = &v[dofs.clone()];
+        for (r, row) in dofs.clone().enumerate() {
             let rotor_rate: f64 = (0..v_i.len())
                 .map(|c| joint.rotor_velocity_term(r, c, v_i) * v_i[c])
                 .sum();
-            data.tau[row] += armature * (a.map_or(0.0, |a| a[row]) + rotor_rate);
-            if derivatives {
-                data.mass_matrix[(row, row)] += armature;
-                for (c, column) in dofs.clone().enumerate() {
-                    data.dtau_dv[(row, column)] +=
-                        armature * joint.rotor_velocity_jacobian(r, c, v_i);
-                }
-            }
+            data.tau[row] += model.armature[row] * (a.map_or(0.0, |a| a[row]) + rotor_rate);
         }
     }
 }

@@ -98,7 +98,7 @@ pub fn frame_motion_derivatives(
         &mut data.frame_acceleration_dq,
         &mut data.frame_acceleration_dv,
     ] {
-        matrix.fill(0.0);
+        matrix.as_mut_slice().fill(0.0);
     }
     for &j in &data.support {
         let parent = model.parent[j];
@@ -217,8 +217,8 @@ pub fn center_of_mass_velocity_derivatives(
             data.f_world[parent] += momentum;
         }
     }
-    data.jacobian.fill(0.0);
-    data.com_velocity_dq.fill(0.0);
+    data.jacobian.as_mut_slice().fill(0.0);
+    data.com_velocity_dq.as_mut_slice().fill(0.0);
     let total = model.total_mass();
     if total <= 0.0 {
         return Ok(());

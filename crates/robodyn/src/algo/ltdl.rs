@@ -25,7 +25,9 @@ use crate::Data;
 /// largest diagonal entry is refused: M is then singular (a massless subtree without armature).
 pub fn factor_mass_matrix(model: &Model, data: &mut Data) -> Result<()> {
     let factor = &mut data.mass_matrix_factor;
-    factor.copy_from(&data.mass_matrix);
+    factor
+        .as_mut_slice()
+        .copy_from_slice(data.mass_matrix.as_slice());
     let scale = (0..model.nv).map(|k| factor[(k, k)]).fold(0.0, f64::max);
     for k in (0..model.nv).rev() {
         let pivot = factor[(k, k)];

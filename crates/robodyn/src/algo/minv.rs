@@ -22,7 +22,8 @@ pub fn inverse_mass_matrix<'d>(
     factor_mass_matrix(model, data)?;
     // M X = 1; X symmetric, so its rows are its columns
     let mut inverse = std::mem::take(&mut data.mass_matrix_inverse);
-    inverse.fill_with_identity();
+    inverse.as_mut_slice().fill(0.0);
+    inverse.fill_diagonal(1.0);
     solve_rows(model, data, inverse.as_mut_slice());
     data.mass_matrix_inverse = inverse;
     Ok(&data.mass_matrix_inverse)

@@ -30,7 +30,7 @@ pub fn torque_regressor<'d>(
     check_vector("a", a, model.nv)?;
     // the bodies' velocities and accelerations (gravity as a base acceleration)
     newton_euler(model, data, q, Some(v), Some(a), None)?;
-    data.regressor.fill(0.0);
+    data.regressor.as_mut_slice().fill(0.0);
     for i in 1..model.nbodies() {
         // F_i, then X_{i←j}ᵀ F_i for each joint j from i towards the world
         let mut columns = Inertia::force_regressor(&data.v[i], &data.a[i]);

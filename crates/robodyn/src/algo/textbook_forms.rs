@@ -67,7 +67,7 @@ pub fn mass_matrix_by_jacobians<'d>(
 ) -> Result<&'d DMatrix<f64>> {
     model.check_configuration(q)?;
     world_inertias_and_subspaces(model, data, q);
-    data.mass_matrix.fill(0.0);
+    data.mass_matrix.as_mut_slice().fill(0.0);
     for i in 1..model.nbodies() {
         let body = &data.i_c[i];
         let com = body.com();

@@ -101,8 +101,8 @@ impl PassiveForces {
         d_q: &mut DMatrix<f64>,
         d_v: &mut DMatrix<f64>,
     ) {
-        d_q.fill(0.0);
-        d_v.fill(0.0);
+        d_q.as_mut_slice().fill(0.0);
+        d_v.as_mut_slice().fill(0.0);
         for i in 1..model.nbodies() {
             let (configuration, dofs) = (model.q_range(i), model.v_range(i));
             // ∂(q ⊖ q_ref)/∂q, the joint's block

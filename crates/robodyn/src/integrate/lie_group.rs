@@ -84,8 +84,8 @@ fn joint_blocks(
 ) -> Result<()> {
     check_length("out", first.nrows() * first.ncols(), model.nv * model.nv)?;
     check_length("out", second.nrows() * second.ncols(), model.nv * model.nv)?;
-    first.fill(0.0);
-    second.fill(0.0);
+    first.as_mut_slice().fill(0.0);
+    second.as_mut_slice().fill(0.0);
     for i in 1..model.nbodies() {
         let (mut a, mut b) = (Mat6::zeros(), Mat6::zeros());
         blocks(i, &mut a, &mut b);

@@ -210,9 +210,11 @@ impl StepWorkspace {
         passive.jacobians(model, q, v, passive_q, passive_v);
         let [by_q, by_v, by_tau] = &mut self.dynamics_jacobians;
         let minv = &self.data.mass_matrix_inverse;
-        by_q.copy_from(&self.data.dqdd_dq);
+        by_q.as_mut_slice()
+            .copy_from_slice(self.data.dqdd_dq.as_slice());
         multiply(by_q, minv, passive_q, 1.0);
-        by_v.copy_from(&self.data.dqdd_dv);
+        by_v.as_mut_slice()
+            .copy_from_slice(self.data.dqdd_dv.as_slice());
         multiply(by_v, minv, passive_v, 1.0);
         by_tau.copy_from(minv);
         Ok(())
@@ -221,12 +223,12 @@ impl StepWorkspace {
     /// ξ = h Σ w_j Ξ_j and v = v₀ + h Σ w_j A_j (and their derivatives) over the stages so far.
     fn weighted_sums(&mut self, weights: &[f64], h: f64, v: &[f64], derivatives: bool) {
         let nv = v.len();
-        self.xi.fill(0.0);
+        self.xi.as_mut_slice().fill(0.0);
         self.stage_v.copy_from_slice(v);
         if derivatives {
             // dξ = 0, dv = [0 1 0] before the sums
-            self.d_xi.fill(0.0);
-            self.d_v.fill(0.0);
+            self.d_xi.as_mut_slice().fill(0.0);
+            self.d_v.as_mut_slice().fill(0.0);
             self.d_v.columns_mut(nv, nv).fill_with_identity();
         }
         for (j, &weight) in weights.iter().enumerate().filter(|(_, w)| **w != 0.0) {
