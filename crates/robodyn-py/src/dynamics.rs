@@ -5,6 +5,7 @@ use crate::args::*;
 use crate::model::*;
 use nalgebra::DVector;
 use pyo3::prelude::*;
+use pyo3::types::PyString;
 use robodyn::algo;
 use robodyn::spatial::Force;
 use robodyn::{Data, Model};
@@ -58,7 +59,7 @@ impl PyModel {
         &self,
         py: Python<'py>,
         arguments: &[Argument<'py>],
-        names: [&str; 3],
+        names: [&Bound<'py, PyString>; 3],
         derivatives: DerivativesAlgorithm,
     ) -> PyResult<Bound<'py, PyAny>> {
         let nv = self.model.nv;
@@ -99,12 +100,10 @@ fn rnea_derivatives(
     f_ext: Option<&[Force]>,
     out: &mut [f64],
 ) -> robodyn::Result<()> {
-    algo::rnea_derivatives(model, data, q, v, a, f_ext)?;
     let nv = model.nv;
     let (by_q, rest) = out.split_at_mut(nv * nv);
     let (by_v, by_a) = rest.split_at_mut(nv * nv);
-    write_row_major(&data.dtau_dq, nv, by_q);
-    write_row_major(&data.dtau_dv, nv, by_v);
+    algo::rnea_derivatives_row_major(model, data, (q, v, a, f_ext), by_q, by_v)?;
     by_a.copy_from_slice(data.mass_matrix.as_slice());
     Ok(())
 }
@@ -213,7 +212,7 @@ impl PyModel {
         f_ext: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let arguments = self.dynamics_arguments(q, v, ("a", a), f_ext)?;
-        let names = ["dtau_dq", "dtau_dv", "dtau_da"];
+        let names = keys!(py, "dtau_dq", "dtau_dv", "dtau_da");
         self.dynamics_derivatives(py, &arguments, names, rnea_derivatives)
     }
 
@@ -230,7 +229,7 @@ impl PyModel {
         f_ext: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let arguments = self.dynamics_arguments(q, v, ("tau", tau), f_ext)?;
-        let names = ["dqdd_dq", "dqdd_dv", "dqdd_dtau"];
+        let names = keys!(py, "dqdd_dq", "dqdd_dv", "dqdd_dtau");
         self.dynamics_derivatives(py, &arguments, names, aba_derivatives)
     }
 

@@ -143,7 +143,7 @@ impl PyModel {
             write_stack(&[&data.frame_velocity_dq, &data.jacobian], 6, out);
             Ok(())
         })?;
-        split_stack(py, &stack, &["dv_dq", "dv_dv"])
+        split_stack(py, &stack, &keys!(py, "dv_dq", "dv_dv"))
     }
 
     /// Derivatives of a frame's velocity and classical acceleration (`frame_acceleration`, same
@@ -178,7 +178,11 @@ impl PyModel {
             write_stack(&matrices, 6, out);
             Ok(())
         })?;
-        split_stack(py, &stack, &["dv_dq", "dv_dv", "da_dq", "da_dv", "da_da"])
+        split_stack(
+            py,
+            &stack,
+            &keys!(py, "dv_dq", "dv_dv", "da_dq", "da_dv", "da_da"),
+        )
     }
 
     /// Derivatives of the centre of mass's velocity ċ = J_com v (world axes): dict of `dv_dq`
@@ -197,7 +201,7 @@ impl PyModel {
             write_stack(&[&data.com_velocity_dq, &data.jacobian], 3, out);
             Ok(())
         })?;
-        split_stack(py, &stack, &["dv_dq", "dv_dv"])
+        split_stack(py, &stack, &keys!(py, "dv_dq", "dv_dv"))
     }
 
     /// Velocity of a frame, (6,) [linear; angular] = J(q) v: "world" (its origin's velocity and

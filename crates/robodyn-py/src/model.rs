@@ -11,6 +11,7 @@ use numpy::{
 };
 use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyString;
 use rayon::prelude::*;
 use robodyn::integrate::StepWorkspace;
 use robodyn::spatial::Force;
@@ -77,8 +78,8 @@ pub(crate) fn run_kernel(
     out: &mut [f64],
 ) -> robodyn::Result<()> {
     kernel(model, workspace, inputs, out)?;
-    // one pass without an early exit (it vectorises), then the first culprit if there is one
-    if out.iter().fold(true, |finite, x| finite & x.is_finite()) {
+    // one vectorised pass, then the first culprit if there is one
+    if robodyn::error::all_finite(out) {
         return Ok(());
     }
     let index = out.iter().position(|x| !x.is_finite()).unwrap_or_default();
@@ -308,12 +309,20 @@ pub(crate) fn matrix_times(matrix: &DMatrix<f64>, vector: &[f64], out: &mut [f64
     }
 }
 
+/// Dict keys as Python strings made once per process (with their hash), not on every call.
+macro_rules! keys {
+    ($py:expr, $($name:literal),+ $(,)?) => {
+        [$(pyo3::intern!($py, $name)),+]
+    };
+}
+pub(crate) use keys;
+
 /// {names[k]: stack[..., k, :, :]}: a stack of results along axis −3 as a dict of views into it
 /// (made without a Python call: contiguous for one sample, strided over a batch).
 pub(crate) fn split_stack<'py>(
     py: Python<'py>,
     stack: &Bound<'py, PyAny>,
-    names: &[&str],
+    names: &[&Bound<'py, PyString>],
 ) -> PyResult<Bound<'py, PyAny>> {
     let out = pyo3::types::PyDict::new(py);
     // SAFETY (both arms): the array was just made by `evaluate` and nothing else refers to it

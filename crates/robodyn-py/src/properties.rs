@@ -352,7 +352,7 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let arguments = [self.q_arg("q", q)?, self.v_arg("v", v)?];
         let pair = self.jacobian_pair(py, &arguments, integrate_jacobians)?;
-        split_stack(py, &pair, &["dq", "dv"])
+        split_stack(py, &pair, &keys!(py, "dq", "dv"))
     }
 
     /// Jacobians of q1 ⊖ q0 in the tangent spaces: dict of `dq0` = −J_l(v)⁻¹ and `dq1` =
@@ -365,7 +365,7 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let arguments = [self.q_arg("q0", q0)?, self.q_arg("q1", q1)?];
         let pair = self.jacobian_pair(py, &arguments, difference_jacobians)?;
-        split_stack(py, &pair, &["dq0", "dq1"])
+        split_stack(py, &pair, &keys!(py, "dq0", "dq1"))
     }
 
     /// q1 ⊖ q0: the velocity that moves q0 to q1 in unit time. (nv,).

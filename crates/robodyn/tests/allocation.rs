@@ -64,6 +64,10 @@ fn algorithms_allocate_nothing_after_data_new() {
         let (q, v, a) = (q.as_slice(), v.as_slice(), a.as_slice());
         let frame = model.frames.len() - 1;
         let mut gamma = vec![0.0; model.nv.pow(3)];
+        let (by_q, by_v) = (
+            &mut vec![0.0; model.nv.pow(2)],
+            &mut vec![0.0; model.nv.pow(2)],
+        );
         let mut jacobians = (
             nalgebra::DMatrix::zeros(model.nv, model.nv),
             nalgebra::DMatrix::zeros(model.nv, model.nv),
@@ -133,6 +137,13 @@ fn algorithms_allocate_nothing_after_data_new() {
                 "rnea_derivatives",
                 allocations(|| {
                     rnea_derivatives(&model, &mut data, q, v, a, None).unwrap();
+                }),
+            ),
+            (
+                "rnea_derivatives_row_major",
+                allocations(|| {
+                    rnea_derivatives_row_major(&model, &mut data, (q, v, a, None), by_q, by_v)
+                        .unwrap();
                 }),
             ),
             (

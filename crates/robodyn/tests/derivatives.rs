@@ -8,7 +8,7 @@ use nalgebra::{DMatrix, DVector};
 use robodyn::algo::{
     aba, aba_derivatives, center_of_mass_jacobian, center_of_mass_velocity_derivatives,
     frame_acceleration, frame_motion_derivatives, frame_velocity, inverse_mass_matrix, rnea,
-    rnea_derivatives, Reference,
+    rnea_derivatives, rnea_derivatives_row_major, Reference,
 };
 use robodyn::spatial::{Force, Vec3};
 use robodyn::{Data, Model};
@@ -137,6 +137,41 @@ fn rnea_derivatives_are_finite_differences() {
         },
         |model, data, q, v, a, f_ext| rnea(model, data, q, v, a, f_ext).unwrap().clone(),
     );
+}
+
+#[test]
+fn row_major_rnea_derivatives_are_the_transposes() {
+    let mut rng = rng();
+    for (name, model) in models() {
+        let (mut data, nv) = (Data::new(&model), model.nv);
+        let (q, v, a) = state(&model, &mut rng);
+        let forces = random_forces(&model, &mut rng);
+        let arguments = (q.as_slice(), v.as_slice(), a.as_slice(), Some(&forces[..]));
+        let (mut by_q, mut by_v) = (vec![f64::NAN; nv * nv], vec![f64::NAN; nv * nv]);
+        rnea_derivatives_row_major(&model, &mut data, arguments, &mut by_q, &mut by_v).unwrap();
+        let (tau, mass_matrix) = (data.tau.clone(), data.mass_matrix.clone());
+        rnea_derivatives(
+            &model,
+            &mut data,
+            arguments.0,
+            arguments.1,
+            arguments.2,
+            arguments.3,
+        )
+        .unwrap();
+        // the same operations into another layout: equal bit for bit
+        assert_eq!(by_q, data.dtau_dq.transpose().as_slice(), "{name}: dtau/dq");
+        assert_eq!(by_v, data.dtau_dv.transpose().as_slice(), "{name}: dtau/dv");
+        assert_eq!(tau, data.tau, "{name}: tau");
+        assert_eq!(mass_matrix, data.mass_matrix, "{name}: M");
+        let error = rnea_derivatives_row_major(&model, &mut data, arguments, &mut by_q, &mut [])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("dtau_dv") && error.contains("length 0"),
+            "{error}"
+        );
+    }
 }
 
 #[test]

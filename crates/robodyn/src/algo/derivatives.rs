@@ -38,7 +38,7 @@ use crate::algo::crba::{
 };
 use crate::algo::ltdl::{factor_mass_matrix, solve_rows};
 use crate::algo::rnea::check_external_forces;
-use crate::error::{check_vector, Result};
+use crate::error::{check_length, check_vector, Result};
 use crate::model::Model;
 use crate::spatial::{CoriolisFactor, Force, Motion, Vec3};
 use crate::Data;
@@ -58,18 +58,55 @@ pub fn rnea_derivatives(
     a: &[f64],
     f_ext: Option<&[Force]>,
 ) -> Result<()> {
-    check_arguments(model, q, v, ("a", a), f_ext)?;
-    velocity_terms(model, data, q, v, f_ext);
-    acceleration_terms(model, data, Some(a));
     let mut matrices = Matrices(
         std::mem::take(&mut data.dtau_dq),
         std::mem::take(&mut data.dtau_dv),
     );
     matrices.0.as_mut_slice().fill(0.0);
     matrices.1.as_mut_slice().fill(0.0);
-    derivative_products(model, data, v, &mut matrices);
-    add_rotor_torques(model, data, v, Some(a));
+    let result = rnea_derivative_passes(model, data, (q, v, a, f_ext), &mut matrices);
     (data.dtau_dq, data.dtau_dv) = (matrices.0, matrices.1);
+    result
+}
+
+/// (q, q̇, q̈ or τ, f_ext): the state and inputs of a dynamics algorithm.
+pub type DynamicsState<'a> = (&'a [f64], &'a [f64], &'a [f64], Option<&'a [Force]>);
+
+/// [`rnea_derivatives`] with ∂τ/∂q and ∂τ/∂q̇ written row-major (nv × nv each) into `dtau_dq` and
+/// `dtau_dv` instead of `data.dtau_dq` and `data.dtau_dv`: for a caller that hands the results on
+/// row by row (NumPy), without a transpose.
+pub fn rnea_derivatives_row_major(
+    model: &Model,
+    data: &mut Data,
+    (q, v, a, f_ext): DynamicsState,
+    dtau_dq: &mut [f64],
+    dtau_dv: &mut [f64],
+) -> Result<()> {
+    let nv = model.nv;
+    check_length("dtau_dq", dtau_dq.len(), nv * nv)?;
+    check_length("dtau_dv", dtau_dv.len(), nv * nv)?;
+    dtau_dq.fill(0.0);
+    dtau_dv.fill(0.0);
+    let mut rows = RowMajor {
+        by_q: dtau_dq,
+        by_v: dtau_dv,
+        nv,
+    };
+    rnea_derivative_passes(model, data, (q, v, a, f_ext), &mut rows)
+}
+
+/// The passes of [`rnea_derivatives`], the two derivatives added into `out` (zeroed).
+fn rnea_derivative_passes(
+    model: &Model,
+    data: &mut Data,
+    (q, v, a, f_ext): DynamicsState,
+    out: &mut impl TorqueDerivatives,
+) -> Result<()> {
+    check_arguments(model, q, v, ("a", a), f_ext)?;
+    velocity_terms(model, data, q, v, f_ext);
+    acceleration_terms(model, data, Some(a));
+    derivative_products(model, data, v, out);
+    add_rotor_torques(model, data, v, Some(a));
     Ok(())
 }
 
@@ -244,6 +281,22 @@ impl TorqueDerivatives for Matrices {
     fn add(&mut self, row: usize, column: usize, by_q: f64, by_v: f64) {
         self.0[(row, column)] += by_q;
         self.1[(row, column)] += by_v;
+    }
+}
+
+/// Into two nv × nv row-major buffers.
+struct RowMajor<'a> {
+    by_q: &'a mut [f64],
+    by_v: &'a mut [f64],
+    nv: usize,
+}
+
+impl TorqueDerivatives for RowMajor<'_> {
+    #[inline(always)]
+    fn add(&mut self, row: usize, column: usize, by_q: f64, by_v: f64) {
+        let index = row * self.nv + column;
+        self.by_q[index] += by_q;
+        self.by_v[index] += by_v;
     }
 }
 
