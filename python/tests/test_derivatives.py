@@ -94,6 +94,20 @@ def test_dynamics_derivatives_are_batched():
     assert forward["dqdd_dv"].shape == (4, model.nv, model.nv)
 
 
+def test_large_batches_equal_single_calls():
+    """A result over 2 MiB (3000 UR5 states) takes the path that asks for huge pages."""
+    model, n = robodyn.load("ur5"), 3000
+    rng = np.random.default_rng(5)
+    q = model.random_configuration(n=n, seed=6)
+    v, a = rng.uniform(-1, 1, (n, model.nv)), rng.uniform(-1, 1, (n, model.nv))
+    for call in (model.inverse_dynamics_derivatives, model.forward_dynamics_derivatives):
+        batch = call(q, v, a)
+        for k in (0, 1, 1499, n - 1):
+            single = call(q[k], v[k], a[k])
+            for key in single:
+                np.testing.assert_array_equal(batch[key][k], single[key], f"{call.__name__} {key} [{k}]")
+
+
 def test_lie_group_jacobians_agree_with_pinocchio(pinocchio_robot):
     name, model, pin_model, mapping = pinocchio_robot
     rng = np.random.default_rng(4)
