@@ -88,6 +88,11 @@ def test_non_finite_input(model, bad):
         model.generalized_gravity(bad_q)
     with pytest.raises(ValueError, match=r"batch element 2: argument 'q': expected finite values"):
         model.generalized_gravity(np.stack([q, q, bad_q]))
+    # a large batch runs in runs of consecutive states: the element is still named by its index
+    many = np.tile(q, (1000, 1))
+    many[737] = bad_q
+    with pytest.raises(ValueError, match=r"batch element 737: argument 'q': expected finite values"):
+        model.generalized_gravity(many)
     with pytest.raises(ValueError, match="argument 'f_ext': expected finite values"):
         f_ext = np.zeros((7, 6))
         f_ext[1, 2] = bad

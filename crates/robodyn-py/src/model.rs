@@ -120,6 +120,8 @@ fn advise_huge_pages(buffer: &mut [f64]) {
 pub(crate) struct PyModel {
     pub(crate) model: Model,
     pub(crate) workspace: Mutex<Workspace>,
+    /// Workspaces for the threads of a batch, kept between calls (making one allocates).
+    pub(crate) batch_workspaces: Mutex<Vec<Workspace>>,
     /// Frame name to index, for the calls that take a frame by name.
     pub(crate) frame_indices: HashMap<String, usize>,
 }
@@ -135,6 +137,7 @@ impl PyModel {
         PyModel {
             model,
             workspace,
+            batch_workspaces: Mutex::new(Vec::new()),
             frame_indices,
         }
     }
@@ -199,23 +202,33 @@ impl PyModel {
                     .collect();
                 let mut out = vec![0.0; n * output_size];
                 advise_huge_pages(&mut out);
+                // a few runs of consecutive states per thread (for balance), each in a workspace
+                // taken from the pool and given back
+                let run = n.div_ceil(4 * rayon::current_num_threads()).max(1);
+                let pool = &self.batch_workspaces;
                 let result = py.detach(|| {
-                    out.par_chunks_mut(output_size.max(1))
+                    out.par_chunks_mut((run * output_size).max(1))
                         .enumerate()
-                        .try_for_each_init(
-                            || (Workspace::new(model), Vec::with_capacity(values.len())),
-                            |(workspace, inputs), (k, out)| {
-                                inputs.clear();
-                                inputs.extend(
-                                    values
-                                        .iter()
-                                        .zip(&sizes)
-                                        .map(|(v, s)| &v[k * s..(k + 1) * s]),
-                                );
-                                run_kernel(kernel, model, workspace, inputs, out)
-                                    .map_err(|e| (k, e))
-                            },
-                        )
+                        .try_for_each(|(r, outputs)| {
+                            let taken = pool.lock().ok().and_then(|mut p| p.pop());
+                            let mut workspace = taken.unwrap_or_else(|| Workspace::new(model));
+                            let mut inputs: [&[f64]; MAX_ARGUMENTS] = [&[]; MAX_ARGUMENTS];
+                            let outputs = outputs.chunks_mut(output_size.max(1));
+                            for (k, out) in (r * run..).zip(outputs) {
+                                for ((input, value), size) in
+                                    inputs.iter_mut().zip(values).zip(&sizes)
+                                {
+                                    *input = &value[k * size..(k + 1) * size];
+                                }
+                                let inputs = &inputs[..values.len()];
+                                run_kernel(kernel, model, &mut workspace, inputs, out)
+                                    .map_err(|e| (k, e))?;
+                            }
+                            if let Ok(mut p) = pool.lock() {
+                                p.push(workspace);
+                            }
+                            Ok(())
+                        })
                 });
                 if let Err((k, error)) = result {
                     let message = format!("batch element {k}: {error}");
