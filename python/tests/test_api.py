@@ -93,14 +93,19 @@ def test_shapes_and_dtypes(floating):
     assert isinstance(m.potential_energy(q), float)
 
 
+def batch_of_states(m, n: int, seed: int):
+    """n random (q, v, a, f_ext) and the model's last frame."""
+    q = m.random_configuration(n=n, seed=seed)
+    rng = np.random.default_rng(seed)
+    v, a = rng.uniform(-1, 1, (n, m.nv)), rng.uniform(-1, 1, (n, m.nv))
+    f_ext = rng.uniform(-1, 1, (n, len(m.body_names), 6))
+    return q, v, a, f_ext, m.frame_names[-1]
+
+
 def test_batches_equal_the_loop_bit_for_bit(floating):
     m = floating
     n = 64
-    q = m.random_configuration(n=n, seed=3)
-    rng = np.random.default_rng(0)
-    v, a = rng.uniform(-1, 1, (n, m.nv)), rng.uniform(-1, 1, (n, m.nv))
-    f_ext = rng.uniform(-1, 1, (n, len(m.body_names), 6))
-    frame = m.frame_names[-1]
+    q, v, a, f_ext, frame = batch_of_states(m, n, seed=3)
     calls = {
         "inverse_dynamics": (q, v, a),
         "forward_dynamics": (q, v, a),
@@ -129,6 +134,49 @@ def test_batches_equal_the_loop_bit_for_bit(floating):
     np.testing.assert_array_equal(batch, np.stack([m.frame_velocity(q[k], v[k], frame, "spatial") for k in range(n)]))
     batch = m.inverse_dynamics(q, v, a, f_ext=f_ext)
     np.testing.assert_array_equal(batch, np.stack([m.inverse_dynamics(q[k], v[k], a[k], f_ext=f_ext[k]) for k in range(n)]))
+
+
+def test_results_can_be_written_into_a_given_array(floating):
+    """`out=`: the result written into the caller's array, which is returned; single and batch,
+    equal to the plain call bit for bit; a wrong array is refused, naming `out`."""
+    m, n = floating, 8
+    q, v, a, f_ext, frame = batch_of_states(m, n, seed=4)
+    calls = {
+        "inverse_dynamics": ((q, v, a), {}),
+        "forward_dynamics": ((q, v, a), {"f_ext": f_ext}),
+        "bias_forces": ((q, v), {}),
+        "generalized_gravity": ((q,), {}),
+        "mass_matrix": ((q,), {}),
+        "frame_pose": ((q, frame), {}),
+        "jacobian": ((q, frame), {"reference": "local"}),
+    }
+    for name, (args, options) in calls.items():
+        method = getattr(m, name)
+        for batch in (True, False):
+            call_args = args if batch else tuple(x[0] if isinstance(x, np.ndarray) else x for x in args)
+            call_options = options if batch else {k: x[0] if isinstance(x, np.ndarray) else x for k, x in options.items()}
+            expected = method(*call_args, **call_options)
+            out = np.full_like(expected, np.nan)
+            returned = method(*call_args, **call_options, out=out)
+            assert returned is out, name
+            np.testing.assert_array_equal(out, expected, err_msg=f"{name} (batch: {batch})")
+    tau = m.inverse_dynamics(q[0], v[0], a[0])
+    for wrong, message in [
+        (np.zeros(m.nv + 1), r"argument 'out': expected shape \(%d,\), got \(%d,\)" % (m.nv, m.nv + 1)),
+        (np.zeros(m.nv, dtype=np.float32), "argument 'out': expected a float64 NumPy array of shape .* got an array of dtype float32"),
+        ([0.0] * m.nv, "argument 'out': expected a float64 NumPy array .* got list"),
+        (np.zeros((m.nv, 2))[:, 0], "argument 'out': expected a C-contiguous array"),
+        (np.zeros(m.nv).view(), None),
+        (a[0], "argument 'out': shares memory with argument 'a'"),
+    ]:
+        if message is None:
+            wrong.flags.writeable = False
+            message = "argument 'out': expected a writeable array"
+        with pytest.raises(ValueError, match=message):
+            m.inverse_dynamics(q[0], v[0], a[0], out=wrong)
+    with pytest.raises(ValueError, match=r"argument 'out': expected shape \(8, %d\)" % m.nv):
+        m.inverse_dynamics(q, v, a, out=np.zeros(m.nv))
+    np.testing.assert_array_equal(m.inverse_dynamics(q[0], v[0], a[0]), tau)
 
 
 def test_any_array_like_is_accepted(ur5):

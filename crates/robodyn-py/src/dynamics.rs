@@ -34,18 +34,17 @@ impl PyModel {
         Ok(arguments)
     }
 
-    /// Dynamics with optional external forces: `algorithm(q, v, x, f_ext)`.
+    /// Dynamics with optional external forces: `algorithm(q, v, x, f_ext)` on the arguments of
+    /// [`Self::dynamics_arguments`], into `out` when given.
     pub(crate) fn with_external_forces<'py>(
         &self,
         py: Python<'py>,
-        q: &Bound<'py, PyAny>,
-        v: &Bound<'py, PyAny>,
-        x: (&'static str, &Bound<'py, PyAny>),
-        f_ext: Option<&Bound<'py, PyAny>>,
+        arguments: &[Argument<'py>],
+        out: Option<&Bound<'py, PyAny>>,
         algorithm: DynamicsAlgorithm,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let arguments = self.dynamics_arguments(q, v, x, f_ext)?;
-        self.evaluate(py, &arguments, &[self.model.nv], &|m, w, i, out| {
+        let shape = [self.model.nv];
+        self.evaluate_into(py, arguments, &shape, out, &|m, w, i, out| {
             let Workspace { data, forces, .. } = w;
             let forces = i.get(3).map(|flat| external_forces(forces, flat));
             out.copy_from_slice(algorithm(m, data, i[0], i[1], i[2], forces)?.as_slice());
@@ -143,8 +142,9 @@ pub(crate) fn christoffel_of(
 impl PyModel {
     /// Inverse dynamics by RNEA: τ = M(q) a + C(q, v) v + g(q) - Σ J_iᵀ f_ext_i.
     /// `f_ext`: optional (nbodies, 6) wrenches [force; torque] on each body (rows as body_names),
-    /// in the body's frame, at its origin.
-    #[pyo3(signature = (q, v, a, f_ext=None))]
+    /// in the body's frame, at its origin. `out`: optional float64 array of the result's shape
+    /// to write into and return (reused by a loop; not one of the inputs).
+    #[pyo3(signature = (q, v, a, f_ext=None, out=None))]
     fn inverse_dynamics<'py>(
         &self,
         py: Python<'py>,
@@ -152,8 +152,10 @@ impl PyModel {
         v: &Bound<'py, PyAny>,
         a: &Bound<'py, PyAny>,
         f_ext: Option<&Bound<'py, PyAny>>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.with_external_forces(py, q, v, ("a", a), f_ext, algo::rnea)
+        let arguments = self.dynamics_arguments(q, v, ("a", a), f_ext)?;
+        self.with_external_forces(py, &arguments, out, algo::rnea)
     }
 
     /// The joint-torque regressor Y(q, v, a), shape (nv, 10 nbodies): τ = Y π with π =
@@ -185,7 +187,8 @@ impl PyModel {
     }
 
     /// Forward dynamics by ABA: a = M(q)⁻¹ (τ - C(q, v) v - g(q) + Σ J_iᵀ f_ext_i).
-    #[pyo3(signature = (q, v, tau, f_ext=None))]
+    /// `out` as in `inverse_dynamics`.
+    #[pyo3(signature = (q, v, tau, f_ext=None, out=None))]
     fn forward_dynamics<'py>(
         &self,
         py: Python<'py>,
@@ -193,8 +196,10 @@ impl PyModel {
         v: &Bound<'py, PyAny>,
         tau: &Bound<'py, PyAny>,
         f_ext: Option<&Bound<'py, PyAny>>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.with_external_forces(py, q, v, ("tau", tau), f_ext, algo::aba)
+        let arguments = self.dynamics_arguments(q, v, ("tau", tau), f_ext)?;
+        self.with_external_forces(py, &arguments, out, algo::aba)
     }
 
     /// Derivatives of inverse dynamics τ = ID(q, v, a, f_ext): dict of `dtau_dq`, `dtau_dv` and
@@ -237,12 +242,14 @@ impl PyModel {
     /// `method`: "crba" (Featherstone's composite-rigid-body algorithm, the fastest), "rnea"
     /// (column k = τ(q, 0, e_k) − g(q), n RNEA calls: the UR5 dynamics notes) or "jacobians"
     /// (Σ m J_vᵀ J_v + J_ωᵀ I J_ω over the bodies: the TU Berlin and UR5 dynamics notes).
-    #[pyo3(signature = (q, method="crba".to_string()), text_signature = "($self, q, method='crba')")]
+    /// `out` as in `inverse_dynamics`.
+    #[pyo3(signature = (q, method="crba".to_string(), out=None), text_signature = "($self, q, method='crba', out=None)")]
     fn mass_matrix<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
         #[pyo3(from_py_with = named::method)] method: String,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let algorithm: MatrixOfQ = match method.as_str() {
             "crba" => algo::crba,
@@ -250,7 +257,7 @@ impl PyModel {
             "jacobians" => algo::mass_matrix_by_jacobians,
             other => return Err(unknown_method(other, "crba, rnea or jacobians")),
         };
-        self.matrix_of_q(py, q, self.model.nv, algorithm)
+        self.matrix_of_q_into(py, q, self.model.nv, out, algorithm)
     }
 
     /// M(q)⁻¹. (nv, nv).
@@ -262,17 +269,20 @@ impl PyModel {
         self.matrix_of_q(py, q, self.model.nv, algo::inverse_mass_matrix)
     }
 
-    /// Bias forces C(q, v) v + g(q) (RNEA with a = 0). (nv,).
+    /// Bias forces C(q, v) v + g(q) (RNEA with a = 0). (nv,). `out` as in `inverse_dynamics`.
+    #[pyo3(signature = (q, v, out=None))]
     fn bias_forces<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
         v: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.evaluate(
+        self.evaluate_into(
             py,
             &[self.q_arg("q", q)?, self.v_arg("v", v)?],
             &[self.model.nv],
+            out,
             &|m, w, i, out| {
                 out.copy_from_slice(algo::bias_forces(m, &mut w.data, i[0], i[1])?.as_slice());
                 Ok(())
@@ -306,13 +316,15 @@ impl PyModel {
     }
 
     /// Generalized gravity g(q). (nv,). `method`: "rnea" (RNEA with v = a = 0) or "jacobians"
-    /// (−Σ J_cᵀ m g over the bodies' centres of mass: the TU Berlin notes "Gravity").
-    #[pyo3(signature = (q, method="rnea".to_string()), text_signature = "($self, q, method='rnea')")]
+    /// (−Σ J_cᵀ m g over the bodies' centres of mass: the TU Berlin notes "Gravity"). `out` as in
+    /// `inverse_dynamics`.
+    #[pyo3(signature = (q, method="rnea".to_string(), out=None), text_signature = "($self, q, method='rnea', out=None)")]
     fn generalized_gravity<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
         #[pyo3(from_py_with = named::method)] method: String,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         type Method = for<'d> fn(&Model, &'d mut Data, &[f64]) -> robodyn::Result<&'d DVector<f64>>;
         let algorithm: Method = match method.as_str() {
@@ -320,10 +332,11 @@ impl PyModel {
             "jacobians" => algo::generalized_gravity_by_jacobians,
             other => return Err(unknown_method(other, "rnea or jacobians")),
         };
-        self.evaluate(
+        self.evaluate_into(
             py,
             &[self.q_arg("q", q)?],
             &[self.model.nv],
+            out,
             &|m, w, i, out| {
                 out.copy_from_slice(algorithm(m, &mut w.data, i[0])?.as_slice());
                 Ok(())

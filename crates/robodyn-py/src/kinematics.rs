@@ -31,15 +31,18 @@ impl PyModel {
 
 #[pymethods]
 impl PyModel {
-    /// Pose of a frame (name or index) in the world: 4x4 homogeneous matrix.
+    /// Pose of a frame (name or index) in the world: 4x4 homogeneous matrix. `out` as in
+    /// `inverse_dynamics`.
+    #[pyo3(signature = (q, frame, out=None))]
     fn frame_pose<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
         frame: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let frame = self.frame_index(frame)?;
-        self.evaluate(py, &[self.q_arg("q", q)?], &[4, 4], &|m, w, i, out| {
+        self.evaluate_into(py, &[self.q_arg("q", q)?], &[4, 4], out, &|m, w, i, out| {
             let pose = algo::frame_pose(m, &mut w.data, i[0], frame)?;
             write_pose(&pose, out);
             Ok(())
@@ -70,21 +73,24 @@ impl PyModel {
 
     /// Jacobian of a frame, (6, nv), rows [linear; angular]. `reference`: "world" (velocity of the
     /// frame's origin and angular velocity in world axes: the geometric Jacobian), "local" (the
-    /// same in the frame's axes) or "spatial" (spatial velocity in world coordinates).
-    #[pyo3(signature = (q, frame, reference="world".to_string()), text_signature = "($self, q, frame, reference='world')")]
+    /// same in the frame's axes) or "spatial" (spatial velocity in world coordinates). `out` as
+    /// in `inverse_dynamics`.
+    #[pyo3(signature = (q, frame, reference="world".to_string(), out=None), text_signature = "($self, q, frame, reference='world', out=None)")]
     fn jacobian<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
         frame: &Bound<'py, PyAny>,
         #[pyo3(from_py_with = named::reference)] reference: String,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let frame = self.frame_index(frame)?;
         let reference = parse_reference(&reference)?;
-        self.evaluate(
+        self.evaluate_into(
             py,
             &[self.q_arg("q", q)?],
             &[6, self.model.nv],
+            out,
             &|m, w, i, out| {
                 write_row_major(
                     algo::jacobian(m, &mut w.data, i[0], frame, reference)?,
@@ -338,7 +344,7 @@ impl PyModel {
         #[pyo3(from_py_with = named::optional_seed)] seed: Option<u64>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let states = self.random_configuration(py, Some(n), seed)?;
-        let poses = self.frame_pose(py, &states, frame)?;
+        let poses = self.frame_pose(py, &states, frame, None)?;
         // the translation column of each pose
         let slicing = (
             pyo3::types::PySlice::full(py),

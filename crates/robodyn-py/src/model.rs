@@ -6,8 +6,10 @@ use crate::args::*;
 use crate::to_py_err;
 use nalgebra::DMatrix;
 use numpy::ndarray::{Axis, IxDyn};
+use numpy::npyffi::NPY_ARRAY_WRITEABLE;
 use numpy::{
-    PyArray1, PyArray2, PyArray3, PyArray4, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods,
+    PyArray1, PyArray2, PyArray3, PyArray4, PyArrayDyn, PyArrayMethods, PyUntypedArray,
+    PyUntypedArrayMethods,
 };
 use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
 use pyo3::prelude::*;
@@ -151,27 +153,30 @@ impl PyModel {
         output_shape: &[usize],
         kernel: &Kernel,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let batch = arguments[0].batch()?;
-        for argument in &arguments[1..] {
-            if argument.batch()? != batch {
-                return Err(PyValueError::new_err(format!(
-                    "argument '{}': expected {} like argument '{}', got shape {}",
-                    argument.name,
-                    match batch {
-                        None => "a single sample".to_string(),
-                        Some(n) => format!("a batch of {n}"),
-                    },
-                    arguments[0].name,
-                    shape_text(argument.array.shape())
-                )));
-            }
-        }
+        self.evaluate_into(py, arguments, output_shape, None, kernel)
+    }
+
+    /// [`Self::evaluate`], writing into the caller's array `out` when one is given (checked by
+    /// [`output_array`]) and returning it, so that a loop can reuse its result array.
+    pub(crate) fn evaluate_into<'py>(
+        &self,
+        py: Python<'py>,
+        arguments: &[Argument<'py>],
+        output_shape: &[usize],
+        out: Option<&Bound<'py, PyAny>>,
+        kernel: &Kernel,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let batch = common_batch(arguments)?;
         let values: [Cow<[f64]>; MAX_ARGUMENTS] = std::array::from_fn(|k| {
             arguments
                 .get(k)
                 .map_or(Cow::Borrowed(&[][..]), |a| a.values())
         });
         let values = &values[..arguments.len()];
+        let target = match out {
+            Some(out) => Some(output_array(out, batch, output_shape, arguments, values)?),
+            None => None,
+        };
         let output_size: usize = output_shape.iter().product();
         let model = &self.model;
         match batch {
@@ -181,8 +186,11 @@ impl PyModel {
                     *input = value.as_ref();
                 }
                 let inputs = &inputs[..values.len()];
-                let output = PyArrayDyn::<f64>::zeros(py, IxDyn(output_shape), false);
-                // SAFETY: the array was created just above and nothing else refers to it yet.
+                let given = target.is_some();
+                let output = target
+                    .unwrap_or_else(|| PyArrayDyn::<f64>::zeros(py, IxDyn(output_shape), false));
+                // SAFETY: a new array nothing else refers to yet, or the caller's, checked to
+                // share no memory with an input
                 let out = unsafe { output.as_slice_mut() }
                     .map_err(|e| PyValueError::new_err(e.to_string()))?;
                 match self.workspace.try_lock() {
@@ -190,59 +198,84 @@ impl PyModel {
                     Err(_) => run_kernel(kernel, model, &mut Workspace::new(model), inputs, out),
                 }
                 .map_err(to_py_err)?;
-                if output_shape.is_empty() {
+                if output_shape.is_empty() && !given {
                     return output.get_item(());
                 }
                 Ok(output.into_any())
             }
             Some(n) => {
-                let sizes: Vec<usize> = arguments
-                    .iter()
-                    .map(|a| a.sample_shape.as_slice().iter().product())
-                    .collect();
+                let sizes: [usize; MAX_ARGUMENTS] = std::array::from_fn(|k| {
+                    arguments
+                        .get(k)
+                        .map_or(0, |a| a.sample_shape.as_slice().iter().product())
+                });
+                let batch = BatchInputs {
+                    values,
+                    sizes: &sizes[..values.len()],
+                    output_size,
+                };
+                if let Some(output) = target {
+                    // SAFETY: as for one sample
+                    let out = unsafe { output.as_slice_mut() }
+                        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+                    self.run_batch(py, &batch, out, kernel)?;
+                    return Ok(output.into_any());
+                }
                 let mut out = vec![0.0; n * output_size];
                 advise_huge_pages(&mut out);
-                // a few runs of consecutive states per thread (for balance), each in a workspace
-                // taken from the pool and given back
-                let run = n.div_ceil(4 * rayon::current_num_threads()).max(1);
-                let pool = &self.batch_workspaces;
-                let result = py.detach(|| {
-                    out.par_chunks_mut((run * output_size).max(1))
-                        .enumerate()
-                        .try_for_each(|(r, outputs)| {
-                            let taken = pool.lock().ok().and_then(|mut p| p.pop());
-                            let mut workspace = taken.unwrap_or_else(|| Workspace::new(model));
-                            let mut inputs: [&[f64]; MAX_ARGUMENTS] = [&[]; MAX_ARGUMENTS];
-                            let outputs = outputs.chunks_mut(output_size.max(1));
-                            for (k, out) in (r * run..).zip(outputs) {
-                                for ((input, value), size) in
-                                    inputs.iter_mut().zip(values).zip(&sizes)
-                                {
-                                    *input = &value[k * size..(k + 1) * size];
-                                }
-                                let inputs = &inputs[..values.len()];
-                                run_kernel(kernel, model, &mut workspace, inputs, out)
-                                    .map_err(|e| (k, e))?;
-                            }
-                            if let Ok(mut p) = pool.lock() {
-                                p.push(workspace);
-                            }
-                            Ok(())
-                        })
-                });
-                if let Err((k, error)) = result {
-                    let message = format!("batch element {k}: {error}");
-                    return Err(match error {
-                        Error::FileNotFound { .. } => PyFileNotFoundError::new_err(message),
-                        _ => PyValueError::new_err(message),
-                    });
-                }
+                self.run_batch(py, &batch, &mut out, kernel)?;
                 let shape: Vec<usize> = std::iter::once(n)
                     .chain(output_shape.iter().copied())
                     .collect();
                 Ok(PyArray1::from_vec(py, out).reshape(shape)?.into_any())
             }
         }
+    }
+
+    /// Runs `kernel` on every sample of a batch into `out`, with the GIL released, on all cores:
+    /// a few runs of consecutive samples per thread (for balance), each in a workspace taken from
+    /// the pool and given back.
+    fn run_batch(
+        &self,
+        py: Python,
+        batch: &BatchInputs,
+        out: &mut [f64],
+        kernel: &Kernel,
+    ) -> PyResult<()> {
+        let (model, pool) = (&self.model, &self.batch_workspaces);
+        let n = out.len() / batch.output_size.max(1);
+        let run = n.div_ceil(4 * rayon::current_num_threads()).max(1);
+        let result = py.detach(|| {
+            out.par_chunks_mut((run * batch.output_size).max(1))
+                .enumerate()
+                .try_for_each(|(r, outputs)| {
+                    let taken = pool.lock().ok().and_then(|mut p| p.pop());
+                    let mut workspace = taken.unwrap_or_else(|| Workspace::new(model));
+                    let mut inputs: [&[f64]; MAX_ARGUMENTS] = [&[]; MAX_ARGUMENTS];
+                    let outputs = outputs.chunks_mut(batch.output_size.max(1));
+                    for (k, out) in (r * run..).zip(outputs) {
+                        for ((input, value), size) in
+                            inputs.iter_mut().zip(batch.values).zip(batch.sizes)
+                        {
+                            *input = &value[k * size..(k + 1) * size];
+                        }
+                        let inputs = &inputs[..batch.values.len()];
+                        run_kernel(kernel, model, &mut workspace, inputs, out)
+                            .map_err(|e| (k, e))?;
+                    }
+                    if let Ok(mut p) = pool.lock() {
+                        p.push(workspace);
+                    }
+                    Ok(())
+                })
+        });
+        result.map_err(|(k, error)| {
+            let message = format!("batch element {k}: {error}");
+            match error {
+                Error::FileNotFound { .. } => PyFileNotFoundError::new_err(message),
+                _ => PyValueError::new_err(message),
+            }
+        })
     }
 
     pub(crate) fn q_arg<'py>(
@@ -279,6 +312,96 @@ impl PyModel {
     }
 }
 
+/// The inputs of a batch: each argument's values, flattened, and its size per sample.
+struct BatchInputs<'v> {
+    values: &'v [Cow<'v, [f64]>],
+    sizes: &'v [usize],
+    output_size: usize,
+}
+
+/// The batch size the arguments share (`None`: one sample each), or an error naming the first
+/// argument that differs.
+fn common_batch(arguments: &[Argument]) -> PyResult<Option<usize>> {
+    let batch = arguments[0].batch()?;
+    for argument in &arguments[1..] {
+        if argument.batch()? != batch {
+            return Err(PyValueError::new_err(format!(
+                "argument '{}': expected {} like argument '{}', got shape {}",
+                argument.name,
+                match batch {
+                    None => "a single sample".to_string(),
+                    Some(n) => format!("a batch of {n}"),
+                },
+                arguments[0].name,
+                shape_text(argument.array.shape())
+            )));
+        }
+    }
+    Ok(batch)
+}
+
+/// The caller's `out` array, checked: float64, the result's shape (with the batch's leading
+/// N), C-contiguous, writeable, and sharing no memory with an input (the kernel would read what
+/// it had just written).
+fn output_array<'py>(
+    out: &Bound<'py, PyAny>,
+    batch: Option<usize>,
+    output_shape: &[usize],
+    arguments: &[Argument],
+    values: &[Cow<[f64]>],
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let expected: Vec<usize> = batch
+        .into_iter()
+        .chain(output_shape.iter().copied())
+        .collect();
+    let error = |what: String| PyValueError::new_err(format!("argument 'out': {what}"));
+    let Ok(array) = out.cast::<PyArrayDyn<f64>>() else {
+        let got = match out.cast::<PyUntypedArray>() {
+            Ok(array) => format!(
+                "an array of dtype {} and shape {}",
+                array.dtype(),
+                shape_text(array.shape())
+            ),
+            Err(_) => format!("{}", out.get_type().name()?),
+        };
+        return Err(error(format!(
+            "expected a float64 NumPy array of shape {}, got {got}",
+            shape_text(&expected)
+        )));
+    };
+    if array.shape() != expected.as_slice() {
+        return Err(error(format!(
+            "expected shape {}, got {}",
+            shape_text(&expected),
+            shape_text(array.shape())
+        )));
+    }
+    if !array.is_c_contiguous() {
+        return Err(error(
+            "expected a C-contiguous array, got a strided view".into(),
+        ));
+    }
+    // SAFETY: reads the flags of a live array object
+    let flags = unsafe { (*array.as_array_ptr()).fields.flags };
+    if flags & NPY_ARRAY_WRITEABLE == 0 {
+        return Err(error(
+            "expected a writeable array, got a read-only one".into(),
+        ));
+    }
+    let start = array.data() as usize;
+    let end = start + std::mem::size_of::<f64>() * array.len();
+    for (argument, value) in arguments.iter().zip(values) {
+        let (input_start, input_end) = (value.as_ptr() as usize, value.as_ptr_range().end as usize);
+        if matches!(value, Cow::Borrowed(_)) && input_start < end && start < input_end {
+            return Err(error(format!(
+                "shares memory with argument '{}'; pass a separate array",
+                argument.name
+            )));
+        }
+    }
+    Ok(array.clone())
+}
+
 /// A core algorithm giving a matrix of the configuration (M, M⁻¹, A_G, J_com) in `Data`.
 pub(crate) type MatrixOfQ =
     for<'d> fn(&Model, &'d mut Data, &[f64]) -> robodyn::Result<&'d DMatrix<f64>>;
@@ -292,8 +415,20 @@ impl PyModel {
         rows: usize,
         algorithm: MatrixOfQ,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let nv = self.model.nv;
-        self.evaluate(py, &[self.q_arg("q", q)?], &[rows, nv], &|m, w, i, out| {
+        self.matrix_of_q_into(py, q, rows, None, algorithm)
+    }
+
+    /// [`Self::matrix_of_q`] into the caller's `out` when given.
+    pub(crate) fn matrix_of_q_into<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        rows: usize,
+        out: Option<&Bound<'py, PyAny>>,
+        algorithm: MatrixOfQ,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let shape = [rows, self.model.nv];
+        self.evaluate_into(py, &[self.q_arg("q", q)?], &shape, out, &|m, w, i, out| {
             write_row_major(algorithm(m, &mut w.data, i[0])?, rows, out);
             Ok(())
         })
