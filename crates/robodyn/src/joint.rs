@@ -16,6 +16,12 @@ mod jacobians;
 /// Below this rotation angle the SE(3)/SO(3) exponential and logarithm use their Taylor series.
 const SMALL_ANGLE: f64 = 1e-6;
 
+/// Which coordinate axis (0, 1, 2 for x, y, z) a unit vector is exactly, if any.
+#[inline]
+fn coordinate_axis(axis: &Vec3) -> Option<usize> {
+    (0..3).find(|&k| axis[k] == 1.0 && axis[(k + 1) % 3] == 0.0 && axis[(k + 2) % 3] == 0.0)
+}
+
 /// A joint between a body and its parent.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Joint {
@@ -92,6 +98,27 @@ impl Joint {
             Joint::Free => {
                 Transform::from_pose(&rotation_of(&q[3..7]), &Vec3::new(q[0], q[1], q[2]))
             }
+        }
+    }
+
+    /// `X_J(q) X_T`: this joint's transform after the constant `x_tree` (parent frame to joint
+    /// frame), the body's `X_{i←λ(i)}`. A revolute joint about a coordinate axis of its frame (most
+    /// joints: URDF and MJCF axes are mostly x, y or z) turns two rows of X_T's rotation and keeps
+    /// its translation; a prismatic joint moves the translation only.
+    #[inline]
+    pub fn transform_after(&self, q: &[f64], x_tree: &Transform) -> Transform {
+        match self {
+            Joint::Fixed => *x_tree,
+            Joint::Revolute { axis } => match coordinate_axis(axis) {
+                Some(k) => x_tree.rotated_about_axis(k, q[0]),
+                None => self.transform(q) * *x_tree,
+            },
+            Joint::Prismatic { axis } => Transform {
+                rotation: x_tree.rotation,
+                // r = r_T + E_Tᵀ (axis q)
+                translation: x_tree.translation + x_tree.rotation.tr_mul(&(axis * q[0])),
+            },
+            Joint::Spherical | Joint::Free => self.transform(q) * *x_tree,
         }
     }
 

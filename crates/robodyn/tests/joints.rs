@@ -4,6 +4,7 @@
 mod common;
 
 use common::{rng, FD_STEP, FD_TOLERANCE};
+use rand::Rng;
 use robodyn::spatial::{Transform, Vec3};
 use robodyn::Joint;
 
@@ -122,4 +123,51 @@ fn neutral_is_the_identity_transform() {
             joint.kind()
         );
     }
+}
+
+/// `transform_after` takes shortcuts for coordinate axes; each is `X_J(q) X_T` to rounding.
+const COMPOSITION_TOLERANCE: f64 = 1e-14;
+
+#[test]
+fn transform_after_is_the_joint_transform_times_the_tree_transform() {
+    let mut rng = rng();
+    let mut all = joints();
+    for k in 0..3 {
+        all.push(Joint::Revolute {
+            axis: Vec3::ith(k, 1.0),
+        });
+        all.push(Joint::Revolute {
+            axis: Vec3::ith(k, -1.0),
+        });
+        all.push(Joint::Prismatic {
+            axis: Vec3::ith(k, 1.0),
+        });
+    }
+    all.push(Joint::Fixed);
+    for joint in all {
+        for _ in 0..5 {
+            let x_tree = Transform::from_pose(
+                &random_rotation(&mut rng),
+                &Vec3::new(rng.random(), rng.random(), rng.random()),
+            );
+            let mut q = vec![0.0; joint.nq()];
+            let unlimited = vec![f64::INFINITY; joint.nq()];
+            joint.random(&mut rng, &unlimited, &unlimited, &mut q);
+            let expected = (joint.transform(&q) * x_tree).to_matrix();
+            let composed = joint.transform_after(&q, &x_tree).to_matrix();
+            assert!(
+                (composed - expected).amax() < COMPOSITION_TOLERANCE,
+                "{joint:?} at {q:?}: {composed} vs {expected}"
+            );
+        }
+    }
+}
+
+fn random_rotation(rng: &mut impl Rng) -> nalgebra::Matrix3<f64> {
+    let axis = nalgebra::Unit::new_normalize(Vec3::new(
+        rng.random::<f64>() - 0.5,
+        rng.random::<f64>() - 0.5,
+        rng.random::<f64>() - 0.5,
+    ));
+    *nalgebra::Rotation3::from_axis_angle(&axis, 6.0 * rng.random::<f64>()).matrix()
 }

@@ -14,7 +14,7 @@ use crate::Data;
 pub(crate) fn update_joint_transforms(model: &Model, data: &mut Data, q: &[f64]) {
     for i in 1..model.nbodies() {
         // X_{i←λ(i)} = X_J(q_i) X_T(i)
-        data.x_up[i] = model.joints[i].transform(&q[model.q_range(i)]) * model.x_tree[i];
+        data.x_up[i] = model.joints[i].transform_after(&q[model.q_range(i)], &model.x_tree[i]);
     }
 }
 
@@ -49,7 +49,7 @@ pub(crate) fn update_support_placements(model: &Model, data: &mut Data, q: &[f64
     }
     for &i in data.support.iter().rev() {
         // X_{i←λ(i)} = X_J(q_i) X_T(i);  X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}
-        data.x_up[i] = model.joints[i].transform(&q[model.q_range(i)]) * model.x_tree[i];
+        data.x_up[i] = model.joints[i].transform_after(&q[model.q_range(i)], &model.x_tree[i]);
         data.x_world[i] = data.x_up[i] * data.x_world[model.parent[i]];
     }
 }

@@ -65,6 +65,28 @@ impl Transform {
         }
     }
 
+    /// `X_J X` for `X_J` a rotation by `angle` about coordinate axis `k` (0, 1, 2 for x, y, z) of
+    /// this transform's target frame: E' = E_J E turns the two rows of E other than k (E_J's
+    /// rows are [c s; −s c] on them, as `from_axis_angle` gives), r' = r (X_J moves no origin).
+    #[inline]
+    pub fn rotated_about_axis(&self, k: usize, angle: f64) -> Transform {
+        let (s, c) = angle.sin_cos();
+        let (first, second) = ((k + 1) % 3, (k + 2) % 3);
+        let mut rotation = self.rotation;
+        for column in 0..3 {
+            let (a, b) = (
+                self.rotation[(first, column)],
+                self.rotation[(second, column)],
+            );
+            rotation[(first, column)] = c * a + s * b;
+            rotation[(second, column)] = c * b - s * a;
+        }
+        Transform {
+            rotation,
+            translation: self.translation,
+        }
+    }
+
     /// Pure translation: B's origin at `position` in A, axes parallel.
     #[inline]
     pub fn from_translation(position: &Vec3) -> Self {
