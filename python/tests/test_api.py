@@ -179,6 +179,14 @@ def test_results_can_be_written_into_a_given_array(floating):
     np.testing.assert_array_equal(m.inverse_dynamics(q[0], v[0], a[0]), tau)
 
 
+def test_crba_mass_matrix_is_exactly_symmetric(floating):
+    """CRBA's M is handed to NumPy as stored, which is right only because it is mirrored."""
+    q = floating.random_configuration(n=4, seed=5)
+    for mass_matrix in [floating.mass_matrix(q[0]), *floating.mass_matrix(q)]:
+        np.testing.assert_array_equal(mass_matrix, mass_matrix.T)
+    assert_close(floating.mass_matrix(q[1]), floating.mass_matrix(q[1], method="rnea"), IDENTITY_TOLERANCE, "M")
+
+
 def test_any_array_like_is_accepted(ur5):
     q = [0.1, -0.5, 1, 0, 2, 3]  # a list with ints
     expected = ur5.generalized_gravity(np.array(q, dtype=float))

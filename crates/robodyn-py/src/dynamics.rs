@@ -257,7 +257,12 @@ impl PyModel {
             "jacobians" => algo::mass_matrix_by_jacobians,
             other => return Err(unknown_method(other, "crba, rnea or jacobians")),
         };
-        self.matrix_of_q_into(py, q, self.model.nv, out, algorithm)
+        // CRBA mirrors M: exactly symmetric; the others are symmetric to rounding only
+        let rows = match method.as_str() {
+            "crba" => MatrixRows::Symmetric,
+            _ => MatrixRows::First(self.model.nv),
+        };
+        self.matrix_of_q_into(py, q, rows, out, algorithm)
     }
 
     /// M(q)⁻¹. (nv, nv).
