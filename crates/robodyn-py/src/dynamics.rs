@@ -117,7 +117,7 @@ fn aba_derivatives(
     f_ext: Option<&[Force]>,
     out: &mut [f64],
 ) -> robodyn::Result<()> {
-    algo::aba_derivatives(model, data, q, v, tau, f_ext)?;
+    algo::aba_derivative_rows(model, data, (q, v, tau, f_ext))?;
     let nv = model.nv;
     for (i, row) in data.derivative_rows.chunks_exact(3 * nv).enumerate() {
         for (block, part) in row.chunks_exact(nv).enumerate() {

@@ -147,6 +147,12 @@ fn algorithms_allocate_nothing_after_data_new() {
                 }),
             ),
             (
+                "aba_derivative_rows",
+                allocations(|| {
+                    aba_derivative_rows(&model, &mut data, (q, v, a, None)).unwrap();
+                }),
+            ),
+            (
                 "aba_derivatives",
                 allocations(|| {
                     aba_derivatives(&model, &mut data, q, v, a, None).unwrap();

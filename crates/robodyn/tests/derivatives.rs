@@ -5,6 +5,7 @@ mod common;
 
 use common::*;
 use nalgebra::{DMatrix, DVector};
+use robodyn::algo::aba_derivative_rows;
 use robodyn::algo::{
     aba, aba_derivatives, center_of_mass_jacobian, center_of_mass_velocity_derivatives,
     frame_acceleration, frame_motion_derivatives, frame_velocity, inverse_mass_matrix, rnea,
@@ -171,6 +172,45 @@ fn row_major_rnea_derivatives_are_the_transposes() {
             error.contains("dtau_dv") && error.contains("length 0"),
             "{error}"
         );
+    }
+}
+
+#[test]
+fn aba_derivative_rows_hold_the_three_matrices() {
+    let mut rng = rng();
+    for (name, model) in models() {
+        let (mut data, nv) = (Data::new(&model), model.nv);
+        let (q, v, tau) = state(&model, &mut rng);
+        let forces = random_forces(&model, &mut rng);
+        let arguments = (
+            q.as_slice(),
+            v.as_slice(),
+            tau.as_slice(),
+            Some(&forces[..]),
+        );
+        aba_derivative_rows(&model, &mut data, arguments).unwrap();
+        let rows = data.derivative_rows.clone();
+        aba_derivatives(
+            &model,
+            &mut data,
+            arguments.0,
+            arguments.1,
+            arguments.2,
+            arguments.3,
+        )
+        .unwrap();
+        assert_eq!(rows, data.derivative_rows, "{name}");
+        for (i, row) in rows.chunks_exact(3 * nv).enumerate() {
+            for j in 0..nv {
+                assert_eq!(row[j], data.dqdd_dq[(i, j)], "{name}: dqdd/dq");
+                assert_eq!(row[nv + j], data.dqdd_dv[(i, j)], "{name}: dqdd/dv");
+                assert_eq!(
+                    row[2 * nv + j],
+                    data.mass_matrix_inverse[(i, j)],
+                    "{name}: M^-1"
+                );
+            }
+        }
     }
 }
 

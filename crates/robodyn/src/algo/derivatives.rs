@@ -112,8 +112,9 @@ fn rnea_derivative_passes(
 
 /// ∂q̈/∂q, ∂q̈/∂q̇ and ∂q̈/∂τ = M⁻¹ of q̈ = FD(q, q̇, τ, f_ext), with q̈ itself: written into
 /// `data.dqdd_dq`, `data.dqdd_dv`, `data.mass_matrix_inverse` and `data.qdd`, and row by row
-/// into `data.derivative_rows`. Also writes what `rnea_derivatives` writes (at q̈) except
-/// `data.dtau_dq` and `data.dtau_dv`, and `data.mass_matrix_factor`.
+/// into `data.derivative_rows` (see [`aba_derivative_rows`]). Also writes what
+/// `rnea_derivatives` writes (at q̈) except `data.dtau_dq` and `data.dtau_dv`, and
+/// `data.mass_matrix_factor`.
 pub fn aba_derivatives(
     model: &Model,
     data: &mut Data,
@@ -121,6 +122,32 @@ pub fn aba_derivatives(
     v: &[f64],
     tau: &[f64],
     f_ext: Option<&[Force]>,
+) -> Result<()> {
+    aba_derivative_rows(model, data, (q, v, tau, f_ext))?;
+    // into the matrices, column by column as they are stored
+    let (rows, nv) = (&data.derivative_rows, model.nv);
+    let width = 3 * nv;
+    for j in 0..nv {
+        let (mut by_q, mut by_v) = (data.dqdd_dq.column_mut(j), data.dqdd_dv.column_mut(j));
+        for i in 0..nv {
+            by_q[i] = rows[i * width + j];
+            by_v[i] = rows[i * width + nv + j];
+        }
+        let mut inverse = data.mass_matrix_inverse.column_mut(j);
+        for i in 0..nv {
+            inverse[i] = rows[i * width + 2 * nv + j];
+        }
+    }
+    Ok(())
+}
+
+/// [`aba_derivatives`] with the results only in `data.derivative_rows`: row i is
+/// [∂q̈_i/∂q, ∂q̈_i/∂q̇, (M⁻¹)_i] (nv rows of 3 nv), for a caller that hands them on row by row
+/// (NumPy), without filling the three matrices.
+pub fn aba_derivative_rows(
+    model: &Model,
+    data: &mut Data,
+    (q, v, tau, f_ext): DynamicsState,
 ) -> Result<()> {
     check_arguments(model, q, v, ("tau", tau), f_ext)?;
     velocity_terms(model, data, q, v, f_ext);
@@ -157,18 +184,6 @@ pub fn aba_derivatives(
         rows[k * width + 2 * nv + k] = 1.0;
     }
     solve_rows(model, data, &mut rows);
-    // into the matrices, column by column as they are stored
-    for j in 0..nv {
-        let (mut by_q, mut by_v) = (data.dqdd_dq.column_mut(j), data.dqdd_dv.column_mut(j));
-        for i in 0..nv {
-            by_q[i] = rows[i * width + j];
-            by_v[i] = rows[i * width + nv + j];
-        }
-        let mut inverse = data.mass_matrix_inverse.column_mut(j);
-        for i in 0..nv {
-            inverse[i] = rows[i * width + 2 * nv + j];
-        }
-    }
     data.derivative_rows = rows;
     Ok(())
 }

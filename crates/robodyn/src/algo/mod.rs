@@ -29,7 +29,8 @@ pub use centroidal::centroidal_momentum_matrix;
 pub use coriolis::{christoffel_symbols, coriolis_matrix};
 pub use crba::crba;
 pub use derivatives::{
-    aba_derivatives, rnea_derivatives, rnea_derivatives_row_major, DynamicsState,
+    aba_derivative_rows, aba_derivatives, rnea_derivatives, rnea_derivatives_row_major,
+    DynamicsState,
 };
 pub use energy::{center_of_mass, center_of_mass_jacobian, kinetic_energy, potential_energy};
 pub use frame_derivatives::{center_of_mass_velocity_derivatives, frame_motion_derivatives};
