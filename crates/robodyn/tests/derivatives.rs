@@ -140,27 +140,22 @@ fn rnea_derivatives_are_finite_differences() {
     );
 }
 
+/// The row-major variants (what Python takes) against the matrices: the same operations into
+/// another layout, so equal bit for bit.
 #[test]
-fn row_major_rnea_derivatives_are_the_transposes() {
+fn row_major_derivatives_equal_the_matrices() {
     let mut rng = rng();
     for (name, model) in models() {
         let (mut data, nv) = (Data::new(&model), model.nv);
-        let (q, v, a) = state(&model, &mut rng);
+        let (q, v, x) = state(&model, &mut rng);
         let forces = random_forces(&model, &mut rng);
-        let arguments = (q.as_slice(), v.as_slice(), a.as_slice(), Some(&forces[..]));
+        let arguments = (q.as_slice(), v.as_slice(), x.as_slice(), Some(&forces[..]));
+        let (q, v, x, f_ext) = arguments;
+
         let (mut by_q, mut by_v) = (vec![f64::NAN; nv * nv], vec![f64::NAN; nv * nv]);
         rnea_derivatives_row_major(&model, &mut data, arguments, &mut by_q, &mut by_v).unwrap();
         let (tau, mass_matrix) = (data.tau.clone(), data.mass_matrix.clone());
-        rnea_derivatives(
-            &model,
-            &mut data,
-            arguments.0,
-            arguments.1,
-            arguments.2,
-            arguments.3,
-        )
-        .unwrap();
-        // the same operations into another layout: equal bit for bit
+        rnea_derivatives(&model, &mut data, q, v, x, f_ext).unwrap();
         assert_eq!(by_q, data.dtau_dq.transpose().as_slice(), "{name}: dtau/dq");
         assert_eq!(by_v, data.dtau_dv.transpose().as_slice(), "{name}: dtau/dv");
         assert_eq!(tau, data.tau, "{name}: tau");
@@ -172,33 +167,10 @@ fn row_major_rnea_derivatives_are_the_transposes() {
             error.contains("dtau_dv") && error.contains("length 0"),
             "{error}"
         );
-    }
-}
 
-#[test]
-fn aba_derivative_rows_hold_the_three_matrices() {
-    let mut rng = rng();
-    for (name, model) in models() {
-        let (mut data, nv) = (Data::new(&model), model.nv);
-        let (q, v, tau) = state(&model, &mut rng);
-        let forces = random_forces(&model, &mut rng);
-        let arguments = (
-            q.as_slice(),
-            v.as_slice(),
-            tau.as_slice(),
-            Some(&forces[..]),
-        );
         aba_derivative_rows(&model, &mut data, arguments).unwrap();
         let rows = data.derivative_rows.clone();
-        aba_derivatives(
-            &model,
-            &mut data,
-            arguments.0,
-            arguments.1,
-            arguments.2,
-            arguments.3,
-        )
-        .unwrap();
+        aba_derivatives(&model, &mut data, q, v, x, f_ext).unwrap();
         assert_eq!(rows, data.derivative_rows, "{name}");
         for (i, row) in rows.chunks_exact(3 * nv).enumerate() {
             for j in 0..nv {
