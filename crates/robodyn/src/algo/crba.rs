@@ -33,18 +33,18 @@ pub(crate) fn composite_mass_matrix(model: &Model, data: &mut Data) {
     let mass_matrix = data.mass_matrix.as_mut_slice();
     mass_matrix.fill(0.0);
     for i in 1..model.nbodies() {
+        let composite = &data.i_c[i];
         for row in model.v_range(i) {
             // F = I^c_i S_i
-            let f = data.i_c[i].mul_motion(&data.s_world[row]);
-            let mut j = i;
-            while j != 0 {
-                for col in model.v_range(j).filter(|&col| j != i || col >= row) {
-                    // column-major storage: H[row, col] at row + col nv
-                    let h = data.s_world[col].dot(&f);
-                    mass_matrix[row + col * nv] = h;
-                    mass_matrix[col + row * nv] = h;
-                }
-                j = model.parent[j];
+            let f = composite.mul_motion(&data.s_world[row]);
+            // the row itself, then up its coordinates' path: the joint's earlier ones, the ancestors'
+            let mut column = Some(row);
+            while let Some(col) = column {
+                // column-major storage: H[row, col] at row + col nv
+                let h = data.s_world[col].dot(&f);
+                mass_matrix[row + col * nv] = h;
+                mass_matrix[col + row * nv] = h;
+                column = model.dof_parent[col];
             }
             mass_matrix[row + row * nv] += model.armature[row];
         }

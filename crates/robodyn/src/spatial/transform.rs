@@ -162,14 +162,16 @@ impl Transform {
         // h' = Eᵀ h_B (the first moment in A's axes, about B's origin)
         let h = self.rotation.tr_mul(&inertia.first_moment);
         // Ī_A = Eᵀ Ī_B E + (2 r·h' + m|r|²) 1 - (r h'ᵀ + h' rᵀ + m r rᵀ), symmetric: the upper
-        // triangle is computed and mirrored
-        let rotated = self.rotation.tr_mul(&(inertia.rotational * self.rotation));
+        // triangle is computed and mirrored, (Eᵀ Ī_B E)_rc as column r of E dotted with column c
+        // of Ī_B E
+        let inertia_e = inertia.rotational * self.rotation;
         let diagonal = 2.0 * r.dot(&h) + m * r.norm_squared();
         let mut rotational = Mat3::zeros();
         for row in 0..3 {
             for col in row..3 {
+                let rotated = self.rotation.column(row).dot(&inertia_e.column(col));
                 let shift = r[row] * h[col] + h[row] * r[col] + m * r[row] * r[col];
-                let value = rotated[(row, col)] - shift + if row == col { diagonal } else { 0.0 };
+                let value = rotated - shift + if row == col { diagonal } else { 0.0 };
                 rotational[(row, col)] = value;
                 rotational[(col, row)] = value;
             }
