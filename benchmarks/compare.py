@@ -1,6 +1,6 @@
 """robodyn against Pinocchio and MuJoCo from Python, in one run: per-call time of each algorithm,
-a 10 000-state batch against a Python loop, and a 10 s UR5 rollout (RK4, PD) against mj_step,
-printed as ratios (< 1 means robodyn is faster).
+a 10 000-state batch against a Python loop, a 10 s UR5 rollout (RK4, PD) against mj_step and 64
+rollouts of 1 s against mujoco.rollout, printed as ratios (< 1 means robodyn is faster).
 
 Run: .venv/bin/python benchmarks/compare.py [--batch 10000] [--robots ur5 panda talos]
 Needs the bench extras (pip install '.[bench]'). Times are the best of several repeats.
@@ -176,13 +176,18 @@ ROLLOUT_DURATION, ROLLOUT_STEP = 10.0, 1e-3
 
 def mujoco_with_pd(urdf: Path, kp: np.ndarray, kd: np.ndarray) -> mujoco.MjModel:
     """MuJoCo's import of the URDF with the same controller as robodyn's native PD: a position
-    actuator (gain kp) and a velocity actuator (gain kd) per joint, and gravity compensation of
-    every body (``gravcomp="1"``), all evaluated by MuJoCo inside its RK4 stages."""
+    actuator (gain kp) and a velocity actuator (gain kd) per joint, no clamp on the joints'
+    actuator forces, and gravity compensation of every body (``gravcomp="1"``), all evaluated by
+    MuJoCo inside its RK4 stages."""
     plain = mujoco_model(urdf)
     names = [plain.joint(j).name for j in range(plain.njnt)]
     spec = mujoco.MjSpec.from_string(re.sub(r"<(visual|collision|gazebo|transmission)\b.*?</\1>", "", urdf.read_text(), flags=re.S))
     for body in spec.bodies:
         body.gravcomp = 1.0
+    # MuJoCo's URDF import turns <limit effort> into a clamp on each joint's actuator force;
+    # robodyn's PD applies its torque as it is
+    for joint in spec.joints:
+        joint.actfrclimited = mujoco.mjtLimited.mjLIMITED_FALSE
     for name, p_gain, d_gain in zip(names, kp, kd):
         spec.add_actuator(target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT).set_to_position(kp=p_gain)
         spec.add_actuator(target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT).set_to_velocity(kv=d_gain)
@@ -222,6 +227,47 @@ def compare_rollout(name: str) -> list[tuple[str, float, float]]:
     return [(f"{name} 10 s rollout, RK4 + PD", *best_times(ours, theirs, 1, 3))]
 
 
+#: The batched-rollout benchmark: rollouts, each this long (s), RK4 at ROLLOUT_STEP.
+BATCHED_ROLLOUTS, BATCHED_DURATION = 64, 1.0
+
+
+def compare_batched_rollouts(name: str) -> list[tuple[str, float, float]]:
+    """64 rollouts of 1 s from random starts, RK4 and the PD of `compare_rollout`, every step
+    recorded: one batched robodyn.simulate call against mujoco.rollout with one MjData per core."""
+    from mujoco import rollout
+
+    path, _ = ROBOTS[name]
+    urdf = robodyn._example_robot_data_dir() / path
+    m = robodyn.load(urdf)
+    inertia = np.diag(m.mass_matrix(np.full(m.nv, 0.3)))
+    kp, kd = 100.0 * inertia, 20.0 * inertia
+    controller = robodyn.PD(kp, kd, q_ref=m.neutral(), gravity_compensation=True)
+    mj = mujoco_with_pd(urdf, kp, kd)
+    starts = m.random_configuration(n=BATCHED_ROLLOUTS, seed=3)
+    steps = int(round(BATCHED_DURATION / ROLLOUT_STEP))
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    d = mujoco.MjData(mj)
+    initial = np.empty((BATCHED_ROLLOUTS, mujoco.mj_stateSize(mj, spec)))
+    for state, q0 in zip(initial, starts):
+        mujoco.mj_resetData(mj, d)
+        d.qpos[:] = q0
+        mujoco.mj_getState(mj, d, state, spec)
+    workers = [mujoco.MjData(mj) for _ in range(os.cpu_count() or 1)]
+    control = np.zeros((BATCHED_ROLLOUTS, 1, mj.nu))
+
+    def ours():
+        return robodyn.simulate(m, starts, t_end=BATCHED_DURATION, dt=ROLLOUT_STEP, integrator="rk4", controller=controller)
+
+    def theirs():
+        return rollout.rollout(mj, workers, initial, control, nstep=steps)
+
+    finals = np.array([trajectory.q[-1] for trajectory in ours()])
+    states, _ = theirs()
+    # the full-physics state starts with the time, then qpos
+    print(f"{name} batched rollouts: final configurations differ by {np.max(np.abs(finals - states[:, -1, 1:1 + m.nq])):.1e} rad")
+    return [(f"{name} {BATCHED_ROLLOUTS} rollouts of {BATCHED_DURATION:g} s, RK4 + PD", *best_times(ours, theirs, 1, 3))]
+
+
 def print_table(title: str, other: str, rows) -> None:
     print(f"\n{title}")
     print(f"{'case':<40}{'robodyn':>14}{other:>14}{'ratio':>9}")
@@ -239,7 +285,7 @@ def main() -> None:
           f"Python {platform.python_version()}, {platform.machine()}, {os.cpu_count()} cores")
     print_table("robodyn vs Pinocchio", "pinocchio", [row for name in args.robots for row in compare_robot(name, args.batch)])
     print_table("robodyn vs MuJoCo (fixed base)", "mujoco", [row for name in args.robots for row in compare_mujoco(name, args.batch)])
-    print_table("Simulation: robodyn.simulate vs mj_step", "mujoco", compare_rollout("ur5"))
+    print_table("Simulation: robodyn.simulate vs mj_step and mujoco.rollout", "mujoco", compare_rollout("ur5") + compare_batched_rollouts("ur5"))
 
 
 if __name__ == "__main__":

@@ -65,6 +65,17 @@ proptest! {
     }
 
     #[test]
+    fn articulated_inertia_transform_is_the_congruence(x in transform(), i in inertia(), j in inertia(), w in vec3(), v in vec3()) {
+        // an articulated inertia has no rigid body's structure: a rigid one less a rank-one term
+        let u = nalgebra::Vector6::new(w.x, w.y, w.z, v.x, v.y, v.z);
+        let articulated = i.to_matrix() + j.to_matrix() - u * u.transpose() * 0.1;
+        let moved = x.transpose_apply_matrix(&articulated);
+        let expected = x.to_matrix().transpose() * articulated * x.to_matrix();
+        prop_assert!((moved - expected).norm() < 1e-9 * expected.norm().max(1.0));
+        prop_assert!((moved - moved.transpose()).norm() < 1e-12 * expected.norm().max(1.0));
+    }
+
+    #[test]
     fn cross_products_match_their_matrices(w in vec3(), v in vec3(), w2 in vec3(), v2 in vec3(), n in vec3(), f in vec3()) {
         let (m, other, force) = (Motion::new(w, v), Motion::new(w2, v2), Force::new(n, f));
         // (m ×* f) · other = -(m × other) · f

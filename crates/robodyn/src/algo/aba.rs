@@ -101,8 +101,8 @@ pub fn aba<'d>(
             }
             p_a += mat6_mul_motion(&i_a, &data.c[i]);
             // I^A_λ(i) += X_iᵀ I^a X_i;  p^A_λ(i) += X_iᵀ p^a
-            let x = data.x_up[i].to_matrix();
-            data.i_a[parent] += x.transpose() * i_a * x;
+            let carried = data.x_up[i].transpose_apply_matrix(&i_a);
+            data.i_a[parent] += carried;
             let p_parent = data.x_up[i].transpose_apply_force(&p_a);
             data.p_a[parent] += p_parent;
         }

@@ -183,6 +183,34 @@ impl Transform {
         }
     }
 
+    /// `Xᵀ I X` for a symmetric 6x6 inertia on `[angular; linear]` (an articulated-body
+    /// inertia, which has no rigid body's structure), by 3x3 blocks instead of two 6x6 products.
+    /// With `I = [A B; Bᵀ C]` and `X = diag(E, E) [1 0; -r× 1]`: rotate, `Â = Eᵀ A E`,
+    /// `B̂ = Eᵀ B E`, `Ĉ = Eᵀ C E`; then shift, `C' = Ĉ`, `B' = B̂ + r× Ĉ`,
+    /// `A' = Â - B̂ r× + r× B̂ᵀ - r× Ĉ r×`.
+    #[inline]
+    pub fn transpose_apply_matrix(&self, inertia: &Mat6) -> Mat6 {
+        let e = &self.rotation;
+        let block =
+            |row: usize, col: usize| -> Mat3 { inertia.fixed_view::<3, 3>(row, col).into() };
+        let (a, b, c) = (block(0, 0), block(0, 3), block(3, 3));
+        let rotated = |m: Mat3| e.tr_mul(&(m * e));
+        let (a, b, c) = (rotated(a), rotated(b), rotated(c));
+        let r = skew(&self.translation);
+        // r× Ĉ, and B̂ r× whose transpose is -r× B̂ᵀ
+        let r_c = r * c;
+        let b_r = b * r;
+        let mut out = Mat6::zeros();
+        out.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&(a - b_r - b_r.transpose() - r_c * r));
+        let coupling = b + r_c;
+        out.fixed_view_mut::<3, 3>(0, 3).copy_from(&coupling);
+        out.fixed_view_mut::<3, 3>(3, 0)
+            .copy_from(&coupling.transpose());
+        out.fixed_view_mut::<3, 3>(3, 3).copy_from(&c);
+        out
+    }
+
     /// `X` as a 6x6 matrix on `[angular; linear]` motion vectors: `[E 0; -E r× E]`.
     #[inline]
     pub fn to_matrix(&self) -> Mat6 {
