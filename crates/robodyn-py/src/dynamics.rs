@@ -3,6 +3,7 @@
 
 use crate::args::*;
 use crate::model::*;
+use arrayvec::ArrayVec;
 use nalgebra::DVector;
 use pyo3::prelude::*;
 use pyo3::types::PyString;
@@ -18,12 +19,12 @@ impl PyModel {
         v: &Bound<'py, PyAny>,
         x: (&'static str, &Bound<'py, PyAny>),
         f_ext: Option<&Bound<'py, PyAny>>,
-    ) -> PyResult<Vec<Argument<'py>>> {
-        let mut arguments = vec![
-            self.q_arg("q", q)?,
-            self.v_arg("v", v)?,
-            self.v_arg(x.0, x.1)?,
-        ];
+    ) -> PyResult<ArrayVec<Argument<'py>, MAX_ARGUMENTS>> {
+        // on the stack: a call's fixed cost counts against the algorithm's
+        let mut arguments = ArrayVec::new();
+        arguments.push(self.q_arg("q", q)?);
+        arguments.push(self.v_arg("v", v)?);
+        arguments.push(self.v_arg(x.0, x.1)?);
         if let Some(f) = f_ext {
             arguments.push(Argument::new(
                 "f_ext",

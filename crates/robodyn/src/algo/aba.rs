@@ -93,8 +93,8 @@ pub fn aba<'d>(
                 let u_r = data.u[i][r].to_vector();
                 let mut d_inv_u = 0.0;
                 for c in 0..nv_i {
-                    let u_c = data.u[i][c].to_vector();
-                    i_a -= u_r * u_c.transpose() * d[(r, c)];
+                    // rank-one update in place: I^a −= D⁻¹_rc U_r U_cᵀ
+                    i_a.ger(-d[(r, c)], &u_r, &data.u[i][c].to_vector(), 1.0);
                     d_inv_u += d[(r, c)] * data.u_tau[i][c];
                 }
                 p_a += data.u[i][r] * d_inv_u;
