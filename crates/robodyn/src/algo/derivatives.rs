@@ -294,8 +294,10 @@ struct Matrices(DMatrix<f64>, DMatrix<f64>);
 impl TorqueDerivatives for Matrices {
     #[inline(always)]
     fn add(&mut self, row: usize, column: usize, by_q: f64, by_v: f64) {
-        self.0[(row, column)] += by_q;
-        self.1[(row, column)] += by_v;
+        // column-major storage
+        let index = row + column * self.0.nrows();
+        self.0.as_mut_slice()[index] += by_q;
+        self.1.as_mut_slice()[index] += by_v;
     }
 }
 
@@ -339,7 +341,9 @@ fn derivative_products(
     v: &[f64],
     out: &mut impl TorqueDerivatives,
 ) {
-    data.mass_matrix.as_mut_slice().fill(0.0);
+    let nv = model.nv;
+    let mass_matrix = data.mass_matrix.as_mut_slice();
+    mass_matrix.fill(0.0);
     for i in 1..model.nbodies() {
         let (composite, h_composite, f_i) =
             (data.i_c[i], data.coriolis_factors[i], data.f_world[i]);
@@ -366,9 +370,10 @@ fn derivative_products(
                         -(z_c.dot(&inertia_s) + u_c.dot(&h_transpose_s)),
                         s_c.dot(&h_transpose_s) - w_c.dot(&inertia_s),
                     );
+                    // column-major storage: M[k, c] at k + c nv
                     let m = s_c.dot(&inertia_s);
-                    data.mass_matrix[(k, c)] = m;
-                    data.mass_matrix[(c, k)] = m;
+                    mass_matrix[k + c * nv] = m;
+                    mass_matrix[c + k * nv] = m;
                     // column k: c's body lies strictly above i
                     if j != i {
                         out.add(c, k, s_c.dot(&position_force), s_c.dot(&velocity_force));
@@ -383,7 +388,7 @@ fn derivative_products(
         let v_i = &v[dofs.clone()];
         for (r, row) in dofs.clone().enumerate() {
             let armature = model.armature[row];
-            data.mass_matrix[(row, row)] += armature;
+            mass_matrix[row + row * nv] += armature;
             for (c, column) in dofs.clone().enumerate() {
                 let by_v = armature * joint.rotor_velocity_jacobian(r, c, v_i);
                 out.add(row, column, 0.0, by_v);
