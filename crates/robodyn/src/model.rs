@@ -193,6 +193,10 @@ impl Model {
     /// Checks a configuration: length nq, finite, unit quaternions.
     pub fn check_configuration(&self, q: &[f64]) -> Result<()> {
         check_vector("q", q, self.nq)?;
+        // only the quaternion joints (spherical, free) have more coordinates than velocities
+        if self.nq == self.nv {
+            return Ok(());
+        }
         for i in 1..self.nbodies() {
             if let Some(offset) = self.joints[i].quaternion_offset() {
                 let start = self.idx_q[i] + offset;
