@@ -93,6 +93,10 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
         for x in pin_states:
             pin.crba(pm, pd, x)
 
+    def pin_aba_loop():
+        for x, w in zip(pin_states, pin_velocities):
+            pin.aba(pm, pd, x, w, w)
+
     def pin_rnea_derivatives_loop():
         for x, w in zip(pin_states, pin_velocities):
             pin.computeRNEADerivatives(pm, pd, x, w, w)
@@ -101,6 +105,7 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
         "gravity": (lambda: m.generalized_gravity(states), pin_gravity_loop),
         "rnea": (lambda: m.inverse_dynamics(states, velocities, velocities), pin_rnea_loop),
         "crba": (lambda: m.mass_matrix(states), pin_crba_loop),
+        "aba": (lambda: m.forward_dynamics(states, velocities, velocities), pin_aba_loop),
         "rnea_derivatives": (lambda: m.inverse_dynamics_derivatives(states, velocities, velocities), pin_rnea_derivatives_loop),
     }
     rows += [(f"{name} {algorithm} ({batch} states)", *best_times(ours, theirs, 1, 5)) for algorithm, (ours, theirs) in batches.items()]
