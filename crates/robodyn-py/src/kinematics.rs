@@ -92,11 +92,15 @@ impl PyModel {
             &[6, self.model.nv],
             out,
             &|m, w, i, out| {
-                write_row_major(
-                    algo::jacobian(m, &mut w.data, i[0], frame, reference)?,
-                    6,
-                    out,
-                );
+                algo::jacobian(m, &mut w.data, i[0], frame, reference)?;
+                // only the columns of the frame's support are not zero
+                let (jacobian, nv) = (&w.data.jacobian, m.nv);
+                out.fill(0.0);
+                for column in w.data.support.iter().flat_map(|&j| m.v_range(j)) {
+                    for (row, value) in jacobian.column(column).iter().enumerate() {
+                        out[row * nv + column] = *value;
+                    }
+                }
                 Ok(())
             },
         )
