@@ -35,9 +35,6 @@ pub struct Data {
     pub v_world: Vec<Motion>,
     /// Rate Ṡ = v_i × ⁰S of each world-frame subspace column; nv. Written by `coriolis_matrix`.
     pub s_dot_world: Vec<Motion>,
-    /// Composite Coriolis factor B^C_i = Σ B(I_k, v_k) over the subtree of body i (6x6 on
-    /// `[angular; linear]`, world coordinates); nbodies. Written by `coriolis_matrix`.
-    pub b_c: Vec<Mat6>,
     /// Coriolis matrix C(q, q̇); nv x nv. Written by `coriolis_matrix`.
     pub coriolis: DMatrix<f64>,
     /// Generalized gravity g(q); nv. Written by `mass_matrix_by_rnea`.
@@ -93,7 +90,7 @@ pub struct Data {
     /// q̇_k does; nv. Written by `rnea_derivatives`.
     pub motion_terms: Vec<[Motion; 3]>,
     /// `H = 2B(I, v)` of the subtree rooted at body i, world coordinates, factored; nbodies.
-    /// Written by `rnea_derivatives`.
+    /// Written by `rnea_derivatives` and `coriolis_matrix`.
     pub coriolis_factors: Vec<CoriolisFactor>,
     /// Each body's own spatial inertia in world coordinates; nbodies. Written by
     /// `rnea_derivatives`.
@@ -142,7 +139,6 @@ impl Data {
             s_world: vec![Motion::ZERO; nv],
             v_world: vec![Motion::ZERO; nb],
             s_dot_world: vec![Motion::ZERO; nv],
-            b_c: vec![Mat6::zeros(); nb],
             coriolis: DMatrix::zeros(nv, nv),
             gravity: DVector::zeros(nv),
             unit_velocity: DVector::zeros(nv),

@@ -14,13 +14,14 @@
 //!   C[a, b] = Ṡ_bᵀ (I^C_i S_a) + S_bᵀ (B^C_iᵀ S_a)        (j ≠ i)
 //! where Ṡ = v_i × S is the rate of a world-frame subspace column (Featherstone eq. 2.42).
 //! Cost O(n·d), d the depth of the tree: O(n²) for a chain, no RNEA calls.
+//! B is kept as H = 2B in the factored form of `CoriolisFactor` (no 6x6 products).
 //! Input: q (nq), q̇ (nv). Writes `data.x_up`, `data.x_world`, `data.i_c`, `data.s_world`,
-//! `data.v_world`, `data.s_dot_world`, `data.b_c`, `data.coriolis` (nv x nv).
+//! `data.v_world`, `data.s_dot_world`, `data.coriolis_factors`, `data.coriolis` (nv x nv).
 
 use crate::algo::crba::{add_composite_inertias, world_inertias_and_subspaces};
 use crate::error::{check_length, check_vector, Result};
 use crate::model::Model;
-use crate::spatial::{mat6_mul_motion, Force};
+use crate::spatial::CoriolisFactor;
 use crate::Data;
 use nalgebra::DMatrix;
 
@@ -41,7 +42,7 @@ pub fn coriolis_matrix<'d>(
 fn fill_coriolis_matrix(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
     world_inertias_and_subspaces(model, data, q);
 
-    // outward: v_i = v_λ(i) + S_i q̇_i, Ṡ_i = v_i × S_i, and each body's B(I_i, v_i)
+    // outward: v_i = v_λ(i) + S_i q̇_i, Ṡ_i = v_i × S_i, and each body's H = 2B(I_i, v_i)
     for i in 1..model.nbodies() {
         let mut velocity = data.v_world[model.parent[i]];
         for dof in model.v_range(i) {
@@ -51,36 +52,39 @@ fn fill_coriolis_matrix(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
         for dof in model.v_range(i) {
             data.s_dot_world[dof] = velocity.cross_motion(&data.s_world[dof]);
         }
-        data.b_c[i] = data.i_c[i].coriolis_factor(&velocity);
+        data.coriolis_factors[i] = CoriolisFactor::new(&data.i_c[i], &velocity);
     }
 
-    // composites, leaves to root: I^C_λ(i) += I^C_i, B^C_λ(i) += B^C_i
+    // composites, leaves to root: I^C_λ(i) += I^C_i, H^C_λ(i) += H^C_i
     add_composite_inertias(model, data);
     for i in (1..model.nbodies()).rev() {
         let parent = model.parent[i];
         if parent != 0 {
-            let subtree = data.b_c[i];
-            data.b_c[parent] += subtree;
+            let subtree = data.coriolis_factors[i];
+            data.coriolis_factors[parent] += subtree;
         }
     }
 
     // the entries, one column of body i against every velocity coordinate on its path to the root
-    let coriolis = &mut data.coriolis;
-    coriolis.as_mut_slice().fill(0.0);
+    let nv = model.nv;
+    let coriolis = data.coriolis.as_mut_slice();
+    coriolis.fill(0.0);
     for i in 1..model.nbodies() {
+        let (composite, h_composite) = (&data.i_c[i], &data.coriolis_factors[i]);
         for a in model.v_range(i) {
             let (s_a, s_dot_a) = (data.s_world[a], data.s_dot_world[a]);
-            // f1 = I^C_i Ṡ_a + B^C_i S_a, f2 = I^C_i S_a, f3 = B^C_iᵀ S_a
-            let f1 = data.i_c[i].mul_motion(&s_dot_a) + mat6_mul_motion(&data.b_c[i], &s_a);
-            let f2 = data.i_c[i].mul_motion(&s_a);
-            let f3 = Force::from_vector(&data.b_c[i].tr_mul(&s_a.to_vector()));
+            // f1 = I^C_i Ṡ_a + B^C_i S_a, f2 = I^C_i S_a, f3 = B^C_iᵀ S_a, with B = H / 2
+            let f1 = composite.mul_motion(&s_dot_a) + h_composite.mul_motion(&s_a) * 0.5;
+            let f2 = composite.mul_motion(&s_a);
+            let f3 = h_composite.tr_mul_motion(&s_a) * 0.5;
             let mut j = i;
             while j != 0 {
                 for b in model.v_range(j) {
                     let (s_b, s_dot_b) = (data.s_world[b], data.s_dot_world[b]);
-                    coriolis[(b, a)] = s_b.dot(&f1);
+                    // column-major storage: C[b, a] at b + a nv
+                    coriolis[b + a * nv] = s_b.dot(&f1);
                     if j != i {
-                        coriolis[(a, b)] = s_dot_b.dot(&f2) + s_b.dot(&f3);
+                        coriolis[a + b * nv] = s_dot_b.dot(&f2) + s_b.dot(&f3);
                     }
                 }
                 j = model.parent[j];
@@ -94,7 +98,7 @@ fn fill_coriolis_matrix(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
         let v_i = &v[dofs.clone()];
         for (r, row) in dofs.clone().enumerate() {
             for (c, column) in dofs.clone().enumerate() {
-                coriolis[(row, column)] +=
+                coriolis[row + column * nv] +=
                     model.armature[row] * model.joints[i].rotor_velocity_term(r, c, v_i);
             }
         }
