@@ -75,13 +75,22 @@ impl PassiveForces {
 
     /// τ_passive(q, q̇) into `tau` (nv). `q` must be a valid configuration.
     pub fn torque(&self, model: &Model, q: &[f64], v: &[f64], tau: &mut [f64]) {
-        // springs: −K (q ⊖ q_ref), with q ⊖ q_ref written into tau first
-        spring_displacement(model, q, tau);
+        // springs: −K (q ⊖ q_ref), with q ⊖ q_ref written into tau first (none without springs:
+        // the Lie-group differences are the costly part)
+        if model.stiffness.iter().any(|k| *k != 0.0) {
+            spring_displacement(model, q, tau);
+        } else {
+            tau.fill(0.0);
+        }
         for (k, value) in tau.iter_mut().enumerate() {
-            // −k (q − q_ref) − d q̇ − f_c tanh(q̇ / v_s)
-            *value = -model.stiffness[k] * *value
-                - model.damping[k] * v[k]
-                - model.friction[k] * (v[k] / self.friction_velocity).tanh();
+            // −k (q − q_ref) − d q̇ − f_c tanh(q̇ / v_s), the tanh only where there is friction
+            let f_c = model.friction[k];
+            let friction = if f_c == 0.0 {
+                0.0
+            } else {
+                f_c * (v[k] / self.friction_velocity).tanh()
+            };
+            *value = -model.stiffness[k] * *value - model.damping[k] * v[k] - friction;
         }
         if let LimitModel::Penalty { stiffness, damping } = self.limits {
             for (dof, push) in limit_penalties(model, (stiffness, damping), q, v) {
