@@ -136,6 +136,35 @@ impl Joint {
         }
     }
 
+    /// `I S_k` for a 6x6 inertia `I` on `[angular; linear]` (an articulated one, say) and this
+    /// joint's subspace column k: one column of I, or its angular (revolute) or linear
+    /// (prismatic) half times the axis — not a full 6x6 product.
+    #[inline]
+    pub fn inertia_times_subspace(&self, inertia: &Mat6, k: usize) -> Force {
+        let column = |c: usize| {
+            let x = inertia.column(c);
+            Force::new(Vec3::new(x[0], x[1], x[2]), Vec3::new(x[3], x[4], x[5]))
+        };
+        let half = |first: usize, axis: &Vec3| {
+            let columns = |start: usize| inertia.fixed_view::<3, 3>(start, first) * axis;
+            Force::new(columns(0), columns(3))
+        };
+        match self {
+            Joint::Fixed => Force::ZERO,
+            Joint::Revolute { axis } => match coordinate_axis(axis) {
+                Some(c) => column(c),
+                None => half(0, axis),
+            },
+            Joint::Prismatic { axis } => match coordinate_axis(axis) {
+                Some(c) => column(3 + c),
+                None => half(3, axis),
+            },
+            Joint::Spherical => column(k),
+            Joint::Free if k < 3 => column(3 + k),
+            Joint::Free => column(k - 3),
+        }
+    }
+
     /// `S_kᵀ f`: the component of force `f` (child frame) along velocity coordinate `k`.
     #[inline]
     pub fn project_force(&self, k: usize, f: &Force) -> f64 {

@@ -5,7 +5,7 @@ mod common;
 
 use common::{rng, FD_STEP, FD_TOLERANCE};
 use rand::Rng;
-use robodyn::spatial::{Transform, Vec3};
+use robodyn::spatial::{mat6_mul_motion, Transform, Vec3};
 use robodyn::Joint;
 
 const ROUND_TRIP_TOLERANCE: f64 = 1e-10;
@@ -170,4 +170,30 @@ fn random_rotation(rng: &mut impl Rng) -> nalgebra::Matrix3<f64> {
         rng.random::<f64>() - 0.5,
     ));
     *nalgebra::Rotation3::from_axis_angle(&axis, 6.0 * rng.random::<f64>()).matrix()
+}
+
+#[test]
+fn inertia_times_subspace_is_the_product_with_the_subspace_column() {
+    let mut rng = rng();
+    let mut all = joints();
+    for k in 0..3 {
+        all.push(Joint::Revolute {
+            axis: Vec3::ith(k, 1.0),
+        });
+        all.push(Joint::Prismatic {
+            axis: Vec3::ith(k, 1.0),
+        });
+    }
+    for joint in all {
+        let inertia = nalgebra::Matrix6::from_fn(|_, _| rng.random::<f64>() - 0.5);
+        for k in 0..joint.nv() {
+            let expected = mat6_mul_motion(&inertia, &joint.subspace_column(k));
+            // the same products in the same order, less some + 0 terms: equal
+            assert_eq!(
+                joint.inertia_times_subspace(&inertia, k).to_vector(),
+                expected.to_vector(),
+                "{joint:?} column {k}"
+            );
+        }
+    }
 }

@@ -57,7 +57,7 @@ pub fn aba<'d>(
         let v_i = &v[dofs.clone()];
         for k in 0..nv_i {
             // U_i = I^A_i S_i;  u_i = τ_i - S_iᵀ p^A_i - armature K(q̇_i) q̇_i
-            data.u[i][k] = mat6_mul_motion(&data.i_a[i], &joint.subspace_column(k));
+            data.u[i][k] = joint.inertia_times_subspace(&data.i_a[i], k);
             let rotor: f64 = (0..nv_i)
                 .map(|c| joint.rotor_velocity_term(k, c, v_i) * v_i[c])
                 .sum();
