@@ -128,23 +128,28 @@ fn neutral_is_the_identity_transform() {
 /// `transform_after` takes shortcuts for coordinate axes; each is `X_J(q) X_T` to rounding.
 const COMPOSITION_TOLERANCE: f64 = 1e-14;
 
+/// [`joints`], and revolute and prismatic joints along each coordinate axis (both ways) and the
+/// fixed joint: the cases the joints' shortcuts tell apart.
+fn joints_and_shortcuts() -> Vec<Joint> {
+    let mut all = joints();
+    for k in 0..3 {
+        for sign in [1.0, -1.0] {
+            all.push(Joint::Revolute {
+                axis: Vec3::ith(k, sign),
+            });
+            all.push(Joint::Prismatic {
+                axis: Vec3::ith(k, sign),
+            });
+        }
+    }
+    all.push(Joint::Fixed);
+    all
+}
+
 #[test]
 fn transform_after_is_the_joint_transform_times_the_tree_transform() {
     let mut rng = rng();
-    let mut all = joints();
-    for k in 0..3 {
-        all.push(Joint::Revolute {
-            axis: Vec3::ith(k, 1.0),
-        });
-        all.push(Joint::Revolute {
-            axis: Vec3::ith(k, -1.0),
-        });
-        all.push(Joint::Prismatic {
-            axis: Vec3::ith(k, 1.0),
-        });
-    }
-    all.push(Joint::Fixed);
-    for joint in all {
+    for joint in joints_and_shortcuts() {
         for _ in 0..5 {
             let x_tree = Transform::from_pose(
                 &random_rotation(&mut rng),
@@ -175,16 +180,7 @@ fn random_rotation(rng: &mut impl Rng) -> nalgebra::Matrix3<f64> {
 #[test]
 fn inertia_times_subspace_is_the_product_with_the_subspace_column() {
     let mut rng = rng();
-    let mut all = joints();
-    for k in 0..3 {
-        all.push(Joint::Revolute {
-            axis: Vec3::ith(k, 1.0),
-        });
-        all.push(Joint::Prismatic {
-            axis: Vec3::ith(k, 1.0),
-        });
-    }
-    for joint in all {
+    for joint in joints_and_shortcuts() {
         let inertia = nalgebra::Matrix6::from_fn(|_, _| rng.random::<f64>() - 0.5);
         for k in 0..joint.nv() {
             let expected = mat6_mul_motion(&inertia, &joint.subspace_column(k));
