@@ -253,17 +253,18 @@ impl PyModel {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let algorithm: MatrixOfQ = match method.as_str() {
-            "crba" => algo::crba,
+            "crba" => {
+                // straight into the result: CRBA mirrors M, so it is exactly symmetric
+                let (shape, arguments) = ([self.model.nv; 2], [self.q_arg("q", q)?]);
+                return self.evaluate_into(py, &arguments, &shape, out, &|m, w, i, out| {
+                    algo::crba_into(m, &mut w.data, i[0], out)
+                });
+            }
             "rnea" => algo::mass_matrix_by_rnea,
             "jacobians" => algo::mass_matrix_by_jacobians,
             other => return Err(unknown_method(other, "crba, rnea or jacobians")),
         };
-        // CRBA mirrors M: exactly symmetric; the others are symmetric to rounding only
-        let rows = match method.as_str() {
-            "crba" => MatrixRows::Symmetric,
-            _ => MatrixRows::First(self.model.nv),
-        };
-        self.matrix_of_q_into(py, q, rows, out, algorithm)
+        self.matrix_of_q_into(py, q, self.model.nv, out, algorithm)
     }
 
     /// M(q)⁻¹. (nv, nv).

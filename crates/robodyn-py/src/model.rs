@@ -406,15 +406,6 @@ fn output_array<'py>(
 pub(crate) type MatrixOfQ =
     for<'d> fn(&Model, &'d mut Data, &[f64]) -> robodyn::Result<&'d DMatrix<f64>>;
 
-/// Which rows of a matrix of the configuration a call returns.
-#[derive(Clone, Copy)]
-pub(crate) enum MatrixRows {
-    /// All of an exactly symmetric nv × nv matrix.
-    Symmetric,
-    /// The first rows, as many as given.
-    First(usize),
-}
-
 impl PyModel {
     /// The first `rows` rows of `algorithm`'s matrix (rows × nv), per state.
     pub(crate) fn matrix_of_q<'py>(
@@ -424,30 +415,21 @@ impl PyModel {
         rows: usize,
         algorithm: MatrixOfQ,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.matrix_of_q_into(py, q, MatrixRows::First(rows), None, algorithm)
+        self.matrix_of_q_into(py, q, rows, None, algorithm)
     }
 
-    /// [`Self::matrix_of_q`] into the caller's `out` when given; a `MatrixRows::Symmetric`
-    /// matrix is copied as it is stored (its column-major storage is its row-major one).
+    /// [`Self::matrix_of_q`] into the caller's `out` when given.
     pub(crate) fn matrix_of_q_into<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
-        rows: MatrixRows,
+        rows: usize,
         out: Option<&Bound<'py, PyAny>>,
         algorithm: MatrixOfQ,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let nv = self.model.nv;
-        let shape = match rows {
-            MatrixRows::Symmetric => [nv, nv],
-            MatrixRows::First(rows) => [rows, nv],
-        };
+        let shape = [rows, self.model.nv];
         self.evaluate_into(py, &[self.q_arg("q", q)?], &shape, out, &|m, w, i, out| {
-            let matrix = algorithm(m, &mut w.data, i[0])?;
-            match rows {
-                MatrixRows::Symmetric => out.copy_from_slice(matrix.as_slice()),
-                MatrixRows::First(rows) => write_row_major(matrix, rows, out),
-            }
+            write_row_major(algorithm(m, &mut w.data, i[0])?, rows, out);
             Ok(())
         })
     }

@@ -140,6 +140,12 @@ fn algorithms_allocate_nothing_after_data_new() {
                 }),
             ),
             (
+                "crba_into",
+                allocations(|| {
+                    crba_into(&model, &mut data, q, by_q).unwrap();
+                }),
+            ),
+            (
                 "rnea_derivatives_row_major",
                 allocations(|| {
                     rnea_derivatives_row_major(&model, &mut data, (q, v, a, None), by_q, by_v)

@@ -358,3 +358,22 @@ fn mass_matrix_and_gravity_the_notes_ways_equal_crba_and_rnea() {
         );
     }
 }
+
+#[test]
+fn crba_into_writes_crba_s_matrix_which_is_exactly_symmetric() {
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        let q = model.random_configuration(&mut rng);
+        let mut out = vec![f64::NAN; model.nv * model.nv];
+        crba_into(&model, &mut data, q.as_slice(), &mut out).unwrap();
+        let m = crba(&model, &mut data, q.as_slice()).unwrap();
+        assert_eq!(out, m.as_slice(), "{name}");
+        // handed on as row-major, which is right only for an exactly symmetric matrix
+        assert_eq!(m, &m.transpose(), "{name}");
+        let error = crba_into(&model, &mut data, q.as_slice(), &mut out[1..])
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("out"), "{error}");
+    }
+}

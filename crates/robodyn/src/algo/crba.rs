@@ -11,26 +11,36 @@
 //! Cost: O(n) transforms plus one 6-vector dot product per pair (joint, ancestor joint).
 
 use crate::algo::kinematics::update_body_placements;
-use crate::error::Result;
+use crate::error::{check_length, Result};
 use crate::model::Model;
 use crate::Data;
 use nalgebra::DMatrix;
 
 /// M(q), written into `data.mass_matrix`.
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMatrix<f64>> {
-    model.check_configuration(q)?;
-    world_inertias_and_subspaces(model, data, q);
-    add_composite_inertias(model, data);
-    composite_mass_matrix(model, data);
-    Ok(&data.mass_matrix)
+    let mut mass_matrix = std::mem::take(&mut data.mass_matrix);
+    let result = crba_into(model, data, q, mass_matrix.as_mut_slice());
+    data.mass_matrix = mass_matrix;
+    result.map(|()| &data.mass_matrix)
 }
 
-/// M from the world-frame composites in `data.i_c` and subspaces in `data.s_world`, armature on
-/// the diagonal.
-pub(crate) fn composite_mass_matrix(model: &Model, data: &mut Data) {
+/// [`crba`] with M written into `out` (nv × nv; M is mirrored, exactly symmetric, so its
+/// row-major and column-major layouts are the same) instead of `data.mass_matrix`: for a caller
+/// that hands it on (NumPy) without a copy.
+pub fn crba_into(model: &Model, data: &mut Data, q: &[f64], out: &mut [f64]) -> Result<()> {
+    model.check_configuration(q)?;
+    check_length("out", out.len(), model.nv * model.nv)?;
+    world_inertias_and_subspaces(model, data, q);
+    add_composite_inertias(model, data);
+    composite_mass_matrix(model, data, out);
+    Ok(())
+}
+
+/// M into `mass_matrix` (column-major, nv × nv) from the world-frame composites in `data.i_c`
+/// and subspaces in `data.s_world`, armature on the diagonal.
+pub(crate) fn composite_mass_matrix(model: &Model, data: &Data, mass_matrix: &mut [f64]) {
     // H_ij = ⁰S_jᵀ (I^c_i ⁰S_i) for j on the path from i to the root; other entries are zero
     let nv = model.nv;
-    let mass_matrix = data.mass_matrix.as_mut_slice();
     mass_matrix.fill(0.0);
     for i in 1..model.nbodies() {
         let composite = &data.i_c[i];

@@ -160,7 +160,9 @@ pub fn aba_derivative_rows(
         }
     }
     add_rotor_torques(model, data, v, None);
-    composite_mass_matrix(model, data);
+    let mut mass_matrix = std::mem::take(&mut data.mass_matrix);
+    composite_mass_matrix(model, data, mass_matrix.as_mut_slice());
+    data.mass_matrix = mass_matrix;
     factor_mass_matrix(model, data)?;
     for (qdd, (applied, bias)) in data.qdd.iter_mut().zip(tau.iter().zip(data.tau.iter())) {
         *qdd = applied - bias;

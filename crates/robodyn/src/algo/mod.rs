@@ -27,7 +27,7 @@ pub mod textbook_forms;
 pub use aba::aba;
 pub use centroidal::centroidal_momentum_matrix;
 pub use coriolis::{christoffel_symbols, coriolis_matrix};
-pub use crba::crba;
+pub use crba::{crba, crba_into};
 pub use derivatives::{
     aba_derivative_rows, aba_derivatives, rnea_derivatives, rnea_derivatives_row_major,
     DynamicsState,
