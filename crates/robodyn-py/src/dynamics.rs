@@ -13,7 +13,7 @@ use robodyn::{Data, Model};
 
 impl PyModel {
     /// The arguments (q, v, x[, f_ext]) of a dynamics algorithm with optional external forces.
-    fn dynamics_arguments<'py>(
+    pub(crate) fn dynamics_arguments<'py>(
         &self,
         q: &Bound<'py, PyAny>,
         v: &Bound<'py, PyAny>,
@@ -66,7 +66,7 @@ impl PyModel {
         let stack = self.evaluate(py, arguments, &[3, nv, nv], &|m, w, i, out| {
             let Workspace { data, forces, .. } = w;
             let forces = i.get(3).map(|flat| external_forces(forces, flat));
-            derivatives(m, data, i[0], i[1], i[2], forces, out)
+            derivatives(m, data, (i[0], i[1], i[2], forces), out)
         })?;
         split_stack(py, &stack, &names)
     }
@@ -74,15 +74,8 @@ impl PyModel {
 
 /// A derivatives algorithm `(q, v, x, f_ext)` writing its three nv × nv results row-major, one
 /// after the other.
-type DerivativesAlgorithm = fn(
-    &Model,
-    &mut Data,
-    &[f64],
-    &[f64],
-    &[f64],
-    Option<&[Force]>,
-    &mut [f64],
-) -> robodyn::Result<()>;
+type DerivativesAlgorithm =
+    fn(&Model, &mut Data, algo::DynamicsState, &mut [f64]) -> robodyn::Result<()>;
 
 /// `forces` filled from the flat (nbodies − 1) × 6 rows of an `f_ext` argument.
 fn external_forces<'w>(forces: &'w mut [Force], flat: &[f64]) -> &'w [Force] {
@@ -94,16 +87,13 @@ fn external_forces<'w>(forces: &'w mut [Force], flat: &[f64]) -> &'w [Force] {
 fn rnea_derivatives(
     model: &Model,
     data: &mut Data,
-    q: &[f64],
-    v: &[f64],
-    a: &[f64],
-    f_ext: Option<&[Force]>,
+    state: algo::DynamicsState,
     out: &mut [f64],
 ) -> robodyn::Result<()> {
     let nv = model.nv;
     let (by_q, rest) = out.split_at_mut(nv * nv);
     let (by_v, by_a) = rest.split_at_mut(nv * nv);
-    algo::rnea_derivatives_row_major(model, data, (q, v, a, f_ext), by_q, by_v)?;
+    algo::rnea_derivatives_row_major(model, data, state, by_q, by_v)?;
     by_a.copy_from_slice(data.mass_matrix.as_slice());
     Ok(())
 }
@@ -112,13 +102,10 @@ fn rnea_derivatives(
 fn aba_derivatives(
     model: &Model,
     data: &mut Data,
-    q: &[f64],
-    v: &[f64],
-    tau: &[f64],
-    f_ext: Option<&[Force]>,
+    state: algo::DynamicsState,
     out: &mut [f64],
 ) -> robodyn::Result<()> {
-    algo::aba_derivative_rows(model, data, (q, v, tau, f_ext))?;
+    algo::aba_derivative_rows(model, data, state)?;
     let nv = model.nv;
     for (i, row) in data.derivative_rows.chunks_exact(3 * nv).enumerate() {
         for (block, part) in row.chunks_exact(nv).enumerate() {
@@ -170,11 +157,7 @@ impl PyModel {
         a: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let columns = 10 * (self.model.nbodies() - 1);
-        let arguments = [
-            self.q_arg("q", q)?,
-            self.v_arg("v", v)?,
-            self.v_arg("a", a)?,
-        ];
+        let arguments = self.dynamics_arguments(q, v, ("a", a), None)?;
         self.evaluate(
             py,
             &arguments,

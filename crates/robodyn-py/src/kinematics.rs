@@ -170,11 +170,7 @@ impl PyModel {
         #[pyo3(from_py_with = named::reference)] reference: String,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (frame, reference) = (self.frame_index(frame)?, parse_reference(&reference)?);
-        let arguments = [
-            self.q_arg("q", q)?,
-            self.v_arg("v", v)?,
-            self.v_arg("a", a)?,
-        ];
+        let arguments = self.dynamics_arguments(q, v, ("a", a), None)?;
         let stack = self.evaluate(py, &arguments, &[5, 6, self.model.nv], &|m, w, i, out| {
             let data = &mut w.data;
             algo::frame_motion_derivatives(m, data, i[0], i[1], i[2], frame, reference)?;
@@ -259,11 +255,7 @@ impl PyModel {
         #[pyo3(from_py_with = named::reference)] reference: String,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (frame, reference) = (self.frame_index(frame)?, parse_reference(&reference)?);
-        let arguments = [
-            self.q_arg("q", q)?,
-            self.v_arg("v", v)?,
-            self.v_arg("a", a)?,
-        ];
+        let arguments = self.dynamics_arguments(q, v, ("a", a), None)?;
         self.evaluate(py, &arguments, &[6], &|m, w, i, out| {
             out.copy_from_slice(&algo::frame_acceleration(
                 m,

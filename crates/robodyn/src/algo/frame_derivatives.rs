@@ -21,7 +21,8 @@
 //! Cost: O(depth).
 
 use crate::algo::crba::{add_composite_inertias, world_inertias_and_subspaces};
-use crate::algo::kinematics::{check_frame, frame_placement, update_support_placements};
+use crate::algo::frame_motion::place_frame_support;
+use crate::algo::kinematics::frame_placement;
 use crate::algo::Reference;
 use crate::error::{check_vector, Result};
 use crate::model::Model;
@@ -41,12 +42,8 @@ pub fn frame_motion_derivatives(
     frame: usize,
     reference: Reference,
 ) -> Result<()> {
-    model.check_configuration(q)?;
-    check_vector("v", v, model.nv)?;
+    let body = place_frame_support(model, data, q, v, frame)?;
     check_vector("a", a, model.nv)?;
-    check_frame(model, frame)?;
-    let body = model.frames[frame].body;
-    update_support_placements(model, data, q, body);
 
     // outward along the support, world coordinates: ν_i = ν_λ + S q̇, α_i = α_λ + S q̈ + ν_i × S q̇
     data.v_world[0] = Motion::ZERO;

@@ -55,6 +55,23 @@ pub fn frame_acceleration(
     Ok(acceleration)
 }
 
+/// Checks (q, q̇, frame) and places the bodies from the frame's body to the world
+/// (`data.support`, `data.x_up`, `data.x_world` along it); returns the frame's body.
+pub(crate) fn place_frame_support(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    v: &[f64],
+    frame: usize,
+) -> Result<usize> {
+    model.check_configuration(q)?;
+    check_vector("v", v, model.nv)?;
+    check_frame(model, frame)?;
+    let body = model.frames[frame].body;
+    update_support_placements(model, data, q, body);
+    Ok(body)
+}
+
 /// Velocity and acceleration of a frame in the requested coordinates.
 fn frame_motion(
     model: &Model,
@@ -65,11 +82,7 @@ fn frame_motion(
     frame: usize,
     reference: Reference,
 ) -> Result<([f64; 6], [f64; 6])> {
-    model.check_configuration(q)?;
-    check_vector("v", v, model.nv)?;
-    check_frame(model, frame)?;
-    let body = model.frames[frame].body;
-    update_support_placements(model, data, q, body);
+    let body = place_frame_support(model, data, q, v, frame)?;
 
     // outward along the support: v_i = X_i v_λ(i) + v_J;  a_i = X_i a_λ(i) + S q̈ + v_i × v_J
     data.v[0] = Motion::ZERO;
