@@ -237,6 +237,31 @@ def test_mimic_joints_are_reported():
     assert m.mimic_joints == [("r", "l", -1.0, 0.0)]
 
 
+@pytest.mark.parametrize("n", [1, 7, 37, 1001])
+def test_newton_euler_batches_in_lanes_equal_the_loop_bit_for_bit(floating, n):
+    """Inverse dynamics, bias forces and gravity run a batch several states per instruction
+    (the widest lanes this CPU has) and leftover states one at a time: every state's result is the
+    one-state call's, bit for bit, whatever the batch size."""
+    for m in (floating, robodyn.load("ur5")):
+        q, v, a, _, _ = batch_of_states(m, n, seed=n)
+        for name, args in {
+            "inverse_dynamics": (q, v, a),
+            "bias_forces": (q, v),
+            "generalized_gravity": (q,),
+        }.items():
+            batch = getattr(m, name)(*args)
+            loop = np.stack([getattr(m, name)(*(x[k] for x in args)) for k in range(n)])
+            np.testing.assert_array_equal(batch, loop, err_msg=f"{m.name} {name} n={n}")
+
+
+def test_an_overflow_in_lanes_names_its_batch_element():
+    m = robodyn.load("ur5")
+    q, v, a, _, _ = batch_of_states(m, 40, seed=5)
+    v[29, 1] = 1e200
+    with pytest.raises(ValueError, match=r"batch element 29: the result is not finite"):
+        m.inverse_dynamics(q, v, a)
+
+
 def test_batches_release_the_gil(floating):
     """A batch in one thread lets another Python thread run meanwhile."""
     states = floating.random_configuration(n=200_000, seed=1)

@@ -36,21 +36,29 @@ impl PyModel {
     }
 
     /// Dynamics with optional external forces: `algorithm(q, v, x, f_ext)` on the arguments of
-    /// [`Self::dynamics_arguments`], into `out` when given.
+    /// [`Self::dynamics_arguments`], into `out` when given; a batch without external forces runs
+    /// `runs` (the algorithm in lanes) when given.
     pub(crate) fn with_external_forces<'py>(
         &self,
         py: Python<'py>,
         arguments: &[Argument<'py>],
         out: Option<&Bound<'py, PyAny>>,
         algorithm: DynamicsAlgorithm,
+        runs: Option<&RunKernel>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let shape = [self.model.nv];
-        self.evaluate_into(py, arguments, &shape, out, &|m, w, i, out| {
-            let Workspace { data, forces, .. } = w;
-            let forces = i.get(3).map(|flat| external_forces(forces, flat));
-            out.copy_from_slice(algorithm(m, data, i[0], i[1], i[2], forces)?.as_slice());
-            Ok(())
-        })
+        self.evaluate_in_runs(
+            py,
+            arguments,
+            &[self.model.nv],
+            out,
+            &|m, w, i, out| {
+                let Workspace { data, forces, .. } = w;
+                let forces = i.get(3).map(|flat| external_forces(forces, flat));
+                out.copy_from_slice(algorithm(m, data, i[0], i[1], i[2], forces)?.as_slice());
+                Ok(())
+            },
+            runs.filter(|_| arguments.len() < 4),
+        )
     }
 
     /// The three nv × nv derivatives of a dynamics algorithm with optional external forces, as a
@@ -143,7 +151,7 @@ impl PyModel {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let arguments = self.dynamics_arguments(q, v, ("a", a), f_ext)?;
-        self.with_external_forces(py, &arguments, out, algo::rnea)
+        self.with_external_forces(py, &arguments, out, algo::rnea, Some(&newton_euler_run))
     }
 
     /// The joint-torque regressor Y(q, v, a), shape (nv, 10 nbodies): τ = Y π with π =
@@ -183,7 +191,7 @@ impl PyModel {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let arguments = self.dynamics_arguments(q, v, ("tau", tau), f_ext)?;
-        self.with_external_forces(py, &arguments, out, algo::aba)
+        self.with_external_forces(py, &arguments, out, algo::aba, None)
     }
 
     /// Derivatives of inverse dynamics τ = ID(q, v, a, f_ext): dict of `dtau_dq`, `dtau_dv` and
@@ -268,7 +276,7 @@ impl PyModel {
         v: &Bound<'py, PyAny>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.evaluate_into(
+        self.evaluate_in_runs(
             py,
             &[self.q_arg("q", q)?, self.v_arg("v", v)?],
             &[self.model.nv],
@@ -277,6 +285,7 @@ impl PyModel {
                 out.copy_from_slice(algo::bias_forces(m, &mut w.data, i[0], i[1])?.as_slice());
                 Ok(())
             },
+            Some(&newton_euler_run),
         )
     }
 
@@ -317,12 +326,12 @@ impl PyModel {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         type Method = for<'d> fn(&Model, &'d mut Data, &[f64]) -> robodyn::Result<&'d DVector<f64>>;
-        let algorithm: Method = match method.as_str() {
-            "rnea" => algo::generalized_gravity,
-            "jacobians" => algo::generalized_gravity_by_jacobians,
+        let (algorithm, runs): (Method, Option<&RunKernel>) = match method.as_str() {
+            "rnea" => (algo::generalized_gravity, Some(&newton_euler_run)),
+            "jacobians" => (algo::generalized_gravity_by_jacobians, None),
             other => return Err(unknown_method(other, "rnea or jacobians")),
         };
-        self.evaluate_into(
+        self.evaluate_in_runs(
             py,
             &[self.q_arg("q", q)?],
             &[self.model.nv],
@@ -331,6 +340,7 @@ impl PyModel {
                 out.copy_from_slice(algorithm(m, &mut w.data, i[0])?.as_slice());
                 Ok(())
             },
+            runs,
         )
     }
 

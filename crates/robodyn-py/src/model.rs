@@ -15,6 +15,7 @@ use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyString;
 use rayon::prelude::*;
+use robodyn::algo::{self, BatchResult, BatchWorkspace, States};
 use robodyn::integrate::StepWorkspace;
 use robodyn::spatial::Force;
 use robodyn::{Data, Error, Model};
@@ -30,6 +31,8 @@ pub(crate) struct Workspace {
     pub(crate) jacobians: (DMatrix<f64>, DMatrix<f64>),
     /// The stages of a simulation step, made on the first `step` call.
     pub(crate) step: Option<Box<StepWorkspace>>,
+    /// The lane buffers of the batch kernels, made on the first batch that uses them.
+    pub(crate) lanes: Option<Box<BatchWorkspace>>,
 }
 
 impl Workspace {
@@ -42,6 +45,7 @@ impl Workspace {
                 DMatrix::zeros(model.nv, model.nv),
             ),
             step: None,
+            lanes: None,
         }
     }
 }
@@ -67,6 +71,29 @@ pub(crate) type DynamicsAlgorithm = for<'d> fn(
 pub(crate) type Kernel<'k> =
     dyn Fn(&Model, &mut Workspace, &[&[f64]], &mut [f64]) -> robodyn::Result<()> + Sync + 'k;
 
+/// A kernel over a run of consecutive samples at once (a batch kernel in lanes): inputs and
+/// output hold the run's rows; an error names the sample by its place in the run.
+pub(crate) type RunKernel<'k> =
+    dyn Fn(&Model, &mut Workspace, &[&[f64]], &mut [f64]) -> BatchResult + Sync + 'k;
+
+/// Newton–Euler in lanes over a run: the inputs are q and, when given, v and a (zero otherwise).
+pub(crate) fn newton_euler_run(
+    model: &Model,
+    workspace: &mut Workspace,
+    inputs: &[&[f64]],
+    out: &mut [f64],
+) -> BatchResult {
+    let lanes = workspace
+        .lanes
+        .get_or_insert_with(|| Box::new(BatchWorkspace::new(model)));
+    let states = States {
+        q: inputs[0],
+        v: inputs.get(1).copied(),
+        a: inputs.get(2).copied(),
+    };
+    algo::newton_euler_batch(model, lanes, states, out)
+}
+
 /// The most numeric arguments a method takes (q, v, a, f_ext).
 pub(crate) const MAX_ARGUMENTS: usize = 4;
 
@@ -80,15 +107,21 @@ pub(crate) fn run_kernel(
     out: &mut [f64],
 ) -> robodyn::Result<()> {
     kernel(model, workspace, inputs, out)?;
-    // one vectorised pass, then the first culprit if there is one
-    if robodyn::error::all_finite(out) {
-        return Ok(());
+    match first_overflow(out) {
+        Some(index) => Err(Error::Overflow {
+            index,
+            value: out[index],
+        }),
+        None => Ok(()),
     }
-    let index = out.iter().position(|x| !x.is_finite()).unwrap_or_default();
-    Err(Error::Overflow {
-        index,
-        value: out[index],
-    })
+}
+
+/// The first entry of `out` that is not finite, if any: one vectorised pass, then the search.
+fn first_overflow(out: &[f64]) -> Option<usize> {
+    if robodyn::error::all_finite(out) {
+        return None;
+    }
+    out.iter().position(|x| !x.is_finite())
 }
 
 /// Asks the kernel to back a large buffer not yet touched with huge pages (Linux's transparent
@@ -166,6 +199,20 @@ impl PyModel {
         out: Option<&Bound<'py, PyAny>>,
         kernel: &Kernel,
     ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate_in_runs(py, arguments, output_shape, out, kernel, None)
+    }
+
+    /// [`Self::evaluate_into`], a batch running `runs` (when given) on each thread's run of
+    /// samples instead of `kernel` on one sample at a time.
+    pub(crate) fn evaluate_in_runs<'py>(
+        &self,
+        py: Python<'py>,
+        arguments: &[Argument<'py>],
+        output_shape: &[usize],
+        out: Option<&Bound<'py, PyAny>>,
+        kernel: &Kernel,
+        runs: Option<&RunKernel>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let batch = common_batch(arguments)?;
         let values: [Cow<[f64]>; MAX_ARGUMENTS] = std::array::from_fn(|k| {
             arguments
@@ -218,12 +265,12 @@ impl PyModel {
                     // SAFETY: as for one sample
                     let out = unsafe { output.as_slice_mut() }
                         .map_err(|e| PyValueError::new_err(e.to_string()))?;
-                    self.run_batch(py, &batch, out, kernel)?;
+                    self.run_batch(py, &batch, out, kernel, runs)?;
                     return Ok(output.into_any());
                 }
                 let mut out = vec![0.0; n * output_size];
                 advise_huge_pages(&mut out);
-                self.run_batch(py, &batch, &mut out, kernel)?;
+                self.run_batch(py, &batch, &mut out, kernel, runs)?;
                 let shape: Vec<usize> = std::iter::once(n)
                     .chain(output_shape.iter().copied())
                     .collect();
@@ -232,36 +279,63 @@ impl PyModel {
         }
     }
 
-    /// Runs `kernel` on every sample of a batch into `out`, with the GIL released, on all cores:
-    /// a few runs of consecutive samples per thread (for balance), each in a workspace taken from
-    /// the pool and given back.
+    /// Runs `kernel` on every sample of a batch into `out` (or `runs` on runs of samples), with
+    /// the GIL released, on all cores: a few runs of consecutive samples per thread (for
+    /// balance), each in a workspace taken from the pool and given back.
     fn run_batch(
         &self,
         py: Python,
         batch: &BatchInputs,
         out: &mut [f64],
         kernel: &Kernel,
+        runs: Option<&RunKernel>,
     ) -> PyResult<()> {
         let (model, pool) = (&self.model, &self.batch_workspaces);
-        let n = out.len() / batch.output_size.max(1);
+        let output_size = batch.output_size.max(1);
+        let n = out.len() / output_size;
         let run = n.div_ceil(4 * rayon::current_num_threads()).max(1);
         let result = py.detach(|| {
-            out.par_chunks_mut((run * batch.output_size).max(1))
+            out.par_chunks_mut(run * output_size)
                 .enumerate()
                 .try_for_each(|(r, outputs)| {
                     let taken = pool.lock().ok().and_then(|mut p| p.pop());
                     let mut workspace = taken.unwrap_or_else(|| Workspace::new(model));
+                    let first = r * run;
                     let mut inputs: [&[f64]; MAX_ARGUMENTS] = [&[]; MAX_ARGUMENTS];
-                    let outputs = outputs.chunks_mut(batch.output_size.max(1));
-                    for (k, out) in (r * run..).zip(outputs) {
+                    let mut select = |first: usize, count: usize| {
                         for ((input, value), size) in
                             inputs.iter_mut().zip(batch.values).zip(batch.sizes)
                         {
-                            *input = &value[k * size..(k + 1) * size];
+                            *input = &value[first * size..(first + count) * size];
                         }
-                        let inputs = &inputs[..batch.values.len()];
-                        run_kernel(kernel, model, &mut workspace, inputs, out)
-                            .map_err(|e| (k, e))?;
+                        inputs
+                    };
+                    let arguments = batch.values.len();
+                    match runs {
+                        Some(runs) => {
+                            let count = outputs.len() / output_size;
+                            let inputs = select(first, count);
+                            runs(model, &mut workspace, &inputs[..arguments], outputs)
+                                .map_err(|(k, e)| (first + k, e))?;
+                            if let Some(index) = first_overflow(outputs) {
+                                let value = outputs[index];
+                                let (k, index) = (index / output_size, index % output_size);
+                                return Err((first + k, Error::Overflow { index, value }));
+                            }
+                        }
+                        None => {
+                            for (k, out) in (first..).zip(outputs.chunks_mut(output_size)) {
+                                let inputs = select(k, 1);
+                                run_kernel(
+                                    kernel,
+                                    model,
+                                    &mut workspace,
+                                    &inputs[..arguments],
+                                    out,
+                                )
+                                .map_err(|e| (k, e))?;
+                            }
+                        }
                     }
                     if let Ok(mut p) = pool.lock() {
                         p.push(workspace);

@@ -7,8 +7,11 @@
 //! differences act on the joint's Lie group (quaternions for the spherical and free joints), so
 //! `difference(q, integrate(q, v)) = v`.
 
-use crate::spatial::{log_rotation, skew, Force, Mat3, Mat6, Motion, Transform, Vec3};
-use nalgebra::{Quaternion, UnitQuaternion, Vector6};
+use crate::spatial::{
+    log_rotation, rotate_back, skew, splat_vector, zero_vector, Force, Mat3, Mat6, Motion, Real,
+    Transform, Vec3,
+};
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3, Vector6};
 use rand::Rng;
 
 mod jacobians;
@@ -87,16 +90,18 @@ impl Joint {
     }
 
     /// The joint transform `X_J(q)` from the joint frame to the child body frame.
-    /// `q` is this joint's slice of the configuration.
-    #[inline]
-    pub fn transform(&self, q: &[f64]) -> Transform {
+    /// `q` is this joint's slice of the configuration (`f64`, or lanes of a batch).
+    #[inline(always)]
+    pub fn transform<S: Real>(&self, q: &[S]) -> Transform<S> {
         match self {
-            Joint::Fixed => Transform::IDENTITY,
+            Joint::Fixed => Transform::splat(&Transform::IDENTITY),
             Joint::Revolute { axis } => Transform::from_axis_angle(axis, q[0]),
-            Joint::Prismatic { axis } => Transform::from_translation(&(axis * q[0])),
-            Joint::Spherical => Transform::from_pose(&rotation_of(&q[0..4]), &Vec3::zeros()),
+            Joint::Prismatic { axis } => {
+                Transform::from_translation(&(splat_vector::<S>(axis) * q[0]))
+            }
+            Joint::Spherical => Transform::from_pose(&rotation_of(&q[0..4]), &zero_vector()),
             Joint::Free => {
-                Transform::from_pose(&rotation_of(&q[3..7]), &Vec3::new(q[0], q[1], q[2]))
+                Transform::from_pose(&rotation_of(&q[3..7]), &Vector3::new(q[0], q[1], q[2]))
             }
         }
     }
@@ -105,25 +110,27 @@ impl Joint {
     /// frame), the body's `X_{i←λ(i)}`. A revolute joint about a coordinate axis of its frame (most
     /// joints: URDF and MJCF axes are mostly x, y or z) turns two rows of X_T's rotation and keeps
     /// its translation; a prismatic joint moves the translation only.
-    #[inline]
-    pub fn transform_after(&self, q: &[f64], x_tree: &Transform) -> Transform {
+    #[inline(always)]
+    pub fn transform_after<S: Real>(&self, q: &[S], x_tree: &Transform) -> Transform<S> {
+        let x_tree = Transform::splat(x_tree);
         match self {
-            Joint::Fixed => *x_tree,
+            Joint::Fixed => x_tree,
             Joint::Revolute { axis } => match coordinate_axis(axis) {
                 Some(k) => x_tree.rotated_about_axis(k, q[0]),
-                None => self.transform(q) * *x_tree,
+                None => self.transform(q) * x_tree,
             },
             Joint::Prismatic { axis } => Transform {
                 rotation: x_tree.rotation,
                 // r = r_T + E_Tᵀ (axis q)
-                translation: x_tree.translation + x_tree.rotation.tr_mul(&(axis * q[0])),
+                translation: x_tree.translation
+                    + rotate_back(&x_tree.rotation, &(splat_vector::<S>(axis) * q[0])),
             },
-            Joint::Spherical | Joint::Free => self.transform(q) * *x_tree,
+            Joint::Spherical | Joint::Free => self.transform(q) * x_tree,
         }
     }
 
     /// Column `k` of the motion subspace `S`, in the child frame.
-    #[inline]
+    #[inline(always)]
     pub fn subspace_column(&self, k: usize) -> Motion {
         let unit = |i: usize| Vec3::ith(i % 3, 1.0);
         match self {
@@ -166,12 +173,12 @@ impl Joint {
     }
 
     /// `S_kᵀ f`: the component of force `f` (child frame) along velocity coordinate `k`.
-    #[inline]
-    pub fn project_force(&self, k: usize, f: &Force) -> f64 {
+    #[inline(always)]
+    pub fn project_force<S: Real>(&self, k: usize, f: &Force<S>) -> S {
         match self {
-            Joint::Fixed => 0.0,
-            Joint::Revolute { axis } => axis.dot(&f.angular),
-            Joint::Prismatic { axis } => axis.dot(&f.linear),
+            Joint::Fixed => S::zero(),
+            Joint::Revolute { axis } => splat_vector::<S>(axis).dot(&f.angular),
+            Joint::Prismatic { axis } => splat_vector::<S>(axis).dot(&f.linear),
             Joint::Spherical => f.angular[k % 3],
             Joint::Free if k < 3 => f.linear[k],
             Joint::Free => f.angular[k % 3],
@@ -183,11 +190,11 @@ impl Joint {
     /// armature acts, as in MuJoCo, on the world-frame linear velocity R v_lin: its rate in body
     /// axes is v̇_lin + ω × v_lin, so K's linear block is [ω×] (skew-symmetric, so Ṁ − 2C stays
     /// skew and the rotor does no work). Needs the same armature on the three linear coordinates.
-    #[inline]
-    pub fn rotor_velocity_term(&self, r: usize, c: usize, v: &[f64]) -> f64 {
+    #[inline(always)]
+    pub fn rotor_velocity_term<S: Real>(&self, r: usize, c: usize, v: &[S]) -> S {
         match self {
-            Joint::Free if r < 3 && c < 3 => skew(&Vec3::new(v[3], v[4], v[5]))[(r, c)],
-            _ => 0.0,
+            Joint::Free if r < 3 && c < 3 => skew(&Vector3::new(v[3], v[4], v[5]))[(r, c)],
+            _ => S::zero(),
         }
     }
 
@@ -216,9 +223,13 @@ impl Joint {
     }
 
     /// The joint velocity `v_J = S q̇` for this joint's slice `v` of the velocity.
-    #[inline]
-    pub fn motion(&self, v: &[f64]) -> Motion {
-        (0..self.nv()).fold(Motion::ZERO, |sum, k| sum + self.subspace_column(k) * v[k])
+    #[inline(always)]
+    pub fn motion<S: Real>(&self, v: &[S]) -> Motion<S> {
+        let mut sum = Motion::zeros();
+        for (k, v_k) in v.iter().enumerate().take(self.nv()) {
+            sum += Motion::splat(&self.subspace_column(k)) * *v_k;
+        }
+        sum
     }
 
     /// The neutral configuration (zero angles, identity quaternions).
@@ -421,13 +432,29 @@ where
 }
 
 /// The unit quaternion of `[qx, qy, qz, qw]` (normalised).
-fn quaternion_of(q: &[f64]) -> UnitQuaternion<f64> {
+fn quaternion_of<S: Real>(q: &[S]) -> UnitQuaternion<S> {
     UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]))
 }
 
-/// The rotation matrix of `[qx, qy, qz, qw]`.
-fn rotation_of(q: &[f64]) -> Mat3 {
-    *quaternion_of(q).to_rotation_matrix().matrix()
+/// The rotation matrix of `[qx, qy, qz, qw]`, normalised on the way: with s = 2 / |q|²,
+/// R = 1 − s [y²+z², ...] (the quaternion's rotation formula, written out so that it inlines
+/// into the batch kernels).
+#[inline(always)]
+fn rotation_of<S: Real>(q: &[S]) -> Matrix3<S> {
+    let (x, y, z, w) = (q[0], q[1], q[2], q[3]);
+    let s = S::splat(2.0) / (x * x + y * y + z * z + w * w);
+    let one = S::one();
+    Matrix3::new(
+        one - s * (y * y + z * z),
+        s * (x * y - w * z),
+        s * (x * z + w * y),
+        s * (x * y + w * z),
+        one - s * (x * x + z * z),
+        s * (y * z - w * x),
+        s * (x * z - w * y),
+        s * (y * z + w * x),
+        one - s * (x * x + y * y),
+    )
 }
 
 /// Writes `[qx, qy, qz, qw]`, with qw ≥ 0 for a canonical sign.

@@ -7,14 +7,20 @@
 
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::spatial::Transform;
+use crate::spatial::{Real, Transform};
 use crate::Data;
 
 /// Writes `data.x_up` for configuration `q` (assumed already checked).
 pub(crate) fn update_joint_transforms(model: &Model, data: &mut Data, q: &[f64]) {
+    joint_transforms(model, q, &mut data.x_up);
+}
+
+/// `X_{i←λ(i)}` of every body for `q`, in `f64` or lanes (assumed already checked).
+#[inline(always)]
+pub(crate) fn joint_transforms<S: Real>(model: &Model, q: &[S], x_up: &mut [Transform<S>]) {
     for i in 1..model.nbodies() {
         // X_{i←λ(i)} = X_J(q_i) X_T(i)
-        data.x_up[i] = model.joints[i].transform_after(&q[model.q_range(i)], &model.x_tree[i]);
+        x_up[i] = model.joints[i].transform_after(&q[model.q_range(i)], &model.x_tree[i]);
     }
 }
 

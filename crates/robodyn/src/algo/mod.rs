@@ -17,6 +17,7 @@ pub mod frame_motion;
 pub mod inverse_kinematics;
 pub mod jacobian;
 pub mod kinematics;
+pub mod lanes;
 pub mod ltdl;
 pub mod manipulability;
 pub mod minv;
@@ -38,6 +39,7 @@ pub use frame_motion::{frame_acceleration, frame_velocity, jacobian_time_variati
 pub use inverse_kinematics::{inverse_kinematics, IkOptions, IkSolution};
 pub use jacobian::{jacobian, Reference};
 pub use kinematics::{forward_kinematics, frame_placement, frame_pose};
+pub use lanes::{newton_euler_batch, BatchResult, BatchWorkspace, LaneWidth, States};
 pub use manipulability::manipulability;
 pub use minv::inverse_mass_matrix;
 pub use regressor::torque_regressor;

@@ -6,10 +6,10 @@
 //! Inputs: q (nq), v (nv), a (nv), optional external forces per moving body (in the body's frame,
 //! at its origin). Writes `data.x_up`, `data.v`, `data.a`, `data.f`, `data.tau`. Cost: O(n).
 
-use crate::algo::kinematics::update_joint_transforms;
+use crate::algo::kinematics::joint_transforms;
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::model::Model;
-use crate::spatial::{Force, Motion, Vec3};
+use crate::spatial::{splat_vector, zero_vector, Force, Motion, Real, Transform};
 use crate::Data;
 use nalgebra::DVector;
 
@@ -48,7 +48,8 @@ pub fn generalized_gravity<'d>(
     newton_euler(model, data, q, None, None, None)
 }
 
-/// The two passes of Table 5.1; `None` stands for a zero velocity or acceleration.
+/// The two passes of Table 5.1 for one checked state, into `data`; `None` stands for a zero
+/// velocity or acceleration.
 pub(crate) fn newton_euler<'d>(
     model: &Model,
     data: &'d mut Data,
@@ -61,17 +62,50 @@ pub(crate) fn newton_euler<'d>(
     if let Some(forces) = f_ext {
         check_external_forces(model, forces)?;
     }
-    update_joint_transforms(model, data, q);
+    let buffers = NewtonEulerBuffers {
+        x_up: &mut data.x_up,
+        v: &mut data.v,
+        a: &mut data.a,
+        f: &mut data.f,
+        tau: data.tau.as_mut_slice(),
+    };
+    newton_euler_passes(model, q, v, a, f_ext, buffers);
+    Ok(&data.tau)
+}
+
+/// What the Newton–Euler passes write, per body (x_up, v, a, f) and per velocity coordinate
+/// (tau): one state's, borrowed from [`Data`], or several states' in lanes (see
+/// [`crate::algo::lanes`]).
+pub(crate) struct NewtonEulerBuffers<'b, S> {
+    pub x_up: &'b mut [Transform<S>],
+    pub v: &'b mut [Motion<S>],
+    pub a: &'b mut [Motion<S>],
+    pub f: &'b mut [Force<S>],
+    pub tau: &'b mut [S],
+}
+
+/// The two passes of Table 5.1 on checked inputs, in `f64` or in lanes (the same operations in
+/// every lane, so each lane's result is the one-state result bit for bit).
+#[inline(always)]
+pub(crate) fn newton_euler_passes<S: Real>(
+    model: &Model,
+    q: &[S],
+    v: Option<&[S]>,
+    a: Option<&[S]>,
+    f_ext: Option<&[Force<S>]>,
+    out: NewtonEulerBuffers<S>,
+) {
+    joint_transforms(model, q, out.x_up);
 
     // outward pass: velocities, accelerations and the force each body needs
-    data.v[0] = Motion::ZERO;
-    data.a[0] = Motion::new(Vec3::zeros(), -model.gravity);
+    out.v[0] = Motion::zeros();
+    out.a[0] = Motion::new(zero_vector(), -splat_vector::<S>(&model.gravity));
     for i in 1..model.nbodies() {
         let joint = &model.joints[i];
         let parent = model.parent[i];
         let inertia = &model.inertias[i];
         // a_i = X_i a_λ(i) + S q̈_i + v_i × v_J   (c_J = 0)
-        let mut a_i = data.x_up[i].apply_motion(&data.a[parent]);
+        let mut a_i = out.x_up[i].apply_motion(&out.a[parent]);
         if let Some(a) = a {
             a_i += joint.motion(&a[model.v_range(i)]);
         }
@@ -80,22 +114,22 @@ pub(crate) fn newton_euler<'d>(
             Some(v) => {
                 // v_i = X_i v_λ(i) + v_J
                 let v_j = joint.motion(&v[model.v_range(i)]);
-                let v_i = data.x_up[i].apply_motion(&data.v[parent]) + v_j;
+                let v_i = out.x_up[i].apply_motion(&out.v[parent]) + v_j;
                 a_i += v_i.cross_motion(&v_j);
-                data.v[i] = v_i;
+                out.v[i] = v_i;
                 inertia.mul_motion(&a_i) + v_i.cross_force(&inertia.mul_motion(&v_i))
             }
             None => {
                 // at rest every velocity product vanishes
-                data.v[i] = Motion::ZERO;
+                out.v[i] = Motion::zeros();
                 inertia.mul_motion(&a_i)
             }
         };
         if let Some(forces) = f_ext {
             f_i -= forces[i - 1];
         }
-        data.a[i] = a_i;
-        data.f[i] = f_i;
+        out.a[i] = a_i;
+        out.f[i] = f_i;
     }
 
     // inward pass: project onto the joint axes, pass the rest to the parent
@@ -104,23 +138,22 @@ pub(crate) fn newton_euler<'d>(
         let dofs = model.v_range(i);
         for (k, dof) in dofs.clone().enumerate() {
             // τ_i = S_iᵀ f_i + armature (q̈_i + K(q̇_i) q̇_i)
-            let mut rate = a.map_or(0.0, |a| a[dof]);
+            let mut rate = a.map_or(S::zero(), |a| a[dof]);
             if let Some(v) = v {
                 let v_i = &v[dofs.clone()];
-                rate += (0..v_i.len())
-                    .map(|c| joint.rotor_velocity_term(k, c, v_i) * v_i[c])
-                    .sum::<f64>();
+                for (c, v_c) in v_i.iter().enumerate() {
+                    rate += joint.rotor_velocity_term(k, c, v_i) * *v_c;
+                }
             }
-            data.tau[dof] = joint.project_force(k, &data.f[i]) + model.armature[dof] * rate;
+            out.tau[dof] = joint.project_force(k, &out.f[i]) + S::splat(model.armature[dof]) * rate;
         }
         let parent = model.parent[i];
         if parent != 0 {
             // f_λ(i) += X_iᵀ f_i
-            let f_parent = data.x_up[i].transpose_apply_force(&data.f[i]);
-            data.f[parent] += f_parent;
+            let f_parent = out.x_up[i].transpose_apply_force(&out.f[i]);
+            out.f[parent] += f_parent;
         }
     }
-    Ok(&data.tau)
 }
 
 /// Checks one finite force per moving body.

@@ -1,14 +1,38 @@
 //! Spatial force vectors (wrenches, momenta).
 
-use super::Vec3;
+use super::{Real, Vec3};
+use nalgebra::Vector3;
 use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
 
 /// A spatial force `f = (n_O, f)`: the moment about the frame's origin and the linear force, both
-/// in the frame's axes (Featherstone §2.4).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Force {
-    pub angular: Vec3,
-    pub linear: Vec3,
+/// in the frame's axes (Featherstone §2.4). `S` as for [`super::Motion`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Force<S = f64> {
+    pub angular: Vector3<S>,
+    pub linear: Vector3<S>,
+}
+
+impl<S: Real> Force<S> {
+    #[inline(always)]
+    pub fn new(angular: Vector3<S>, linear: Vector3<S>) -> Self {
+        Force { angular, linear }
+    }
+
+    /// A constant force in every lane.
+    #[inline(always)]
+    pub fn splat(f: &Force) -> Self {
+        Force::new(
+            super::splat_vector(&f.angular),
+            super::splat_vector(&f.linear),
+        )
+    }
+}
+
+impl Default for Force {
+    #[inline(always)]
+    fn default() -> Self {
+        Force::ZERO
+    }
 }
 
 impl Force {
@@ -17,13 +41,9 @@ impl Force {
         linear: Vec3::new(0.0, 0.0, 0.0),
     };
 
-    pub fn new(angular: Vec3, linear: Vec3) -> Self {
-        Force { angular, linear }
-    }
-
     /// The 6x6 matrix `f ×̄` on `[angular; linear]` motions with `(f ×̄) m = m ×* f`
     /// (Echeandia & Wensing 2021): `[-n× -f×; -f× 0]` for `f = (n, f)`.
-    #[inline]
+    #[inline(always)]
     pub fn bar_cross_matrix(&self) -> super::Mat6 {
         let (n, f) = (super::skew(&self.angular), super::skew(&self.linear));
         let mut x = super::Mat6::zeros();
@@ -34,7 +54,7 @@ impl Force {
     }
 
     /// The Plücker 6-vector `[angular; linear]` (moment; force).
-    #[inline]
+    #[inline(always)]
     pub fn to_vector(&self) -> nalgebra::Vector6<f64> {
         nalgebra::Vector6::new(
             self.angular.x,
@@ -47,13 +67,13 @@ impl Force {
     }
 
     /// Inverse of [`Force::to_vector`].
-    #[inline]
+    #[inline(always)]
     pub fn from_vector(f: &nalgebra::Vector6<f64>) -> Self {
         Force::new(Vec3::new(f[0], f[1], f[2]), Vec3::new(f[3], f[4], f[5]))
     }
 
     /// Flattened `[linear; angular]` (force; moment), robodyn's public order.
-    #[inline]
+    #[inline(always)]
     pub fn to_array(&self) -> [f64; 6] {
         [
             self.linear.x,
@@ -66,7 +86,7 @@ impl Force {
     }
 
     /// Inverse of [`Force::to_array`].
-    #[inline]
+    #[inline(always)]
     pub fn from_array(values: &[f64; 6]) -> Self {
         Force {
             linear: Vec3::new(values[0], values[1], values[2]),
@@ -75,50 +95,50 @@ impl Force {
     }
 }
 
-impl Add for Force {
-    type Output = Force;
-    #[inline]
-    fn add(self, rhs: Force) -> Force {
+impl<S: Real> Add for Force<S> {
+    type Output = Force<S>;
+    #[inline(always)]
+    fn add(self, rhs: Force<S>) -> Force<S> {
         Force::new(self.angular + rhs.angular, self.linear + rhs.linear)
     }
 }
 
-impl AddAssign for Force {
-    #[inline]
-    fn add_assign(&mut self, rhs: Force) {
+impl<S: Real> AddAssign for Force<S> {
+    #[inline(always)]
+    fn add_assign(&mut self, rhs: Force<S>) {
         self.angular += rhs.angular;
         self.linear += rhs.linear;
     }
 }
 
-impl Sub for Force {
-    type Output = Force;
-    #[inline]
-    fn sub(self, rhs: Force) -> Force {
+impl<S: Real> Sub for Force<S> {
+    type Output = Force<S>;
+    #[inline(always)]
+    fn sub(self, rhs: Force<S>) -> Force<S> {
         Force::new(self.angular - rhs.angular, self.linear - rhs.linear)
     }
 }
 
-impl SubAssign for Force {
-    #[inline]
-    fn sub_assign(&mut self, rhs: Force) {
+impl<S: Real> SubAssign for Force<S> {
+    #[inline(always)]
+    fn sub_assign(&mut self, rhs: Force<S>) {
         self.angular -= rhs.angular;
         self.linear -= rhs.linear;
     }
 }
 
-impl Neg for Force {
-    type Output = Force;
-    #[inline]
-    fn neg(self) -> Force {
+impl<S: Real> Neg for Force<S> {
+    type Output = Force<S>;
+    #[inline(always)]
+    fn neg(self) -> Force<S> {
         Force::new(-self.angular, -self.linear)
     }
 }
 
-impl Mul<f64> for Force {
-    type Output = Force;
-    #[inline]
-    fn mul(self, s: f64) -> Force {
+impl<S: Real> Mul<S> for Force<S> {
+    type Output = Force<S>;
+    #[inline(always)]
+    fn mul(self, s: S) -> Force<S> {
         Force::new(self.angular * s, self.linear * s)
     }
 }

@@ -1,6 +1,7 @@
 //! Rigid-body spatial inertia (Featherstone §2.13).
 
-use super::{skew, Force, Mat3, Mat6, Motion, Vec3};
+use super::{rotate, skew, splat_matrix, splat_vector, Force, Mat3, Mat6, Motion, Real, Vec3};
+use nalgebra::Vector3;
 use std::ops::{Add, AddAssign};
 
 /// The spatial inertia of a rigid body about a frame's origin, stored as the mass `m`, the first
@@ -51,12 +52,14 @@ impl Inertia {
         }
     }
 
-    /// `f = I m`: `n = Ī_O ω + h × v`, `f = m v - h × ω`.
-    #[inline]
-    pub fn mul_motion(&self, m: &Motion) -> Force {
+    /// `f = I m`: `n = Ī_O ω + h × v`, `f = m v - h × ω`; `m` in `f64` or lanes.
+    #[inline(always)]
+    pub fn mul_motion<S: Real>(&self, m: &Motion<S>) -> Force<S> {
+        let first_moment: Vector3<S> = splat_vector(&self.first_moment);
+        let rotational = splat_matrix(&self.rotational);
         Force {
-            angular: self.rotational * m.angular + self.first_moment.cross(&m.linear),
-            linear: m.linear * self.mass - self.first_moment.cross(&m.angular),
+            angular: rotate(&rotational, &m.angular) + first_moment.cross(&m.linear),
+            linear: m.linear * S::splat(self.mass) - first_moment.cross(&m.angular),
         }
     }
 

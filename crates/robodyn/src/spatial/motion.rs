@@ -1,14 +1,23 @@
 //! Spatial motion vectors (velocities, accelerations, motion subspace columns).
 
-use super::{Force, Vec3};
+use super::{Force, Real, Vec3};
+use nalgebra::Vector3;
 use std::ops::{Add, AddAssign, Mul, Neg, Sub};
 
 /// A spatial motion vector `m = (ω, v_O)`: angular part and the linear velocity of the point at
-/// the frame's origin, both in the frame's axes (Featherstone §2.3).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Motion {
-    pub angular: Vec3,
-    pub linear: Vec3,
+/// the frame's origin, both in the frame's axes (Featherstone §2.3). `S` is `f64`, or a lane
+/// type for a batch of states (see [`Real`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Motion<S = f64> {
+    pub angular: Vector3<S>,
+    pub linear: Vector3<S>,
+}
+
+impl Default for Motion {
+    #[inline(always)]
+    fn default() -> Self {
+        Motion::ZERO
+    }
 }
 
 impl Motion {
@@ -16,14 +25,32 @@ impl Motion {
         angular: Vec3::new(0.0, 0.0, 0.0),
         linear: Vec3::new(0.0, 0.0, 0.0),
     };
+}
 
-    pub fn new(angular: Vec3, linear: Vec3) -> Self {
+impl<S: Real> Motion<S> {
+    #[inline(always)]
+    pub fn new(angular: Vector3<S>, linear: Vector3<S>) -> Self {
         Motion { angular, linear }
     }
 
+    /// The zero motion.
+    #[inline(always)]
+    pub fn zeros() -> Self {
+        Motion::new(super::zero_vector(), super::zero_vector())
+    }
+
+    /// A constant motion (of the model) in every lane.
+    #[inline(always)]
+    pub fn splat(m: &Motion) -> Self {
+        Motion::new(
+            super::splat_vector(&m.angular),
+            super::splat_vector(&m.linear),
+        )
+    }
+
     /// `m × n`: the motion cross product (Featherstone eq. 2.31).
-    #[inline]
-    pub fn cross_motion(&self, other: &Motion) -> Motion {
+    #[inline(always)]
+    pub fn cross_motion(&self, other: &Motion<S>) -> Motion<S> {
         Motion {
             angular: self.angular.cross(&other.angular),
             linear: self.angular.cross(&other.linear) + self.linear.cross(&other.angular),
@@ -31,16 +58,24 @@ impl Motion {
     }
 
     /// `m ×* f`: the force cross product (Featherstone eq. 2.32).
-    #[inline]
-    pub fn cross_force(&self, f: &Force) -> Force {
+    #[inline(always)]
+    pub fn cross_force(&self, f: &Force<S>) -> Force<S> {
         Force {
             angular: self.angular.cross(&f.angular) + self.linear.cross(&f.linear),
             linear: self.angular.cross(&f.linear),
         }
     }
 
+    /// The scalar product `m · f` (power).
+    #[inline(always)]
+    pub fn dot(&self, f: &Force<S>) -> S {
+        self.angular.dot(&f.angular) + self.linear.dot(&f.linear)
+    }
+}
+
+impl Motion {
     /// The 6x6 matrix of `m ×` on `[angular; linear]`: `[ω× 0; v× ω×]` (Featherstone eq. 2.31).
-    #[inline]
+    #[inline(always)]
     pub fn cross_matrix(&self) -> super::Mat6 {
         let (w, v) = (super::skew(&self.angular), super::skew(&self.linear));
         let mut x = super::Mat6::zeros();
@@ -50,15 +85,9 @@ impl Motion {
         x
     }
 
-    /// The scalar product `m · f` (power).
-    #[inline]
-    pub fn dot(&self, f: &Force) -> f64 {
-        self.angular.dot(&f.angular) + self.linear.dot(&f.linear)
-    }
-
     /// The Plücker 6-vector `[angular; linear]` that [`super::Transform::to_matrix`] and
     /// [`super::Inertia::to_matrix`] act on.
-    #[inline]
+    #[inline(always)]
     pub fn to_vector(&self) -> nalgebra::Vector6<f64> {
         nalgebra::Vector6::new(
             self.angular.x,
@@ -71,7 +100,7 @@ impl Motion {
     }
 
     /// Flattened `[linear; angular]`, robodyn's public order.
-    #[inline]
+    #[inline(always)]
     pub fn to_array(&self) -> [f64; 6] {
         [
             self.linear.x,
@@ -84,7 +113,7 @@ impl Motion {
     }
 
     /// Inverse of [`Motion::to_array`].
-    #[inline]
+    #[inline(always)]
     pub fn from_array(values: &[f64; 6]) -> Self {
         Motion {
             linear: Vec3::new(values[0], values[1], values[2]),
@@ -93,42 +122,42 @@ impl Motion {
     }
 }
 
-impl Add for Motion {
-    type Output = Motion;
-    #[inline]
-    fn add(self, rhs: Motion) -> Motion {
+impl<S: Real> Add for Motion<S> {
+    type Output = Motion<S>;
+    #[inline(always)]
+    fn add(self, rhs: Motion<S>) -> Motion<S> {
         Motion::new(self.angular + rhs.angular, self.linear + rhs.linear)
     }
 }
 
-impl AddAssign for Motion {
-    #[inline]
-    fn add_assign(&mut self, rhs: Motion) {
+impl<S: Real> AddAssign for Motion<S> {
+    #[inline(always)]
+    fn add_assign(&mut self, rhs: Motion<S>) {
         self.angular += rhs.angular;
         self.linear += rhs.linear;
     }
 }
 
-impl Sub for Motion {
-    type Output = Motion;
-    #[inline]
-    fn sub(self, rhs: Motion) -> Motion {
+impl<S: Real> Sub for Motion<S> {
+    type Output = Motion<S>;
+    #[inline(always)]
+    fn sub(self, rhs: Motion<S>) -> Motion<S> {
         Motion::new(self.angular - rhs.angular, self.linear - rhs.linear)
     }
 }
 
-impl Neg for Motion {
-    type Output = Motion;
-    #[inline]
-    fn neg(self) -> Motion {
+impl<S: Real> Neg for Motion<S> {
+    type Output = Motion<S>;
+    #[inline(always)]
+    fn neg(self) -> Motion<S> {
         Motion::new(-self.angular, -self.linear)
     }
 }
 
-impl Mul<f64> for Motion {
-    type Output = Motion;
-    #[inline]
-    fn mul(self, s: f64) -> Motion {
+impl<S: Real> Mul<S> for Motion<S> {
+    type Output = Motion<S>;
+    #[inline(always)]
+    fn mul(self, s: S) -> Motion<S> {
         Motion::new(self.angular * s, self.linear * s)
     }
 }

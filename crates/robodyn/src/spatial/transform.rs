@@ -1,6 +1,7 @@
 //! Plücker coordinate transforms (Featherstone §2.8).
 
-use super::{skew, Force, Inertia, Mat3, Mat6, Motion, Vec3};
+use super::{compose, rotate, rotate_back, skew, Force, Inertia, Mat3, Mat6, Motion, Real, Vec3};
+use nalgebra::{Matrix3, Vector3};
 use std::ops::Mul;
 
 /// Featherstone's `X = B_X_A`: the coordinate transform from frame A to frame B, stored as the
@@ -8,13 +9,13 @@ use std::ops::Mul;
 /// As a 6x6 matrix on `[angular; linear]` motion vectors, `X = [E 0; -E r× E]`.
 ///
 /// The same object describes the pose of B in A: rotation `Eᵀ`, translation `r`
-/// (see [`Transform::from_pose`] and [`Transform::to_homogeneous`]).
+/// (see [`Transform::from_pose`] and [`Transform::to_homogeneous`]). `S` as for [`Motion`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Transform {
+pub struct Transform<S = f64> {
     /// `E`: rotates A coordinates into B coordinates.
-    pub rotation: Mat3,
+    pub rotation: Matrix3<S>,
     /// `r`: B's origin expressed in A coordinates.
-    pub translation: Vec3,
+    pub translation: Vector3<S>,
 }
 
 impl Default for Transform {
@@ -29,11 +30,22 @@ impl Transform {
         rotation: Mat3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0),
         translation: Vec3::new(0.0, 0.0, 0.0),
     };
+}
+
+impl<S: Real> Transform<S> {
+    /// A constant transform (of the model) in every lane.
+    #[inline(always)]
+    pub fn splat(x: &Transform) -> Self {
+        Transform {
+            rotation: super::splat_matrix(&x.rotation),
+            translation: super::splat_vector(&x.translation),
+        }
+    }
 
     /// The transform into a frame B whose axes are `rotation` (columns = B's axes in A) and whose
     /// origin is at `position`, both in A coordinates: `E = rotationᵀ`, `r = position`.
-    #[inline]
-    pub fn from_pose(rotation: &Mat3, position: &Vec3) -> Self {
+    #[inline(always)]
+    pub fn from_pose(rotation: &Matrix3<S>, position: &Vector3<S>) -> Self {
         Transform {
             rotation: rotation.transpose(),
             translation: *position,
@@ -42,13 +54,13 @@ impl Transform {
 
     /// Rotation about a unit `axis` by `angle` (a frame rotated by `angle`): by Rodrigues' formula
     /// `R = c 1 + s a× + (1 - c) a aᵀ`, and `E = Rᵀ`.
-    #[inline]
-    pub fn from_axis_angle(axis: &Vec3, angle: f64) -> Self {
-        let (s, c) = angle.sin_cos();
-        let t = 1.0 - c;
-        let a = axis;
+    #[inline(always)]
+    pub fn from_axis_angle(axis: &Vec3, angle: S) -> Self {
+        let (s, c) = super::trig::sin_cos(angle);
+        let t = S::one() - c;
+        let a: Vector3<S> = super::splat_vector(axis);
         // E = c 1 - s a× + (1 - c) a aᵀ
-        let rotation = Mat3::new(
+        let rotation = Matrix3::new(
             c + t * a.x * a.x,
             t * a.x * a.y + s * a.z,
             t * a.x * a.z - s * a.y,
@@ -61,16 +73,16 @@ impl Transform {
         );
         Transform {
             rotation,
-            translation: Vec3::zeros(),
+            translation: super::zero_vector(),
         }
     }
 
     /// `X_J X` for `X_J` a rotation by `angle` about coordinate axis `k` (0, 1, 2 for x, y, z) of
     /// this transform's target frame: E' = E_J E turns the two rows of E other than k (E_J's
     /// rows are [c s; −s c] on them, as `from_axis_angle` gives), r' = r (X_J moves no origin).
-    #[inline]
-    pub fn rotated_about_axis(&self, k: usize, angle: f64) -> Transform {
-        let (s, c) = angle.sin_cos();
+    #[inline(always)]
+    pub fn rotated_about_axis(&self, k: usize, angle: S) -> Transform<S> {
+        let (s, c) = super::trig::sin_cos(angle);
         let (first, second) = ((k + 1) % 3, (k + 2) % 3);
         let mut rotation = self.rotation;
         for column in 0..3 {
@@ -88,14 +100,69 @@ impl Transform {
     }
 
     /// Pure translation: B's origin at `position` in A, axes parallel.
-    #[inline]
-    pub fn from_translation(position: &Vec3) -> Self {
+    #[inline(always)]
+    pub fn from_translation(position: &Vector3<S>) -> Self {
         Transform {
-            rotation: Mat3::identity(),
+            rotation: super::splat_matrix(&Mat3::identity()),
             translation: *position,
         }
     }
 
+    /// `X⁻¹ = A_X_B`: `E' = Eᵀ`, `r' = -E r`.
+    #[inline(always)]
+    pub fn inverse(&self) -> Transform<S> {
+        Transform {
+            rotation: self.rotation.transpose(),
+            translation: -rotate(&self.rotation, &self.translation),
+        }
+    }
+
+    /// `X m`: `ω' = E ω`, `v' = E (v - r × ω)`.
+    #[inline(always)]
+    pub fn apply_motion(&self, m: &Motion<S>) -> Motion<S> {
+        Motion {
+            angular: rotate(&self.rotation, &m.angular),
+            linear: rotate(
+                &self.rotation,
+                &(m.linear - self.translation.cross(&m.angular)),
+            ),
+        }
+    }
+
+    /// `X⁻¹ m`: `ω = Eᵀ ω'`, `v = Eᵀ v' + r × ω`.
+    #[inline(always)]
+    pub fn inverse_apply_motion(&self, m: &Motion<S>) -> Motion<S> {
+        let angular = rotate_back(&self.rotation, &m.angular);
+        Motion {
+            angular,
+            linear: rotate_back(&self.rotation, &m.linear) + self.translation.cross(&angular),
+        }
+    }
+
+    /// `X* f`: `n' = E (n - r × f)`, `f' = E f`.
+    #[inline(always)]
+    pub fn apply_force(&self, f: &Force<S>) -> Force<S> {
+        Force {
+            angular: rotate(
+                &self.rotation,
+                &(f.angular - self.translation.cross(&f.linear)),
+            ),
+            linear: rotate(&self.rotation, &f.linear),
+        }
+    }
+
+    /// `Xᵀ f` (B forces to A): `f = Eᵀ f'`, `n = Eᵀ n' + r × f`.
+    #[inline(always)]
+    pub fn transpose_apply_force(&self, f: &Force<S>) -> Force<S> {
+        let linear = rotate_back(&self.rotation, &f.linear);
+        Force {
+            angular: rotate_back(&self.rotation, &f.angular) + self.translation.cross(&linear),
+            linear,
+        }
+    }
+}
+
+impl Transform {
     /// The pose of B in A as a 4x4 homogeneous matrix `[Eᵀ r; 0 1]` (maps B points to A points).
     #[inline]
     pub fn to_homogeneous(&self) -> nalgebra::Matrix4<f64> {
@@ -105,53 +172,6 @@ impl Transform {
         pose.fixed_view_mut::<3, 1>(0, 3)
             .copy_from(&self.translation);
         pose
-    }
-
-    /// `X⁻¹ = A_X_B`: `E' = Eᵀ`, `r' = -E r`.
-    #[inline]
-    pub fn inverse(&self) -> Transform {
-        Transform {
-            rotation: self.rotation.transpose(),
-            translation: -(self.rotation * self.translation),
-        }
-    }
-
-    /// `X m`: `ω' = E ω`, `v' = E (v - r × ω)`.
-    #[inline]
-    pub fn apply_motion(&self, m: &Motion) -> Motion {
-        Motion {
-            angular: self.rotation * m.angular,
-            linear: self.rotation * (m.linear - self.translation.cross(&m.angular)),
-        }
-    }
-
-    /// `X⁻¹ m`: `ω = Eᵀ ω'`, `v = Eᵀ v' + r × ω`.
-    #[inline]
-    pub fn inverse_apply_motion(&self, m: &Motion) -> Motion {
-        let angular = self.rotation.tr_mul(&m.angular);
-        Motion {
-            angular,
-            linear: self.rotation.tr_mul(&m.linear) + self.translation.cross(&angular),
-        }
-    }
-
-    /// `X* f`: `n' = E (n - r × f)`, `f' = E f`.
-    #[inline]
-    pub fn apply_force(&self, f: &Force) -> Force {
-        Force {
-            angular: self.rotation * (f.angular - self.translation.cross(&f.linear)),
-            linear: self.rotation * f.linear,
-        }
-    }
-
-    /// `Xᵀ f` (B forces to A): `f = Eᵀ f'`, `n = Eᵀ n' + r × f`.
-    #[inline]
-    pub fn transpose_apply_force(&self, f: &Force) -> Force {
-        let linear = self.rotation.tr_mul(&f.linear);
-        Force {
-            angular: self.rotation.tr_mul(&f.angular) + self.translation.cross(&linear),
-            linear,
-        }
     }
 
     /// `Xᵀ I X`: a rigid-body inertia given in B coordinates, expressed in A coordinates.
@@ -224,13 +244,14 @@ impl Transform {
 }
 
 /// Composition `C_X_A = C_X_B * B_X_A`: `E = E_cb E_ba`, `r = r_ba + E_baᵀ r_cb`.
-impl Mul for Transform {
-    type Output = Transform;
-    #[inline]
-    fn mul(self, rhs: Transform) -> Transform {
+impl<S: Real> Mul for Transform<S> {
+    type Output = Transform<S>;
+    #[inline(always)]
+    #[allow(clippy::suspicious_arithmetic_impl)] // composing adds the rotated translation
+    fn mul(self, rhs: Transform<S>) -> Transform<S> {
         Transform {
-            rotation: self.rotation * rhs.rotation,
-            translation: rhs.translation + rhs.rotation.tr_mul(&self.translation),
+            rotation: compose(&self.rotation, &rhs.rotation),
+            translation: rhs.translation + rotate_back(&rhs.rotation, &self.translation),
         }
     }
 }

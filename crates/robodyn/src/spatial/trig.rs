@@ -1,0 +1,139 @@
+//! sin and cos of a joint angle in arithmetic alone, so that a batch kernel computes them in
+//! vector lanes (a library call per lane would cost as much as the rest of the kernel) and a
+//! one-state call gets the same digits from the same operations.
+//!
+//! Method (Cody & Waite 1980; the kernels of Sun's fdlibm, 1993): reduce x by the nearest
+//! multiple n of π/2, r = x − n π/2 with π/2 split in three parts (each product n·part exact for
+//! |n| < 2²⁰), evaluate the minimax polynomials of sin and cos on |r| ≤ π/4 (error below 2⁻⁵⁸),
+//! and pick and sign them by the quadrant n mod 4. Accurate to an ulp or so; beyond
+//! [`REDUCTION_LIMIT`] the library's sin and cos are used.
+
+// the constants are written as published, to 21 digits; each rounds to the intended double
+#![allow(clippy::excessive_precision)]
+
+use super::Real;
+use nalgebra::SimdBool;
+
+/// Largest |x| the three-part reduction handles (|n| < 2²⁰ with margin); beyond it, and for
+/// non-finite x, the standard library's functions answer.
+pub const REDUCTION_LIMIT: f64 = 1e5;
+
+/// π/2 in three parts of 33 significant bits (fdlibm's `pio2_1`, `pio2_2`, `pio2_3`).
+const HALF_PI: [f64; 3] = [
+    1.570_796_326_734_125_614_17,
+    6.077_100_506_506_192_249_32e-11,
+    2.022_266_248_711_166_455_80e-21,
+];
+
+/// sin r = r + r³ (S1 + r² (S2 + ... + r² S6)) on |r| ≤ π/4 (fdlibm `k_sin.c`).
+const SIN: [f64; 6] = [
+    -1.666_666_666_666_663_243_48e-1,
+    8.333_333_333_322_489_461_24e-3,
+    -1.984_126_982_985_794_931_34e-4,
+    2.755_731_370_707_006_767_89e-6,
+    -2.505_076_025_340_686_341_95e-8,
+    1.589_690_995_211_550_102_21e-10,
+];
+
+/// cos r = 1 − r²/2 + r⁴ (C1 + r² (C2 + ... + r² C6)) on |r| ≤ π/4 (fdlibm `k_cos.c`).
+const COS: [f64; 6] = [
+    4.166_666_666_666_660_190_37e-2,
+    -1.388_888_888_887_410_957_49e-3,
+    2.480_158_728_947_672_941_78e-5,
+    -2.755_731_435_139_066_330_35e-7,
+    2.087_572_321_298_174_827_90e-9,
+    -1.135_964_755_778_819_482_65e-11,
+];
+
+/// Adding and subtracting 1.5·2⁵² rounds a float below 2⁵¹ in magnitude to the nearest integer.
+const ROUNDING: f64 = 6_755_399_441_055_744.0;
+
+/// `(sin x, cos x)`, in every lane at once.
+#[inline(always)]
+pub fn sin_cos<S: Real>(x: S) -> (S, S) {
+    let splat = S::splat;
+    // n = round(x 2/π), r = x − n π/2
+    let n = (x * splat(std::f64::consts::FRAC_2_PI) + splat(ROUNDING)) - splat(ROUNDING);
+    let r = ((x - n * splat(HALF_PI[0])) - n * splat(HALF_PI[1])) - n * splat(HALF_PI[2]);
+    let z = r * r;
+    let polynomial = |c: &[f64; 6]| {
+        let mut p = splat(c[5]);
+        for &c_k in c[..5].iter().rev() {
+            p = p * z + splat(c_k);
+        }
+        p
+    };
+    let sin_r = r + r * z * polynomial(&SIN);
+    // 1 − z/2 rounded, and what that rounding lost added back
+    let half_z = splat(0.5) * z;
+    let w = splat(1.0) - half_z;
+    let cos_r = w + (((splat(1.0) - w) - half_z) + z * z * polynomial(&COS));
+    // quadrant k = n mod 4: (sin, cos) = (s, c), (c, −s), (−s, −c), (−c, s)
+    let k = n - splat(4.0) * (n * splat(0.25)).simd_floor();
+    let odd = k.simd_eq(splat(1.0)) | k.simd_eq(splat(3.0));
+    let (sin, cos) = (cos_r.select(odd, sin_r), sin_r.select(odd, cos_r));
+    let sin = (-sin).select(k.simd_ge(splat(2.0)), sin);
+    let cos = (-cos).select(k.simd_eq(splat(1.0)) | k.simd_eq(splat(2.0)), cos);
+    // the lanes beyond the reduction's range from the library, each lane on its own
+    let beyond = x.simd_abs().simd_gt(splat(REDUCTION_LIMIT));
+    if beyond.any() {
+        let (sin_far, cos_far) = x.simd_sin_cos();
+        return (sin_far.select(beyond, sin), cos_far.select(beyond, cos));
+    }
+    (sin, cos)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use simba::simd::AutoF64x4;
+
+    /// Both within this many units in the last place of 1 of the library's values.
+    const ULPS: f64 = 2.0;
+
+    fn check(x: f64) {
+        let (sin, cos) = sin_cos(x);
+        let (sin_ref, cos_ref) = x.sin_cos();
+        let tolerance = ULPS * f64::EPSILON;
+        assert!(
+            (sin - sin_ref).abs() <= tolerance,
+            "sin({x}) = {sin} != {sin_ref}"
+        );
+        assert!(
+            (cos - cos_ref).abs() <= tolerance,
+            "cos({x}) = {cos} != {cos_ref}"
+        );
+    }
+
+    #[test]
+    fn agrees_with_the_library_to_an_ulp() {
+        for k in -400_000..=400_000 {
+            check(k as f64 * 2.5e-4);
+        }
+        for k in 0..200 {
+            let quarter = k as f64 * std::f64::consts::FRAC_PI_4;
+            for x in [quarter, -quarter, quarter + 1e-9, quarter - 1e-12] {
+                check(x);
+            }
+        }
+        for x in [
+            0.0, -0.0, 1e-300, -1e-20, 123.456, 9.99e4, -9.99e4, 1e5, 3e5, 1e300,
+        ] {
+            check(x);
+        }
+        assert!(sin_cos(f64::NAN).0.is_nan() && sin_cos(f64::INFINITY).1.is_nan());
+    }
+
+    #[test]
+    fn lanes_equal_one_value_bit_for_bit() {
+        let x = AutoF64x4::from([0.3, -2.9, 7.1, 2.0e5]);
+        let (sin, cos) = sin_cos(x);
+        for l in 0..4 {
+            let (s, c) = sin_cos(x.0[l]);
+            assert_eq!(
+                (sin.0[l].to_bits(), cos.0[l].to_bits()),
+                (s.to_bits(), c.to_bits())
+            );
+        }
+    }
+}
