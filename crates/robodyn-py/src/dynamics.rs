@@ -191,7 +191,7 @@ impl PyModel {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let arguments = self.dynamics_arguments(q, v, ("tau", tau), f_ext)?;
-        self.with_external_forces(py, &arguments, out, algo::aba, None)
+        self.with_external_forces(py, &arguments, out, algo::aba, Some(&aba_run))
     }
 
     /// Derivatives of inverse dynamics τ = ID(q, v, a, f_ext): dict of `dtau_dq`, `dtau_dv` and

@@ -48,6 +48,12 @@ impl Workspace {
             lanes: None,
         }
     }
+
+    /// The lane buffers of the batch kernels, made on first use.
+    fn lanes(&mut self, model: &Model) -> &mut BatchWorkspace {
+        self.lanes
+            .get_or_insert_with(|| Box::new(BatchWorkspace::new(model)))
+    }
 }
 
 /// Copies a flat array of `[linear; angular]` rows, one per body, into `forces`.
@@ -83,15 +89,29 @@ pub(crate) fn newton_euler_run(
     inputs: &[&[f64]],
     out: &mut [f64],
 ) -> BatchResult {
-    let lanes = workspace
-        .lanes
-        .get_or_insert_with(|| Box::new(BatchWorkspace::new(model)));
     let states = States {
         q: inputs[0],
         v: inputs.get(1).copied(),
         a: inputs.get(2).copied(),
+        tau: None,
     };
-    algo::newton_euler_batch(model, lanes, states, out)
+    algo::newton_euler_batch(model, workspace.lanes(model), states, out)
+}
+
+/// The articulated-body algorithm in lanes over a run: the inputs are q, v and τ.
+pub(crate) fn aba_run(
+    model: &Model,
+    workspace: &mut Workspace,
+    inputs: &[&[f64]],
+    out: &mut [f64],
+) -> BatchResult {
+    let states = States {
+        q: inputs[0],
+        v: Some(inputs[1]),
+        a: None,
+        tau: Some(inputs[2]),
+    };
+    algo::aba_batch(model, workspace.lanes(model), states, out)
 }
 
 /// The most numeric arguments a method takes (q, v, a, f_ext).

@@ -11,7 +11,7 @@ use crate::spatial::{
     log_rotation, rotate_back, skew, splat_vector, zero_vector, Force, Mat3, Mat6, Motion, Real,
     Transform, Vec3,
 };
-use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3, Vector6};
+use nalgebra::{Matrix3, Matrix6, Quaternion, UnitQuaternion, Vector3, Vector6};
 use rand::Rng;
 
 mod jacobians;
@@ -146,29 +146,21 @@ impl Joint {
     /// `I S_k` for a 6x6 inertia `I` on `[angular; linear]` (an articulated one, say) and this
     /// joint's subspace column k: one column of I, or its angular (revolute) or linear
     /// (prismatic) half times the axis — not a full 6x6 product.
-    #[inline]
-    pub fn inertia_times_subspace(&self, inertia: &Mat6, k: usize) -> Force {
-        let column = |c: usize| {
-            let x = inertia.column(c);
-            Force::new(Vec3::new(x[0], x[1], x[2]), Vec3::new(x[3], x[4], x[5]))
-        };
-        let half = |first: usize, axis: &Vec3| {
-            let columns = |start: usize| inertia.fixed_view::<3, 3>(start, first) * axis;
-            Force::new(columns(0), columns(3))
-        };
+    #[inline(always)]
+    pub fn inertia_times_subspace<S: Real>(&self, inertia: &Matrix6<S>, k: usize) -> Force<S> {
         match self {
-            Joint::Fixed => Force::ZERO,
+            Joint::Fixed => Force::new(zero_vector(), zero_vector()),
             Joint::Revolute { axis } => match coordinate_axis(axis) {
-                Some(c) => column(c),
-                None => half(0, axis),
+                Some(c) => inertia_column(inertia, c),
+                None => inertia_times_axis(inertia, 0, axis),
             },
             Joint::Prismatic { axis } => match coordinate_axis(axis) {
-                Some(c) => column(3 + c),
-                None => half(3, axis),
+                Some(c) => inertia_column(inertia, 3 + c),
+                None => inertia_times_axis(inertia, 3, axis),
             },
-            Joint::Spherical => column(k),
-            Joint::Free if k < 3 => column(3 + k),
-            Joint::Free => column(k - 3),
+            Joint::Spherical => inertia_column(inertia, k),
+            Joint::Free if k < 3 => inertia_column(inertia, 3 + k),
+            Joint::Free => inertia_column(inertia, k - 3),
         }
     }
 
@@ -429,6 +421,31 @@ where
     let ad2 = ad(ad1);
     let ad4 = ad(ad(ad2));
     v + ad1 * 0.5 + ad2 * (1.0 / 12.0) + ad4 * (-1.0 / 720.0)
+}
+
+/// Column `c` of a 6x6 inertia, as a force.
+#[inline(always)]
+fn inertia_column<S: Real>(inertia: &Matrix6<S>, c: usize) -> Force<S> {
+    Force::new(
+        Vector3::new(inertia[(0, c)], inertia[(1, c)], inertia[(2, c)]),
+        Vector3::new(inertia[(3, c)], inertia[(4, c)], inertia[(5, c)]),
+    )
+}
+
+/// Columns `first..first + 3` of a 6x6 inertia times `axis`, as a force.
+#[inline(always)]
+fn inertia_times_axis<S: Real>(inertia: &Matrix6<S>, first: usize, axis: &Vec3) -> Force<S> {
+    let a = splat_vector::<S>(axis);
+    let mut rows = [S::splat(0.0); 6];
+    for (r, row) in rows.iter_mut().enumerate() {
+        *row = inertia[(r, first)] * a.x
+            + inertia[(r, first + 1)] * a.y
+            + inertia[(r, first + 2)] * a.z;
+    }
+    Force::new(
+        Vector3::new(rows[0], rows[1], rows[2]),
+        Vector3::new(rows[3], rows[4], rows[5]),
+    )
 }
 
 /// The unit quaternion of `[qx, qy, qz, qw]` (normalised).

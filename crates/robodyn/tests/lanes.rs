@@ -1,11 +1,12 @@
 //! Batches in lanes (`algo::lanes`) against the one-state calls: every width, every test model,
-//! inverse dynamics, bias forces and gravity, bit for bit.
+//! inverse dynamics, bias forces, gravity and forward dynamics, bit for bit.
 
 mod common;
 
 use common::*;
 use robodyn::algo::{
-    bias_forces, generalized_gravity, newton_euler_batch, rnea, BatchWorkspace, LaneWidth, States,
+    aba, aba_batch, bias_forces, generalized_gravity, newton_euler_batch, rnea, BatchWorkspace,
+    LaneWidth, States,
 };
 use robodyn::{Data, Error, Model};
 
@@ -30,15 +31,42 @@ fn one_state(model: &Model, data: &mut Data, states: &States, k: usize) -> Vec<f
     let (nq, nv) = (model.nq, model.nv);
     let q = &states.q[k * nq..(k + 1) * nq];
     let row = |x: &[f64]| x[k * nv..(k + 1) * nv].to_vec();
-    match (states.v.map(row), states.a.map(row)) {
-        (Some(v), Some(a)) => rnea(model, data, q, &v, &a, None),
-        (Some(v), None) => bias_forces(model, data, q, &v),
-        (None, None) => generalized_gravity(model, data, q),
-        (None, Some(_)) => unreachable!("no acceleration without a velocity here"),
+    match (states.v.map(row), states.a.map(row), states.tau.map(row)) {
+        (Some(v), None, Some(tau)) => aba(model, data, q, &v, &tau, None),
+        (Some(v), Some(a), None) => rnea(model, data, q, &v, &a, None),
+        (Some(v), None, None) => bias_forces(model, data, q, &v),
+        (None, None, None) => generalized_gravity(model, data, q),
+        _ => unreachable!("not a combination these tests make"),
     }
     .unwrap()
     .as_slice()
     .to_vec()
+}
+
+/// The batch of `states` at `width`, or `None` where this CPU lacks the width.
+fn batch_at(model: &Model, width: LaneWidth, states: States) -> Option<Vec<f64>> {
+    let Ok(mut workspace) = BatchWorkspace::with_width(model, width) else {
+        assert!(!width.available(), "{width:?} is available but refused");
+        return None;
+    };
+    let mut out = vec![f64::NAN; STATES * model.nv];
+    match states.tau {
+        Some(_) => aba_batch(model, &mut workspace, states, &mut out),
+        None => newton_euler_batch(model, &mut workspace, states, &mut out),
+    }
+    .unwrap();
+    // the full groups ran in lanes (forward dynamics at four lanes at most)
+    let group = match (states.tau, width) {
+        (Some(_), LaneWidth::Eight) => 4,
+        (_, width) if width.states() > 1 => width.states(),
+        _ => STATES + 1,
+    };
+    assert_eq!(
+        workspace.states_in_lanes(),
+        STATES - STATES % group,
+        "{width:?}"
+    );
+    Some(out)
 }
 
 #[test]
@@ -52,27 +80,30 @@ fn every_lane_width_equals_the_one_state_call_bit_for_bit() {
                 q: &q,
                 v: Some(&v),
                 a: Some(&a),
+                tau: None,
+            },
+            States {
+                q: &q,
+                v: Some(&v),
+                ..States::default()
+            },
+            States {
+                q: &q,
+                ..States::default()
             },
             States {
                 q: &q,
                 v: Some(&v),
                 a: None,
-            },
-            States {
-                q: &q,
-                v: None,
-                a: None,
+                tau: Some(&a),
             },
         ] {
             for width in LaneWidth::ALL {
-                let Ok(mut workspace) = BatchWorkspace::with_width(&model, width) else {
-                    assert!(!width.available(), "{width:?} is available but refused");
+                let Some(out) = batch_at(&model, width, states) else {
                     continue;
                 };
                 exercised += 1;
-                let mut tau = vec![f64::NAN; STATES * model.nv];
-                newton_euler_batch(&model, &mut workspace, states, &mut tau).unwrap();
-                for (k, row) in tau.chunks(model.nv).enumerate() {
+                for (k, row) in out.chunks(model.nv).enumerate() {
                     let expected = one_state(&model, &mut data, &states, k);
                     let same = row
                         .iter()
@@ -87,7 +118,7 @@ fn every_lane_width_equals_the_one_state_call_bit_for_bit() {
         }
     }
     // the one-state width runs everywhere
-    assert!(exercised >= 3 * test_models().len());
+    assert!(exercised >= 4 * test_models().len());
 }
 
 #[test]
@@ -117,6 +148,7 @@ fn a_bad_state_is_named_by_its_index() {
             q: &q,
             v: Some(&v),
             a: Some(&a),
+            tau: None,
         };
         match newton_euler_batch(&model, &mut workspace, states, &mut tau) {
             Err((13, Error::NotFinite { argument, .. })) => assert_eq!(argument, "v", "{name}"),
@@ -128,6 +160,7 @@ fn a_bad_state_is_named_by_its_index() {
             q: &q,
             v: Some(&v),
             a: Some(&a),
+            tau: None,
         };
         let result = newton_euler_batch(&model, &mut workspace, states, &mut tau);
         assert!(matches!(result, Err((5, _))), "{name}: {result:?}");
@@ -136,6 +169,7 @@ fn a_bad_state_is_named_by_its_index() {
             q: &q[1..],
             v: Some(&v),
             a: Some(&a),
+            tau: None,
         };
         let result = newton_euler_batch(&model, &mut workspace, states, &mut tau);
         assert!(
@@ -143,4 +177,34 @@ fn a_bad_state_is_named_by_its_index() {
             "{name}: {result:?}"
         );
     }
+}
+
+#[test]
+fn a_singular_state_in_a_group_is_named_by_its_index() {
+    // the floating UR5's base link is massless: forward dynamics is singular at every state, so
+    // the group in lanes fails and the first state is named, as a one-state call would name it
+    let model = robodyn::io::bundled_model("ur5", true).unwrap();
+    let (q, v, a) = batch(&model);
+    let mut workspace = BatchWorkspace::new(&model);
+    let mut out = vec![0.0; STATES * model.nv];
+    let states = States {
+        q: &q,
+        v: Some(&v),
+        a: None,
+        tau: Some(&a),
+    };
+    match aba_batch(&model, &mut workspace, states, &mut out) {
+        Err((0, Error::InvalidValue { message, .. })) => assert!(message.contains("singular")),
+        other => panic!("expected state 0 to be singular, got {other:?}"),
+    }
+    let states = States {
+        q: &q,
+        v: Some(&v),
+        ..States::default()
+    };
+    let result = aba_batch(&model, &mut workspace, states, &mut out);
+    assert!(
+        matches!(result, Err((0, Error::InvalidValue { .. }))),
+        "{result:?}"
+    );
 }

@@ -6,14 +6,16 @@
 //! Writes `data.x_up`, `data.v`, `data.c`, `data.i_a`, `data.p_a`, `data.u`, `data.d_inv`,
 //! `data.u_tau`, `data.a`, `data.qdd`. Cost: O(n).
 
-use crate::algo::kinematics::update_joint_transforms;
+use crate::algo::kinematics::joint_transforms;
 use crate::algo::rnea::check_external_forces;
 use crate::algo::SINGULARITY_TOLERANCE;
 use crate::error::{check_vector, Error, Result};
 use crate::model::Model;
-use crate::spatial::{mat6_mul_motion, Force, Mat6, Motion, Vec3};
+use crate::spatial::{
+    mat6_mul_motion, splat_matrix6, splat_vector, zero_vector, Force, Motion, Real, Transform,
+};
 use crate::Data;
-use nalgebra::DVector;
+use nalgebra::{DVector, Matrix6, SimdBool};
 
 /// q̈ = FD(q, q̇, τ, f_ext), written into `data.qdd`.
 pub fn aba<'d>(
@@ -30,26 +32,82 @@ pub fn aba<'d>(
     if let Some(forces) = f_ext {
         check_external_forces(model, forces)?;
     }
-    update_joint_transforms(model, data, q);
+    let buffers = AbaBuffers {
+        x_up: &mut data.x_up,
+        v: &mut data.v,
+        c: &mut data.c,
+        a: &mut data.a,
+        i_a: &mut data.i_a,
+        p_a: &mut data.p_a,
+        u: &mut data.u,
+        u_tau: &mut data.u_tau,
+        d_inv: &mut data.d_inv,
+        qdd: data.qdd.as_mut_slice(),
+    };
+    articulated_body_passes(model, q, v, tau, f_ext, buffers)
+        .map_err(|joint| singular_joint(model, joint))?;
+    Ok(&data.qdd)
+}
+
+/// The error for a joint whose articulated inertia `D_i` is singular.
+pub(crate) fn singular_joint(model: &Model, joint: usize) -> Error {
+    Error::InvalidValue {
+        argument: "q".into(),
+        message: format!(
+            "the articulated inertia of joint '{}' is singular (a massless subtree without \
+             armature): forward dynamics is undefined",
+            model.joint_names[joint]
+        ),
+    }
+}
+
+/// What the ABA passes write, per body and per velocity coordinate (qdd): one state's,
+/// borrowed from [`Data`] (see its fields), or several states' in lanes ([`crate::algo::lanes`]).
+pub(crate) struct AbaBuffers<'b, S> {
+    pub x_up: &'b mut [Transform<S>],
+    pub v: &'b mut [Motion<S>],
+    pub c: &'b mut [Motion<S>],
+    pub a: &'b mut [Motion<S>],
+    pub i_a: &'b mut [Matrix6<S>],
+    pub p_a: &'b mut [Force<S>],
+    pub u: &'b mut [[Force<S>; 6]],
+    pub u_tau: &'b mut [[S; 6]],
+    pub d_inv: &'b mut [Matrix6<S>],
+    pub qdd: &'b mut [S],
+}
+
+/// The three passes of Table 7.1 on checked inputs, in `f64` or in lanes (the same operations
+/// in every lane). An error gives the first body whose `D_i` is singular in some lane.
+#[inline(always)]
+pub(crate) fn articulated_body_passes<S: Real>(
+    model: &Model,
+    q: &[S],
+    v: &[S],
+    tau: &[S],
+    f_ext: Option<&[Force<S>]>,
+    out: AbaBuffers<S>,
+) -> std::result::Result<(), usize> {
+    joint_transforms(model, q, out.x_up);
 
     // pass 1, outward: velocities, velocity-product accelerations, rigid-body inertias and biases
-    data.v[0] = Motion::ZERO;
+    out.v[0] = Motion::zeros();
     for i in 1..model.nbodies() {
         let v_j = model.joints[i].motion(&v[model.v_range(i)]);
         // v_i = X_i v_λ(i) + v_J;  c_i = v_i × v_J
-        let v_i = data.x_up[i].apply_motion(&data.v[model.parent[i]]) + v_j;
-        data.c[i] = v_i.cross_motion(&v_j);
+        let v_i = out.x_up[i].apply_motion(&out.v[model.parent[i]]) + v_j;
+        out.c[i] = v_i.cross_motion(&v_j);
         let inertia = &model.inertias[i];
-        data.i_a[i] = inertia.to_matrix();
+        out.i_a[i] = splat_matrix6(&inertia.to_matrix());
         // p^A_i = v_i ×* I_i v_i - f_ext_i
-        data.p_a[i] = v_i.cross_force(&inertia.mul_motion(&v_i));
+        out.p_a[i] = v_i.cross_force(&inertia.mul_motion(&v_i));
         if let Some(forces) = f_ext {
-            data.p_a[i] -= forces[i - 1];
+            out.p_a[i] -= forces[i - 1];
         }
-        data.v[i] = v_i;
+        out.v[i] = v_i;
     }
 
     // pass 2, inward: articulated inertias and bias forces
+    let mut singular = None;
     for i in (1..model.nbodies()).rev() {
         let joint = &model.joints[i];
         let nv_i = joint.nv();
@@ -57,105 +115,129 @@ pub fn aba<'d>(
         let v_i = &v[dofs.clone()];
         for k in 0..nv_i {
             // U_i = I^A_i S_i;  u_i = τ_i - S_iᵀ p^A_i - armature K(q̇_i) q̇_i
-            data.u[i][k] = joint.inertia_times_subspace(&data.i_a[i], k);
-            let rotor: f64 = (0..nv_i)
-                .map(|c| joint.rotor_velocity_term(k, c, v_i) * v_i[c])
-                .sum();
-            data.u_tau[i][k] = tau[dofs.start + k]
-                - joint.project_force(k, &data.p_a[i])
-                - model.armature[dofs.start + k] * rotor;
+            out.u[i][k] = joint.inertia_times_subspace(&out.i_a[i], k);
+            let mut rotor = S::splat(0.0);
+            for (c, v_c) in v_i.iter().enumerate() {
+                rotor += joint.rotor_velocity_term(k, c, v_i) * *v_c;
+            }
+            out.u_tau[i][k] = tau[dofs.start + k]
+                - joint.project_force(k, &out.p_a[i])
+                - S::splat(model.armature[dofs.start + k]) * rotor;
         }
-        // D_i = S_iᵀ U_i + armature
-        let mut d = Mat6::identity();
+        // D_i = S_iᵀ U_i + armature, inverted in place
+        let d = &mut out.d_inv[i];
         for r in 0..nv_i {
             for c in 0..nv_i {
-                d[(r, c)] = joint.project_force(r, &data.u[i][c]);
+                d[(r, c)] = joint.project_force(r, &out.u[i][c]);
             }
-            d[(r, r)] += model.armature[dofs.start + r];
+            d[(r, r)] += S::splat(model.armature[dofs.start + r]);
         }
-        if !invert_leading_block(&mut d, nv_i) {
-            return Err(Error::InvalidValue {
-                argument: "q".into(),
-                message: format!(
-                    "the articulated inertia of joint '{}' is singular (a massless subtree without \
-                     armature): forward dynamics is undefined",
-                    model.joint_names[i]
-                ),
-            });
+        if invert_leading_block(d, nv_i).any() && singular.is_none() {
+            singular = Some(i);
         }
-        data.d_inv[i] = d;
+        let d = &out.d_inv[i];
         let parent = model.parent[i];
         if parent != 0 {
             // I^a = I^A - U D⁻¹ Uᵀ;  p^a = p^A + I^a c + U D⁻¹ u
-            let mut i_a = data.i_a[i];
-            let mut p_a = data.p_a[i];
+            let mut i_a = out.i_a[i];
+            let mut p_a = out.p_a[i];
             for r in 0..nv_i {
-                let u_r = data.u[i][r].to_vector();
-                let mut d_inv_u = 0.0;
+                let mut d_inv_u = S::splat(0.0);
                 for c in 0..nv_i {
                     // rank-one update in place: I^a −= D⁻¹_rc U_r U_cᵀ
-                    i_a.ger(-d[(r, c)], &u_r, &data.u[i][c].to_vector(), 1.0);
-                    d_inv_u += d[(r, c)] * data.u_tau[i][c];
+                    subtract_outer(&mut i_a, d[(r, c)], &out.u[i][r], &out.u[i][c]);
+                    d_inv_u += d[(r, c)] * out.u_tau[i][c];
                 }
-                p_a += data.u[i][r] * d_inv_u;
+                p_a += out.u[i][r] * d_inv_u;
             }
-            p_a += mat6_mul_motion(&i_a, &data.c[i]);
+            p_a += mat6_mul_motion(&i_a, &out.c[i]);
             // I^A_λ(i) += X_iᵀ I^a X_i;  p^A_λ(i) += X_iᵀ p^a
-            let carried = data.x_up[i].transpose_apply_matrix(&i_a);
-            data.i_a[parent] += carried;
-            let p_parent = data.x_up[i].transpose_apply_force(&p_a);
-            data.p_a[parent] += p_parent;
+            let carried = out.x_up[i].transpose_apply_matrix(&i_a);
+            for (sum, x) in out.i_a[parent]
+                .as_mut_slice()
+                .iter_mut()
+                .zip(carried.as_slice())
+            {
+                *sum += *x;
+            }
+            let p_parent = out.x_up[i].transpose_apply_force(&p_a);
+            out.p_a[parent] += p_parent;
         }
+    }
+    if let Some(joint) = singular {
+        return Err(joint);
     }
 
     // pass 3, outward: accelerations
-    data.a[0] = Motion::new(Vec3::zeros(), -model.gravity);
+    out.a[0] = Motion::new(zero_vector(), -splat_vector::<S>(&model.gravity));
     for i in 1..model.nbodies() {
         let joint = &model.joints[i];
         let dofs = model.v_range(i);
         // a'_i = X_i a_λ(i) + c_i
-        let a_i = data.x_up[i].apply_motion(&data.a[model.parent[i]]) + data.c[i];
+        let mut a_i = out.x_up[i].apply_motion(&out.a[model.parent[i]]) + out.c[i];
         // q̈_i = D_i⁻¹ (u_i - U_iᵀ a'_i)
         let nv_i = joint.nv();
-        let mut rhs = [0.0; 6];
+        let mut rhs = [S::splat(0.0); 6];
         for (k, value) in rhs.iter_mut().enumerate().take(nv_i) {
-            *value = data.u_tau[i][k] - a_i.dot(&data.u[i][k]);
+            *value = out.u_tau[i][k] - a_i.dot(&out.u[i][k]);
         }
-        let mut a_i = a_i;
         for (r, dof) in dofs.enumerate() {
-            let qdd: f64 = (0..nv_i).map(|c| data.d_inv[i][(r, c)] * rhs[c]).sum();
-            data.qdd[dof] = qdd;
+            let mut qdd = S::splat(0.0);
+            for (c, rhs_c) in rhs.iter().enumerate().take(nv_i) {
+                qdd += out.d_inv[i][(r, c)] * *rhs_c;
+            }
+            out.qdd[dof] = qdd;
             // a_i = a'_i + S_i q̈_i
-            a_i += joint.subspace_column(r) * qdd;
+            a_i += Motion::splat(&joint.subspace_column(r)) * qdd;
         }
-        data.a[i] = a_i;
+        out.a[i] = a_i;
     }
-    Ok(&data.qdd)
+    Ok(())
+}
+
+/// `I −= d x yᵀ` for two forces taken as `[angular; linear]` 6-vectors.
+#[inline(always)]
+fn subtract_outer<S: Real>(inertia: &mut Matrix6<S>, d: S, x: &Force<S>, y: &Force<S>) {
+    let (x, y) = (x.plucker(), y.plucker());
+    for (col, y_col) in y.iter().enumerate() {
+        let scale = -(d * *y_col);
+        for (row, x_row) in x.iter().enumerate() {
+            inertia[(row, col)] += scale * *x_row;
+        }
+    }
 }
 
 /// Inverts the leading `n` x `n` block of `m` in place by Gauss–Jordan elimination without
-/// pivoting (the block, `D_i`, is symmetric positive definite). Returns false if a pivot is not
-/// positive relative to the block's largest diagonal entry ([`SINGULARITY_TOLERANCE`]).
-fn invert_leading_block(m: &mut Mat6, n: usize) -> bool {
-    let scale = (0..n).map(|k| m[(k, k)]).fold(0.0, f64::max);
+/// pivoting (the block, `D_i`, is symmetric positive definite). Returns the lanes where a pivot is
+/// not positive relative to the block's largest diagonal entry ([`SINGULARITY_TOLERANCE`]).
+#[inline(always)]
+fn invert_leading_block<S: Real>(m: &mut Matrix6<S>, n: usize) -> S::SimdBool {
+    let zero = S::splat(0.0);
+    let mut scale = zero;
+    for k in 0..n {
+        scale = scale.simd_max(m[(k, k)]);
+    }
+    let threshold = S::splat(SINGULARITY_TOLERANCE) * scale;
+    // false in every lane, unless the scale is NaN
+    let mut singular = scale.simd_ne(scale);
     for k in 0..n {
         let pivot = m[(k, k)];
-        if pivot.is_nan() || pivot <= SINGULARITY_TOLERANCE * scale || pivot <= 0.0 {
-            return false;
-        }
-        m[(k, k)] = 1.0;
+        // NaN compares false, so a NaN pivot is singular too
+        singular = singular | !(pivot.simd_gt(threshold) & pivot.simd_gt(zero));
+        m[(k, k)] = S::splat(1.0);
         for j in 0..n {
             m[(k, j)] /= pivot;
         }
         for i in 0..n {
             if i != k {
                 let factor = m[(i, k)];
-                m[(i, k)] = 0.0;
+                m[(i, k)] = zero;
                 for j in 0..n {
-                    m[(i, j)] -= factor * m[(k, j)];
+                    let product = factor * m[(k, j)];
+                    m[(i, j)] -= product;
                 }
             }
         }
     }
-    true
+    singular
 }

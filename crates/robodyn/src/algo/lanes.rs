@@ -10,11 +10,13 @@
 //! width is chosen at run time by the CPU found ([`LaneWidth::detect`]); the wide kernels are
 //! compiled once per instruction set (`#[target_feature]`), so one binary serves every x86-64 CPU.
 
+use crate::algo::aba::{aba, articulated_body_passes, AbaBuffers};
 use crate::algo::rnea::{newton_euler, newton_euler_passes, NewtonEulerBuffers};
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::model::Model;
-use crate::spatial::{Force, Motion, Real, Transform};
+use crate::spatial::{splat_matrix6, Force, Mat6, Motion, Real, Transform};
 use crate::Data;
+use nalgebra::Matrix6;
 use simba::simd::{AutoF64x4, AutoF64x8};
 
 /// How many states a batch kernel runs at once.
@@ -64,32 +66,49 @@ impl LaneWidth {
     }
 }
 
-/// The per-lane buffers of one lane type: inputs gathered into lanes and the kernel's results.
+/// The per-lane buffers of one lane type: inputs gathered into lanes, the kernels' intermediates
+/// and their result.
 #[derive(Debug, Clone)]
 struct Lanes<S> {
     q: Vec<S>,
     v: Vec<S>,
     a: Vec<S>,
+    tau: Vec<S>,
     x_up: Vec<Transform<S>>,
     velocities: Vec<Motion<S>>,
     accelerations: Vec<Motion<S>>,
     forces: Vec<Force<S>>,
-    tau: Vec<S>,
+    velocity_products: Vec<Motion<S>>,
+    articulated_inertias: Vec<Matrix6<S>>,
+    articulated_biases: Vec<Force<S>>,
+    u: Vec<[Force<S>; 6]>,
+    u_tau: Vec<[S; 6]>,
+    d_inv: Vec<Matrix6<S>>,
+    out: Vec<S>,
 }
 
 impl<S: Real> Lanes<S> {
     fn new(model: &Model) -> Self {
         let bodies = model.nbodies();
         let zero = S::splat(0.0);
+        let zero_force = Force::splat(&Force::ZERO);
+        let zero_matrix = splat_matrix6(&Mat6::zeros());
         Lanes {
             q: vec![zero; model.nq],
             v: vec![zero; model.nv],
             a: vec![zero; model.nv],
+            tau: vec![zero; model.nv],
             x_up: vec![Transform::splat(&Transform::IDENTITY); bodies],
             velocities: vec![Motion::zeros(); bodies],
             accelerations: vec![Motion::zeros(); bodies],
-            forces: vec![Force::splat(&Force::ZERO); bodies],
-            tau: vec![zero; model.nv],
+            forces: vec![zero_force; bodies],
+            velocity_products: vec![Motion::zeros(); bodies],
+            articulated_inertias: vec![zero_matrix; bodies],
+            articulated_biases: vec![zero_force; bodies],
+            u: vec![[zero_force; 6]; bodies],
+            u_tau: vec![[zero; 6]; bodies],
+            d_inv: vec![zero_matrix; bodies],
+            out: vec![zero; model.nv],
         }
     }
 }
@@ -99,6 +118,8 @@ impl<S: Real> Lanes<S> {
 #[derive(Debug, Clone)]
 pub struct BatchWorkspace {
     width: LaneWidth,
+    /// How many states of the last batch ran in lanes.
+    in_lanes: usize,
     data: Data,
     four: Lanes<AutoF64x4>,
     eight: Lanes<AutoF64x8>,
@@ -109,6 +130,7 @@ impl BatchWorkspace {
     pub fn new(model: &Model) -> Self {
         BatchWorkspace {
             width: LaneWidth::detect(),
+            in_lanes: 0,
             data: Data::new(model),
             four: Lanes::new(model),
             eight: Lanes::new(model),
@@ -133,18 +155,50 @@ impl BatchWorkspace {
     pub fn width(&self) -> LaneWidth {
         self.width
     }
+
+    /// How many states of the last batch ran in lanes (the others ran one at a time).
+    pub fn states_in_lanes(&self) -> usize {
+        self.in_lanes
+    }
 }
 
-/// A batch of states, each row-major: `q` is n × nq, `v` and `a` n × nv or `None` for zero.
-#[derive(Debug, Clone, Copy)]
+/// A batch of states, each row-major: `q` is n × nq; `v`, `a` and `tau` n × nv, or `None` where
+/// the algorithm takes zero (Newton–Euler's v and a) or does not take them.
+#[derive(Debug, Clone, Copy, Default)]
 pub struct States<'s> {
     pub q: &'s [f64],
     pub v: Option<&'s [f64]>,
     pub a: Option<&'s [f64]>,
+    pub tau: Option<&'s [f64]>,
 }
 
 /// A batch error: the state it came from and what was wrong with it.
 pub type BatchResult = std::result::Result<(), (usize, Error)>;
+
+/// The algorithms that run in lanes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Algorithm {
+    /// τ = ID(q, v, a) (Newton–Euler; bias forces without a, gravity without v and a).
+    NewtonEuler,
+    /// q̈ = FD(q, v, τ) (the articulated-body algorithm).
+    ArticulatedBody,
+}
+
+impl Algorithm {
+    /// The width to run at on a CPU that runs `widest`. The articulated-body algorithm's 6x6
+    /// inertias (36 values per body) no longer fit in the vector registers at eight lanes, and
+    /// the spills cost more than the wider instructions gain (on this project's AMD EPYC, whose
+    /// AVX-512 executes as two 256-bit halves, it ran 1.6x slower than at four lanes): it runs
+    /// at four.
+    fn width(self, widest: LaneWidth) -> LaneWidth {
+        match (self, widest) {
+            (Algorithm::ArticulatedBody, LaneWidth::Eight) if LaneWidth::Four.available() => {
+                LaneWidth::Four
+            }
+            (_, width) => width,
+        }
+    }
+}
 
 /// Newton–Euler over a batch, `tau` (n × nv) = ID(q, v, a) of every state: inverse dynamics,
 /// bias forces (`a = None`) or gravity (`v = a = None`). Every state is checked first (the error
@@ -155,97 +209,159 @@ pub fn newton_euler_batch(
     states: States,
     tau: &mut [f64],
 ) -> BatchResult {
-    if model.nv == 0 {
+    run_batch(Algorithm::NewtonEuler, model, workspace, states, tau)
+}
+
+/// The articulated-body algorithm over a batch, `qdd` (n × nv) = FD(q, v, τ) of every state
+/// (`states.v` and `states.tau` are required), checked and grouped as [`newton_euler_batch`].
+pub fn aba_batch(
+    model: &Model,
+    workspace: &mut BatchWorkspace,
+    states: States,
+    qdd: &mut [f64],
+) -> BatchResult {
+    for (name, values) in [("v", states.v), ("tau", states.tau)] {
+        if values.is_none() {
+            let message = "forward dynamics needs it".into();
+            let argument = name.into();
+            return Err((0, Error::InvalidValue { argument, message }));
+        }
+    }
+    run_batch(Algorithm::ArticulatedBody, model, workspace, states, qdd)
+}
+
+/// Checks the states, runs the full groups in lanes and the rest (and any group where a lane
+/// failed, to name the state) one state at a time.
+fn run_batch(
+    algorithm: Algorithm,
+    model: &Model,
+    workspace: &mut BatchWorkspace,
+    states: States,
+    out: &mut [f64],
+) -> BatchResult {
+    let nv = model.nv;
+    if nv == 0 {
         return Ok(());
     }
-    let n = tau.len() / model.nv;
+    let n = out.len() / nv;
     check_states(model, &states, n)?;
-    let grouped = match workspace.width {
+    let width = algorithm.width(workspace.width);
+    let grouped = match width {
         LaneWidth::One => 0,
         width => n - n % width.states(),
     };
-    match workspace.width {
-        LaneWidth::One => {}
+    let lanes_out = &mut out[..grouped * nv];
+    let in_lanes = match width {
+        LaneWidth::One => Ok(()),
         // SAFETY (both): the width was found available on this CPU when the workspace was made
         LaneWidth::Four => unsafe {
-            newton_euler_four(
-                model,
-                &mut workspace.four,
-                states,
-                &mut tau[..grouped * model.nv],
-            )
+            groups_four(algorithm, model, &mut workspace.four, states, lanes_out)
         },
         LaneWidth::Eight => unsafe {
-            newton_euler_eight(
-                model,
-                &mut workspace.eight,
-                states,
-                &mut tau[..grouped * model.nv],
-            )
+            groups_eight(algorithm, model, &mut workspace.eight, states, lanes_out)
         },
-    }
+    };
     // what is left, one state at a time
-    for k in grouped..n {
+    let first = in_lanes.err().unwrap_or(grouped);
+    workspace.in_lanes = first;
+    if first < grouped {
+        eprintln!("DEBUG fallback at {first}");
+    }
+    for k in first..n {
         let state = state(model, &states, k);
-        let result = newton_euler(model, &mut workspace.data, state.q, state.v, state.a, None)
-            .map_err(|e| (k, e))?;
-        tau[k * model.nv..(k + 1) * model.nv].copy_from_slice(result.as_slice());
+        let data = &mut workspace.data;
+        let result = match algorithm {
+            Algorithm::NewtonEuler => newton_euler(model, data, state.q, state.v, state.a, None),
+            Algorithm::ArticulatedBody => {
+                let (v, tau) = (state.v.unwrap_or_default(), state.tau.unwrap_or_default());
+                aba(model, data, state.q, v, tau, None)
+            }
+        };
+        out[k * nv..(k + 1) * nv].copy_from_slice(result.map_err(|e| (k, e))?.as_slice());
     }
     Ok(())
 }
 
-/// [`newton_euler_groups`] compiled for AVX2. Safety: only on a CPU with AVX2 and FMA.
+/// [`groups`] compiled for AVX2. Safety: only on a CPU with AVX2 and FMA.
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx2,fma"))]
-unsafe fn newton_euler_four(
+unsafe fn groups_four(
+    algorithm: Algorithm,
     model: &Model,
     lanes: &mut Lanes<AutoF64x4>,
     states: States,
-    tau: &mut [f64],
-) {
-    newton_euler_groups(model, lanes, states, tau);
+    out: &mut [f64],
+) -> std::result::Result<(), usize> {
+    groups(algorithm, model, lanes, states, out)
 }
 
-/// [`newton_euler_groups`] compiled for AVX-512. Safety: only on a CPU with AVX-512F.
+/// [`groups`] compiled for AVX-512. Safety: only on a CPU with AVX-512F.
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx512f"))]
-unsafe fn newton_euler_eight(
+unsafe fn groups_eight(
+    algorithm: Algorithm,
     model: &Model,
     lanes: &mut Lanes<AutoF64x8>,
     states: States,
-    tau: &mut [f64],
-) {
-    newton_euler_groups(model, lanes, states, tau);
+    out: &mut [f64],
+) -> std::result::Result<(), usize> {
+    groups(algorithm, model, lanes, states, out)
 }
 
-/// The Newton–Euler passes on the groups of states that fill `tau`, `S::LANES` at a time.
+/// `algorithm` on the groups of states that fill `out`, `S::LANES` at a time. An error gives the
+/// first state of a group where a lane failed (a singular articulated inertia).
 #[inline(always)]
-fn newton_euler_groups<S: Real>(
+fn groups<S: Real>(
+    algorithm: Algorithm,
     model: &Model,
     lanes: &mut Lanes<S>,
     states: States,
-    tau: &mut [f64],
-) {
+    out: &mut [f64],
+) -> std::result::Result<(), usize> {
     let (nq, nv) = (model.nq, model.nv);
-    for (g, tau) in tau.chunks_exact_mut(S::LANES * nv).enumerate() {
+    for (g, out) in out.chunks_exact_mut(S::LANES * nv).enumerate() {
         let first = g * S::LANES;
         gather(&mut lanes.q, states.q, first, nq);
-        if let Some(v) = states.v {
-            gather(&mut lanes.v, v, first, nv);
+        for (input, lanes) in [
+            (states.v, &mut lanes.v),
+            (states.a, &mut lanes.a),
+            (states.tau, &mut lanes.tau),
+        ] {
+            if let Some(input) = input {
+                gather(lanes, input, first, nv);
+            }
         }
-        if let Some(a) = states.a {
-            gather(&mut lanes.a, a, first, nv);
+        match algorithm {
+            Algorithm::NewtonEuler => {
+                let buffers = NewtonEulerBuffers {
+                    x_up: &mut lanes.x_up,
+                    v: &mut lanes.velocities,
+                    a: &mut lanes.accelerations,
+                    f: &mut lanes.forces,
+                    tau: &mut lanes.out,
+                };
+                let v = states.v.map(|_| &lanes.v[..]);
+                let a = states.a.map(|_| &lanes.a[..]);
+                newton_euler_passes(model, &lanes.q, v, a, None, buffers);
+            }
+            Algorithm::ArticulatedBody => {
+                let buffers = AbaBuffers {
+                    x_up: &mut lanes.x_up,
+                    v: &mut lanes.velocities,
+                    c: &mut lanes.velocity_products,
+                    a: &mut lanes.accelerations,
+                    i_a: &mut lanes.articulated_inertias,
+                    p_a: &mut lanes.articulated_biases,
+                    u: &mut lanes.u,
+                    u_tau: &mut lanes.u_tau,
+                    d_inv: &mut lanes.d_inv,
+                    qdd: &mut lanes.out,
+                };
+                articulated_body_passes(model, &lanes.q, &lanes.v, &lanes.tau, None, buffers)
+                    .map_err(|_| first)?;
+            }
         }
-        let buffers = NewtonEulerBuffers {
-            x_up: &mut lanes.x_up,
-            v: &mut lanes.velocities,
-            a: &mut lanes.accelerations,
-            f: &mut lanes.forces,
-            tau: &mut lanes.tau,
-        };
-        let v = states.v.map(|_| &lanes.v[..]);
-        let a = states.a.map(|_| &lanes.a[..]);
-        newton_euler_passes(model, &lanes.q, v, a, None, buffers);
-        scatter(&lanes.tau, tau, nv);
+        scatter(&lanes.out, out, nv);
     }
+    Ok(())
 }
 
 /// Lane l of `lanes[j]` = entry j of row `first + l` of the row-major `rows` (width `size`).
@@ -253,9 +369,7 @@ fn newton_euler_groups<S: Real>(
 fn gather<S: Real>(lanes: &mut [S], rows: &[f64], first: usize, size: usize) {
     let rows = &rows[first * size..(first + S::LANES) * size];
     for (j, lane) in lanes.iter_mut().enumerate() {
-        for l in 0..S::LANES {
-            lane.replace(l, rows[l * size + j]);
-        }
+        *lane = S::from_lanes(|l| rows[l * size + j]);
     }
 }
 
@@ -272,10 +386,12 @@ fn scatter<S: Real>(lanes: &[S], rows: &mut [f64], size: usize) {
 /// State k of the batch.
 fn state<'s>(model: &Model, states: &States<'s>, k: usize) -> States<'s> {
     let (nq, nv) = (model.nq, model.nv);
+    let row = |x: &'s [f64]| &x[k * nv..(k + 1) * nv];
     States {
         q: &states.q[k * nq..(k + 1) * nq],
-        v: states.v.map(|v| &v[k * nv..(k + 1) * nv]),
-        a: states.a.map(|a| &a[k * nv..(k + 1) * nv]),
+        v: states.v.map(row),
+        a: states.a.map(row),
+        tau: states.tau.map(row),
     }
 }
 
@@ -283,7 +399,7 @@ fn state<'s>(model: &Model, states: &States<'s>, k: usize) -> States<'s> {
 fn check_states(model: &Model, states: &States, n: usize) -> BatchResult {
     let whole = |e| (0, e);
     check_length("q", states.q.len(), n * model.nq).map_err(whole)?;
-    for (name, values) in [("v", states.v), ("a", states.a)] {
+    for (name, values) in [("v", states.v), ("a", states.a), ("tau", states.tau)] {
         if let Some(values) = values {
             check_length(name, values.len(), n * model.nv).map_err(whole)?;
         }
@@ -291,7 +407,7 @@ fn check_states(model: &Model, states: &States, n: usize) -> BatchResult {
     for k in 0..n {
         let state = state(model, states, k);
         model.check_configuration(state.q).map_err(|e| (k, e))?;
-        for (name, values) in [("v", state.v), ("a", state.a)] {
+        for (name, values) in [("v", state.v), ("a", state.a), ("tau", state.tau)] {
             if let Some(values) = values {
                 check_vector(name, values, model.nv).map_err(|e| (k, e))?;
             }
@@ -307,8 +423,14 @@ mod tests {
 
     /// The lane kernels themselves, compiled without the wide instruction sets, so that they are
     /// checked on a CPU that lacks them too: each lane equals the one-state call bit for bit.
-    fn lanes_equal_one_state<S: Real>() {
-        let model = bundled_model("ur5", true).unwrap();
+    fn lanes_equal_one_state<S: Real>(algorithm: Algorithm) {
+        let mut model = bundled_model("ur5", true).unwrap();
+        // a floating UR5 needs a base mass for forward dynamics
+        model.inertias[1] = crate::spatial::Inertia::from_com(
+            4.0,
+            &crate::spatial::Vec3::new(0.0, 0.0, 0.02),
+            &crate::spatial::Mat3::from_diagonal_element(0.01),
+        );
         let mut rng = <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(7);
         let n = 2 * S::LANES;
         let (mut q, mut v, mut a) = (Vec::new(), Vec::new(), Vec::new());
@@ -317,28 +439,60 @@ mod tests {
             v.extend((0..model.nv).map(|j| (k + j) as f64 * 0.1 - 0.3));
             a.extend((0..model.nv).map(|j| (k * j) as f64 * 0.05 - 0.2));
         }
-        let states = States {
-            q: &q,
-            v: Some(&v),
-            a: Some(&a),
+        let states = match algorithm {
+            Algorithm::NewtonEuler => States {
+                q: &q,
+                v: Some(&v),
+                a: Some(&a),
+                tau: None,
+            },
+            Algorithm::ArticulatedBody => States {
+                q: &q,
+                v: Some(&v),
+                a: None,
+                tau: Some(&a),
+            },
         };
-        let mut tau = vec![0.0; n * model.nv];
-        newton_euler_groups(&model, &mut Lanes::<S>::new(&model), states, &mut tau);
+        let mut out = vec![0.0; n * model.nv];
+        groups(
+            algorithm,
+            &model,
+            &mut Lanes::<S>::new(&model),
+            states,
+            &mut out,
+        )
+        .unwrap();
         let mut data = Data::new(&model);
         for k in 0..n {
             let one = state(&model, &states, k);
-            let expected = newton_euler(&model, &mut data, one.q, one.v, one.a, None).unwrap();
-            let row = &tau[k * model.nv..(k + 1) * model.nv];
-            assert!(row
+            let expected = match algorithm {
+                Algorithm::NewtonEuler => {
+                    newton_euler(&model, &mut data, one.q, one.v, one.a, None)
+                }
+                Algorithm::ArticulatedBody => aba(
+                    &model,
+                    &mut data,
+                    one.q,
+                    &v[k * model.nv..][..model.nv],
+                    &a[k * model.nv..][..model.nv],
+                    None,
+                ),
+            }
+            .unwrap();
+            let row = &out[k * model.nv..(k + 1) * model.nv];
+            let same = row
                 .iter()
                 .zip(expected.iter())
-                .all(|(x, y)| x.to_bits() == y.to_bits()));
+                .all(|(x, y)| x.to_bits() == y.to_bits());
+            assert!(same, "{algorithm:?}, {} lanes, state {k}", S::LANES);
         }
     }
 
     #[test]
     fn four_and_eight_lanes_equal_one_state_without_wide_instructions() {
-        lanes_equal_one_state::<AutoF64x4>();
-        lanes_equal_one_state::<AutoF64x8>();
+        for algorithm in [Algorithm::NewtonEuler, Algorithm::ArticulatedBody] {
+            lanes_equal_one_state::<AutoF64x4>(algorithm);
+            lanes_equal_one_state::<AutoF64x8>(algorithm);
+        }
     }
 }

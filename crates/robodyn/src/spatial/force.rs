@@ -18,6 +18,13 @@ impl<S: Real> Force<S> {
         Force { angular, linear }
     }
 
+    /// The Plücker coordinates `[angular; linear]` (moment; force).
+    #[inline(always)]
+    pub fn plucker(&self) -> [S; 6] {
+        let (n, f) = (&self.angular, &self.linear);
+        [n.x, n.y, n.z, f.x, f.y, f.z]
+    }
+
     /// A constant force in every lane.
     #[inline(always)]
     pub fn splat(f: &Force) -> Self {

@@ -1,6 +1,8 @@
 //! Rigid-body spatial inertia (Featherstone §2.13).
 
-use super::{rotate, skew, splat_matrix, splat_vector, Force, Mat3, Mat6, Motion, Real, Vec3};
+use super::{
+    cross, rotate, skew, splat_matrix, splat_vector, Force, Mat3, Mat6, Motion, Real, Vec3,
+};
 use nalgebra::Vector3;
 use std::ops::{Add, AddAssign};
 
@@ -58,8 +60,8 @@ impl Inertia {
         let first_moment: Vector3<S> = splat_vector(&self.first_moment);
         let rotational = splat_matrix(&self.rotational);
         Force {
-            angular: rotate(&rotational, &m.angular) + first_moment.cross(&m.linear),
-            linear: m.linear * S::splat(self.mass) - first_moment.cross(&m.angular),
+            angular: rotate(&rotational, &m.angular) + cross(&first_moment, &m.linear),
+            linear: m.linear * S::splat(self.mass) - cross(&first_moment, &m.angular),
         }
     }
 
@@ -243,9 +245,4 @@ impl AddAssign for Inertia {
     fn add_assign(&mut self, rhs: Inertia) {
         *self = *self + rhs;
     }
-}
-
-/// `f = I m` for a general (articulated-body) 6x6 inertia on `[angular; linear]`.
-pub fn mat6_mul_motion(inertia: &Mat6, m: &Motion) -> Force {
-    Force::from_vector(&(inertia * m.to_vector()))
 }

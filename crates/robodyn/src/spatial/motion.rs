@@ -1,6 +1,6 @@
 //! Spatial motion vectors (velocities, accelerations, motion subspace columns).
 
-use super::{Force, Real, Vec3};
+use super::{cross, Force, Real, Vec3};
 use nalgebra::Vector3;
 use std::ops::{Add, AddAssign, Mul, Neg, Sub};
 
@@ -52,8 +52,8 @@ impl<S: Real> Motion<S> {
     #[inline(always)]
     pub fn cross_motion(&self, other: &Motion<S>) -> Motion<S> {
         Motion {
-            angular: self.angular.cross(&other.angular),
-            linear: self.angular.cross(&other.linear) + self.linear.cross(&other.angular),
+            angular: cross(&self.angular, &other.angular),
+            linear: cross(&self.angular, &other.linear) + cross(&self.linear, &other.angular),
         }
     }
 
@@ -61,8 +61,8 @@ impl<S: Real> Motion<S> {
     #[inline(always)]
     pub fn cross_force(&self, f: &Force<S>) -> Force<S> {
         Force {
-            angular: self.angular.cross(&f.angular) + self.linear.cross(&f.linear),
-            linear: self.angular.cross(&f.linear),
+            angular: cross(&self.angular, &f.angular) + cross(&self.linear, &f.linear),
+            linear: cross(&self.angular, &f.linear),
         }
     }
 

@@ -1,7 +1,10 @@
 //! Plücker coordinate transforms (Featherstone §2.8).
 
-use super::{compose, rotate, rotate_back, skew, Force, Inertia, Mat3, Mat6, Motion, Real, Vec3};
-use nalgebra::{Matrix3, Vector3};
+use super::{
+    block, compose, compose_transposed, cross, from_blocks, rotate, rotate_back, skew, transposed,
+    Force, Inertia, Mat3, Mat6, Motion, Real, Vec3,
+};
+use nalgebra::{Matrix3, Matrix6, Vector3};
 use std::ops::Mul;
 
 /// Featherstone's `X = B_X_A`: the coordinate transform from frame A to frame B, stored as the
@@ -124,7 +127,7 @@ impl<S: Real> Transform<S> {
             angular: rotate(&self.rotation, &m.angular),
             linear: rotate(
                 &self.rotation,
-                &(m.linear - self.translation.cross(&m.angular)),
+                &(m.linear - cross(&self.translation, &m.angular)),
             ),
         }
     }
@@ -135,7 +138,7 @@ impl<S: Real> Transform<S> {
         let angular = rotate_back(&self.rotation, &m.angular);
         Motion {
             angular,
-            linear: rotate_back(&self.rotation, &m.linear) + self.translation.cross(&angular),
+            linear: rotate_back(&self.rotation, &m.linear) + cross(&self.translation, &angular),
         }
     }
 
@@ -145,7 +148,7 @@ impl<S: Real> Transform<S> {
         Force {
             angular: rotate(
                 &self.rotation,
-                &(f.angular - self.translation.cross(&f.linear)),
+                &(f.angular - cross(&self.translation, &f.linear)),
             ),
             linear: rotate(&self.rotation, &f.linear),
         }
@@ -156,9 +159,31 @@ impl<S: Real> Transform<S> {
     pub fn transpose_apply_force(&self, f: &Force<S>) -> Force<S> {
         let linear = rotate_back(&self.rotation, &f.linear);
         Force {
-            angular: rotate_back(&self.rotation, &f.angular) + self.translation.cross(&linear),
+            angular: rotate_back(&self.rotation, &f.angular) + cross(&self.translation, &linear),
             linear,
         }
+    }
+
+    /// `Xᵀ I X` for a symmetric 6x6 inertia on `[angular; linear]` (an articulated-body
+    /// inertia, which has no rigid body's structure), by 3x3 blocks instead of two 6x6 products.
+    /// With `I = [A B; Bᵀ C]` and `X = diag(E, E) [1 0; -r× 1]`: rotate, `Â = Eᵀ A E`,
+    /// `B̂ = Eᵀ B E`, `Ĉ = Eᵀ C E`; then shift, `C' = Ĉ`, `B' = B̂ + r× Ĉ`,
+    /// `A' = Â - B̂ r× + r× B̂ᵀ - r× Ĉ r×`.
+    #[inline(always)]
+    pub fn transpose_apply_matrix(&self, inertia: &Matrix6<S>) -> Matrix6<S> {
+        let e = &self.rotation;
+        let (a, b, c) = (
+            rotated(e, &block(inertia, 0, 0)),
+            rotated(e, &block(inertia, 0, 3)),
+            rotated(e, &block(inertia, 3, 3)),
+        );
+        let r = skew(&self.translation);
+        // r× Ĉ, and B̂ r× whose transpose is -r× B̂ᵀ
+        let r_c = compose(&r, &c);
+        let b_r = compose(&b, &r);
+        let coupling = b + r_c;
+        let angular = a - b_r - transposed(&b_r) - compose(&r_c, &r);
+        from_blocks(&angular, &coupling, &transposed(&coupling), &c)
     }
 }
 
@@ -203,34 +228,6 @@ impl Transform {
         }
     }
 
-    /// `Xᵀ I X` for a symmetric 6x6 inertia on `[angular; linear]` (an articulated-body
-    /// inertia, which has no rigid body's structure), by 3x3 blocks instead of two 6x6 products.
-    /// With `I = [A B; Bᵀ C]` and `X = diag(E, E) [1 0; -r× 1]`: rotate, `Â = Eᵀ A E`,
-    /// `B̂ = Eᵀ B E`, `Ĉ = Eᵀ C E`; then shift, `C' = Ĉ`, `B' = B̂ + r× Ĉ`,
-    /// `A' = Â - B̂ r× + r× B̂ᵀ - r× Ĉ r×`.
-    #[inline]
-    pub fn transpose_apply_matrix(&self, inertia: &Mat6) -> Mat6 {
-        let e = &self.rotation;
-        let block =
-            |row: usize, col: usize| -> Mat3 { inertia.fixed_view::<3, 3>(row, col).into() };
-        let (a, b, c) = (block(0, 0), block(0, 3), block(3, 3));
-        let rotated = |m: Mat3| e.tr_mul(&(m * e));
-        let (a, b, c) = (rotated(a), rotated(b), rotated(c));
-        let r = skew(&self.translation);
-        // r× Ĉ, and B̂ r× whose transpose is -r× B̂ᵀ
-        let r_c = r * c;
-        let b_r = b * r;
-        let mut out = Mat6::zeros();
-        out.fixed_view_mut::<3, 3>(0, 0)
-            .copy_from(&(a - b_r - b_r.transpose() - r_c * r));
-        let coupling = b + r_c;
-        out.fixed_view_mut::<3, 3>(0, 3).copy_from(&coupling);
-        out.fixed_view_mut::<3, 3>(3, 0)
-            .copy_from(&coupling.transpose());
-        out.fixed_view_mut::<3, 3>(3, 3).copy_from(&c);
-        out
-    }
-
     /// `X` as a 6x6 matrix on `[angular; linear]` motion vectors: `[E 0; -E r× E]`.
     #[inline]
     pub fn to_matrix(&self) -> Mat6 {
@@ -254,4 +251,10 @@ impl<S: Real> Mul for Transform<S> {
             translation: rhs.translation + rotate_back(&rhs.rotation, &self.translation),
         }
     }
+}
+
+/// `Eᵀ M E`.
+#[inline(always)]
+fn rotated<S: Real>(e: &Matrix3<S>, m: &Matrix3<S>) -> Matrix3<S> {
+    compose_transposed(e, &compose(m, e))
 }

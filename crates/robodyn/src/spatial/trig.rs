@@ -68,8 +68,10 @@ pub fn sin_cos<S: Real>(x: S) -> (S, S) {
     let half_z = splat(0.5) * z;
     let w = splat(1.0) - half_z;
     let cos_r = w + (((splat(1.0) - w) - half_z) + z * z * polynomial(&COS));
-    // quadrant k = n mod 4: (sin, cos) = (s, c), (c, −s), (−s, −c), (−c, s)
-    let k = n - splat(4.0) * (n * splat(0.25)).simd_floor();
+    // quadrant k = n mod 4: (sin, cos) = (s, c), (c, −s), (−s, −c), (−c, s); for an integer n,
+    // floor(n/4) is (n − 1.5)/4 rounded, which is never a tie (no library floor call)
+    let quarter = ((n - splat(1.5)) * splat(0.25) + splat(ROUNDING)) - splat(ROUNDING);
+    let k = n - splat(4.0) * quarter;
     let odd = k.simd_eq(splat(1.0)) | k.simd_eq(splat(3.0));
     let (sin, cos) = (cos_r.select(odd, sin_r), sin_r.select(odd, cos_r));
     let sin = (-sin).select(k.simd_ge(splat(2.0)), sin);
