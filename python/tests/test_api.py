@@ -239,8 +239,8 @@ def test_mimic_joints_are_reported():
 
 @pytest.mark.parametrize("n", [1, 7, 37, 1001])
 def test_batches_in_lanes_equal_the_loop_bit_for_bit(floating, n):
-    """Inverse dynamics, bias forces, gravity and forward dynamics run a batch several states per
-    instruction (the widest lanes this CPU has) and leftover states one at a time: every state's
+    """Inverse dynamics, bias forces, gravity, forward dynamics and the mass matrix run a batch
+    several states per instruction (the widest lanes this CPU has) and leftover states one at a time: every state's
     result is the one-state call's, bit for bit, whatever the batch size."""
     for m in (floating, robodyn.load("ur5")):
         q, v, a, _, _ = batch_of_states(m, n, seed=n)
@@ -249,6 +249,7 @@ def test_batches_in_lanes_equal_the_loop_bit_for_bit(floating, n):
             "bias_forces": (q, v),
             "generalized_gravity": (q,),
             "forward_dynamics": (q, v, a),
+            "mass_matrix": (q,),
         }.items():
             batch = getattr(m, name)(*args)
             loop = np.stack([getattr(m, name)(*(x[k] for x in args)) for k in range(n)])

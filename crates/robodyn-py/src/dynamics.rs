@@ -247,9 +247,9 @@ impl PyModel {
             "crba" => {
                 // straight into the result: CRBA mirrors M, so it is exactly symmetric
                 let (shape, arguments) = ([self.model.nv; 2], [self.q_arg("q", q)?]);
-                return self.evaluate_into(py, &arguments, &shape, out, &|m, w, i, out| {
-                    algo::crba_into(m, &mut w.data, i[0], out)
-                });
+                let kernel: &Kernel = &|m, w, i, out| algo::crba_into(m, &mut w.data, i[0], out);
+                let runs: Option<&RunKernel> = Some(&crba_run);
+                return self.evaluate_in_runs(py, &arguments, &shape, out, kernel, runs);
             }
             "rnea" => algo::mass_matrix_by_rnea,
             "jacobians" => algo::mass_matrix_by_jacobians,

@@ -114,6 +114,16 @@ pub(crate) fn aba_run(
     algo::aba_batch(model, workspace.lanes(model), states, out)
 }
 
+/// CRBA in lanes over a run: the input is q.
+pub(crate) fn crba_run(
+    model: &Model,
+    workspace: &mut Workspace,
+    inputs: &[&[f64]],
+    out: &mut [f64],
+) -> BatchResult {
+    algo::crba_batch(model, workspace.lanes(model), inputs[0], out)
+}
+
 /// The most numeric arguments a method takes (q, v, a, f_ext).
 pub(crate) const MAX_ARGUMENTS: usize = 4;
 

@@ -5,8 +5,8 @@ mod common;
 
 use common::*;
 use robodyn::algo::{
-    aba, aba_batch, bias_forces, generalized_gravity, newton_euler_batch, rnea, BatchWorkspace,
-    LaneWidth, States,
+    aba, aba_batch, bias_forces, crba, crba_batch, generalized_gravity, newton_euler_batch, rnea,
+    BatchWorkspace, LaneWidth, States,
 };
 use robodyn::{Data, Error, Model};
 
@@ -207,4 +207,39 @@ fn a_singular_state_in_a_group_is_named_by_its_index() {
         matches!(result, Err((0, Error::InvalidValue { .. }))),
         "{result:?}"
     );
+}
+
+#[test]
+fn mass_matrices_in_lanes_equal_crba_bit_for_bit() {
+    for (name, model) in test_models() {
+        let (q, _, _) = batch(&model);
+        let mut data = Data::new(&model);
+        let size = model.nv * model.nv;
+        for width in LaneWidth::ALL {
+            let Ok(mut workspace) = BatchWorkspace::with_width(&model, width) else {
+                continue;
+            };
+            let mut out = vec![f64::NAN; STATES * size];
+            crba_batch(&model, &mut workspace, &q, &mut out).unwrap();
+            let group = width.states();
+            let expected_in_lanes = if group > 1 {
+                STATES - STATES % group
+            } else {
+                0
+            };
+            assert_eq!(
+                workspace.states_in_lanes(),
+                expected_in_lanes,
+                "{name} {width:?}"
+            );
+            for (k, m) in out.chunks(size).enumerate() {
+                let expected = crba(&model, &mut data, &q[k * model.nq..(k + 1) * model.nq]);
+                let same = m
+                    .iter()
+                    .zip(expected.unwrap().iter())
+                    .all(|(x, y)| x.to_bits() == y.to_bits());
+                assert!(same, "{name}, {width:?}, state {k}");
+            }
+        }
+    }
 }

@@ -12,7 +12,8 @@ use crate::algo::SINGULARITY_TOLERANCE;
 use crate::error::{check_vector, Error, Result};
 use crate::model::Model;
 use crate::spatial::{
-    mat6_mul_motion, splat_matrix6, splat_vector, zero_vector, Force, Motion, Real, Transform,
+    mat6_mul_motion, splat_matrix6, splat_vector, zero_vector, Force, Inertia, Motion, Real,
+    Transform,
 };
 use crate::Data;
 use nalgebra::{DVector, Matrix6, SimdBool};
@@ -96,8 +97,8 @@ pub(crate) fn articulated_body_passes<S: Real>(
         // v_i = X_i v_λ(i) + v_J;  c_i = v_i × v_J
         let v_i = out.x_up[i].apply_motion(&out.v[model.parent[i]]) + v_j;
         out.c[i] = v_i.cross_motion(&v_j);
-        let inertia = &model.inertias[i];
-        out.i_a[i] = splat_matrix6(&inertia.to_matrix());
+        let inertia = Inertia::<S>::splat(&model.inertias[i]);
+        out.i_a[i] = splat_matrix6(&model.inertias[i].to_matrix());
         // p^A_i = v_i ×* I_i v_i - f_ext_i
         out.p_a[i] = v_i.cross_force(&inertia.mul_motion(&v_i));
         if let Some(forces) = f_ext {

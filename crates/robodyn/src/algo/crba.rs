@@ -10,9 +10,10 @@
 //! coordinates), `data.mass_matrix` (full, symmetric, armature on the diagonal).
 //! Cost: O(n) transforms plus one 6-vector dot product per pair (joint, ancestor joint).
 
-use crate::algo::kinematics::update_body_placements;
+use crate::algo::kinematics::body_placements;
 use crate::error::{check_length, Result};
 use crate::model::Model;
+use crate::spatial::{Inertia, Motion, Real, Transform};
 use crate::Data;
 use nalgebra::DMatrix;
 
@@ -39,24 +40,34 @@ pub fn crba_into(model: &Model, data: &mut Data, q: &[f64], out: &mut [f64]) -> 
 /// M into `mass_matrix` (column-major, nv × nv) from the world-frame composites in `data.i_c`
 /// and subspaces in `data.s_world`, armature on the diagonal.
 pub(crate) fn composite_mass_matrix(model: &Model, data: &Data, mass_matrix: &mut [f64]) {
+    mass_matrix_of_composites(model, &data.i_c, &data.s_world, mass_matrix);
+}
+
+/// M from world-frame composites and subspaces, in `f64` or lanes.
+#[inline(always)]
+pub(crate) fn mass_matrix_of_composites<S: Real>(
+    model: &Model,
+    composites: &[Inertia<S>],
+    subspaces: &[Motion<S>],
+    mass_matrix: &mut [S],
+) {
     // H_ij = ⁰S_jᵀ (I^c_i ⁰S_i) for j on the path from i to the root; other entries are zero
     let nv = model.nv;
-    mass_matrix.fill(0.0);
-    for i in 1..model.nbodies() {
-        let composite = &data.i_c[i];
+    mass_matrix.fill(S::splat(0.0));
+    for (i, composite) in composites.iter().enumerate().skip(1) {
         for row in model.v_range(i) {
             // F = I^c_i S_i
-            let f = composite.mul_motion(&data.s_world[row]);
+            let f = composite.mul_motion(&subspaces[row]);
             // the row itself, then up its coordinates' path: the joint's earlier ones, the ancestors'
             let mut column = Some(row);
             while let Some(col) = column {
                 // column-major storage: H[row, col] at row + col nv
-                let h = data.s_world[col].dot(&f);
+                let h = subspaces[col].dot(&f);
                 mass_matrix[row + col * nv] = h;
                 mass_matrix[col + row * nv] = h;
                 column = model.dof_parent[col];
             }
-            mass_matrix[row + row * nv] += model.armature[row];
+            mass_matrix[row + row * nv] += S::splat(model.armature[row]);
         }
     }
 }
@@ -64,23 +75,51 @@ pub(crate) fn composite_mass_matrix(model: &Model, data: &Data, mass_matrix: &mu
 /// Poses, then each body's own inertia in world coordinates in `data.i_c` and the motion subspace
 /// columns in `data.s_world`: ⁰I_i = X_{i←0}ᵀ I_i X_{i←0}, ⁰S_i = X_{i←0}⁻¹ S_i.
 pub(crate) fn world_inertias_and_subspaces(model: &Model, data: &mut Data, q: &[f64]) {
-    update_body_placements(model, data, q);
+    let buffers = CompositeBuffers {
+        x_up: &mut data.x_up,
+        x_world: &mut data.x_world,
+        composites: &mut data.i_c,
+        subspaces: &mut data.s_world,
+    };
+    world_inertias_of(model, q, buffers);
+}
+
+/// What the CRBA's passes write: one state's, borrowed from [`Data`], or several states' in
+/// lanes ([`crate::algo::lanes`]).
+pub(crate) struct CompositeBuffers<'b, S> {
+    pub x_up: &'b mut [Transform<S>],
+    pub x_world: &'b mut [Transform<S>],
+    pub composites: &'b mut [Inertia<S>],
+    pub subspaces: &'b mut [Motion<S>],
+}
+
+/// [`world_inertias_and_subspaces`] in `f64` or lanes.
+#[inline(always)]
+pub(crate) fn world_inertias_of<S: Real>(model: &Model, q: &[S], out: CompositeBuffers<S>) {
+    body_placements(model, q, out.x_up, out.x_world);
     for i in 1..model.nbodies() {
-        data.i_c[i] = data.x_world[i].transpose_apply_inertia(&model.inertias[i]);
+        let x_world = &out.x_world[i];
+        out.composites[i] = x_world.transpose_apply_inertia(&Inertia::splat(&model.inertias[i]));
         for (k, dof) in model.v_range(i).enumerate() {
-            data.s_world[dof] =
-                data.x_world[i].inverse_apply_motion(&model.joints[i].subspace_column(k));
+            let column = Motion::splat(&model.joints[i].subspace_column(k));
+            out.subspaces[dof] = x_world.inverse_apply_motion(&column);
         }
     }
 }
 
 /// Composite inertias, leaves to root: I^c_λ(i) += I^c_i (world coordinates, no transform).
 pub(crate) fn add_composite_inertias(model: &Model, data: &mut Data) {
+    add_composites(model, &mut data.i_c);
+}
+
+/// [`add_composite_inertias`] in `f64` or lanes.
+#[inline(always)]
+pub(crate) fn add_composites<S: Real>(model: &Model, composites: &mut [Inertia<S>]) {
     for i in (1..model.nbodies()).rev() {
         let parent = model.parent[i];
         if parent != 0 {
-            let subtree = data.i_c[i];
-            data.i_c[parent] += subtree;
+            let subtree = composites[i];
+            composites[parent] += subtree;
         }
     }
 }

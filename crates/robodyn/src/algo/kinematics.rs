@@ -26,10 +26,22 @@ pub(crate) fn joint_transforms<S: Real>(model: &Model, q: &[S], x_up: &mut [Tran
 
 /// Writes `data.x_up` and `data.x_world` (the pose of every body) for `q` and returns the poses.
 pub(crate) fn update_body_placements(model: &Model, data: &mut Data, q: &[f64]) {
-    update_joint_transforms(model, data, q);
+    body_placements(model, q, &mut data.x_up, &mut data.x_world);
+}
+
+/// `X_{i←λ(i)}` and `X_{i←0}` of every body for `q`, in `f64` or lanes (`x_world[0]` is left as
+/// it is: the identity).
+#[inline(always)]
+pub(crate) fn body_placements<S: Real>(
+    model: &Model,
+    q: &[S],
+    x_up: &mut [Transform<S>],
+    x_world: &mut [Transform<S>],
+) {
+    joint_transforms(model, q, x_up);
     for i in 1..model.nbodies() {
         // X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}
-        data.x_world[i] = data.x_up[i] * data.x_world[model.parent[i]];
+        x_world[i] = x_up[i] * x_world[model.parent[i]];
     }
 }
 

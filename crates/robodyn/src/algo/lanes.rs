@@ -11,10 +11,13 @@
 //! compiled once per instruction set (`#[target_feature]`), so one binary serves every x86-64 CPU.
 
 use crate::algo::aba::{aba, articulated_body_passes, AbaBuffers};
+use crate::algo::crba::{
+    add_composites, crba_into, mass_matrix_of_composites, world_inertias_of, CompositeBuffers,
+};
 use crate::algo::rnea::{newton_euler, newton_euler_passes, NewtonEulerBuffers};
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::model::Model;
-use crate::spatial::{splat_matrix6, Force, Mat6, Motion, Real, Transform};
+use crate::spatial::{splat_matrix6, Force, Inertia, Mat6, Motion, Real, Transform};
 use crate::Data;
 use nalgebra::Matrix6;
 use simba::simd::{AutoF64x4, AutoF64x8};
@@ -84,6 +87,10 @@ struct Lanes<S> {
     u: Vec<[Force<S>; 6]>,
     u_tau: Vec<[S; 6]>,
     d_inv: Vec<Matrix6<S>>,
+    x_world: Vec<Transform<S>>,
+    composites: Vec<Inertia<S>>,
+    subspaces: Vec<Motion<S>>,
+    mass_matrix: Vec<S>,
     out: Vec<S>,
 }
 
@@ -108,6 +115,10 @@ impl<S: Real> Lanes<S> {
             u: vec![[zero_force; 6]; bodies],
             u_tau: vec![[zero; 6]; bodies],
             d_inv: vec![zero_matrix; bodies],
+            x_world: vec![Transform::splat(&Transform::IDENTITY); bodies],
+            composites: vec![Inertia::splat(&Inertia::ZERO); bodies],
+            subspaces: vec![Motion::zeros(); model.nv],
+            mass_matrix: vec![zero; model.nv * model.nv],
             out: vec![zero; model.nv],
         }
     }
@@ -182,6 +193,8 @@ enum Algorithm {
     NewtonEuler,
     /// q̈ = FD(q, v, τ) (the articulated-body algorithm).
     ArticulatedBody,
+    /// M(q) (the composite-rigid-body algorithm).
+    CompositeRigidBody,
 }
 
 impl Algorithm {
@@ -190,6 +203,14 @@ impl Algorithm {
     /// the spills cost more than the wider instructions gain (on this project's AMD EPYC, whose
     /// AVX-512 executes as two 256-bit halves, it ran 1.6x slower than at four lanes): it runs
     /// at four.
+    /// The values of one state's result.
+    fn output_size(self, model: &Model) -> usize {
+        match self {
+            Algorithm::CompositeRigidBody => model.nv * model.nv,
+            _ => model.nv,
+        }
+    }
+
     fn width(self, widest: LaneWidth) -> LaneWidth {
         match (self, widest) {
             (Algorithm::ArticulatedBody, LaneWidth::Eight) if LaneWidth::Four.available() => {
@@ -230,6 +251,27 @@ pub fn aba_batch(
     run_batch(Algorithm::ArticulatedBody, model, workspace, states, qdd)
 }
 
+/// CRBA over a batch, `mass_matrix` (n × nv × nv) = M(q) of every state (only `states.q` is
+/// read), checked and grouped as [`newton_euler_batch`].
+pub fn crba_batch(
+    model: &Model,
+    workspace: &mut BatchWorkspace,
+    q: &[f64],
+    mass_matrix: &mut [f64],
+) -> BatchResult {
+    let states = States {
+        q,
+        ..States::default()
+    };
+    run_batch(
+        Algorithm::CompositeRigidBody,
+        model,
+        workspace,
+        states,
+        mass_matrix,
+    )
+}
+
 /// Checks the states, runs the full groups in lanes and the rest (and any group where a lane
 /// failed, to name the state) one state at a time.
 fn run_batch(
@@ -239,18 +281,18 @@ fn run_batch(
     states: States,
     out: &mut [f64],
 ) -> BatchResult {
-    let nv = model.nv;
+    let (nv, size) = (model.nv, algorithm.output_size(model));
     if nv == 0 {
         return Ok(());
     }
-    let n = out.len() / nv;
+    let n = out.len() / size;
     check_states(model, &states, n)?;
     let width = algorithm.width(workspace.width);
     let grouped = match width {
         LaneWidth::One => 0,
         width => n - n % width.states(),
     };
-    let lanes_out = &mut out[..grouped * nv];
+    let lanes_out = &mut out[..grouped * size];
     let in_lanes = match width {
         LaneWidth::One => Ok(()),
         // SAFETY (both): the width was found available on this CPU when the workspace was made
@@ -270,14 +312,19 @@ fn run_batch(
     for k in first..n {
         let state = state(model, &states, k);
         let data = &mut workspace.data;
+        let out = &mut out[k * size..(k + 1) * size];
         let result = match algorithm {
             Algorithm::NewtonEuler => newton_euler(model, data, state.q, state.v, state.a, None),
             Algorithm::ArticulatedBody => {
                 let (v, tau) = (state.v.unwrap_or_default(), state.tau.unwrap_or_default());
                 aba(model, data, state.q, v, tau, None)
             }
+            Algorithm::CompositeRigidBody => {
+                crba_into(model, data, state.q, out).map_err(|e| (k, e))?;
+                continue;
+            }
         };
-        out[k * nv..(k + 1) * nv].copy_from_slice(result.map_err(|e| (k, e))?.as_slice());
+        out.copy_from_slice(result.map_err(|e| (k, e))?.as_slice());
     }
     Ok(())
 }
@@ -316,8 +363,8 @@ fn groups<S: Real>(
     states: States,
     out: &mut [f64],
 ) -> std::result::Result<(), usize> {
-    let (nq, nv) = (model.nq, model.nv);
-    for (g, out) in out.chunks_exact_mut(S::LANES * nv).enumerate() {
+    let (nq, nv, size) = (model.nq, model.nv, algorithm.output_size(model));
+    for (g, out) in out.chunks_exact_mut(S::LANES * size).enumerate() {
         let first = g * S::LANES;
         gather(&mut lanes.q, states.q, first, nq);
         for (input, lanes) in [
@@ -357,6 +404,20 @@ fn groups<S: Real>(
                 };
                 articulated_body_passes(model, &lanes.q, &lanes.v, &lanes.tau, None, buffers)
                     .map_err(|_| first)?;
+            }
+            Algorithm::CompositeRigidBody => {
+                let buffers = CompositeBuffers {
+                    x_up: &mut lanes.x_up,
+                    x_world: &mut lanes.x_world,
+                    composites: &mut lanes.composites,
+                    subspaces: &mut lanes.subspaces,
+                };
+                world_inertias_of(model, &lanes.q, buffers);
+                add_composites(model, &mut lanes.composites);
+                let (composites, subspaces) = (&lanes.composites, &lanes.subspaces);
+                mass_matrix_of_composites(model, composites, subspaces, &mut lanes.mass_matrix);
+                scatter(&lanes.mass_matrix, out, size);
+                continue;
             }
         }
         scatter(&lanes.out, out, nv);
@@ -420,17 +481,15 @@ fn check_states(model: &Model, states: &States, n: usize) -> BatchResult {
 mod tests {
     use super::*;
     use crate::io::bundled_model;
+    use crate::spatial::{Mat3, Vec3};
 
     /// The lane kernels themselves, compiled without the wide instruction sets, so that they are
     /// checked on a CPU that lacks them too: each lane equals the one-state call bit for bit.
     fn lanes_equal_one_state<S: Real>(algorithm: Algorithm) {
         let mut model = bundled_model("ur5", true).unwrap();
-        // a floating UR5 needs a base mass for forward dynamics
-        model.inertias[1] = crate::spatial::Inertia::from_com(
-            4.0,
-            &crate::spatial::Vec3::new(0.0, 0.0, 0.02),
-            &crate::spatial::Mat3::from_diagonal_element(0.01),
-        );
+        // a floating UR5 needs a base inertia for forward dynamics
+        let base = Mat3::from_diagonal_element(0.01);
+        model.inertias[1] = Inertia::from_com(4.0, &Vec3::new(0.0, 0.0, 0.02), &base);
         let mut rng = <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(7);
         let n = 2 * S::LANES;
         let (mut q, mut v, mut a) = (Vec::new(), Vec::new(), Vec::new());
@@ -439,58 +498,52 @@ mod tests {
             v.extend((0..model.nv).map(|j| (k + j) as f64 * 0.1 - 0.3));
             a.extend((0..model.nv).map(|j| (k * j) as f64 * 0.05 - 0.2));
         }
+        let (v, a) = (Some(&v[..]), Some(&a[..]));
         let states = match algorithm {
             Algorithm::NewtonEuler => States {
                 q: &q,
-                v: Some(&v),
-                a: Some(&a),
+                v,
+                a,
                 tau: None,
             },
             Algorithm::ArticulatedBody => States {
                 q: &q,
-                v: Some(&v),
+                v,
                 a: None,
-                tau: Some(&a),
+                tau: a,
+            },
+            Algorithm::CompositeRigidBody => States {
+                q: &q,
+                ..States::default()
             },
         };
-        let mut out = vec![0.0; n * model.nv];
+        let size = algorithm.output_size(&model);
+        let mut lanes = vec![0.0; n * size];
         groups(
             algorithm,
             &model,
             &mut Lanes::<S>::new(&model),
             states,
-            &mut out,
+            &mut lanes,
         )
         .unwrap();
-        let mut data = Data::new(&model);
-        for k in 0..n {
-            let one = state(&model, &states, k);
-            let expected = match algorithm {
-                Algorithm::NewtonEuler => {
-                    newton_euler(&model, &mut data, one.q, one.v, one.a, None)
-                }
-                Algorithm::ArticulatedBody => aba(
-                    &model,
-                    &mut data,
-                    one.q,
-                    &v[k * model.nv..][..model.nv],
-                    &a[k * model.nv..][..model.nv],
-                    None,
-                ),
-            }
-            .unwrap();
-            let row = &out[k * model.nv..(k + 1) * model.nv];
-            let same = row
-                .iter()
-                .zip(expected.iter())
-                .all(|(x, y)| x.to_bits() == y.to_bits());
-            assert!(same, "{algorithm:?}, {} lanes, state {k}", S::LANES);
-        }
+        let mut one_by_one = vec![0.0; n * size];
+        let mut workspace = BatchWorkspace::with_width(&model, LaneWidth::One).unwrap();
+        run_batch(algorithm, &model, &mut workspace, states, &mut one_by_one).unwrap();
+        let same = lanes
+            .iter()
+            .zip(&one_by_one)
+            .all(|(x, y)| x.to_bits() == y.to_bits());
+        assert!(same, "{algorithm:?}, {} lanes", S::LANES);
     }
 
     #[test]
     fn four_and_eight_lanes_equal_one_state_without_wide_instructions() {
-        for algorithm in [Algorithm::NewtonEuler, Algorithm::ArticulatedBody] {
+        for algorithm in [
+            Algorithm::NewtonEuler,
+            Algorithm::ArticulatedBody,
+            Algorithm::CompositeRigidBody,
+        ] {
             lanes_equal_one_state::<AutoF64x4>(algorithm);
             lanes_equal_one_state::<AutoF64x8>(algorithm);
         }

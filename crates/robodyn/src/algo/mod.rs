@@ -39,7 +39,9 @@ pub use frame_motion::{frame_acceleration, frame_velocity, jacobian_time_variati
 pub use inverse_kinematics::{inverse_kinematics, IkOptions, IkSolution};
 pub use jacobian::{jacobian, Reference};
 pub use kinematics::{forward_kinematics, frame_placement, frame_pose};
-pub use lanes::{aba_batch, newton_euler_batch, BatchResult, BatchWorkspace, LaneWidth, States};
+pub use lanes::{
+    aba_batch, crba_batch, newton_euler_batch, BatchResult, BatchWorkspace, LaneWidth, States,
+};
 pub use manipulability::manipulability;
 pub use minv::inverse_mass_matrix;
 pub use regressor::torque_regressor;

@@ -9,7 +9,7 @@
 use crate::algo::kinematics::joint_transforms;
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::model::Model;
-use crate::spatial::{splat_vector, zero_vector, Force, Motion, Real, Transform};
+use crate::spatial::{splat_vector, zero_vector, Force, Inertia, Motion, Real, Transform};
 use crate::Data;
 use nalgebra::DVector;
 
@@ -103,6 +103,7 @@ pub(crate) fn newton_euler_passes<S: Real>(
     for i in 1..model.nbodies() {
         let joint = &model.joints[i];
         let parent = model.parent[i];
+        // I_i read into each product where it is used (kept whole, it would be copied)
         let inertia = &model.inertias[i];
         // a_i = X_i a_λ(i) + S q̈_i + v_i × v_J   (c_J = 0)
         let mut a_i = out.x_up[i].apply_motion(&out.a[parent]);
@@ -117,12 +118,13 @@ pub(crate) fn newton_euler_passes<S: Real>(
                 let v_i = out.x_up[i].apply_motion(&out.v[parent]) + v_j;
                 a_i += v_i.cross_motion(&v_j);
                 out.v[i] = v_i;
-                inertia.mul_motion(&a_i) + v_i.cross_force(&inertia.mul_motion(&v_i))
+                let momentum = Inertia::<S>::splat(inertia).mul_motion(&v_i);
+                Inertia::<S>::splat(inertia).mul_motion(&a_i) + v_i.cross_force(&momentum)
             }
             None => {
                 // at rest every velocity product vanishes
                 out.v[i] = Motion::zeros();
-                inertia.mul_motion(&a_i)
+                Inertia::<S>::splat(inertia).mul_motion(&a_i)
             }
         };
         if let Some(forces) = f_ext {

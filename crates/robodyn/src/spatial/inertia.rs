@@ -3,19 +3,41 @@
 use super::{
     cross, rotate, skew, splat_matrix, splat_vector, Force, Mat3, Mat6, Motion, Real, Vec3,
 };
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 use std::ops::{Add, AddAssign};
 
 /// The spatial inertia of a rigid body about a frame's origin, stored as the mass `m`, the first
 /// moment `h = m c` (c: centre of mass) and the rotational inertia `Ī_O` about the origin, all in
 /// the frame's axes. As a 6x6 matrix on `[angular; linear]`: `I = [Ī_O  h×; h×ᵀ  m 1]`.
+/// `S` as for [`Motion`]: a model's inertias are `f64`; composites that depend on q can be lanes.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Inertia {
-    pub mass: f64,
+pub struct Inertia<S = f64> {
+    pub mass: S,
     /// `h = m c`.
-    pub first_moment: Vec3,
+    pub first_moment: Vector3<S>,
     /// `Ī_O = I_C + m (c·c 1 - c cᵀ)`, the rotational inertia about the frame's origin.
-    pub rotational: Mat3,
+    pub rotational: Matrix3<S>,
+}
+
+impl<S: Real> Inertia<S> {
+    /// A constant inertia (of the model) in every lane.
+    #[inline(always)]
+    pub fn splat(inertia: &Inertia) -> Self {
+        Inertia {
+            mass: S::splat(inertia.mass),
+            first_moment: splat_vector(&inertia.first_moment),
+            rotational: splat_matrix(&inertia.rotational),
+        }
+    }
+
+    /// `f = I m`: `n = Ī_O ω + h × v`, `f = m v - h × ω`.
+    #[inline(always)]
+    pub fn mul_motion(&self, m: &Motion<S>) -> Force<S> {
+        Force {
+            angular: rotate(&self.rotational, &m.angular) + cross(&self.first_moment, &m.linear),
+            linear: m.linear * self.mass - cross(&self.first_moment, &m.angular),
+        }
+    }
 }
 
 impl Default for Inertia {
@@ -51,17 +73,6 @@ impl Inertia {
             self.first_moment / self.mass
         } else {
             Vec3::zeros()
-        }
-    }
-
-    /// `f = I m`: `n = Ī_O ω + h × v`, `f = m v - h × ω`; `m` in `f64` or lanes.
-    #[inline(always)]
-    pub fn mul_motion<S: Real>(&self, m: &Motion<S>) -> Force<S> {
-        let first_moment: Vector3<S> = splat_vector(&self.first_moment);
-        let rotational = splat_matrix(&self.rotational);
-        Force {
-            angular: rotate(&rotational, &m.angular) + cross(&first_moment, &m.linear),
-            linear: m.linear * S::splat(self.mass) - cross(&first_moment, &m.angular),
         }
     }
 
@@ -228,10 +239,10 @@ impl AddAssign for CoriolisFactor {
     }
 }
 
-impl Add for Inertia {
-    type Output = Inertia;
-    #[inline]
-    fn add(self, rhs: Inertia) -> Inertia {
+impl<S: Real> Add for Inertia<S> {
+    type Output = Inertia<S>;
+    #[inline(always)]
+    fn add(self, rhs: Inertia<S>) -> Inertia<S> {
         Inertia {
             mass: self.mass + rhs.mass,
             first_moment: self.first_moment + rhs.first_moment,
@@ -240,9 +251,9 @@ impl Add for Inertia {
     }
 }
 
-impl AddAssign for Inertia {
-    #[inline]
-    fn add_assign(&mut self, rhs: Inertia) {
+impl<S: Real> AddAssign for Inertia<S> {
+    #[inline(always)]
+    fn add_assign(&mut self, rhs: Inertia<S>) {
         *self = *self + rhs;
     }
 }

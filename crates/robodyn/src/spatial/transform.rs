@@ -185,6 +185,37 @@ impl<S: Real> Transform<S> {
         let angular = a - b_r - transposed(&b_r) - compose(&r_c, &r);
         from_blocks(&angular, &coupling, &transposed(&coupling), &c)
     }
+
+    /// `Xᵀ I X`: a rigid-body inertia given in B coordinates, expressed in A coordinates.
+    #[inline(always)]
+    pub fn transpose_apply_inertia(&self, inertia: &Inertia<S>) -> Inertia<S> {
+        let (e, r, m) = (&self.rotation, &self.translation, inertia.mass);
+        // h' = Eᵀ h_B (the first moment in A's axes, about B's origin)
+        let h = rotate_back(e, &inertia.first_moment);
+        // Ī_A = Eᵀ Ī_B E + (2 r·h' + m|r|²) 1 - (r h'ᵀ + h' rᵀ + m r rᵀ), symmetric: the upper
+        // triangle is computed and mirrored
+        let rotated = compose_transposed(e, &compose(&inertia.rotational, e));
+        let two = S::splat(2.0);
+        let diagonal =
+            two * (r.x * h.x + r.y * h.y + r.z * h.z) + m * (r.x * r.x + r.y * r.y + r.z * r.z);
+        let mut rotational = rotated;
+        for row in 0..3 {
+            for col in row..3 {
+                let shift = r[row] * h[col] + h[row] * r[col] + m * r[row] * r[col];
+                let mut value = rotated[(row, col)] - shift;
+                if row == col {
+                    value += diagonal;
+                }
+                rotational[(row, col)] = value;
+                rotational[(col, row)] = value;
+            }
+        }
+        Inertia {
+            mass: m,
+            first_moment: h + r * m,
+            rotational,
+        }
+    }
 }
 
 impl Transform {
@@ -197,35 +228,6 @@ impl Transform {
         pose.fixed_view_mut::<3, 1>(0, 3)
             .copy_from(&self.translation);
         pose
-    }
-
-    /// `Xᵀ I X`: a rigid-body inertia given in B coordinates, expressed in A coordinates.
-    #[inline]
-    pub fn transpose_apply_inertia(&self, inertia: &Inertia) -> Inertia {
-        let r = &self.translation;
-        let m = inertia.mass;
-        // h' = Eᵀ h_B (the first moment in A's axes, about B's origin)
-        let h = self.rotation.tr_mul(&inertia.first_moment);
-        // Ī_A = Eᵀ Ī_B E + (2 r·h' + m|r|²) 1 - (r h'ᵀ + h' rᵀ + m r rᵀ), symmetric: the upper
-        // triangle is computed and mirrored, (Eᵀ Ī_B E)_rc as column r of E dotted with column c
-        // of Ī_B E
-        let inertia_e = inertia.rotational * self.rotation;
-        let diagonal = 2.0 * r.dot(&h) + m * r.norm_squared();
-        let mut rotational = Mat3::zeros();
-        for row in 0..3 {
-            for col in row..3 {
-                let rotated = self.rotation.column(row).dot(&inertia_e.column(col));
-                let shift = r[row] * h[col] + h[row] * r[col] + m * r[row] * r[col];
-                let value = rotated - shift + if row == col { diagonal } else { 0.0 };
-                rotational[(row, col)] = value;
-                rotational[(col, row)] = value;
-            }
-        }
-        Inertia {
-            mass: m,
-            first_moment: h + r * m,
-            rotational,
-        }
     }
 
     /// `X` as a 6x6 matrix on `[angular; linear]` motion vectors: `[E 0; -E r× E]`.
