@@ -69,13 +69,16 @@ impl PyModel {
         arguments: &[Argument<'py>],
         names: [&Bound<'py, PyString>; 3],
         derivatives: DerivativesAlgorithm,
+        runs: Option<&RunKernel>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let nv = self.model.nv;
-        let stack = self.evaluate(py, arguments, &[3, nv, nv], &|m, w, i, out| {
+        let kernel: &Kernel = &|m, w, i, out| {
             let Workspace { data, forces, .. } = w;
             let forces = i.get(3).map(|flat| external_forces(forces, flat));
             derivatives(m, data, (i[0], i[1], i[2], forces), out)
-        })?;
+        };
+        let runs = runs.filter(|_| arguments.len() < 4);
+        let stack = self.evaluate_in_runs(py, arguments, &[3, nv, nv], None, kernel, runs)?;
         split_stack(py, &stack, &names)
     }
 }
@@ -89,21 +92,6 @@ type DerivativesAlgorithm =
 fn external_forces<'w>(forces: &'w mut [Force], flat: &[f64]) -> &'w [Force] {
     fill_forces(forces, flat);
     forces
-}
-
-/// ∂τ/∂q, ∂τ/∂v, ∂τ/∂a = M (symmetric: its storage is already row-major).
-fn rnea_derivatives(
-    model: &Model,
-    data: &mut Data,
-    state: algo::DynamicsState,
-    out: &mut [f64],
-) -> robodyn::Result<()> {
-    let nv = model.nv;
-    let (by_q, rest) = out.split_at_mut(nv * nv);
-    let (by_v, by_a) = rest.split_at_mut(nv * nv);
-    algo::rnea_derivatives_row_major(model, data, state, by_q, by_v)?;
-    by_a.copy_from_slice(data.mass_matrix.as_slice());
-    Ok(())
 }
 
 /// ∂q̈/∂q, ∂q̈/∂v, ∂q̈/∂τ = M⁻¹, from the rows [∂q̈/∂q, ∂q̈/∂v, M⁻¹] the algorithm solves.
@@ -210,7 +198,13 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let arguments = self.dynamics_arguments(q, v, ("a", a), f_ext)?;
         let names = keys!(py, "dtau_dq", "dtau_dv", "dtau_da");
-        self.dynamics_derivatives(py, &arguments, names, rnea_derivatives)
+        self.dynamics_derivatives(
+            py,
+            &arguments,
+            names,
+            algo::rnea_derivatives_stacked,
+            Some(&rnea_derivatives_run),
+        )
     }
 
     /// Derivatives of forward dynamics a = FD(q, v, tau, f_ext): dict of `dqdd_dq`, `dqdd_dv`
@@ -227,7 +221,7 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let arguments = self.dynamics_arguments(q, v, ("tau", tau), f_ext)?;
         let names = keys!(py, "dqdd_dq", "dqdd_dv", "dqdd_dtau");
-        self.dynamics_derivatives(py, &arguments, names, aba_derivatives)
+        self.dynamics_derivatives(py, &arguments, names, aba_derivatives, None)
     }
 
     /// Joint-space inertia matrix M(q), full and symmetric, armature included. (nv, nv).

@@ -124,6 +124,23 @@ pub(crate) fn crba_run(
     algo::crba_batch(model, workspace.lanes(model), inputs[0], out)
 }
 
+/// The RNEA derivatives in lanes over a run: the inputs are q, v and a; per sample ∂τ/∂q,
+/// ∂τ/∂v and M stacked.
+pub(crate) fn rnea_derivatives_run(
+    model: &Model,
+    workspace: &mut Workspace,
+    inputs: &[&[f64]],
+    out: &mut [f64],
+) -> BatchResult {
+    let states = States {
+        q: inputs[0],
+        v: Some(inputs[1]),
+        a: Some(inputs[2]),
+        tau: None,
+    };
+    algo::rnea_derivatives_batch(model, workspace.lanes(model), states, out)
+}
+
 /// The most numeric arguments a method takes (q, v, a, f_ext).
 pub(crate) const MAX_ARGUMENTS: usize = 4;
 

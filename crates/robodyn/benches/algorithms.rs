@@ -23,12 +23,16 @@ fn benchmarks(c: &mut Criterion) {
 /// States in one benchmarked batch: enough groups of eight that the leftovers do not count.
 const BATCH: usize = 256;
 
-/// Batches of `BATCH` states through the lane kernels (`algo::lanes`) at every width this CPU
-/// runs, in states per second: the one-state width is the plain loop of single calls.
+/// Batches of `BATCH` states through the lane kernels (`algo::lanes`: RNEA, gravity, ABA, CRBA,
+/// RNEA derivatives) at every width this CPU runs, in states per second: the one-state width is
+/// the plain loop of single calls.
 fn lanes(c: &mut Criterion) {
     use rand::{rngs::StdRng, SeedableRng};
     use robodyn::algo::States;
-    use robodyn::algo::{aba_batch, crba_batch, newton_euler_batch, BatchWorkspace, LaneWidth};
+    use robodyn::algo::{
+        aba_batch, crba_batch, newton_euler_batch, rnea_derivatives_batch, BatchWorkspace,
+        LaneWidth,
+    };
     let mut group = c.benchmark_group("lanes");
     group.throughput(Throughput::Elements(BATCH as u64));
     for (name, model, _) in models() {
@@ -39,7 +43,7 @@ fn lanes(c: &mut Criterion) {
         let v: Vec<f64> = (0..BATCH * model.nv)
             .map(|k| (k % 7) as f64 * 0.2 - 0.6)
             .collect();
-        let (mut out, mut matrices) = (vec![0.0; v.len()], vec![0.0; v.len() * model.nv]);
+        let (mut out, mut matrices) = (vec![0.0; v.len()], vec![0.0; 3 * v.len() * model.nv]);
         for width in LaneWidth::ALL.into_iter().filter(|w| w.available()) {
             let mut workspace = BatchWorkspace::with_width(&model, width).unwrap();
             let id = |algorithm: &str| format!("{name}/{algorithm}/{width:?}");
@@ -68,8 +72,12 @@ fn lanes(c: &mut Criterion) {
             group.bench_function(id("aba"), |b| {
                 b.iter(|| aba_batch(&model, &mut workspace, forward, &mut out))
             });
+            let square = BATCH * model.nv * model.nv;
             group.bench_function(id("crba"), |b| {
-                b.iter(|| crba_batch(&model, &mut workspace, &q, &mut matrices))
+                b.iter(|| crba_batch(&model, &mut workspace, &q, &mut matrices[..square]))
+            });
+            group.bench_function(id("rnea_derivatives"), |b| {
+                b.iter(|| rnea_derivatives_batch(&model, &mut workspace, dynamics, &mut matrices))
             });
         }
     }

@@ -192,12 +192,12 @@ impl Joint {
 
     /// Entry (r, c) of ∂(K(v) v)/∂v, the derivative of the rotor's velocity term above: on a free
     /// joint (K v)_lin = ω × v_lin, so ∂/∂v_lin = [ω×] and ∂/∂ω = −[v_lin×].
-    #[inline]
-    pub fn rotor_velocity_jacobian(&self, r: usize, c: usize, v: &[f64]) -> f64 {
+    #[inline(always)]
+    pub fn rotor_velocity_jacobian<S: Real>(&self, r: usize, c: usize, v: &[S]) -> S {
         match self {
-            Joint::Free if r < 3 && c < 3 => skew(&Vec3::new(v[3], v[4], v[5]))[(r, c)],
-            Joint::Free if r < 3 => -skew(&Vec3::new(v[0], v[1], v[2]))[(r, c - 3)],
-            _ => 0.0,
+            Joint::Free if r < 3 && c < 3 => skew(&Vector3::new(v[3], v[4], v[5]))[(r, c)],
+            Joint::Free if r < 3 => -skew(&Vector3::new(v[0], v[1], v[2]))[(r, c - 3)],
+            _ => S::splat(0.0),
         }
     }
 

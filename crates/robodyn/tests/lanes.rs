@@ -1,12 +1,13 @@
 //! Batches in lanes (`algo::lanes`) against the one-state calls: every width, every test model,
-//! inverse dynamics, bias forces, gravity and forward dynamics, bit for bit.
+//! inverse dynamics, bias forces, gravity, forward dynamics, the mass matrix and the derivatives
+//! of inverse dynamics, bit for bit.
 
 mod common;
 
 use common::*;
 use robodyn::algo::{
     aba, aba_batch, bias_forces, crba, crba_batch, generalized_gravity, newton_euler_batch, rnea,
-    BatchWorkspace, LaneWidth, States,
+    rnea_derivatives_batch, rnea_derivatives_stacked, BatchWorkspace, LaneWidth, States,
 };
 use robodyn::{Data, Error, Model};
 
@@ -69,6 +70,25 @@ fn batch_at(model: &Model, width: LaneWidth, states: States) -> Option<Vec<f64>>
     Some(out)
 }
 
+/// The same numbers, bit for bit (signed zeros and NaN payloads included).
+fn bit_equal(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
+/// The last batch ran its full groups of `group` states in lanes (none for a group of one).
+fn assert_groups_ran_in_lanes(workspace: &BatchWorkspace, group: usize, name: &str) {
+    let expected = if group > 1 {
+        STATES - STATES % group
+    } else {
+        0
+    };
+    assert_eq!(
+        workspace.states_in_lanes(),
+        expected,
+        "{name}, groups of {group}"
+    );
+}
+
 #[test]
 fn every_lane_width_equals_the_one_state_call_bit_for_bit() {
     let mut exercised = 0;
@@ -105,10 +125,7 @@ fn every_lane_width_equals_the_one_state_call_bit_for_bit() {
                 exercised += 1;
                 for (k, row) in out.chunks(model.nv).enumerate() {
                     let expected = one_state(&model, &mut data, &states, k);
-                    let same = row
-                        .iter()
-                        .zip(&expected)
-                        .all(|(x, y)| x.to_bits() == y.to_bits());
+                    let same = bit_equal(row, &expected);
                     assert!(
                         same,
                         "{name}, {width:?}, state {k}: {row:?} != {expected:?}"
@@ -221,23 +238,42 @@ fn mass_matrices_in_lanes_equal_crba_bit_for_bit() {
             };
             let mut out = vec![f64::NAN; STATES * size];
             crba_batch(&model, &mut workspace, &q, &mut out).unwrap();
-            let group = width.states();
-            let expected_in_lanes = if group > 1 {
-                STATES - STATES % group
-            } else {
-                0
-            };
-            assert_eq!(
-                workspace.states_in_lanes(),
-                expected_in_lanes,
-                "{name} {width:?}"
-            );
+            assert_groups_ran_in_lanes(&workspace, width.states(), name);
             for (k, m) in out.chunks(size).enumerate() {
                 let expected = crba(&model, &mut data, &q[k * model.nq..(k + 1) * model.nq]);
-                let same = m
-                    .iter()
-                    .zip(expected.unwrap().iter())
-                    .all(|(x, y)| x.to_bits() == y.to_bits());
+                let same = bit_equal(m, expected.unwrap().as_slice());
+                assert!(same, "{name}, {width:?}, state {k}");
+            }
+        }
+    }
+}
+
+#[test]
+fn inverse_dynamics_derivatives_in_lanes_equal_the_one_state_call_bit_for_bit() {
+    for (name, model) in test_models() {
+        let (q, v, a) = batch(&model);
+        let mut data = Data::new(&model);
+        let size = 3 * model.nv * model.nv;
+        let states = States {
+            q: &q,
+            v: Some(&v),
+            a: Some(&a),
+            tau: None,
+        };
+        for width in LaneWidth::ALL {
+            let Ok(mut workspace) = BatchWorkspace::with_width(&model, width) else {
+                continue;
+            };
+            let mut out = vec![f64::NAN; STATES * size];
+            rnea_derivatives_batch(&model, &mut workspace, states, &mut out).unwrap();
+            assert_groups_ran_in_lanes(&workspace, width.states(), name);
+            let mut expected = vec![0.0; size];
+            for (k, stacked) in out.chunks(size).enumerate() {
+                let (nq, nv) = (model.nq, model.nv);
+                let row = |x: &[f64]| x[k * nv..(k + 1) * nv].to_vec();
+                let one = (&q[k * nq..(k + 1) * nq], &row(&v)[..], &row(&a)[..], None);
+                rnea_derivatives_stacked(&model, &mut data, one, &mut expected).unwrap();
+                let same = bit_equal(stacked, &expected);
                 assert!(same, "{name}, {width:?}, state {k}");
             }
         }

@@ -34,13 +34,15 @@
 //! Cost: O(n · depth) for RNEA's; ABA's add O(n Σ depth) for the solves.
 
 use crate::algo::crba::{
-    add_composite_inertias, composite_mass_matrix, world_inertias_and_subspaces,
+    add_composites, composite_mass_matrix, world_inertias_of, CompositeBuffers,
 };
 use crate::algo::ltdl::{factor_mass_matrix, solve_rows};
 use crate::algo::rnea::check_external_forces;
 use crate::error::{check_length, check_vector, Result};
 use crate::model::Model;
-use crate::spatial::{CoriolisFactor, Force, Motion, Vec3};
+use crate::spatial::{
+    splat_vector, zero_vector, CoriolisFactor, Force, Inertia, Motion, Real, Transform,
+};
 use crate::Data;
 use nalgebra::DMatrix;
 
@@ -69,8 +71,8 @@ pub fn rnea_derivatives(
     result
 }
 
-/// (q, q̇, q̈ or τ, f_ext): the state and inputs of a dynamics algorithm.
-pub type DynamicsState<'a> = (&'a [f64], &'a [f64], &'a [f64], Option<&'a [Force]>);
+/// (q, q̇, q̈ or τ, f_ext): the state and inputs of a dynamics algorithm (in `f64`, or lanes).
+pub type DynamicsState<'a, S = f64> = (&'a [S], &'a [S], &'a [S], Option<&'a [Force<S>]>);
 
 /// [`rnea_derivatives`] with ∂τ/∂q and ∂τ/∂q̇ written row-major (nv × nv each) into `dtau_dq` and
 /// `dtau_dv` instead of `data.dtau_dq` and `data.dtau_dv`: for a caller that hands the results on
@@ -100,14 +102,83 @@ fn rnea_derivative_passes(
     model: &Model,
     data: &mut Data,
     (q, v, a, f_ext): DynamicsState,
-    out: &mut impl TorqueDerivatives,
+    out: &mut impl TorqueDerivatives<f64>,
 ) -> Result<()> {
     check_arguments(model, q, v, ("a", a), f_ext)?;
-    velocity_terms(model, data, q, v, f_ext);
-    acceleration_terms(model, data, Some(a));
-    derivative_products(model, data, v, out);
-    add_rotor_torques(model, data, v, Some(a));
+    let mut buffers = DerivativeBuffers::of(data);
+    derivative_passes(model, &mut buffers, (q, v, a, f_ext), out);
     Ok(())
+}
+
+/// [`rnea_derivatives`] of one state into `out`: ∂τ/∂q, ∂τ/∂q̇ and M, each nv × nv row-major,
+/// one after the other.
+pub fn rnea_derivatives_stacked(
+    model: &Model,
+    data: &mut Data,
+    state: DynamicsState,
+    out: &mut [f64],
+) -> Result<()> {
+    let nv = model.nv;
+    check_length("out", out.len(), 3 * nv * nv)?;
+    let (by_q, rest) = out.split_at_mut(nv * nv);
+    let (by_v, by_a) = rest.split_at_mut(nv * nv);
+    rnea_derivatives_row_major(model, data, state, by_q, by_v)?;
+    // M is mirrored: its column-major storage is its row-major one
+    by_a.copy_from_slice(data.mass_matrix.as_slice());
+    Ok(())
+}
+
+/// The derivative passes on checked inputs, in `f64` or lanes: τ, M and ∂τ/∂q, ∂τ/∂q̇ into `out`.
+#[inline(always)]
+pub(crate) fn derivative_passes<S: Real>(
+    model: &Model,
+    buffers: &mut DerivativeBuffers<S>,
+    (q, v, a, f_ext): DynamicsState<S>,
+    out: &mut impl TorqueDerivatives<S>,
+) {
+    velocity_terms(model, buffers, q, v, f_ext);
+    acceleration_terms(model, buffers, Some(a));
+    derivative_products(model, buffers, v, out);
+    add_rotor_torques(model, buffers, v, Some(a));
+}
+
+/// What the derivative passes read and write (see `Data`'s fields of the same meaning): one
+/// state's, borrowed from [`Data`], or several states' in lanes ([`crate::algo::lanes`]).
+pub(crate) struct DerivativeBuffers<'b, S> {
+    pub x_up: &'b mut [Transform<S>],
+    pub x_world: &'b mut [Transform<S>],
+    pub i_c: &'b mut [Inertia<S>],
+    pub s_world: &'b mut [Motion<S>],
+    pub v_world: &'b mut [Motion<S>],
+    pub a_world: &'b mut [Motion<S>],
+    pub motion_terms: &'b mut [[Motion<S>; 3]],
+    pub i_world: &'b mut [Inertia<S>],
+    pub f_velocity: &'b mut [Force<S>],
+    pub f_world: &'b mut [Force<S>],
+    pub coriolis_factors: &'b mut [CoriolisFactor<S>],
+    pub tau: &'b mut [S],
+    pub mass_matrix: &'b mut [S],
+}
+
+impl<'b> DerivativeBuffers<'b, f64> {
+    /// `data`'s fields.
+    fn of(data: &'b mut Data) -> Self {
+        DerivativeBuffers {
+            x_up: &mut data.x_up,
+            x_world: &mut data.x_world,
+            i_c: &mut data.i_c,
+            s_world: &mut data.s_world,
+            v_world: &mut data.v_world,
+            a_world: &mut data.a_world,
+            motion_terms: &mut data.motion_terms,
+            i_world: &mut data.i_world,
+            f_velocity: &mut data.f_velocity,
+            f_world: &mut data.f_world,
+            coriolis_factors: &mut data.coriolis_factors,
+            tau: data.tau.as_mut_slice(),
+            mass_matrix: data.mass_matrix.as_mut_slice(),
+        }
+    }
 }
 
 /// ∂q̈/∂q, ∂q̈/∂q̇ and ∂q̈/∂τ = M⁻¹ of q̈ = FD(q, q̇, τ, f_ext), with q̈ itself: written into
@@ -150,16 +221,17 @@ pub fn aba_derivative_rows(
     (q, v, tau, f_ext): DynamicsState,
 ) -> Result<()> {
     check_arguments(model, q, v, ("tau", tau), f_ext)?;
-    velocity_terms(model, data, q, v, f_ext);
+    let mut buffers = DerivativeBuffers::of(data);
+    velocity_terms(model, &mut buffers, q, v, f_ext);
 
     // q̈ = M⁻¹ (τ − b), b = ID(q, q̇, 0)
-    acceleration_terms(model, data, None);
+    acceleration_terms(model, &mut buffers, None);
     for i in 1..model.nbodies() {
         for k in model.v_range(i) {
             data.tau[k] = data.s_world[k].dot(&data.f_world[i]);
         }
     }
-    add_rotor_torques(model, data, v, None);
+    add_rotor_torques(model, &mut DerivativeBuffers::of(data), v, None);
     let mut mass_matrix = std::mem::take(&mut data.mass_matrix);
     composite_mass_matrix(model, data, mass_matrix.as_mut_slice());
     data.mass_matrix = mass_matrix;
@@ -171,15 +243,16 @@ pub fn aba_derivative_rows(
     solve_rows(model, data, qdd.as_mut_slice());
 
     // [∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂τ] = M⁻¹ [−∂τ/∂q, −∂τ/∂q̇, 1] at q̈, solved row by row
-    acceleration_terms(model, data, Some(qdd.as_slice()));
     let nv = model.nv;
     let mut rows = NegatedRows {
         rows: std::mem::take(&mut data.derivative_rows),
         nv,
     };
     rows.rows.fill(0.0);
-    derivative_products(model, data, v, &mut rows);
-    add_rotor_torques(model, data, v, Some(qdd.as_slice()));
+    let mut buffers = DerivativeBuffers::of(data);
+    acceleration_terms(model, &mut buffers, Some(qdd.as_slice()));
+    derivative_products(model, &mut buffers, v, &mut rows);
+    add_rotor_torques(model, &mut buffers, v, Some(qdd.as_slice()));
     data.qdd = qdd;
     let (mut rows, width) = (rows.rows, 3 * nv);
     for k in 0..nv {
@@ -207,93 +280,106 @@ fn check_arguments(
     Ok(())
 }
 
-/// What does not depend on q̈: poses, world inertias (each body's in `data.i_world`, the
-/// subtrees' in `data.i_c`) and subspaces, velocities, the terms u and u + u', each body's
-/// velocity-product force less its external force, and the subtrees' H^C.
-fn velocity_terms(model: &Model, data: &mut Data, q: &[f64], v: &[f64], f_ext: Option<&[Force]>) {
-    world_inertias_and_subspaces(model, data, q);
-    data.v_world[0] = Motion::ZERO;
+/// What does not depend on q̈: poses, world inertias (each body's in `i_world`, the subtrees'
+/// in `i_c`) and subspaces, velocities, the terms u and u + u', each body's velocity-product
+/// force less its external force, and the subtrees' H^C.
+#[inline(always)]
+fn velocity_terms<S: Real>(
+    model: &Model,
+    b: &mut DerivativeBuffers<S>,
+    q: &[S],
+    v: &[S],
+    f_ext: Option<&[Force<S>]>,
+) {
+    let composites = CompositeBuffers {
+        x_up: b.x_up,
+        x_world: b.x_world,
+        composites: b.i_c,
+        subspaces: b.s_world,
+    };
+    world_inertias_of(model, q, composites);
+    b.v_world[0] = Motion::zeros();
     for i in 1..model.nbodies() {
-        let v_parent = data.v_world[model.parent[i]];
-        let mut v_joint = Motion::ZERO;
+        let v_parent = b.v_world[model.parent[i]];
+        let mut v_joint = Motion::zeros();
         for dof in model.v_range(i) {
-            v_joint += data.s_world[dof] * v[dof];
+            v_joint += b.s_world[dof] * v[dof];
         }
         // v_i = v_λ + S q̇
         let v_i = v_parent + v_joint;
         for dof in model.v_range(i) {
-            let s = data.s_world[dof];
+            let s = b.s_world[dof];
             let u = s.cross_motion(&v_parent);
-            data.motion_terms[dof][0] = u;
-            data.motion_terms[dof][1] = u + s.cross_motion(&v_i);
+            b.motion_terms[dof][0] = u;
+            b.motion_terms[dof][1] = u + s.cross_motion(&v_i);
         }
         // v_i ×* I_i v_i − f_ext_i
-        let inertia = data.i_c[i];
+        let inertia = b.i_c[i];
         let coriolis = CoriolisFactor::new(&inertia, &v_i);
         let mut f_velocity = v_i.cross_force(&coriolis.momentum);
         if let Some(forces) = f_ext {
-            f_velocity -= data.x_world[i].transpose_apply_force(&forces[i - 1]);
+            f_velocity -= b.x_world[i].transpose_apply_force(&forces[i - 1]);
         }
-        data.i_world[i] = inertia;
-        data.f_velocity[i] = f_velocity;
-        data.coriolis_factors[i] = coriolis;
-        data.v_world[i] = v_i;
+        b.i_world[i] = inertia;
+        b.f_velocity[i] = f_velocity;
+        b.coriolis_factors[i] = coriolis;
+        b.v_world[i] = v_i;
     }
     // composites, leaves to root
-    add_composite_inertias(model, data);
+    add_composites(model, b.i_c);
     for i in (1..model.nbodies()).rev() {
         let parent = model.parent[i];
         if parent != 0 {
-            let h = data.coriolis_factors[i];
-            data.coriolis_factors[parent] += h;
+            let h = b.coriolis_factors[i];
+            b.coriolis_factors[parent] += h;
         }
     }
 }
 
 /// What q̈ (zero for `None`) adds: accelerations, the terms z, each body's force
-/// f_i = I_i a_i + v_i ×* I_i v_i − f_ext_i and the subtrees' sums F in `data.f_world`.
-fn acceleration_terms(model: &Model, data: &mut Data, a: Option<&[f64]>) {
-    data.a_world[0] = Motion::new(Vec3::zeros(), -model.gravity);
+/// f_i = I_i a_i + v_i ×* I_i v_i − f_ext_i and the subtrees' sums F in `f_world`.
+#[inline(always)]
+fn acceleration_terms<S: Real>(model: &Model, b: &mut DerivativeBuffers<S>, a: Option<&[S]>) {
+    b.a_world[0] = Motion::new(zero_vector(), -splat_vector::<S>(&model.gravity));
     for i in 1..model.nbodies() {
         let parent = model.parent[i];
-        let (v_parent, a_parent, v_i) =
-            (data.v_world[parent], data.a_world[parent], data.v_world[i]);
-        let mut a_joint = Motion::ZERO;
+        let (v_parent, a_parent, v_i) = (b.v_world[parent], b.a_world[parent], b.v_world[i]);
+        let mut a_joint = Motion::zeros();
         if let Some(a) = a {
             for dof in model.v_range(i) {
-                a_joint += data.s_world[dof] * a[dof];
+                a_joint += b.s_world[dof] * a[dof];
             }
         }
         // a_i = a_λ + S q̈ + v_i × S q̇, with S q̇ = v_i − v_λ
         let a_i = a_parent + a_joint + v_i.cross_motion(&(v_i - v_parent));
         for dof in model.v_range(i) {
-            let [u, ..] = data.motion_terms[dof];
+            let [u, ..] = b.motion_terms[dof];
             // z_k = S_k × a_λ − u_k × v_λ
-            data.motion_terms[dof][2] =
-                data.s_world[dof].cross_motion(&a_parent) - u.cross_motion(&v_parent);
+            b.motion_terms[dof][2] =
+                b.s_world[dof].cross_motion(&a_parent) - u.cross_motion(&v_parent);
         }
-        data.a_world[i] = a_i;
-        data.f_world[i] = data.i_world[i].mul_motion(&a_i) + data.f_velocity[i];
+        b.a_world[i] = a_i;
+        b.f_world[i] = b.i_world[i].mul_motion(&a_i) + b.f_velocity[i];
     }
     for i in (1..model.nbodies()).rev() {
         let parent = model.parent[i];
         if parent != 0 {
-            let f = data.f_world[i];
-            data.f_world[parent] += f;
+            let f = b.f_world[i];
+            b.f_world[parent] += f;
         }
     }
 }
 
 /// Where the entries of ∂τ/∂q and ∂τ/∂q̇ go, added to a zeroed buffer (a joint's own block gets
 /// the recursion's term and its rotor's).
-trait TorqueDerivatives {
-    fn add(&mut self, row: usize, column: usize, by_q: f64, by_v: f64);
+pub(crate) trait TorqueDerivatives<S> {
+    fn add(&mut self, row: usize, column: usize, by_q: S, by_v: S);
 }
 
 /// Into two nv × nv matrices: `data.dtau_dq`, `data.dtau_dv`.
 struct Matrices(DMatrix<f64>, DMatrix<f64>);
 
-impl TorqueDerivatives for Matrices {
+impl TorqueDerivatives<f64> for Matrices {
     #[inline(always)]
     fn add(&mut self, row: usize, column: usize, by_q: f64, by_v: f64) {
         // column-major storage
@@ -303,16 +389,16 @@ impl TorqueDerivatives for Matrices {
     }
 }
 
-/// Into two nv × nv row-major buffers.
-struct RowMajor<'a> {
-    by_q: &'a mut [f64],
-    by_v: &'a mut [f64],
-    nv: usize,
+/// Into two nv × nv row-major buffers, in `f64` or lanes.
+pub(crate) struct RowMajor<'a, S> {
+    pub by_q: &'a mut [S],
+    pub by_v: &'a mut [S],
+    pub nv: usize,
 }
 
-impl TorqueDerivatives for RowMajor<'_> {
+impl<S: Real> TorqueDerivatives<S> for RowMajor<'_, S> {
     #[inline(always)]
-    fn add(&mut self, row: usize, column: usize, by_q: f64, by_v: f64) {
+    fn add(&mut self, row: usize, column: usize, by_q: S, by_v: S) {
         let index = row * self.nv + column;
         self.by_q[index] += by_q;
         self.by_v[index] += by_v;
@@ -325,7 +411,7 @@ struct NegatedRows {
     nv: usize,
 }
 
-impl TorqueDerivatives for NegatedRows {
+impl TorqueDerivatives<f64> for NegatedRows {
     #[inline(always)]
     fn add(&mut self, row: usize, column: usize, by_q: f64, by_v: f64) {
         let start = row * 3 * self.nv + column;
@@ -337,22 +423,23 @@ impl TorqueDerivatives for NegatedRows {
 /// τ, M and both derivatives from the terms and composites above: one coordinate k of body i
 /// against the coordinates on its path to the root; then the rotors' armature on M and their
 /// velocity term's Jacobian on ∂τ/∂q̇.
-fn derivative_products(
+#[inline(always)]
+fn derivative_products<S: Real>(
     model: &Model,
-    data: &mut Data,
-    v: &[f64],
-    out: &mut impl TorqueDerivatives,
+    b: &mut DerivativeBuffers<S>,
+    v: &[S],
+    out: &mut impl TorqueDerivatives<S>,
 ) {
     let nv = model.nv;
-    let mass_matrix = data.mass_matrix.as_mut_slice();
-    mass_matrix.fill(0.0);
+    let zero = S::splat(0.0);
+    let mass_matrix = &mut *b.mass_matrix;
+    mass_matrix.fill(zero);
     for i in 1..model.nbodies() {
-        let (composite, h_composite, f_i) =
-            (data.i_c[i], data.coriolis_factors[i], data.f_world[i]);
+        let (composite, h_composite, f_i) = (b.i_c[i], b.coriolis_factors[i], b.f_world[i]);
         for k in model.v_range(i) {
-            let s_k = data.s_world[k];
-            let [u_k, w_k, z_k] = data.motion_terms[k];
-            data.tau[k] = s_k.dot(&f_i);
+            let s_k = b.s_world[k];
+            let [u_k, w_k, z_k] = b.motion_terms[k];
+            b.tau[k] = s_k.dot(&f_i);
             // I^C_i S_k and H^C_iᵀ S_k, for the rows of k
             let inertia_s = composite.mul_motion(&s_k);
             let h_transpose_s = h_composite.tr_mul_motion(&s_k);
@@ -363,8 +450,8 @@ fn derivative_products(
             let mut j = i;
             while j != 0 {
                 for c in model.v_range(j) {
-                    let s_c = data.s_world[c];
-                    let [u_c, w_c, z_c] = data.motion_terms[c];
+                    let s_c = b.s_world[c];
+                    let [u_c, w_c, z_c] = b.motion_terms[c];
                     // row k: i lies in the subtree of c's body
                     out.add(
                         k,
@@ -389,11 +476,11 @@ fn derivative_products(
         let (joint, dofs) = (&model.joints[i], model.v_range(i));
         let v_i = &v[dofs.clone()];
         for (r, row) in dofs.clone().enumerate() {
-            let armature = model.armature[row];
+            let armature = S::splat(model.armature[row]);
             mass_matrix[row + row * nv] += armature;
             for (c, column) in dofs.clone().enumerate() {
                 let by_v = armature * joint.rotor_velocity_jacobian(r, c, v_i);
-                out.add(row, column, 0.0, by_v);
+                out.add(row, column, zero, by_v);
             }
         }
     }
@@ -401,15 +488,22 @@ fn derivative_products(
 
 /// The rotors' torque armature · (q̈ + K(q̇) q̇) added to τ on each joint's own coordinates (q̈ = 0
 /// for `None`).
-fn add_rotor_torques(model: &Model, data: &mut Data, v: &[f64], a: Option<&[f64]>) {
+#[inline(always)]
+fn add_rotor_torques<S: Real>(
+    model: &Model,
+    b: &mut DerivativeBuffers<S>,
+    v: &[S],
+    a: Option<&[S]>,
+) {
     for i in 1..model.nbodies() {
         let (joint, dofs) = (&model.joints[i], model.v_range(i));
         let v_i = &v[dofs.clone()];
         for (r, row) in dofs.clone().enumerate() {
-            let rotor_rate: f64 = (0..v_i.len())
-                .map(|c| joint.rotor_velocity_term(r, c, v_i) * v_i[c])
-                .sum();
-            data.tau[row] += model.armature[row] * (a.map_or(0.0, |a| a[row]) + rotor_rate);
+            let mut rate = a.map_or(S::splat(0.0), |a| a[row]);
+            for (c, v_c) in v_i.iter().enumerate() {
+                rate += joint.rotor_velocity_term(r, c, v_i) * *v_c;
+            }
+            b.tau[row] += S::splat(model.armature[row]) * rate;
         }
     }
 }

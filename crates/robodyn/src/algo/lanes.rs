@@ -10,16 +10,16 @@
 //! width is chosen at run time by the CPU found ([`LaneWidth::detect`]); the wide kernels are
 //! compiled once per instruction set (`#[target_feature]`), so one binary serves every x86-64 CPU.
 
-use crate::algo::aba::{aba, articulated_body_passes, AbaBuffers};
-use crate::algo::crba::{
-    add_composites, crba_into, mass_matrix_of_composites, world_inertias_of, CompositeBuffers,
-};
-use crate::algo::rnea::{newton_euler, newton_euler_passes, NewtonEulerBuffers};
+mod groups;
+
+use crate::algo::aba::aba;
+use crate::algo::crba::crba_into;
+use crate::algo::derivatives::rnea_derivatives_stacked;
+use crate::algo::rnea::newton_euler;
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::model::Model;
-use crate::spatial::{splat_matrix6, Force, Inertia, Mat6, Motion, Real, Transform};
 use crate::Data;
-use nalgebra::Matrix6;
+use groups::{groups_eight, groups_four, Lanes};
 use simba::simd::{AutoF64x4, AutoF64x8};
 
 /// How many states a batch kernel runs at once.
@@ -66,61 +66,6 @@ impl LaneWidth {
             .rev()
             .find(|width| width.available())
             .unwrap_or(&LaneWidth::One)
-    }
-}
-
-/// The per-lane buffers of one lane type: inputs gathered into lanes, the kernels' intermediates
-/// and their result.
-#[derive(Debug, Clone)]
-struct Lanes<S> {
-    q: Vec<S>,
-    v: Vec<S>,
-    a: Vec<S>,
-    tau: Vec<S>,
-    x_up: Vec<Transform<S>>,
-    velocities: Vec<Motion<S>>,
-    accelerations: Vec<Motion<S>>,
-    forces: Vec<Force<S>>,
-    velocity_products: Vec<Motion<S>>,
-    articulated_inertias: Vec<Matrix6<S>>,
-    articulated_biases: Vec<Force<S>>,
-    u: Vec<[Force<S>; 6]>,
-    u_tau: Vec<[S; 6]>,
-    d_inv: Vec<Matrix6<S>>,
-    x_world: Vec<Transform<S>>,
-    composites: Vec<Inertia<S>>,
-    subspaces: Vec<Motion<S>>,
-    mass_matrix: Vec<S>,
-    out: Vec<S>,
-}
-
-impl<S: Real> Lanes<S> {
-    fn new(model: &Model) -> Self {
-        let bodies = model.nbodies();
-        let zero = S::splat(0.0);
-        let zero_force = Force::splat(&Force::ZERO);
-        let zero_matrix = splat_matrix6(&Mat6::zeros());
-        Lanes {
-            q: vec![zero; model.nq],
-            v: vec![zero; model.nv],
-            a: vec![zero; model.nv],
-            tau: vec![zero; model.nv],
-            x_up: vec![Transform::splat(&Transform::IDENTITY); bodies],
-            velocities: vec![Motion::zeros(); bodies],
-            accelerations: vec![Motion::zeros(); bodies],
-            forces: vec![zero_force; bodies],
-            velocity_products: vec![Motion::zeros(); bodies],
-            articulated_inertias: vec![zero_matrix; bodies],
-            articulated_biases: vec![zero_force; bodies],
-            u: vec![[zero_force; 6]; bodies],
-            u_tau: vec![[zero; 6]; bodies],
-            d_inv: vec![zero_matrix; bodies],
-            x_world: vec![Transform::splat(&Transform::IDENTITY); bodies],
-            composites: vec![Inertia::splat(&Inertia::ZERO); bodies],
-            subspaces: vec![Motion::zeros(); model.nv],
-            mass_matrix: vec![zero; model.nv * model.nv],
-            out: vec![zero; model.nv],
-        }
     }
 }
 
@@ -195,6 +140,8 @@ enum Algorithm {
     ArticulatedBody,
     /// M(q) (the composite-rigid-body algorithm).
     CompositeRigidBody,
+    /// ∂τ/∂q, ∂τ/∂q̇ and M of τ = ID(q, v, a), stacked.
+    RneaDerivatives,
 }
 
 impl Algorithm {
@@ -207,6 +154,7 @@ impl Algorithm {
     fn output_size(self, model: &Model) -> usize {
         match self {
             Algorithm::CompositeRigidBody => model.nv * model.nv,
+            Algorithm::RneaDerivatives => 3 * model.nv * model.nv,
             _ => model.nv,
         }
     }
@@ -241,13 +189,7 @@ pub fn aba_batch(
     states: States,
     qdd: &mut [f64],
 ) -> BatchResult {
-    for (name, values) in [("v", states.v), ("tau", states.tau)] {
-        if values.is_none() {
-            let message = "forward dynamics needs it".into();
-            let argument = name.into();
-            return Err((0, Error::InvalidValue { argument, message }));
-        }
-    }
+    require(&[("v", states.v), ("tau", states.tau)], "forward dynamics")?;
     run_batch(Algorithm::ArticulatedBody, model, workspace, states, qdd)
 }
 
@@ -270,6 +212,36 @@ pub fn crba_batch(
         states,
         mass_matrix,
     )
+}
+
+/// The RNEA derivatives over a batch: per state, ∂τ/∂q, ∂τ/∂q̇ and M (each nv × nv row-major,
+/// stacked: `out` is n × 3 × nv × nv) at (q, v, a) (`states.v` and `states.a` are required),
+/// checked and grouped as [`newton_euler_batch`].
+pub fn rnea_derivatives_batch(
+    model: &Model,
+    workspace: &mut BatchWorkspace,
+    states: States,
+    out: &mut [f64],
+) -> BatchResult {
+    require(
+        &[("v", states.v), ("a", states.a)],
+        "the derivatives of inverse dynamics",
+    )?;
+    run_batch(Algorithm::RneaDerivatives, model, workspace, states, out)
+}
+
+/// An error if one of `inputs` is missing.
+fn require(inputs: &[(&str, Option<&[f64]>)], what: &str) -> BatchResult {
+    match inputs.iter().find(|(_, values)| values.is_none()) {
+        Some((name, _)) => Err((
+            0,
+            Error::InvalidValue {
+                argument: (*name).into(),
+                message: format!("{what} needs it"),
+            },
+        )),
+        None => Ok(()),
+    }
 }
 
 /// Checks the states, runs the full groups in lanes and the rest (and any group where a lane
@@ -323,125 +295,16 @@ fn run_batch(
                 crba_into(model, data, state.q, out).map_err(|e| (k, e))?;
                 continue;
             }
+            Algorithm::RneaDerivatives => {
+                let (v, a) = (state.v.unwrap_or_default(), state.a.unwrap_or_default());
+                let one = (state.q, v, a, None);
+                rnea_derivatives_stacked(model, data, one, out).map_err(|e| (k, e))?;
+                continue;
+            }
         };
         out.copy_from_slice(result.map_err(|e| (k, e))?.as_slice());
     }
     Ok(())
-}
-
-/// [`groups`] compiled for AVX2. Safety: only on a CPU with AVX2 and FMA.
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx2,fma"))]
-unsafe fn groups_four(
-    algorithm: Algorithm,
-    model: &Model,
-    lanes: &mut Lanes<AutoF64x4>,
-    states: States,
-    out: &mut [f64],
-) -> std::result::Result<(), usize> {
-    groups(algorithm, model, lanes, states, out)
-}
-
-/// [`groups`] compiled for AVX-512. Safety: only on a CPU with AVX-512F.
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx512f"))]
-unsafe fn groups_eight(
-    algorithm: Algorithm,
-    model: &Model,
-    lanes: &mut Lanes<AutoF64x8>,
-    states: States,
-    out: &mut [f64],
-) -> std::result::Result<(), usize> {
-    groups(algorithm, model, lanes, states, out)
-}
-
-/// `algorithm` on the groups of states that fill `out`, `S::LANES` at a time. An error gives the
-/// first state of a group where a lane failed (a singular articulated inertia).
-#[inline(always)]
-fn groups<S: Real>(
-    algorithm: Algorithm,
-    model: &Model,
-    lanes: &mut Lanes<S>,
-    states: States,
-    out: &mut [f64],
-) -> std::result::Result<(), usize> {
-    let (nq, nv, size) = (model.nq, model.nv, algorithm.output_size(model));
-    for (g, out) in out.chunks_exact_mut(S::LANES * size).enumerate() {
-        let first = g * S::LANES;
-        gather(&mut lanes.q, states.q, first, nq);
-        for (input, lanes) in [
-            (states.v, &mut lanes.v),
-            (states.a, &mut lanes.a),
-            (states.tau, &mut lanes.tau),
-        ] {
-            if let Some(input) = input {
-                gather(lanes, input, first, nv);
-            }
-        }
-        match algorithm {
-            Algorithm::NewtonEuler => {
-                let buffers = NewtonEulerBuffers {
-                    x_up: &mut lanes.x_up,
-                    v: &mut lanes.velocities,
-                    a: &mut lanes.accelerations,
-                    f: &mut lanes.forces,
-                    tau: &mut lanes.out,
-                };
-                let v = states.v.map(|_| &lanes.v[..]);
-                let a = states.a.map(|_| &lanes.a[..]);
-                newton_euler_passes(model, &lanes.q, v, a, None, buffers);
-            }
-            Algorithm::ArticulatedBody => {
-                let buffers = AbaBuffers {
-                    x_up: &mut lanes.x_up,
-                    v: &mut lanes.velocities,
-                    c: &mut lanes.velocity_products,
-                    a: &mut lanes.accelerations,
-                    i_a: &mut lanes.articulated_inertias,
-                    p_a: &mut lanes.articulated_biases,
-                    u: &mut lanes.u,
-                    u_tau: &mut lanes.u_tau,
-                    d_inv: &mut lanes.d_inv,
-                    qdd: &mut lanes.out,
-                };
-                articulated_body_passes(model, &lanes.q, &lanes.v, &lanes.tau, None, buffers)
-                    .map_err(|_| first)?;
-            }
-            Algorithm::CompositeRigidBody => {
-                let buffers = CompositeBuffers {
-                    x_up: &mut lanes.x_up,
-                    x_world: &mut lanes.x_world,
-                    composites: &mut lanes.composites,
-                    subspaces: &mut lanes.subspaces,
-                };
-                world_inertias_of(model, &lanes.q, buffers);
-                add_composites(model, &mut lanes.composites);
-                let (composites, subspaces) = (&lanes.composites, &lanes.subspaces);
-                mass_matrix_of_composites(model, composites, subspaces, &mut lanes.mass_matrix);
-                scatter(&lanes.mass_matrix, out, size);
-                continue;
-            }
-        }
-        scatter(&lanes.out, out, nv);
-    }
-    Ok(())
-}
-
-/// Lane l of `lanes[j]` = entry j of row `first + l` of the row-major `rows` (width `size`).
-#[inline(always)]
-fn gather<S: Real>(lanes: &mut [S], rows: &[f64], first: usize, size: usize) {
-    let rows = &rows[first * size..(first + S::LANES) * size];
-    for (j, lane) in lanes.iter_mut().enumerate() {
-        *lane = S::from_lanes(|l| rows[l * size + j]);
-    }
-}
-
-/// Entry j of row l of the row-major `rows` (width `size`) = lane l of `lanes[j]`.
-#[inline(always)]
-fn scatter<S: Real>(lanes: &[S], rows: &mut [f64], size: usize) {
-    for (j, lane) in lanes.iter().enumerate() {
-        for l in 0..S::LANES {
-            rows[l * size + j] = lane.extract(l);
-        }
-    }
 }
 
 /// State k of the batch.
@@ -479,8 +342,10 @@ fn check_states(model: &Model, states: &States, n: usize) -> BatchResult {
 
 #[cfg(test)]
 mod tests {
+    use super::groups::groups;
     use super::*;
     use crate::io::bundled_model;
+    use crate::spatial::{Inertia, Real};
     use crate::spatial::{Mat3, Vec3};
 
     /// The lane kernels themselves, compiled without the wide instruction sets, so that they are
@@ -516,6 +381,12 @@ mod tests {
                 q: &q,
                 ..States::default()
             },
+            Algorithm::RneaDerivatives => States {
+                q: &q,
+                v,
+                a,
+                tau: None,
+            },
         };
         let size = algorithm.output_size(&model);
         let mut lanes = vec![0.0; n * size];
@@ -543,6 +414,7 @@ mod tests {
             Algorithm::NewtonEuler,
             Algorithm::ArticulatedBody,
             Algorithm::CompositeRigidBody,
+            Algorithm::RneaDerivatives,
         ] {
             lanes_equal_one_state::<AutoF64x4>(algorithm);
             lanes_equal_one_state::<AutoF64x8>(algorithm);

@@ -1,7 +1,7 @@
 //! Rigid-body spatial inertia (Featherstone §2.13).
 
 use super::{
-    cross, rotate, skew, splat_matrix, splat_vector, Force, Mat3, Mat6, Motion, Real, Vec3,
+    cross, matrix3, rotate, skew, splat_matrix, splat_vector, Force, Mat3, Mat6, Motion, Real, Vec3,
 };
 use nalgebra::{Matrix3, Vector3};
 use std::ops::{Add, AddAssign};
@@ -173,13 +173,13 @@ impl Inertia {
 /// `ω×h× − h×ω× = (ω × h)×`), so `H s = (A + Aᵀ) s + s ×* I v` and, `(I v)×̄` being skew,
 /// `Hᵀ s = (A + Aᵀ) s − s ×* I v`. Every part is linear in the body, so a subtree's H is the sum.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CoriolisFactor {
+pub struct CoriolisFactor<S = f64> {
     /// `S`, symmetric.
-    pub rotational: Mat3,
+    pub rotational: Matrix3<S>,
     /// `p = ω × h + m u`.
-    pub coupling: Vec3,
+    pub coupling: Vector3<S>,
     /// `I v`, the momentum.
-    pub momentum: Force,
+    pub momentum: Force<S>,
 }
 
 impl CoriolisFactor {
@@ -188,51 +188,67 @@ impl CoriolisFactor {
         coupling: Vec3::new(0.0, 0.0, 0.0),
         momentum: Force::ZERO,
     };
+}
+
+impl<S: Real> CoriolisFactor<S> {
+    /// A constant factor in every lane.
+    #[inline(always)]
+    pub fn splat(factor: &CoriolisFactor) -> Self {
+        CoriolisFactor {
+            rotational: splat_matrix(&factor.rotational),
+            coupling: splat_vector(&factor.coupling),
+            momentum: Force::splat(&factor.momentum),
+        }
+    }
 
     /// `H(I, v)` of a body of inertia `inertia` moving with `v` (both in the same coordinates).
-    #[inline]
-    pub fn new(inertia: &Inertia, v: &Motion) -> Self {
+    #[inline(always)]
+    pub fn new(inertia: &Inertia<S>, v: &Motion<S>) -> Self {
         let (w, u, h) = (&v.angular, &v.linear, &inertia.first_moment);
-        // ω×Ī column by column; ω×Ī − Īω× = C + Cᵀ
-        let c = Mat3::from_columns(&[
-            w.cross(&inertia.rotational.column(0).into_owned()),
-            w.cross(&inertia.rotational.column(1).into_owned()),
-            w.cross(&inertia.rotational.column(2).into_owned()),
-        ]);
-        let h_u = h * u.transpose();
+        // ω×Ī column by column, C; ω×Ī − Īω× = C + Cᵀ
+        let i = &inertia.rotational;
+        let columns = [0, 1, 2].map(|c| cross(w, &Vector3::new(i[(0, c)], i[(1, c)], i[(2, c)])));
+        let u_h = u.x * h.x + u.y * h.y + u.z * h.z;
+        let rotational = matrix3(|r, c| {
+            let value = columns[c][r] + columns[r][c] - (h[r] * u[c] + u[r] * h[c]);
+            if r == c {
+                value + S::splat(2.0) * u_h
+            } else {
+                value
+            }
+        });
         CoriolisFactor {
-            rotational: c + c.transpose() - h_u - h_u.transpose()
-                + Mat3::identity() * (2.0 * u.dot(h)),
-            coupling: w.cross(h) + u * inertia.mass,
+            rotational,
+            coupling: cross(w, h) + u * inertia.mass,
             momentum: inertia.mul_motion(v),
         }
     }
 
     /// `(A + Aᵀ) s = [S s_ω + p × s_u; −p × s_ω]`.
-    #[inline]
-    fn symmetric_mul_motion(&self, s: &Motion) -> Force {
+    #[inline(always)]
+    fn symmetric_mul_motion(&self, s: &Motion<S>) -> Force<S> {
         Force {
-            angular: self.rotational * s.angular + self.coupling.cross(&s.linear),
-            linear: s.angular.cross(&self.coupling),
+            angular: rotate(&self.rotational, &s.angular) + cross(&self.coupling, &s.linear),
+            linear: cross(&s.angular, &self.coupling),
         }
     }
 
     /// `H s`.
-    #[inline]
-    pub fn mul_motion(&self, s: &Motion) -> Force {
+    #[inline(always)]
+    pub fn mul_motion(&self, s: &Motion<S>) -> Force<S> {
         self.symmetric_mul_motion(s) + s.cross_force(&self.momentum)
     }
 
     /// `Hᵀ s`.
-    #[inline]
-    pub fn tr_mul_motion(&self, s: &Motion) -> Force {
+    #[inline(always)]
+    pub fn tr_mul_motion(&self, s: &Motion<S>) -> Force<S> {
         self.symmetric_mul_motion(s) - s.cross_force(&self.momentum)
     }
 }
 
-impl AddAssign for CoriolisFactor {
-    #[inline]
-    fn add_assign(&mut self, rhs: CoriolisFactor) {
+impl<S: Real> AddAssign for CoriolisFactor<S> {
+    #[inline(always)]
+    fn add_assign(&mut self, rhs: CoriolisFactor<S>) {
         self.rotational += rhs.rotational;
         self.coupling += rhs.coupling;
         self.momentum += rhs.momentum;

@@ -1,0 +1,234 @@
+//! The lane kernels: a group of `S::LANES` states gathered into lanes, run through an algorithm's
+//! generic passes, scattered back; compiled once per instruction set.
+
+use super::{Algorithm, States};
+use crate::algo::aba::{articulated_body_passes, AbaBuffers};
+use crate::algo::crba::{
+    add_composites, mass_matrix_of_composites, world_inertias_of, CompositeBuffers,
+};
+use crate::algo::derivatives::{derivative_passes, DerivativeBuffers, RowMajor};
+use crate::algo::rnea::{newton_euler_passes, NewtonEulerBuffers};
+use crate::model::Model;
+use crate::spatial::{
+    splat_matrix6, CoriolisFactor, Force, Inertia, Mat6, Motion, Real, Transform,
+};
+use nalgebra::Matrix6;
+use simba::simd::{AutoF64x4, AutoF64x8};
+
+/// The per-lane buffers of one lane type: inputs gathered into lanes, the kernels' intermediates
+/// and their result.
+#[derive(Debug, Clone)]
+pub(super) struct Lanes<S> {
+    q: Vec<S>,
+    v: Vec<S>,
+    a: Vec<S>,
+    tau: Vec<S>,
+    x_up: Vec<Transform<S>>,
+    velocities: Vec<Motion<S>>,
+    accelerations: Vec<Motion<S>>,
+    forces: Vec<Force<S>>,
+    velocity_products: Vec<Motion<S>>,
+    articulated_inertias: Vec<Matrix6<S>>,
+    articulated_biases: Vec<Force<S>>,
+    u: Vec<[Force<S>; 6]>,
+    u_tau: Vec<[S; 6]>,
+    d_inv: Vec<Matrix6<S>>,
+    x_world: Vec<Transform<S>>,
+    composites: Vec<Inertia<S>>,
+    subspaces: Vec<Motion<S>>,
+    mass_matrix: Vec<S>,
+    motion_terms: Vec<[Motion<S>; 3]>,
+    body_inertias: Vec<Inertia<S>>,
+    velocity_forces: Vec<Force<S>>,
+    coriolis_factors: Vec<CoriolisFactor<S>>,
+    dtau_dq: Vec<S>,
+    dtau_dv: Vec<S>,
+    out: Vec<S>,
+}
+
+impl<S: Real> Lanes<S> {
+    pub(super) fn new(model: &Model) -> Self {
+        let bodies = model.nbodies();
+        let zero = S::splat(0.0);
+        let zero_force = Force::splat(&Force::ZERO);
+        let zero_matrix = splat_matrix6(&Mat6::zeros());
+        Lanes {
+            q: vec![zero; model.nq],
+            v: vec![zero; model.nv],
+            a: vec![zero; model.nv],
+            tau: vec![zero; model.nv],
+            x_up: vec![Transform::splat(&Transform::IDENTITY); bodies],
+            velocities: vec![Motion::zeros(); bodies],
+            accelerations: vec![Motion::zeros(); bodies],
+            forces: vec![zero_force; bodies],
+            velocity_products: vec![Motion::zeros(); bodies],
+            articulated_inertias: vec![zero_matrix; bodies],
+            articulated_biases: vec![zero_force; bodies],
+            u: vec![[zero_force; 6]; bodies],
+            u_tau: vec![[zero; 6]; bodies],
+            d_inv: vec![zero_matrix; bodies],
+            x_world: vec![Transform::splat(&Transform::IDENTITY); bodies],
+            composites: vec![Inertia::splat(&Inertia::ZERO); bodies],
+            subspaces: vec![Motion::zeros(); model.nv],
+            mass_matrix: vec![zero; model.nv * model.nv],
+            motion_terms: vec![[Motion::zeros(); 3]; model.nv],
+            body_inertias: vec![Inertia::splat(&Inertia::ZERO); bodies],
+            velocity_forces: vec![zero_force; bodies],
+            coriolis_factors: vec![CoriolisFactor::splat(&CoriolisFactor::ZERO); bodies],
+            dtau_dq: vec![zero; model.nv * model.nv],
+            dtau_dv: vec![zero; model.nv * model.nv],
+            out: vec![zero; model.nv],
+        }
+    }
+}
+
+/// [`groups`] compiled for AVX2. Safety: only on a CPU with AVX2 and FMA.
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx2,fma"))]
+pub(super) unsafe fn groups_four(
+    algorithm: Algorithm,
+    model: &Model,
+    lanes: &mut Lanes<AutoF64x4>,
+    states: States,
+    out: &mut [f64],
+) -> std::result::Result<(), usize> {
+    groups(algorithm, model, lanes, states, out)
+}
+
+/// [`groups`] compiled for AVX-512. Safety: only on a CPU with AVX-512F.
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx512f"))]
+pub(super) unsafe fn groups_eight(
+    algorithm: Algorithm,
+    model: &Model,
+    lanes: &mut Lanes<AutoF64x8>,
+    states: States,
+    out: &mut [f64],
+) -> std::result::Result<(), usize> {
+    groups(algorithm, model, lanes, states, out)
+}
+
+/// `algorithm` on the groups of states that fill `out`, `S::LANES` at a time. An error gives the
+/// first state of a group where a lane failed (a singular articulated inertia).
+#[inline(always)]
+pub(super) fn groups<S: Real>(
+    algorithm: Algorithm,
+    model: &Model,
+    lanes: &mut Lanes<S>,
+    states: States,
+    out: &mut [f64],
+) -> std::result::Result<(), usize> {
+    let (nq, nv, size) = (model.nq, model.nv, algorithm.output_size(model));
+    for (g, out) in out.chunks_exact_mut(S::LANES * size).enumerate() {
+        let first = g * S::LANES;
+        gather(&mut lanes.q, states.q, first, nq);
+        for (input, lanes) in [
+            (states.v, &mut lanes.v),
+            (states.a, &mut lanes.a),
+            (states.tau, &mut lanes.tau),
+        ] {
+            if let Some(input) = input {
+                gather(lanes, input, first, nv);
+            }
+        }
+        match algorithm {
+            Algorithm::NewtonEuler => {
+                let buffers = NewtonEulerBuffers {
+                    x_up: &mut lanes.x_up,
+                    v: &mut lanes.velocities,
+                    a: &mut lanes.accelerations,
+                    f: &mut lanes.forces,
+                    tau: &mut lanes.out,
+                };
+                let v = states.v.map(|_| &lanes.v[..]);
+                let a = states.a.map(|_| &lanes.a[..]);
+                newton_euler_passes(model, &lanes.q, v, a, None, buffers);
+            }
+            Algorithm::ArticulatedBody => {
+                let buffers = AbaBuffers {
+                    x_up: &mut lanes.x_up,
+                    v: &mut lanes.velocities,
+                    c: &mut lanes.velocity_products,
+                    a: &mut lanes.accelerations,
+                    i_a: &mut lanes.articulated_inertias,
+                    p_a: &mut lanes.articulated_biases,
+                    u: &mut lanes.u,
+                    u_tau: &mut lanes.u_tau,
+                    d_inv: &mut lanes.d_inv,
+                    qdd: &mut lanes.out,
+                };
+                articulated_body_passes(model, &lanes.q, &lanes.v, &lanes.tau, None, buffers)
+                    .map_err(|_| first)?;
+            }
+            Algorithm::CompositeRigidBody => {
+                let buffers = CompositeBuffers {
+                    x_up: &mut lanes.x_up,
+                    x_world: &mut lanes.x_world,
+                    composites: &mut lanes.composites,
+                    subspaces: &mut lanes.subspaces,
+                };
+                world_inertias_of(model, &lanes.q, buffers);
+                add_composites(model, &mut lanes.composites);
+                let (composites, subspaces) = (&lanes.composites, &lanes.subspaces);
+                mass_matrix_of_composites(model, composites, subspaces, &mut lanes.mass_matrix);
+                scatter(&lanes.mass_matrix, out, size, 0);
+                continue;
+            }
+            Algorithm::RneaDerivatives => {
+                let mut buffers = DerivativeBuffers {
+                    x_up: &mut lanes.x_up,
+                    x_world: &mut lanes.x_world,
+                    i_c: &mut lanes.composites,
+                    s_world: &mut lanes.subspaces,
+                    v_world: &mut lanes.velocities,
+                    a_world: &mut lanes.accelerations,
+                    motion_terms: &mut lanes.motion_terms,
+                    i_world: &mut lanes.body_inertias,
+                    f_velocity: &mut lanes.velocity_forces,
+                    f_world: &mut lanes.forces,
+                    coriolis_factors: &mut lanes.coriolis_factors,
+                    tau: &mut lanes.out,
+                    mass_matrix: &mut lanes.mass_matrix,
+                };
+                let zero = S::splat(0.0);
+                lanes.dtau_dq.fill(zero);
+                lanes.dtau_dv.fill(zero);
+                let mut sink = RowMajor {
+                    by_q: &mut lanes.dtau_dq,
+                    by_v: &mut lanes.dtau_dv,
+                    nv,
+                };
+                let inputs = (&lanes.q[..], &lanes.v[..], &lanes.a[..], None);
+                derivative_passes(model, &mut buffers, inputs, &mut sink);
+                let block = nv * nv;
+                for (part, lanes) in [&lanes.dtau_dq, &lanes.dtau_dv, &lanes.mass_matrix]
+                    .into_iter()
+                    .enumerate()
+                {
+                    scatter(lanes, out, size, part * block);
+                }
+                continue;
+            }
+        }
+        scatter(&lanes.out, out, nv, 0);
+    }
+    Ok(())
+}
+
+/// Lane l of `lanes[j]` = entry j of row `first + l` of the row-major `rows` (width `size`).
+#[inline(always)]
+fn gather<S: Real>(lanes: &mut [S], rows: &[f64], first: usize, size: usize) {
+    let rows = &rows[first * size..(first + S::LANES) * size];
+    for (j, lane) in lanes.iter_mut().enumerate() {
+        *lane = S::from_lanes(|l| rows[l * size + j]);
+    }
+}
+
+/// Entry j of row l of the row-major `rows` (width `size`), from `offset` on, = lane l of
+/// `lanes[j]` (`offset` places one block of a stacked result).
+#[inline(always)]
+fn scatter<S: Real>(lanes: &[S], rows: &mut [f64], size: usize, offset: usize) {
+    for (j, lane) in lanes.iter().enumerate() {
+        for l in 0..S::LANES {
+            rows[l * size + offset + j] = lane.extract(l);
+        }
+    }
+}
