@@ -49,6 +49,7 @@ fn _core(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(load_dh_dict, module)?)?;
     module.add_function(wrap_pyfunction!(bundled_names, module)?)?;
     module.add_function(wrap_pyfunction!(bundled_urdf, module)?)?;
+    module.add_function(wrap_pyfunction!(model_from_bytes, module)?)?;
     module.add_function(wrap_pyfunction!(simulation::simulate, module)?)?;
     module.add_function(wrap_pyfunction!(simulation::step, module)?)?;
     module.add_function(wrap_pyfunction!(visuals::read_mesh_file, module)?)?;

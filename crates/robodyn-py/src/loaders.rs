@@ -1,11 +1,12 @@
-//! Loaders: URDF, MJCF and DH tables from files, strings and dicts, and the bundled models.
+//! Loaders: URDF, MJCF and DH tables from files, strings and dicts, the bundled models, and a
+//! model's own bytes (pickling).
 
 use crate::args::named;
 use crate::model::*;
 use crate::to_py_err;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyBytes, PyDict};
 use robodyn::io::LoadOptions;
 
 /// Loads a URDF file. `floating_base` adds a free joint "root_joint" above the root link;
@@ -141,4 +142,27 @@ pub(crate) fn bundled_urdf(name: &str) -> PyResult<(&'static str, [f64; 3])> {
 #[pyfunction]
 pub(crate) fn bundled_names() -> Vec<&'static str> {
     robodyn::io::bundled_names()
+}
+
+/// A model from the bytes `Model.__reduce__` gives (pickle, `copy.deepcopy`, worker processes):
+/// every field, edits made after loading included. Bytes of another robodyn model format, or
+/// damaged ones, are a `ValueError` saying which.
+#[pyfunction(name = "_model_from_bytes")]
+pub(crate) fn model_from_bytes(data: &[u8]) -> PyResult<PyModel> {
+    robodyn::io::model_from_bytes(data)
+        .map(PyModel::wrap)
+        .map_err(to_py_err)
+}
+
+#[pymethods]
+impl PyModel {
+    /// Pickling and copying: the model as bytes, and the function that reads them back.
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyBytes>,))> {
+        let function = py.import("robodyn._core")?.getattr("_model_from_bytes")?;
+        let bytes = PyBytes::new(py, &robodyn::io::model_to_bytes(&self.model));
+        Ok((function, (bytes,)))
+    }
 }

@@ -26,7 +26,7 @@ fn coordinate_axis(axis: &Vec3) -> Option<usize> {
 }
 
 /// A joint between a body and its parent.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Joint {
     /// No motion: nq = nv = 0. Only the world (body 0) carries it; the loaders merge fixed joints
     /// into the parent body and keep the child link as a frame.

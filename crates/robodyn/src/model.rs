@@ -20,7 +20,7 @@ pub const STANDARD_GRAVITY: f64 = 9.81;
 
 /// A named frame rigidly attached to a body: a URDF link (moving or merged through a fixed joint)
 /// or a user frame.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Frame {
     pub name: String,
     /// The body it is attached to (0 = world).
@@ -31,7 +31,7 @@ pub struct Frame {
 
 /// A mimic relation from URDF: `q[joint] = multiplier * q[mimicked] + offset`. robodyn keeps both
 /// joints independent and reports the relation; enforcing it is the caller's choice.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Mimic {
     /// Body index of the mimicking joint.
     pub joint: usize,
@@ -77,7 +77,7 @@ impl Default for JointProperties {
 
 /// A rigid multibody tree. Bodies are numbered so that `parent[i] < i`; body 0 is the world and
 /// has no joint (`Joint::Fixed`). Body `i ≥ 1` moves relative to its parent through `joints[i]`.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Model {
     pub name: String,
     /// Number of configuration coordinates.

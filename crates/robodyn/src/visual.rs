@@ -10,7 +10,7 @@ use std::path::PathBuf;
 pub const DEFAULT_RGBA: [f64; 4] = [0.5, 0.5, 0.5, 1.0];
 
 /// Where a mesh's triangles come from.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum MeshSource {
     /// A file on disk (STL, OBJ, MuJoCo's .msh, Collada, glTF, ...), found when the model loaded.
     File(PathBuf),
@@ -22,7 +22,7 @@ pub enum MeshSource {
 }
 
 /// The shape of a visual, in its own frame (the z axis is the axis of cylinders and capsules).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Shape {
     Box {
         half_extents: Vec3,
@@ -69,7 +69,7 @@ impl Shape {
 }
 
 /// One piece of visual geometry.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Visual {
     /// Its name in the file, or one made from the link or body and its position there.
     pub name: String,

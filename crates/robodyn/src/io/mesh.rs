@@ -30,7 +30,7 @@ mod polygon;
 const MIN_VALUE: f64 = 1e-15;
 
 /// A mesh as read from its file: vertices and triangles (indices into the vertices).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TriangleMesh {
     pub vertices: Vec<Vec3>,
     pub faces: Vec<[usize; 3]>,

@@ -6,6 +6,7 @@ pub mod dh;
 pub mod mesh;
 pub mod mjcf;
 mod schema;
+pub mod snapshot;
 pub mod urdf;
 mod urdf_schema;
 mod xml;
@@ -17,6 +18,7 @@ pub use dh::{
     build_dh, load_dh_document, load_dh_file, load_dh_str, DhConvention, DhJoint, DhRow, DhTable,
 };
 pub use mjcf::{load_mjcf_file, load_mjcf_str};
+pub use snapshot::{model_from_bytes, model_to_bytes};
 pub use urdf::{load_urdf_file, load_urdf_str};
 
 /// How a model file is turned into a model.

@@ -10,7 +10,11 @@ use std::ops::{Add, AddAssign};
 /// moment `h = m c` (c: centre of mass) and the rotational inertia `Ī_O` about the origin, all in
 /// the frame's axes. As a 6x6 matrix on `[angular; linear]`: `I = [Ī_O  h×; h×ᵀ  m 1]`.
 /// `S` as for [`Motion`]: a model's inertias are `f64`; composites that depend on q can be lanes.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(bound(
+    serialize = "S: nalgebra::Scalar + serde::Serialize",
+    deserialize = "S: nalgebra::Scalar + serde::Deserialize<'de>"
+))]
 pub struct Inertia<S = f64> {
     pub mass: S,
     /// `h = m c`.

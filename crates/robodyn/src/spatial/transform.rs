@@ -13,7 +13,11 @@ use std::ops::Mul;
 ///
 /// The same object describes the pose of B in A: rotation `Eᵀ`, translation `r`
 /// (see [`Transform::from_pose`] and [`Transform::to_homogeneous`]). `S` as for [`Motion`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(bound(
+    serialize = "S: nalgebra::Scalar + serde::Serialize",
+    deserialize = "S: nalgebra::Scalar + serde::Deserialize<'de>"
+))]
 pub struct Transform<S = f64> {
     /// `E`: rotates A coordinates into B coordinates.
     pub rotation: Matrix3<S>,

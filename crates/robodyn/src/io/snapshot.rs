@@ -1,0 +1,176 @@
+//! A model as bytes and back: every field, edits made after loading included, for pickling and
+//! for sending a model to worker processes.
+//!
+//! Layout: the 8-byte tag `robodyn\0`, the format number (u32, little-endian), the length (u16)
+//! and text of the robodyn version that wrote it, then the model in postcard's compact serde
+//! encoding. The format number changes whenever `Model`'s fields do; bytes of another format are
+//! refused with both versions named. Decoded bytes are checked for a consistent tree before
+//! they become a model, so damaged bytes are an error, never a crash later.
+
+use crate::error::{Error, Result};
+use crate::model::Model;
+
+/// What every snapshot starts with.
+const TAG: &[u8; 8] = b"robodyn\0";
+
+/// The snapshot format: bumped whenever `Model` (or a type inside it) changes its fields.
+pub const MODEL_FORMAT: u32 = 1;
+
+/// The model as bytes.
+pub fn model_to_bytes(model: &Model) -> Vec<u8> {
+    let version = env!("CARGO_PKG_VERSION").as_bytes();
+    let mut bytes = Vec::with_capacity(1024);
+    bytes.extend_from_slice(TAG);
+    bytes.extend_from_slice(&MODEL_FORMAT.to_le_bytes());
+    // a version string is a few bytes: its length fits in a u16
+    bytes.extend_from_slice(&(version.len() as u16).to_le_bytes());
+    bytes.extend_from_slice(version);
+    postcard::to_extend(model, bytes).expect("a model's fields all serialise")
+}
+
+/// The model of [`model_to_bytes`]; an error names what is wrong with bytes that are not one,
+/// or come from an incompatible robodyn.
+pub fn model_from_bytes(bytes: &[u8]) -> Result<Model> {
+    let refuse = |message: String| Error::InvalidValue {
+        argument: "bytes".into(),
+        message,
+    };
+    let rest = bytes
+        .strip_prefix(TAG)
+        .ok_or_else(|| refuse("expected a robodyn model snapshot, got other bytes".into()))?;
+    let (format, rest) =
+        take::<4>(rest).ok_or_else(|| refuse("the snapshot is cut short".into()))?;
+    let (length, rest) =
+        take::<2>(rest).ok_or_else(|| refuse("the snapshot is cut short".into()))?;
+    let length = u16::from_le_bytes(length) as usize;
+    if rest.len() < length {
+        return Err(refuse("the snapshot is cut short".into()));
+    }
+    let (version, payload) = rest.split_at(length);
+    let version = String::from_utf8_lossy(version);
+    let format = u32::from_le_bytes(format);
+    if format != MODEL_FORMAT {
+        return Err(refuse(format!(
+            "this model was saved by robodyn {version} (model format {format}); robodyn {} reads \
+             format {MODEL_FORMAT}: load the model from its file again",
+            env!("CARGO_PKG_VERSION")
+        )));
+    }
+    let model: Model = postcard::from_bytes(payload)
+        .map_err(|e| refuse(format!("the snapshot (robodyn {version}) is damaged: {e}")))?;
+    check_structure(&model)?;
+    Ok(model)
+}
+
+/// The first `N` bytes and the rest.
+fn take<const N: usize>(bytes: &[u8]) -> Option<([u8; N], &[u8])> {
+    let (head, rest) = bytes.split_first_chunk::<N>()?;
+    Some((*head, rest))
+}
+
+/// Checks that the decoded fields make a tree the algorithms can index: one entry per body where
+/// there should be, parents before children, coordinates laid out joint after joint, vectors of
+/// length nq or nv, frames, visuals and mimics on existing bodies.
+fn check_structure(model: &Model) -> Result<()> {
+    let damaged = |message: String| Err(Error::model("model snapshot", message));
+    let bodies = model.parent.len();
+    let per_body = [
+        ("joints", model.joints.len()),
+        ("joint_names", model.joint_names.len()),
+        ("body_names", model.body_names.len()),
+        ("x_tree", model.x_tree.len()),
+        ("inertias", model.inertias.len()),
+        ("idx_q", model.idx_q.len()),
+        ("idx_v", model.idx_v.len()),
+    ];
+    if bodies == 0 || model.parent[0] != 0 {
+        return damaged("body 0 must be the world".into());
+    }
+    if let Some((name, length)) = per_body.iter().find(|(_, length)| *length != bodies) {
+        return damaged(format!("{name} has {length} entries for {bodies} bodies"));
+    }
+    let (mut nq, mut nv) = (0, 0);
+    for i in 0..bodies {
+        if i > 0 && model.parent[i] >= i {
+            return damaged(format!(
+                "body {i}'s parent {} is not before it",
+                model.parent[i]
+            ));
+        }
+        if model.idx_q[i] != nq || model.idx_v[i] != nv {
+            return damaged(format!("body {i}'s coordinates are out of place"));
+        }
+        nq += model.joints[i].nq();
+        nv += model.joints[i].nv();
+    }
+    if (nq, nv) != (model.nq, model.nv) || model.dof_parent.len() != nv {
+        return damaged(format!(
+            "the joints have {nq} + {nv} coordinates, the model says {} + {}",
+            model.nq, model.nv
+        ));
+    }
+    let by_coordinate = [
+        ("lower_position_limit", model.lower_position_limit.len(), nq),
+        ("upper_position_limit", model.upper_position_limit.len(), nq),
+        ("spring_reference", model.spring_reference.len(), nq),
+        ("velocity_limit", model.velocity_limit.len(), nv),
+        ("effort_limit", model.effort_limit.len(), nv),
+        ("armature", model.armature.len(), nv),
+        ("damping", model.damping.len(), nv),
+        ("friction", model.friction.len(), nv),
+        ("stiffness", model.stiffness.len(), nv),
+    ];
+    if let Some((name, length, expected)) = by_coordinate.iter().find(|(_, l, e)| l != e) {
+        return damaged(format!("{name} has {length} entries, expected {expected}"));
+    }
+    let bodies_named = model
+        .frames
+        .iter()
+        .map(|f| f.body)
+        .chain(model.visuals.iter().map(|v| v.body))
+        .chain(model.mimics.iter().flat_map(|m| [m.joint, m.mimicked]));
+    let dof_parents_before = model
+        .dof_parent
+        .iter()
+        .enumerate()
+        .all(|(k, parent)| parent.is_none_or(|p| p < k));
+    if bodies_named.into_iter().any(|body| body >= bodies) || !dof_parents_before {
+        return damaged("a frame, visual, mimic or coordinate refers to a missing one".into());
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::bundled_model;
+
+    #[test]
+    fn a_model_comes_back_with_its_edits() {
+        let mut model = bundled_model("ur5", true).unwrap();
+        model.armature.fill(0.1);
+        model.gravity.z = -3.7;
+        model.inertias[3].mass = 7.5;
+        let back = model_from_bytes(&model_to_bytes(&model)).unwrap();
+        assert_eq!(format!("{back:?}"), format!("{model:?}"));
+    }
+
+    #[test]
+    fn other_bytes_and_other_formats_are_refused_by_name() {
+        let bytes = model_to_bytes(&bundled_model("pendulum", false).unwrap());
+        let message = |bytes: &[u8]| model_from_bytes(bytes).unwrap_err().to_string();
+        assert!(message(b"not a model").contains("expected a robodyn model snapshot"));
+        assert!(message(&bytes[..11]).contains("cut short"));
+        let mut other = bytes.clone();
+        other[8] = other[8].wrapping_add(1);
+        assert!(message(&other).contains("model format"));
+        assert!(message(&bytes[..bytes.len() - 3]).contains("damaged"));
+        // a consistent encoding of an inconsistent tree
+        let mut model = bundled_model("pendulum", false).unwrap();
+        model.parent[1] = 5;
+        assert!(message(&model_to_bytes(&model)).contains("not before it"));
+        let mut model = bundled_model("pendulum", false).unwrap();
+        model.armature = nalgebra::DVector::zeros(3);
+        assert!(message(&model_to_bytes(&model)).contains("armature has 3 entries"));
+    }
+}
