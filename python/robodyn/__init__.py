@@ -35,6 +35,7 @@ from robodyn._core import (
 )
 from robodyn.operational_space import operational_space as _operational_space
 from robodyn.simulation import PD, ComputedTorque, GravityCompensation, Trajectory, simulate, step
+from robodyn.datasets import dataset
 
 # methods composed in NumPy from the core's batched calls
 Model.operational_space = _operational_space
@@ -63,6 +64,7 @@ Model.to_html = _to_html
 
 __all__ = [
     "ComputedTorque",
+    "dataset",
     "GravityCompensation",
     "Model",
     "PD",

@@ -1,7 +1,7 @@
 """The README's examples run as written: each Python block on its own, in a fresh subprocess in an
 empty temporary folder (not the repository), with the interpreter of a clean environment that has
-only the wheel and its `robots` extra when the test command provides one (ROBODYN_CLEAN_PYTHON),
-else this one."""
+only the wheel and its `robots` and `distributed` extras when the test command provides one
+(ROBODYN_CLEAN_PYTHON), else this one."""
 
 from __future__ import annotations
 

@@ -1,0 +1,140 @@
+"""robodyn.dataset: sampled states and their dynamics in a Zarr store, here or on a Dask cluster
+(issue 17): values equal to the batched calls, the same store for any chunking and any workers,
+resumable, and complete after a worker dies."""
+
+import os
+import threading
+import time
+
+import numpy as np
+import pytest
+import robodyn
+import robodyn.datasets
+import zarr
+from dask.distributed import Client, LocalCluster
+
+ARRAYS = ["q", "v", "a", "tau_applied", "tau", "M", "qdd"]  # what `make` stores
+
+
+def make(tmp_path, name, **options):
+    m = options.pop("model", None) or robodyn.load("ur5")
+    arguments = dict(n=1500, quantities=["tau", "M", "qdd"], seed=5, chunk=512)
+    arguments.update(options)
+    return robodyn.dataset(m, out=str(tmp_path / name), **arguments)
+
+
+def assert_same_store(a, b):
+    """The same samples and values (the chunk flags differ with the chunking)."""
+    names = sorted(set(a.array_keys()) - {"done"})
+    assert names == sorted(set(b.array_keys()) - {"done"})
+    for name in names:
+        np.testing.assert_array_equal(a[name][:], b[name][:], err_msg=name)
+
+
+@pytest.fixture(scope="module")
+def client():
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        with Client(cluster) as c:
+            yield c
+
+
+def test_a_store_holds_the_batched_calls_and_its_provenance(tmp_path):
+    m = robodyn.load("ur5")
+    store = make(tmp_path, "a.zarr", model=m)
+    q, v, a, applied = (store[k][:] for k in ["q", "v", "a", "tau_applied"])
+    assert q.shape == (1500, 6) and store["M"].shape == (1500, 6, 6) and store["done"][:].all()
+    np.testing.assert_array_equal(store["tau"][:], m.inverse_dynamics(q, v, a))
+    np.testing.assert_array_equal(store["M"][:], m.mass_matrix(q))
+    np.testing.assert_array_equal(store["qdd"][:], m.forward_dynamics(q, v, applied))
+    lower, upper = m.lower_position_limit, m.upper_position_limit
+    assert np.all((q >= lower) & (q <= upper)) and np.all(np.abs(v) <= m.velocity_limit)
+    attributes = dict(store.attrs)
+    assert attributes["model"] == m.name and attributes["seed"] == 5 and attributes["n"] == 1500
+    assert attributes["sampler"] == {"kind": "uniform"} and len(attributes["model_sha256"]) == 64
+    assert attributes["robodyn_version"] and attributes["quantities"] == ["tau", "M", "qdd"]
+
+
+def test_the_store_does_not_depend_on_the_chunking(tmp_path):
+    assert_same_store(make(tmp_path, "a.zarr", chunk=256), make(tmp_path, "b.zarr", chunk=1024))
+    other_seed = make(tmp_path, "c.zarr", seed=6)
+    assert not np.array_equal(other_seed["q"][:], make(tmp_path, "d.zarr")["q"][:])
+
+
+def test_gaussian_and_given_samplers(tmp_path):
+    m = robodyn.load("ur5")
+    center = m.neutral() + 0.3
+    store = make(tmp_path, "g.zarr", model=m, sampler="gaussian", center=center, std=0.05)
+    spread = store["q"][:] - center
+    assert abs(spread.std() - 0.05) < 0.005 and abs(spread.mean()) < 0.005
+    q = m.random_configuration(n=1500, seed=1)
+    given = make(tmp_path, "q.zarr", model=m, sampler=q)
+    np.testing.assert_array_equal(given["q"][:], q)
+    assert dict(given.attrs)["sampler"]["kind"] == "array"
+
+
+def test_bad_arguments_are_named(tmp_path):
+    m = robodyn.load("ur5")
+    with pytest.raises(ValueError, match="argument 'chunk': expected a multiple of 256"):
+        make(tmp_path, "x.zarr", chunk=1000)
+    with pytest.raises(ValueError, match="argument 'quantities'"):
+        make(tmp_path, "x.zarr", quantities=["torque"])
+    with pytest.raises(ValueError, match="argument 'sampler'"):
+        make(tmp_path, "x.zarr", sampler="sobol")
+    with pytest.raises(ValueError, match=r"argument 'sampler': expected an array of shape \(1500, 6\)"):
+        make(tmp_path, "x.zarr", sampler=np.zeros((3, 6)))
+    make(tmp_path, "y.zarr")
+    with pytest.raises(ValueError, match="argument 'out': .* exists; pass resume=True"):
+        make(tmp_path, "y.zarr")
+    with pytest.raises(ValueError, match="argument 'resume': .* made with other seed"):
+        make(tmp_path, "y.zarr", seed=9, resume=True)
+    assert m.nv == 6
+
+
+def test_an_interrupted_store_resumes_without_recomputing_finished_chunks(tmp_path, monkeypatch):
+    complete = make(tmp_path, "full.zarr")
+    partial = make(tmp_path, "partial.zarr")
+    # as a run stopped after chunks 0 and 2: chunk 1 never written, never marked done
+    writable = zarr.open_group(str(tmp_path / "partial.zarr"), mode="r+")
+    writable["done"][1] = False
+    for name in ARRAYS:
+        writable[name][512:1024] = 0.0
+    computed = []
+    fill = robodyn.datasets._fill_chunk
+    monkeypatch.setattr(robodyn.datasets, "_fill_chunk", lambda *a: computed.append(a[2]) or fill(*a))
+    resumed = make(tmp_path, "partial.zarr", resume=True)
+    assert computed == [1]
+    assert_same_store(resumed, complete)
+    assert partial["done"][:].all()
+
+
+def test_a_dask_cluster_writes_the_same_store(tmp_path, client):
+    assert_same_store(make(tmp_path, "dask.zarr", client=client), make(tmp_path, "here.zarr"))
+
+
+def test_a_worker_killed_mid_run_leaves_a_complete_equal_store(tmp_path, client):
+    talos = robodyn.load("talos_full_v2.urdf", floating_base=True)
+    options = dict(model=talos, n=256 * 40, chunk=256, quantities=["tau", "M"])
+    result = {}
+    run = threading.Thread(target=lambda: result.setdefault("store", make(tmp_path, "killed.zarr", client=client, **options)))
+    run.start()
+    done_path = str(tmp_path / "killed.zarr")
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        try:
+            if zarr.open_group(done_path, mode="r")["done"][:].any():
+                break
+        except Exception:
+            pass
+        time.sleep(0.02)
+    finished_before = int(zarr.open_group(done_path, mode="r")["done"][:].sum())
+    victim = sorted(client.scheduler_info()["workers"])[0]
+    try:
+        client.run(os._exit, 1, workers=[victim])
+    except Exception:
+        pass  # the worker died before it could answer
+    run.join(timeout=300)
+    # the worker died with chunks still to do, and the run finished them all anyway
+    assert 0 < finished_before < 40, finished_before
+    store = result["store"]
+    assert store["done"][:].all()
+    assert_same_store(store, make(tmp_path, "unharmed.zarr", **options))
