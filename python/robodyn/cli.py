@@ -471,7 +471,61 @@ def _parser() -> _Parser:
     view_parser.add_argument("--com", action="store_true", help="mark the centre of mass")
     view_parser.add_argument("--browser", action=argparse.BooleanOptionalAction, default=None,
                              help="open the page in a browser (default: when a desktop session is there)")
+    dataset_parser = commands.add_parser("dataset", help="sample states and write their dynamics to a Zarr store")
+    dataset_parser.add_argument("model", help=MODEL_HELP)
+    dataset_parser.add_argument("--n", type=_count, required=True, help="number of states, e.g. 1e6")
+    dataset_parser.add_argument("--out", required=True, help="the Zarr store to write (a folder)")
+    dataset_parser.add_argument("--quantities", nargs="+", default=["tau"], choices=["tau", "M", "g", "qdd"],
+                                help="what to evaluate at each state (default tau)")
+    dataset_parser.add_argument("--seed", type=int, default=0, help="the seed (default 0)")
+    dataset_parser.add_argument("--chunk", type=_positive_int, default=65_536,
+                                help="states per task and Zarr chunk, a multiple of 256 (default 65536)")
+    dataset_parser.add_argument("--sampler", choices=["uniform", "gaussian"], default="uniform",
+                                help="q uniform within the limits, or Gaussian around the neutral pose")
+    dataset_parser.add_argument("--scheduler", help="a Dask scheduler's address (default: this machine, no Dask)")
+    dataset_parser.add_argument("--resume", action="store_true", help="complete a store an interrupted run left")
+    dataset_parser.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                                help="show a progress bar (default: on a terminal)")
     return parser
+
+
+# ---------------------------------------------------------------------------------------------------
+# robodyn dataset
+
+
+def _count(text: str) -> int:
+    """A positive whole number, also written as 1e8."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive whole number such as 1000000 or 1e6, got '{text}'") from None
+    if not (np.isfinite(value) and value >= 1 and value == int(value)):
+        raise argparse.ArgumentTypeError(f"expected a positive whole number such as 1000000 or 1e6, got {text}")
+    return int(value)
+
+
+def dataset(model: str, n: int, out: str, quantities: list[str], seed: int, chunk: int, sampler: str,
+            scheduler: str | None, resume: bool, progress: bool | None) -> int:
+    """Samples n states of a model and writes them with their dynamics to a Zarr store."""
+    m = _load(model)
+    _check_writable(out, "--out")
+    client = None
+    if scheduler is not None:
+        from dask.distributed import Client
+
+        client = Client(scheduler)
+    show = _is_terminal(sys.stderr) if progress is None else progress
+    started = time.perf_counter()
+    try:
+        store = robodyn.dataset(m, n, quantities, sampler=sampler, seed=seed, chunk=chunk, out=out,
+                                client=client, resume=resume, progress=_progress_bar("dataset") if show else None)
+    finally:
+        if client is not None:
+            client.close()
+    seconds = time.perf_counter() - started
+    print(f"{out}: {n} states of {m.name} ({', '.join(['q', 'v', 'a', 'tau_applied', *quantities])}), "
+          f"{store['done'].shape[0]} chunks, {seconds:.1f} s, {n / seconds:,.0f} states/s")
+    return 0
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -485,6 +539,9 @@ def _run(args: argparse.Namespace) -> int:
     if args.command == "derive":
         return derive(args.model, args.rods, args.latex, args.codegen, args.symbolic_params, args.newton_euler,
                       args.output)
+    if args.command == "dataset":
+        return dataset(args.model, args.n, args.out, args.quantities, args.seed, args.chunk, args.sampler,
+                       args.scheduler, args.resume, args.progress)
     if args.command == "view":
         return view(args.model, args.q, args.html, args.port, args.frames, args.com, args.browser)
     return simulate(args.model, args.t_end, args.dt, args.integrator, args.q0, args.controller, args.target,
@@ -494,7 +551,8 @@ def _run(args: argparse.Namespace) -> int:
 def main(argv: list[str] | None = None) -> int:
     arguments = sys.argv[1:] if argv is None else argv
     command = next((a for a in arguments if not a.startswith("-")), "")
-    prefix = f"robodyn {command}".strip() if command in ("demo", "info", "models", "derive", "simulate", "view") else "robodyn"
+    commands = ("demo", "info", "models", "derive", "simulate", "view", "dataset")
+    prefix = f"robodyn {command}".strip() if command in commands else "robodyn"
     try:
         return _run(_parser().parse_args(arguments))
     except (UsageError, ValueError, FileNotFoundError) as error:

@@ -138,3 +138,16 @@ def test_a_worker_killed_mid_run_leaves_a_complete_equal_store(tmp_path, client)
     store = result["store"]
     assert store["done"][:].all()
     assert_same_store(store, make(tmp_path, "unharmed.zarr", **options))
+
+
+def test_the_dataset_command(tmp_path):
+    from robodyn.cli import main
+
+    out = str(tmp_path / "cli.zarr")
+    assert main(["dataset", "ur5", "--n", "2e3", "--out", out, "--quantities", "tau", "M", "--chunk", "512",
+                 "--no-progress"]) == 0
+    store = zarr.open_group(out, mode="r")
+    assert store["M"].shape == (2000, 6, 6) and store["done"][:].all()
+    assert_same_store(store, make(tmp_path, "api.zarr", n=2000, quantities=["tau", "M"], seed=0))
+    assert main(["dataset", "ur5", "--n", "1.5", "--out", out]) == 2
+    assert main(["dataset", "ur5", "--n", "2e3", "--out", out]) == 2
