@@ -1,5 +1,5 @@
-"""Datasets of sampled states and their dynamics, on this machine or a Dask cluster, written to a
-chunked Zarr store.
+"""Datasets of sampled states and their dynamics, and batches of rollouts, on this machine or a
+Dask cluster; datasets are written to a chunked Zarr store, rollouts gathered or written there.
 
 `dataset(model, n, quantities, sampler, seed, chunk, out, client)` samples n states (q, v, a),
 evaluates the requested quantities with the batched core calls (all cores, lanes) chunk by
@@ -211,8 +211,9 @@ def dataset(
     else:
         from dask.distributed import as_completed
 
-        # the model goes to every worker once (it pickles), each chunk is one task
-        remote = client.scatter(model, broadcast=True)
+        # the model goes to every worker once (it pickles), each chunk is one task; a fresh key
+        # each call (hash=False): a worker restarted since an earlier scatter lacks the old one
+        remote = client.scatter(model, broadcast=True, hash=False)
         futures = [client.submit(_fill_chunk, remote, path, k, *rest, pure=False) for k in todo]
         for future in as_completed(futures):
             future.result()
@@ -220,3 +221,60 @@ def dataset(
             if progress is not None:
                 progress(finished / chunks)
     return zarr.open_group(path, mode="r")
+
+
+def _rollouts(model: _core.Model, q0: FloatArray, v0: FloatArray, options: dict[str, Any]) -> list[Any]:
+    """One task: a batch of rollouts, in parallel on the worker's cores."""
+    from robodyn.simulation import simulate
+
+    return list(simulate(model, q0, v0, **options))
+
+
+def simulate_many(
+    model: _core.Model,
+    q0: Any,
+    v0: Any = None,
+    client: Any = None,
+    per_task: int = 64,
+    out: str | Path | None = None,
+    **options: Any,
+) -> Any:
+    """Rollouts from every row of `q0` (N, nq) and `v0` (N, nv; zeros by default), in tasks of
+    `per_task` rollouts spread over the workers of a `dask.distributed` `client`, each task
+    simulating its rollouts in parallel on its worker's cores (`robodyn.simulate`); without a
+    client the tasks run here. `options` are `robodyn.simulate`'s (t_end, dt, integrator,
+    controller, ...; the controller and wrenches must pickle: the native controller
+    descriptions do, a Python callable must be a module-level function).
+
+    Returns the N trajectories in order (each equal to `robodyn.simulate`'s), or, with `out`, writes
+    a Zarr store with `t` (T,) and `q`, `v`, `a`, `tau` (N, T, ...) and returns it.
+    """
+    q0 = np.atleast_2d(np.asarray(q0, dtype=np.float64))
+    if q0.ndim != 2 or q0.shape[1] != model.nq:
+        raise ValueError(f"argument 'q0': expected an array of shape (N, {model.nq}), got {q0.shape}")
+    count = q0.shape[0]
+    v0 = np.zeros((count, model.nv)) if v0 is None else np.atleast_2d(np.asarray(v0, dtype=np.float64))
+    if v0.shape != (count, model.nv):
+        raise ValueError(f"argument 'v0': expected an array of shape ({count}, {model.nv}), got {v0.shape}")
+    if per_task < 1:
+        raise ValueError(f"argument 'per_task': expected a positive number of rollouts, got {per_task}")
+    if out is not None and Path(out).exists():
+        raise ValueError(f"argument 'out': {out} exists; remove it or choose another")
+    groups = [(start, min(start + per_task, count)) for start in range(0, count, per_task)]
+    if client is None:
+        parts = [_rollouts(model, q0[a:b], v0[a:b], options) for a, b in groups]
+    else:
+        remote = client.scatter(model, broadcast=True, hash=False)
+        futures = [client.submit(_rollouts, remote, q0[a:b], v0[a:b], options, pure=False) for a, b in groups]
+        parts = client.gather(futures)
+    trajectories = [trajectory for part in parts for trajectory in part]
+    if out is None:
+        return trajectories
+    import zarr
+
+    store = zarr.open_group(str(out), mode="w")
+    store.create_array("t", data=trajectories[0].t)
+    for name in ("q", "v", "a", "tau"):
+        store.create_array(name, data=np.stack([getattr(t, name) for t in trajectories]))
+    store.attrs.update({"model": model.name, "rollouts": count, "robodyn_version": version("robodyn")})
+    return store

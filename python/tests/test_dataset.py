@@ -151,3 +151,21 @@ def test_the_dataset_command(tmp_path):
     assert_same_store(store, make(tmp_path, "api.zarr", n=2000, quantities=["tau", "M"], seed=0))
     assert main(["dataset", "ur5", "--n", "1.5", "--out", out]) == 2
     assert main(["dataset", "ur5", "--n", "2e3", "--out", out]) == 2
+
+
+def test_rollouts_spread_over_workers_equal_the_local_batch(tmp_path, client):
+    m = robodyn.load("ur5")
+    q0 = m.random_configuration(n=7, seed=3)
+    options = dict(t_end=0.2, dt=1e-3, controller=robodyn.GravityCompensation())
+    here = robodyn.simulate(m, q0, **options)
+    for spread in (robodyn.simulate_many(m, q0, client=client, per_task=3, **options),
+                   robodyn.simulate_many(m, q0, per_task=2, **options)):
+        assert len(spread) == 7
+        for one, other in zip(here, spread):
+            for name in ("t", "q", "v", "a", "tau"):
+                np.testing.assert_array_equal(getattr(other, name), getattr(one, name), err_msg=name)
+    store = robodyn.simulate_many(m, q0, client=client, per_task=4, out=str(tmp_path / "r.zarr"), **options)
+    assert store["q"].shape == (7, len(here[0].t), 6)
+    np.testing.assert_array_equal(store["tau"][3], here[3].tau)
+    with pytest.raises(ValueError, match=r"argument 'q0': expected an array of shape \(N, 6\)"):
+        robodyn.simulate_many(m, np.zeros((2, 5)), **options)
