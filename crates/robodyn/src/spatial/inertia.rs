@@ -1,7 +1,7 @@
 //! Rigid-body spatial inertia (Featherstone §2.13).
 
 use super::{
-    cross, matrix3, rotate, skew, splat_matrix, splat_vector, Force, Mat3, Mat6, Motion, Real, Vec3,
+    cross, rotate, skew, splat_matrix, splat_vector, Force, Mat3, Mat6, Motion, Real, Vec3,
 };
 use nalgebra::{Matrix3, Vector3};
 use std::ops::{Add, AddAssign};
@@ -212,15 +212,19 @@ impl<S: Real> CoriolisFactor<S> {
         // ω×Ī column by column, C; ω×Ī − Īω× = C + Cᵀ
         let i = &inertia.rotational;
         let columns = [0, 1, 2].map(|c| cross(w, &Vector3::new(i[(0, c)], i[(1, c)], i[(2, c)])));
-        let u_h = u.x * h.x + u.y * h.y + u.z * h.z;
-        let rotational = matrix3(|r, c| {
-            let value = columns[c][r] + columns[r][c] - (h[r] * u[c] + u[r] * h[c]);
-            if r == c {
-                value + S::splat(2.0) * u_h
-            } else {
-                value
+        let diagonal = S::splat(2.0) * (u.x * h.x + u.y * h.y + u.z * h.z);
+        // symmetric: the upper triangle, mirrored
+        let mut rotational = *i;
+        for r in 0..3 {
+            for c in r..3 {
+                let mut value = columns[c][r] + columns[r][c] - (h[r] * u[c] + u[r] * h[c]);
+                if r == c {
+                    value += diagonal;
+                }
+                rotational[(r, c)] = value;
+                rotational[(c, r)] = value;
             }
-        });
+        }
         CoriolisFactor {
             rotational,
             coupling: cross(w, h) + u * inertia.mass,
