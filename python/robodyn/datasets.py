@@ -18,6 +18,7 @@ from __future__ import annotations
 import hashlib
 import pickle
 from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from importlib.metadata import version
 from pathlib import Path
 from typing import Any
@@ -203,11 +204,13 @@ def dataset(
     rest = (chunk, n, list(quantities), spec, int(seed))
     finished = chunks - len(todo)
     if client is None:
-        for k in todo:
-            _fill_chunk(model, path, k, *rest)
-            finished += 1
-            if progress is not None:
-                progress(finished / chunks)
+        # two chunks at a time, so that one's store writes overlap the other's sampling and
+        # dynamics (both release the GIL); each writes only its own region and flag
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            for _ in pool.map(lambda k: _fill_chunk(model, path, k, *rest), todo):
+                finished += 1
+                if progress is not None:
+                    progress(finished / chunks)
     else:
         from dask.distributed import as_completed
 
