@@ -44,7 +44,7 @@ impl PyModel {
         arguments: &[Argument<'py>],
         out: Option<&Bound<'py, PyAny>>,
         algorithm: DynamicsAlgorithm,
-        runs: Option<&RunKernel>,
+        runs: Option<LaneKernel>,
     ) -> PyResult<Bound<'py, PyAny>> {
         self.evaluate_in_runs(
             py,
@@ -69,7 +69,7 @@ impl PyModel {
         arguments: &[Argument<'py>],
         names: [&Bound<'py, PyString>; 3],
         derivatives: DerivativesAlgorithm,
-        runs: Option<&RunKernel>,
+        runs: Option<LaneKernel>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let nv = self.model.nv;
         let kernel: &Kernel = &|m, w, i, out| {
@@ -139,7 +139,13 @@ impl PyModel {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let arguments = self.dynamics_arguments(q, v, ("a", a), f_ext)?;
-        self.with_external_forces(py, &arguments, out, algo::rnea, Some(&newton_euler_run))
+        self.with_external_forces(
+            py,
+            &arguments,
+            out,
+            algo::rnea,
+            Some(LaneKernel::NewtonEuler),
+        )
     }
 
     /// The joint-torque regressor Y(q, v, a), shape (nv, 10 nbodies): τ = Y π with π =
@@ -179,7 +185,13 @@ impl PyModel {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let arguments = self.dynamics_arguments(q, v, ("tau", tau), f_ext)?;
-        self.with_external_forces(py, &arguments, out, algo::aba, Some(&aba_run))
+        self.with_external_forces(
+            py,
+            &arguments,
+            out,
+            algo::aba,
+            Some(LaneKernel::ArticulatedBody),
+        )
     }
 
     /// Derivatives of inverse dynamics τ = ID(q, v, a, f_ext): dict of `dtau_dq`, `dtau_dv` and
@@ -203,7 +215,7 @@ impl PyModel {
             &arguments,
             names,
             algo::rnea_derivatives_stacked,
-            Some(&rnea_derivatives_run),
+            Some(LaneKernel::RneaDerivatives),
         )
     }
 
@@ -242,7 +254,7 @@ impl PyModel {
                 // straight into the result: CRBA mirrors M, so it is exactly symmetric
                 let (shape, arguments) = ([self.model.nv; 2], [self.q_arg("q", q)?]);
                 let kernel: &Kernel = &|m, w, i, out| algo::crba_into(m, &mut w.data, i[0], out);
-                let runs: Option<&RunKernel> = Some(&crba_run);
+                let runs = Some(LaneKernel::CompositeRigidBody);
                 return self.evaluate_in_runs(py, &arguments, &shape, out, kernel, runs);
             }
             "rnea" => algo::mass_matrix_by_rnea,
@@ -279,7 +291,7 @@ impl PyModel {
                 out.copy_from_slice(algo::bias_forces(m, &mut w.data, i[0], i[1])?.as_slice());
                 Ok(())
             },
-            Some(&newton_euler_run),
+            Some(LaneKernel::NewtonEuler),
         )
     }
 
@@ -320,8 +332,8 @@ impl PyModel {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         type Method = for<'d> fn(&Model, &'d mut Data, &[f64]) -> robodyn::Result<&'d DVector<f64>>;
-        let (algorithm, runs): (Method, Option<&RunKernel>) = match method.as_str() {
-            "rnea" => (algo::generalized_gravity, Some(&newton_euler_run)),
+        let (algorithm, runs): (Method, Option<LaneKernel>) = match method.as_str() {
+            "rnea" => (algo::generalized_gravity, Some(LaneKernel::NewtonEuler)),
             "jacobians" => (algo::generalized_gravity_by_jacobians, None),
             other => return Err(unknown_method(other, "rnea or jacobians")),
         };

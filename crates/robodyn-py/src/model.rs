@@ -77,68 +77,54 @@ pub(crate) type DynamicsAlgorithm = for<'d> fn(
 pub(crate) type Kernel<'k> =
     dyn Fn(&Model, &mut Workspace, &[&[f64]], &mut [f64]) -> robodyn::Result<()> + Sync + 'k;
 
-/// A kernel over a run of consecutive samples at once (a batch kernel in lanes): inputs and
-/// output hold the run's rows; an error names the sample by its place in the run.
-pub(crate) type RunKernel<'k> =
-    dyn Fn(&Model, &mut Workspace, &[&[f64]], &mut [f64]) -> BatchResult + Sync + 'k;
-
-/// Newton–Euler in lanes over a run: the inputs are q and, when given, v and a (zero otherwise).
-pub(crate) fn newton_euler_run(
-    model: &Model,
-    workspace: &mut Workspace,
-    inputs: &[&[f64]],
-    out: &mut [f64],
-) -> BatchResult {
-    let states = States {
-        q: inputs[0],
-        v: inputs.get(1).copied(),
-        a: inputs.get(2).copied(),
-        tau: None,
-    };
-    algo::newton_euler_batch(model, workspace.lanes(model), states, out)
+/// The batch kernels in lanes (`robodyn::algo::lanes`) a method can run on each thread's run of
+/// consecutive samples instead of one sample at a time.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum LaneKernel {
+    /// Inputs q[, v[, a]] (zero where absent): inverse dynamics, bias forces, gravity.
+    NewtonEuler,
+    /// Inputs q, v, τ: forward dynamics.
+    ArticulatedBody,
+    /// Input q: the mass matrix.
+    CompositeRigidBody,
+    /// Inputs q, v, a: ∂τ/∂q, ∂τ/∂v and M stacked.
+    RneaDerivatives,
 }
 
-/// The articulated-body algorithm in lanes over a run: the inputs are q, v and τ.
-pub(crate) fn aba_run(
-    model: &Model,
-    workspace: &mut Workspace,
-    inputs: &[&[f64]],
-    out: &mut [f64],
-) -> BatchResult {
-    let states = States {
-        q: inputs[0],
-        v: Some(inputs[1]),
-        a: None,
-        tau: Some(inputs[2]),
-    };
-    algo::aba_batch(model, workspace.lanes(model), states, out)
-}
-
-/// CRBA in lanes over a run: the input is q.
-pub(crate) fn crba_run(
-    model: &Model,
-    workspace: &mut Workspace,
-    inputs: &[&[f64]],
-    out: &mut [f64],
-) -> BatchResult {
-    algo::crba_batch(model, workspace.lanes(model), inputs[0], out)
-}
-
-/// The RNEA derivatives in lanes over a run: the inputs are q, v and a; per sample ∂τ/∂q,
-/// ∂τ/∂v and M stacked.
-pub(crate) fn rnea_derivatives_run(
-    model: &Model,
-    workspace: &mut Workspace,
-    inputs: &[&[f64]],
-    out: &mut [f64],
-) -> BatchResult {
-    let states = States {
-        q: inputs[0],
-        v: Some(inputs[1]),
-        a: Some(inputs[2]),
-        tau: None,
-    };
-    algo::rnea_derivatives_batch(model, workspace.lanes(model), states, out)
+impl LaneKernel {
+    /// Runs on a run of samples: `inputs` hold the run's rows, `out` its results; an error names
+    /// the sample by its place in the run.
+    fn run(
+        self,
+        model: &Model,
+        workspace: &mut Workspace,
+        inputs: &[&[f64]],
+        out: &mut [f64],
+    ) -> BatchResult {
+        let lanes = workspace.lanes(model);
+        let (q, input) = (inputs[0], |k: usize| inputs.get(k).copied());
+        let dynamics = States {
+            q,
+            v: input(1),
+            a: input(2),
+            tau: None,
+        };
+        match self {
+            LaneKernel::NewtonEuler => algo::newton_euler_batch(model, lanes, dynamics, out),
+            LaneKernel::RneaDerivatives => {
+                algo::rnea_derivatives_batch(model, lanes, dynamics, out)
+            }
+            LaneKernel::CompositeRigidBody => algo::crba_batch(model, lanes, q, out),
+            LaneKernel::ArticulatedBody => {
+                let forward = States {
+                    a: None,
+                    tau: input(2),
+                    ..dynamics
+                };
+                algo::aba_batch(model, lanes, forward, out)
+            }
+        }
+    }
 }
 
 /// The most numeric arguments a method takes (q, v, a, f_ext).
@@ -258,7 +244,7 @@ impl PyModel {
         output_shape: &[usize],
         out: Option<&Bound<'py, PyAny>>,
         kernel: &Kernel,
-        runs: Option<&RunKernel>,
+        runs: Option<LaneKernel>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let batch = common_batch(arguments)?;
         let values: [Cow<[f64]>; MAX_ARGUMENTS] = std::array::from_fn(|k| {
@@ -335,7 +321,7 @@ impl PyModel {
         batch: &BatchInputs,
         out: &mut [f64],
         kernel: &Kernel,
-        runs: Option<&RunKernel>,
+        runs: Option<LaneKernel>,
     ) -> PyResult<()> {
         let (model, pool) = (&self.model, &self.batch_workspaces);
         let output_size = batch.output_size.max(1);
@@ -362,7 +348,7 @@ impl PyModel {
                         Some(runs) => {
                             let count = outputs.len() / output_size;
                             let inputs = select(first, count);
-                            runs(model, &mut workspace, &inputs[..arguments], outputs)
+                            runs.run(model, &mut workspace, &inputs[..arguments], outputs)
                                 .map_err(|(k, e)| (first + k, e))?;
                             if let Some(index) = first_overflow(outputs) {
                                 let value = outputs[index];
