@@ -93,7 +93,7 @@ def _fill_chunk(model: _core.Model, out: str, index: int, chunk: int, n: int, qu
     return index
 
 
-def _describe(model: _core.Model, sampler: Any) -> dict[str, Any]:
+def _describe(sampler: Any) -> dict[str, Any]:
     """The sampler as metadata (a user array by its hash)."""
     if sampler["kind"] == "array":
         return {"kind": "array", "sha256": hashlib.sha256(np.ascontiguousarray(sampler["q"]).tobytes()).hexdigest()}
@@ -174,7 +174,7 @@ def dataset(
         "model_sha256": hashlib.sha256(model_bytes).hexdigest(),
         "robodyn_version": version("robodyn"),
         "seed": int(seed),
-        "sampler": _describe(model, spec),
+        "sampler": _describe(spec),
         "n": n,
         "chunk": int(chunk),
         "seed_block": SEED_BLOCK,

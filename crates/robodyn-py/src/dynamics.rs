@@ -37,16 +37,16 @@ impl PyModel {
 
     /// Dynamics with optional external forces: `algorithm(q, v, x, f_ext)` on the arguments of
     /// [`Self::dynamics_arguments`], into `out` when given; a batch without external forces runs
-    /// `runs` (the algorithm in lanes) when given.
+    /// `lanes` (the algorithm in lanes) when given.
     pub(crate) fn with_external_forces<'py>(
         &self,
         py: Python<'py>,
         arguments: &[Argument<'py>],
         out: Option<&Bound<'py, PyAny>>,
         algorithm: DynamicsAlgorithm,
-        runs: Option<LaneKernel>,
+        lanes: Option<LaneKernel>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.evaluate_in_runs(
+        self.evaluate_into(
             py,
             arguments,
             &[self.model.nv],
@@ -57,7 +57,7 @@ impl PyModel {
                 out.copy_from_slice(algorithm(m, data, i[0], i[1], i[2], forces)?.as_slice());
                 Ok(())
             },
-            runs.filter(|_| arguments.len() < 4),
+            lanes.filter(|_| arguments.len() < 4),
         )
     }
 
@@ -69,7 +69,7 @@ impl PyModel {
         arguments: &[Argument<'py>],
         names: [&Bound<'py, PyString>; 3],
         derivatives: DerivativesAlgorithm,
-        runs: Option<LaneKernel>,
+        lanes: Option<LaneKernel>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let nv = self.model.nv;
         let kernel: &Kernel = &|m, w, i, out| {
@@ -77,8 +77,8 @@ impl PyModel {
             let forces = i.get(3).map(|flat| external_forces(forces, flat));
             derivatives(m, data, (i[0], i[1], i[2], forces), out)
         };
-        let runs = runs.filter(|_| arguments.len() < 4);
-        let stack = self.evaluate_in_runs(py, arguments, &[3, nv, nv], None, kernel, runs)?;
+        let lanes = lanes.filter(|_| arguments.len() < 4);
+        let stack = self.evaluate_into(py, arguments, &[3, nv, nv], None, kernel, lanes)?;
         split_stack(py, &stack, &names)
     }
 }
@@ -254,8 +254,8 @@ impl PyModel {
                 // straight into the result: CRBA mirrors M, so it is exactly symmetric
                 let (shape, arguments) = ([self.model.nv; 2], [self.q_arg("q", q)?]);
                 let kernel: &Kernel = &|m, w, i, out| algo::crba_into(m, &mut w.data, i[0], out);
-                let runs = Some(LaneKernel::CompositeRigidBody);
-                return self.evaluate_in_runs(py, &arguments, &shape, out, kernel, runs);
+                let lanes = Some(LaneKernel::CompositeRigidBody);
+                return self.evaluate_into(py, &arguments, &shape, out, kernel, lanes);
             }
             "rnea" => algo::mass_matrix_by_rnea,
             "jacobians" => algo::mass_matrix_by_jacobians,
@@ -282,7 +282,7 @@ impl PyModel {
         v: &Bound<'py, PyAny>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.evaluate_in_runs(
+        self.evaluate_into(
             py,
             &[self.q_arg("q", q)?, self.v_arg("v", v)?],
             &[self.model.nv],
@@ -332,12 +332,12 @@ impl PyModel {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         type Method = for<'d> fn(&Model, &'d mut Data, &[f64]) -> robodyn::Result<&'d DVector<f64>>;
-        let (algorithm, runs): (Method, Option<LaneKernel>) = match method.as_str() {
+        let (algorithm, lanes): (Method, Option<LaneKernel>) = match method.as_str() {
             "rnea" => (algo::generalized_gravity, Some(LaneKernel::NewtonEuler)),
             "jacobians" => (algo::generalized_gravity_by_jacobians, None),
             other => return Err(unknown_method(other, "rnea or jacobians")),
         };
-        self.evaluate_in_runs(
+        self.evaluate_into(
             py,
             &[self.q_arg("q", q)?],
             &[self.model.nv],
@@ -346,7 +346,7 @@ impl PyModel {
                 out.copy_from_slice(algorithm(m, &mut w.data, i[0])?.as_slice());
                 Ok(())
             },
-            runs,
+            lanes,
         )
     }
 

@@ -42,11 +42,12 @@ impl PyModel {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let frame = self.frame_index(frame)?;
-        self.evaluate_into(py, &[self.q_arg("q", q)?], &[4, 4], out, &|m, w, i, out| {
+        let kernel: &Kernel = &|m, w, i, out| {
             let pose = algo::frame_pose(m, &mut w.data, i[0], frame)?;
             write_pose(&pose, out);
             Ok(())
-        })
+        };
+        self.evaluate_into(py, &[self.q_arg("q", q)?], &[4, 4], out, kernel, None)
     }
 
     /// The pose in the world of every body, the world first: (nbodies, 4, 4) homogeneous
@@ -103,6 +104,7 @@ impl PyModel {
                 }
                 Ok(())
             },
+            None,
         )
     }
 

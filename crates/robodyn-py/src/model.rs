@@ -219,11 +219,13 @@ impl PyModel {
         output_shape: &[usize],
         kernel: &Kernel,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.evaluate_into(py, arguments, output_shape, None, kernel)
+        self.evaluate_into(py, arguments, output_shape, None, kernel, None)
     }
 
     /// [`Self::evaluate`], writing into the caller's array `out` when one is given (checked by
-    /// [`output_array`]) and returning it, so that a loop can reuse its result array.
+    /// [`output_array`]) and returning it, so that a loop can reuse its result array; a batch runs
+    /// the kernel in `lanes` (when given) on each thread's run of samples instead of `kernel` on
+    /// one sample at a time.
     pub(crate) fn evaluate_into<'py>(
         &self,
         py: Python<'py>,
@@ -231,20 +233,7 @@ impl PyModel {
         output_shape: &[usize],
         out: Option<&Bound<'py, PyAny>>,
         kernel: &Kernel,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        self.evaluate_in_runs(py, arguments, output_shape, out, kernel, None)
-    }
-
-    /// [`Self::evaluate_into`], a batch running `runs` (when given) on each thread's run of
-    /// samples instead of `kernel` on one sample at a time.
-    pub(crate) fn evaluate_in_runs<'py>(
-        &self,
-        py: Python<'py>,
-        arguments: &[Argument<'py>],
-        output_shape: &[usize],
-        out: Option<&Bound<'py, PyAny>>,
-        kernel: &Kernel,
-        runs: Option<LaneKernel>,
+        lanes: Option<LaneKernel>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let batch = common_batch(arguments)?;
         let values: [Cow<[f64]>; MAX_ARGUMENTS] = std::array::from_fn(|k| {
@@ -298,12 +287,12 @@ impl PyModel {
                     // SAFETY: as for one sample
                     let out = unsafe { output.as_slice_mut() }
                         .map_err(|e| PyValueError::new_err(e.to_string()))?;
-                    self.run_batch(py, &batch, out, kernel, runs)?;
+                    self.run_batch(py, &batch, out, kernel, lanes)?;
                     return Ok(output.into_any());
                 }
                 let mut out = vec![0.0; n * output_size];
                 advise_huge_pages(&mut out);
-                self.run_batch(py, &batch, &mut out, kernel, runs)?;
+                self.run_batch(py, &batch, &mut out, kernel, lanes)?;
                 let shape: Vec<usize> = std::iter::once(n)
                     .chain(output_shape.iter().copied())
                     .collect();
@@ -312,7 +301,7 @@ impl PyModel {
         }
     }
 
-    /// Runs `kernel` on every sample of a batch into `out` (or `runs` on runs of samples), with
+    /// Runs `kernel` on every sample of a batch into `out` (or `lanes` on runs of samples), with
     /// the GIL released, on all cores: a few runs of consecutive samples per thread (for
     /// balance), each in a workspace taken from the pool and given back.
     fn run_batch(
@@ -321,7 +310,7 @@ impl PyModel {
         batch: &BatchInputs,
         out: &mut [f64],
         kernel: &Kernel,
-        runs: Option<LaneKernel>,
+        lanes: Option<LaneKernel>,
     ) -> PyResult<()> {
         let (model, pool) = (&self.model, &self.batch_workspaces);
         let output_size = batch.output_size.max(1);
@@ -344,11 +333,12 @@ impl PyModel {
                         inputs
                     };
                     let arguments = batch.values.len();
-                    match runs {
-                        Some(runs) => {
+                    match lanes {
+                        Some(lanes) => {
                             let count = outputs.len() / output_size;
                             let inputs = select(first, count);
-                            runs.run(model, &mut workspace, &inputs[..arguments], outputs)
+                            lanes
+                                .run(model, &mut workspace, &inputs[..arguments], outputs)
                                 .map_err(|(k, e)| (first + k, e))?;
                             if let Some(index) = first_overflow(outputs) {
                                 let value = outputs[index];
@@ -535,10 +525,11 @@ impl PyModel {
         algorithm: MatrixOfQ,
     ) -> PyResult<Bound<'py, PyAny>> {
         let shape = [rows, self.model.nv];
-        self.evaluate_into(py, &[self.q_arg("q", q)?], &shape, out, &|m, w, i, out| {
+        let kernel: &Kernel = &|m, w, i, out| {
             write_row_major(algorithm(m, &mut w.data, i[0])?, rows, out);
             Ok(())
-        })
+        };
+        self.evaluate_into(py, &[self.q_arg("q", q)?], &shape, out, kernel, None)
     }
 
     /// `algorithm`'s matrix times v (rows,), per state: a momentum or a velocity.
