@@ -11,6 +11,7 @@
 //! compiled once per instruction set (`#[target_feature]`), so one binary serves every x86-64 CPU.
 
 mod groups;
+mod scatter;
 
 use crate::algo::aba::aba;
 use crate::algo::crba::crba_into;
@@ -278,9 +279,6 @@ fn run_batch(
     // what is left, one state at a time
     let first = in_lanes.err().unwrap_or(grouped);
     workspace.in_lanes = first;
-    if first < grouped {
-        eprintln!("DEBUG fallback at {first}");
-    }
     for k in first..n {
         let state = state(model, &states, k);
         let data = &mut workspace.data;
@@ -345,12 +343,12 @@ mod tests {
     use super::groups::groups;
     use super::*;
     use crate::io::bundled_model;
-    use crate::spatial::{Inertia, Real};
+    use crate::spatial::Inertia;
     use crate::spatial::{Mat3, Vec3};
 
     /// The lane kernels themselves, compiled without the wide instruction sets, so that they are
     /// checked on a CPU that lacks them too: each lane equals the one-state call bit for bit.
-    fn lanes_equal_one_state<S: Real>(algorithm: Algorithm) {
+    fn lanes_equal_one_state<S: scatter::Scatter>(algorithm: Algorithm) {
         let mut model = bundled_model("ur5", true).unwrap();
         // a floating UR5 needs a base inertia for forward dynamics
         let base = Mat3::from_diagonal_element(0.01);

@@ -321,7 +321,7 @@ impl Simulation<'_> {
     fn report(&mut self, k: usize) -> Result<()> {
         let stride = (self.samples / 100).max(1);
         match self.progress.as_mut() {
-            Some(callback) if k % stride == 0 || k + 1 == self.samples => {
+            Some(callback) if k.is_multiple_of(stride) || k + 1 == self.samples => {
                 callback(k as f64 / (self.samples - 1).max(1) as f64)
             }
             _ => Ok(()),
@@ -352,7 +352,7 @@ impl Simulation<'_> {
             &self.state,
             h,
         )?;
-        if k == 1 || k % STEP_CHECK_INTERVAL == 0 {
+        if k == 1 || k.is_multiple_of(STEP_CHECK_INTERVAL) {
             self.check_step(h)?;
         }
         self.statistics.steps += 1;

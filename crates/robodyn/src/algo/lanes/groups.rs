@@ -1,6 +1,7 @@
 //! The lane kernels: a group of `S::LANES` states gathered into lanes, run through an algorithm's
 //! generic passes, scattered back; compiled once per instruction set.
 
+use super::scatter::Scatter;
 use super::{Algorithm, States};
 use crate::algo::aba::{articulated_body_passes, AbaBuffers};
 use crate::algo::crba::{
@@ -109,7 +110,7 @@ pub(super) unsafe fn groups_eight(
 /// `algorithm` on the groups of states that fill `out`, `S::LANES` at a time. An error gives the
 /// first state of a group where a lane failed (a singular articulated inertia).
 #[inline(always)]
-pub(super) fn groups<S: Real>(
+pub(super) fn groups<S: Scatter>(
     algorithm: Algorithm,
     model: &Model,
     lanes: &mut Lanes<S>,
@@ -169,7 +170,7 @@ pub(super) fn groups<S: Real>(
                 add_composites(model, &mut lanes.composites);
                 let (composites, subspaces) = (&lanes.composites, &lanes.subspaces);
                 mass_matrix_of_composites(model, composites, subspaces, &mut lanes.mass_matrix);
-                scatter(&lanes.mass_matrix, out, size, 0);
+                S::scatter(&lanes.mass_matrix, out, size, 0);
                 continue;
             }
             Algorithm::RneaDerivatives => {
@@ -203,12 +204,12 @@ pub(super) fn groups<S: Real>(
                     .into_iter()
                     .enumerate()
                 {
-                    scatter(lanes, out, size, part * block);
+                    S::scatter(lanes, out, size, part * block);
                 }
                 continue;
             }
         }
-        scatter(&lanes.out, out, nv, 0);
+        S::scatter(&lanes.out, out, nv, 0);
     }
     Ok(())
 }
@@ -219,16 +220,5 @@ fn gather<S: Real>(lanes: &mut [S], rows: &[f64], first: usize, size: usize) {
     let rows = &rows[first * size..(first + S::LANES) * size];
     for (j, lane) in lanes.iter_mut().enumerate() {
         *lane = S::from_lanes(|l| rows[l * size + j]);
-    }
-}
-
-/// Entry j of row l of the row-major `rows` (width `size`), from `offset` on, = lane l of
-/// `lanes[j]` (`offset` places one block of a stacked result).
-#[inline(always)]
-fn scatter<S: Real>(lanes: &[S], rows: &mut [f64], size: usize, offset: usize) {
-    for (j, lane) in lanes.iter().enumerate() {
-        for l in 0..S::LANES {
-            rows[l * size + offset + j] = lane.extract(l);
-        }
     }
 }

@@ -115,7 +115,7 @@ impl Dynamics<'_> {
         }
         account.last_power = Some((t, power.abs()));
         account.samples += 1;
-        if account.samples != 1 && account.samples % ENERGY_CHECK_INTERVAL != 0 {
+        if account.samples != 1 && !account.samples.is_multiple_of(ENERGY_CHECK_INTERVAL) {
             return Ok(());
         }
         let energy = kinetic_energy(self.model, &mut self.data, q, v)?
