@@ -110,7 +110,7 @@ fn rnea_derivative_passes(
     // code ran about 2 % more instructions)
     one_state(|| velocity_terms(model, &mut b, q, v, f_ext));
     one_state(|| acceleration_terms(model, &mut b, Some(a)));
-    one_state(|| derivative_products(model, &mut b, v, out));
+    one_state(|| derivative_products::<_, true>(model, &mut b, v, out));
     add_rotor_torques(model, &mut b, v, Some(a));
     Ok(())
 }
@@ -149,7 +149,7 @@ pub(crate) fn derivative_passes<S: Real>(
 ) {
     velocity_terms(model, buffers, q, v, f_ext);
     acceleration_terms(model, buffers, Some(a));
-    derivative_products(model, buffers, v, out);
+    derivative_products::<_, true>(model, buffers, v, out);
     add_rotor_torques(model, buffers, v, Some(a));
 }
 
@@ -262,7 +262,7 @@ pub fn aba_derivative_rows(
     rows.rows.fill(0.0);
     let mut buffers = DerivativeBuffers::of(data);
     one_state(|| acceleration_terms(model, &mut buffers, Some(qdd.as_slice())));
-    one_state(|| derivative_products(model, &mut buffers, v, &mut rows));
+    one_state(|| derivative_products::<_, false>(model, &mut buffers, v, &mut rows));
     add_rotor_torques(model, &mut buffers, v, Some(qdd.as_slice()));
     data.qdd = qdd;
     let (mut rows, width) = (rows.rows, 3 * nv);
@@ -431,11 +431,11 @@ impl TorqueDerivatives<f64> for NegatedRows {
     }
 }
 
-/// τ, M and both derivatives from the terms and composites above: one coordinate k of body i
-/// against the coordinates on its path to the root; then the rotors' armature on M and their
-/// velocity term's Jacobian on ∂τ/∂q̇.
+/// τ, M (when `MASS_MATRIX`: the ABA derivatives have it already) and both derivatives from the
+/// terms and composites above: one coordinate k of body i against the coordinates on its path to
+/// the root; then the rotors' armature on M and their velocity term's Jacobian on ∂τ/∂q̇.
 #[inline(always)]
-fn derivative_products<S: Real>(
+fn derivative_products<S: Real, const MASS_MATRIX: bool>(
     model: &Model,
     b: &mut DerivativeBuffers<S>,
     v: &[S],
@@ -444,7 +444,9 @@ fn derivative_products<S: Real>(
     let nv = model.nv;
     let zero = S::splat(0.0);
     let mass_matrix = &mut *b.mass_matrix;
-    mass_matrix.fill(zero);
+    if MASS_MATRIX {
+        mass_matrix.fill(zero);
+    }
     for i in 1..model.nbodies() {
         let (composite, h_composite, f_i) = (b.i_c[i], b.coriolis_factors[i], b.f_world[i]);
         for k in model.v_range(i) {
@@ -471,9 +473,11 @@ fn derivative_products<S: Real>(
                         s_c.dot(&h_transpose_s) - w_c.dot(&inertia_s),
                     );
                     // column-major storage: M[k, c] at k + c nv
-                    let m = s_c.dot(&inertia_s);
-                    mass_matrix[k + c * nv] = m;
-                    mass_matrix[c + k * nv] = m;
+                    if MASS_MATRIX {
+                        let m = s_c.dot(&inertia_s);
+                        mass_matrix[k + c * nv] = m;
+                        mass_matrix[c + k * nv] = m;
+                    }
                     // column k: c's body lies strictly above i
                     if j != i {
                         out.add(c, k, s_c.dot(&position_force), s_c.dot(&velocity_force));
@@ -488,7 +492,9 @@ fn derivative_products<S: Real>(
         let v_i = &v[dofs.clone()];
         for (r, row) in dofs.clone().enumerate() {
             let armature = S::splat(model.armature[row]);
-            mass_matrix[row + row * nv] += armature;
+            if MASS_MATRIX {
+                mass_matrix[row + row * nv] += armature;
+            }
             for (c, column) in dofs.clone().enumerate() {
                 let by_v = armature * joint.rotor_velocity_jacobian(r, c, v_i);
                 out.add(row, column, zero, by_v);
