@@ -35,7 +35,7 @@ from robodyn._core import (
 )
 from robodyn.operational_space import operational_space as _operational_space
 from robodyn.simulation import PD, ComputedTorque, GravityCompensation, Trajectory, simulate, step
-from robodyn.datasets import dataset, simulate_many
+from robodyn.datasets import dataset, read_dataset, simulate_many
 
 # methods composed in NumPy from the core's batched calls
 Model.operational_space = _operational_space
@@ -65,6 +65,7 @@ Model.to_html = _to_html
 __all__ = [
     "ComputedTorque",
     "dataset",
+    "read_dataset",
     "simulate_many",
     "GravityCompensation",
     "Model",

@@ -1,21 +1,24 @@
 """Datasets of sampled states and their dynamics, and batches of rollouts, on this machine or a
-Dask cluster; datasets are written to a chunked Zarr store, rollouts gathered or written there.
+Dask cluster; datasets are written to a chunked Zarr store or a folder of Parquet files (vector
+quantities), rollouts gathered or written to Zarr.
 
 `dataset(model, n, quantities, sampler, seed, chunk, out, client)` samples n states (q, v, a),
 evaluates the requested quantities with the batched core calls (all cores, lanes) chunk by
-chunk, and writes every array of the store chunk by chunk. Samples are drawn in blocks of
+chunk, and writes every array of the store chunk by chunk (one Parquet file per chunk). Samples are drawn in blocks of
 `SEED_BLOCK` states, block b from the seed sequence (seed, b), so the store is the same for any
 chunk size (a multiple of the block) and any number of workers. Each chunk is marked done when
 written, so an interrupted run resumes (`resume=True`) without recomputing finished chunks, and
 a chunk whose worker died is simply computed again (Dask reruns its task).
 
-Dask (`dask[distributed]`) and Zarr (3 or later, so Python 3.11 or later) are the optional extra
-`robodyn[distributed]`.
+Dask (`dask[distributed]`), Zarr (3 or later, so Python 3.11 or later) and PyArrow are the
+optional extra `robodyn[distributed]`.
 """
 
 from __future__ import annotations
 
 import hashlib
+import json
+import os
 import pickle
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -73,10 +76,8 @@ def _block(model: _core.Model, sampler: Any, seed: int, block: int, start: int, 
     }
 
 
-def _fill_chunk(model: _core.Model, out: str, index: int, chunk: int, n: int, quantities: Sequence[str], sampler: Any, seed: int) -> int:
+def _fill_chunk(model: _core.Model, out: str, form: str, index: int, chunk: int, n: int, quantities: Sequence[str], sampler: Any, seed: int) -> int:
     """Samples chunk `index`, evaluates the quantities, writes them and marks the chunk done."""
-    import zarr
-
     start, stop = index * chunk, min((index + 1) * chunk, n)
     parts = [
         _block(model, sampler, seed, b, b * SEED_BLOCK, min((b + 1) * SEED_BLOCK, n))
@@ -86,11 +87,69 @@ def _fill_chunk(model: _core.Model, out: str, index: int, chunk: int, n: int, qu
     q, v, a, tau = arrays["q"], arrays["v"], arrays["a"], arrays["tau_applied"]
     for name in quantities:
         arrays[name] = QUANTITIES[name][0](model, q, v, a, tau)
-    store = zarr.open_group(out, mode="r+")
-    for name, values in arrays.items():
-        store[name][start:stop] = values
-    store["done"][index] = True
+    if form == "parquet":
+        _write_part(Path(out), index, arrays)
+    else:
+        import zarr
+
+        store = zarr.open_group(out, mode="r+")
+        for name, values in arrays.items():
+            store[name][start:stop] = values
+        store["done"][index] = True
     return index
+
+
+#: A Parquet dataset's provenance, beside its parts (readers skip names starting with "_").
+PARQUET_ATTRIBUTES = "_robodyn.json"
+
+
+def _part(directory: Path, index: int) -> Path:
+    """Where chunk `index` of a Parquet dataset goes: names that sort in chunk order."""
+    return directory / f"part-{index:06d}.parquet"
+
+
+def _write_part(directory: Path, index: int, arrays: dict[str, FloatArray]) -> None:
+    """Chunk `index` as one Parquet file, a fixed-size list column per quantity; written under a
+    temporary name and renamed, so that a part that exists is complete (that marks it done)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    columns = {
+        name: pa.FixedSizeListArray.from_arrays(pa.array(values.reshape(-1)), values.shape[1])
+        for name, values in arrays.items()
+    }
+    attributes = (directory / PARQUET_ATTRIBUTES).read_text()
+    table = pa.table(columns).replace_schema_metadata({"robodyn": attributes})
+    partial = directory / f".{_part(directory, index).name}.{os.getpid()}.partial"
+    # uncompressed, as the Zarr arrays: sampled floats barely compress
+    pq.write_table(table, partial, compression="none")
+    os.replace(partial, _part(directory, index))
+
+
+def read_dataset(path: str | Path) -> dict[str, FloatArray]:
+    """A dataset written by `dataset` (a Zarr store or a Parquet folder) as arrays: `q`, `v`,
+    `a`, `tau_applied` and the quantities, each (n, ...); raises if chunks are missing."""
+    path = Path(path)
+    if (path / PARQUET_ATTRIBUTES).exists():
+        import pyarrow.parquet as pq
+
+        attributes = json.loads((path / PARQUET_ATTRIBUTES).read_text())
+        chunks = -(-attributes["n"] // attributes["chunk"])
+        missing = [k for k in range(chunks) if not _part(path, k).exists()]
+        if missing:
+            raise ValueError(f"{path}: chunks {missing} are missing; complete it with dataset(..., resume=True)")
+        table = pq.read_table([str(_part(path, k)) for k in range(chunks)])
+        return {
+            name: column.combine_chunks().flatten().to_numpy().reshape(len(table), -1)
+            for name, column in zip(table.column_names, table.columns)
+        }
+    import zarr
+
+    store = zarr.open_group(str(path), mode="r")
+    flags = np.asarray(store["done"][:])
+    if not flags.all():
+        raise ValueError(f"{path}: chunks {np.flatnonzero(~flags).tolist()} are missing; complete it with dataset(..., resume=True)")
+    return {name: np.asarray(store[name][:]) for name in store.array_keys() if name != "done"}
 
 
 def _describe(sampler: Any) -> dict[str, Any]:
@@ -134,9 +193,13 @@ def dataset(
     center: Any = None,
     std: float = 0.1,
     progress: Callable[[float], None] | None = None,
+    format: str | None = None,
 ) -> Any:
-    """Samples `n` states and writes them with the requested `quantities` to the Zarr store
-    `out`; returns the store (a `zarr.Group`).
+    """Samples `n` states and writes them with the requested `quantities` to `out`: a Zarr store
+    (returned, a `zarr.Group`) or, with `format="parquet"` or `out` ending in ".parquet", a
+    folder of Parquet files, one per chunk, a fixed-size list column per quantity (returned as a
+    `pyarrow.dataset.Dataset`; vector quantities only). `read_dataset(out)` reads either back
+    as NumPy arrays.
 
     - States: q by `sampler` — "uniform" (within the position limits, [-π, π] where none, random
       rotations for ball and free joints), "gaussian" (around `center`, the neutral
@@ -153,11 +216,10 @@ def dataset(
     - `resume=True` continues a store left incomplete by an interrupted run (same arguments),
       computing only the chunks not marked done.
     - `progress`, if given, is called with the fraction of chunks done after each chunk.
-    The store's attributes record the model's name and content hash, the robodyn version, the
-    seed, the sampler, the chunk size and the quantities.
+    The store's attributes (Parquet: each file's metadata under "robodyn" and `_robodyn.json`)
+    record the model's name and content hash, the robodyn version, the seed, the sampler, the
+    chunk size and the quantities.
     """
-    import zarr
-
     n = int(n)
     if n < 1:
         raise ValueError(f"argument 'n': expected a positive number of states, got {n}")
@@ -166,6 +228,7 @@ def dataset(
     unknown = [q for q in quantities if q not in QUANTITIES]
     if unknown:
         raise ValueError(f"argument 'quantities': expected names among {sorted(QUANTITIES)}, got {unknown}")
+    form = _format(out, format, model, quantities)
     spec = _sampler(model, sampler, n, center, std)
     path = str(out)
     model_bytes = pickle.dumps(model)
@@ -181,25 +244,18 @@ def dataset(
         "quantities": list(quantities),
     }
     chunks = (n + chunk - 1) // chunk
+    shapes = {"q": (model.nq,), "v": (model.nv,), "a": (model.nv,), "tau_applied": (model.nv,)}
+    shapes.update({name: QUANTITIES[name][1](model) for name in quantities})
     if resume:
-        store = zarr.open_group(path, mode="r+")
-        stored = dict(store.attrs)
+        stored = _stored_attributes(path, form)
         differing = [key for key, value in attributes.items() if stored.get(key) != value]
         if differing:
             raise ValueError(f"argument 'resume': the store {path} was made with other {', '.join(differing)}")
+    elif Path(path).exists():
+        raise ValueError(f"argument 'out': {path} exists; pass resume=True to complete it, or remove it")
     else:
-        if Path(path).exists():
-            raise ValueError(f"argument 'out': {path} exists; pass resume=True to complete it, or remove it")
-        store = zarr.open_group(path, mode="w")
-        shapes = {"q": (model.nq,), "v": (model.nv,), "a": (model.nv,), "tau_applied": (model.nv,)}
-        shapes.update({name: QUANTITIES[name][1](model) for name in quantities})
-        for name, shape in shapes.items():
-            # uncompressed: sampled floats barely compress, and compressing them cost 5x the dynamics
-            store.create_array(name, shape=(n, *shape), chunks=(chunk, *shape), dtype="float64", compressors=None)
-        # one Zarr chunk per flag: workers marking different chunks never rewrite each other's
-        store.create_array("done", shape=(chunks,), chunks=(1,), dtype="bool", fill_value=False)
-        store.attrs.update(attributes)
-    done = np.asarray(store["done"][:])
+        _create(path, form, attributes, shapes, n, chunk, chunks)
+    done = _done(path, form, chunks)
     todo = [k for k in range(chunks) if not done[k]]
     rest = (chunk, n, list(quantities), spec, int(seed))
     finished = chunks - len(todo)
@@ -207,7 +263,7 @@ def dataset(
         # two chunks at a time, so that one's store writes overlap the other's sampling and
         # dynamics (both release the GIL); each writes only its own region and flag
         with ThreadPoolExecutor(max_workers=2) as pool:
-            for _ in pool.map(lambda k: _fill_chunk(model, path, k, *rest), todo):
+            for _ in pool.map(lambda k: _fill_chunk(model, path, form, k, *rest), todo):
                 finished += 1
                 if progress is not None:
                     progress(finished / chunks)
@@ -217,13 +273,69 @@ def dataset(
         # the model goes to every worker once (it pickles), each chunk is one task; a fresh key
         # each call (hash=False): a worker restarted since an earlier scatter lacks the old one
         remote = client.scatter(model, broadcast=True, hash=False)
-        futures = [client.submit(_fill_chunk, remote, path, k, *rest, pure=False) for k in todo]
+        futures = [client.submit(_fill_chunk, remote, path, form, k, *rest, pure=False) for k in todo]
         for future in as_completed(futures):
             future.result()
             finished += 1
             if progress is not None:
                 progress(finished / chunks)
+    if form == "parquet":
+        import pyarrow.dataset
+
+        return pyarrow.dataset.dataset(path, format="parquet")
+    import zarr
+
     return zarr.open_group(path, mode="r")
+
+
+def _format(out: str | Path, format: str | None, model: _core.Model, quantities: Sequence[str]) -> str:
+    """"zarr" or "parquet", from `format` or else `out`'s suffix; Parquet holds vectors only."""
+    form = format if format is not None else ("parquet" if Path(out).suffix == ".parquet" else "zarr")
+    if form not in ("zarr", "parquet"):
+        raise ValueError(f"argument 'format': expected 'zarr' or 'parquet', got {format!r}")
+    matrices = [name for name in quantities if len(QUANTITIES[name][1](model)) > 1]
+    if form == "parquet" and matrices:
+        raise ValueError(
+            f"argument 'quantities': {matrices} are matrices and Parquet holds vector quantities; "
+            "write them to a Zarr store (an 'out' not ending in .parquet)"
+        )
+    return form
+
+
+def _create(path: str, form: str, attributes: dict[str, Any], shapes: dict[str, tuple[int, ...]], n: int, chunk: int, chunks: int) -> None:
+    """A new, empty store: the Zarr arrays and chunk flags, or the Parquet folder and its
+    attributes file."""
+    if form == "parquet":
+        Path(path).mkdir(parents=True)
+        (Path(path) / PARQUET_ATTRIBUTES).write_text(json.dumps(attributes))
+        return
+    import zarr
+
+    store = zarr.open_group(path, mode="w")
+    for name, shape in shapes.items():
+        # uncompressed: sampled floats barely compress, and compressing them cost 5x the dynamics
+        store.create_array(name, shape=(n, *shape), chunks=(chunk, *shape), dtype="float64", compressors=None)
+    # one Zarr chunk per flag: workers marking different chunks never rewrite each other's
+    store.create_array("done", shape=(chunks,), chunks=(1,), dtype="bool", fill_value=False)
+    store.attrs.update(attributes)
+
+
+def _stored_attributes(path: str, form: str) -> dict[str, Any]:
+    """The attributes an existing store was made with."""
+    if form == "parquet":
+        return dict(json.loads((Path(path) / PARQUET_ATTRIBUTES).read_text()))
+    import zarr
+
+    return dict(zarr.open_group(path, mode="r").attrs)
+
+
+def _done(path: str, form: str, chunks: int) -> list[bool]:
+    """Which chunks are written: a flag per chunk in Zarr, a part file per chunk in Parquet."""
+    if form == "parquet":
+        return [_part(Path(path), k).exists() for k in range(chunks)]
+    import zarr
+
+    return [bool(x) for x in zarr.open_group(path, mode="r")["done"][:]]
 
 
 def _rollouts(model: _core.Model, q0: FloatArray, v0: FloatArray, options: dict[str, Any]) -> list[Any]:
@@ -240,6 +352,7 @@ def simulate_many(
     client: Any = None,
     per_task: int = 64,
     out: str | Path | None = None,
+    progress: Callable[[float], None] | None = None,
     **options: Any,
 ) -> Any:
     """Rollouts from every row of `q0` (N, nq) and `v0` (N, nv; zeros by default), in tasks of
@@ -247,7 +360,8 @@ def simulate_many(
     simulating its rollouts in parallel on its worker's cores (`robodyn.simulate`); without a
     client the tasks run here. `options` are `robodyn.simulate`'s (t_end, dt, integrator,
     controller, ...; the controller and wrenches must pickle: the native controller
-    descriptions do, a Python callable must be a module-level function).
+    descriptions do, a Python callable must be a module-level function). `progress`, if given,
+    is called with the fraction of rollouts done after each task.
 
     Returns the N trajectories in order (each equal to `robodyn.simulate`'s), or, with `out`, writes
     a Zarr store with `t` (T,) and `q`, `v`, `a`, `tau` (N, T, ...) and returns it.
@@ -264,12 +378,26 @@ def simulate_many(
     if out is not None and Path(out).exists():
         raise ValueError(f"argument 'out': {out} exists; remove it or choose another")
     groups = [(start, min(start + per_task, count)) for start in range(0, count, per_task)]
+    parts: list[list[Any]] = [[] for _ in groups]
+    finished = 0
+
+    def record(task: int, part: list[Any]) -> None:
+        nonlocal finished
+        parts[task] = part
+        finished += len(part)
+        if progress is not None:
+            progress(finished / count)
+
     if client is None:
-        parts = [_rollouts(model, q0[a:b], v0[a:b], options) for a, b in groups]
+        for task, (a, b) in enumerate(groups):
+            record(task, _rollouts(model, q0[a:b], v0[a:b], options))
     else:
+        from dask.distributed import as_completed
+
         remote = client.scatter(model, broadcast=True, hash=False)
-        futures = [client.submit(_rollouts, remote, q0[a:b], v0[a:b], options, pure=False) for a, b in groups]
-        parts = client.gather(futures)
+        futures = {client.submit(_rollouts, remote, q0[a:b], v0[a:b], options, pure=False): task for task, (a, b) in enumerate(groups)}
+        for future in as_completed(futures):
+            record(futures[future], future.result())
     trajectories = [trajectory for part in parts for trajectory in part]
     if out is None:
         return trajectories

@@ -2,6 +2,7 @@
 (issue 17): values equal to the batched calls, the same store for any chunking and any workers,
 resumable, and complete after a worker dies."""
 
+import json
 import os
 import threading
 import time
@@ -100,7 +101,7 @@ def test_an_interrupted_store_resumes_without_recomputing_finished_chunks(tmp_pa
         writable[name][512:1024] = 0.0
     computed = []
     fill = robodyn.datasets._fill_chunk
-    monkeypatch.setattr(robodyn.datasets, "_fill_chunk", lambda *a: computed.append(a[2]) or fill(*a))
+    monkeypatch.setattr(robodyn.datasets, "_fill_chunk", lambda *a: computed.append(a[3]) or fill(*a))
     resumed = make(tmp_path, "partial.zarr", resume=True)
     assert computed == [1]
     assert_same_store(resumed, complete)
@@ -169,3 +170,66 @@ def test_rollouts_spread_over_workers_equal_the_local_batch(tmp_path, client):
     np.testing.assert_array_equal(store["tau"][3], here[3].tau)
     with pytest.raises(ValueError, match=r"argument 'q0': expected an array of shape \(N, 6\)"):
         robodyn.simulate_many(m, np.zeros((2, 5)), **options)
+
+
+def test_parquet_files_hold_the_same_vectors_as_a_zarr_store(tmp_path, client):
+    vectors = dict(quantities=["tau", "qdd", "g"])
+    store = robodyn.read_dataset(make(tmp_path, "a.zarr", **vectors).store.root)
+    here = make(tmp_path, "a.parquet", **vectors)
+    assert sorted(here.files) == [str(tmp_path / "a.parquet" / f"part-00000{k}.parquet") for k in range(3)]
+    # a column per quantity, the provenance in every file; the same values for any chunking and workers
+    assert here.schema.names == ["q", "v", "a", "tau_applied", "tau", "qdd", "g"]
+    provenance = json.loads(here.schema.metadata[b"robodyn"])
+    assert provenance["seed"] == 5 and provenance["quantities"] == ["tau", "qdd", "g"]
+    make(tmp_path, "b.parquet", chunk=1024, client=client, **vectors)
+    for name in ("a.parquet", "b.parquet"):
+        arrays = robodyn.read_dataset(tmp_path / name)
+        assert sorted(arrays) == sorted(store)
+        for name, values in store.items():
+            np.testing.assert_array_equal(arrays[name], values, err_msg=name)
+    m = robodyn.load("ur5")
+    np.testing.assert_array_equal(store["g"], m.generalized_gravity(store["q"]))
+
+
+def test_an_interrupted_parquet_dataset_resumes_and_matrices_are_refused(tmp_path, monkeypatch):
+    make(tmp_path, "full.parquet", quantities=["tau"])
+    complete = robodyn.read_dataset(tmp_path / "full.parquet")
+    make(tmp_path, "partial.parquet", quantities=["tau"])
+    (tmp_path / "partial.parquet" / "part-000001.parquet").unlink()
+    with pytest.raises(ValueError, match=r"chunks \[1\] are missing"):
+        robodyn.read_dataset(tmp_path / "partial.parquet")
+    computed = []
+    fill = robodyn.datasets._fill_chunk
+    monkeypatch.setattr(robodyn.datasets, "_fill_chunk", lambda *a: computed.append(a[3]) or fill(*a))
+    make(tmp_path, "partial.parquet", quantities=["tau"], resume=True)
+    assert computed == [1]
+    resumed = robodyn.read_dataset(tmp_path / "partial.parquet")
+    for name, values in complete.items():
+        np.testing.assert_array_equal(resumed[name], values, err_msg=name)
+    with pytest.raises(ValueError, match=r"\['M'\] are matrices and Parquet holds vector quantities"):
+        make(tmp_path, "m.parquet")
+    with pytest.raises(ValueError, match="argument 'format': expected 'zarr' or 'parquet', got 'csv'"):
+        make(tmp_path, "c.csv", format="csv")
+    with pytest.raises(ValueError, match="the store .* was made with other seed"):
+        make(tmp_path, "partial.parquet", quantities=["tau"], resume=True, seed=6)
+
+
+def test_the_dataset_command_writes_parquet(tmp_path, capsys):
+    from robodyn.cli import main
+
+    out = tmp_path / "cli.parquet"
+    assert main(["dataset", "ur5", "--n", "600", "--out", str(out), "--chunk", "256", "--no-progress"]) == 0
+    assert "3 chunks" in capsys.readouterr().out
+    assert robodyn.read_dataset(out)["tau"].shape == (600, 6)
+    assert main(["dataset", "ur5", "--n", "600", "--out", str(tmp_path / "m.parquet"), "--quantities", "M"]) == 2
+    assert "Parquet holds vector quantities" in capsys.readouterr().err
+
+
+def test_rollouts_report_their_progress(client):
+    m = robodyn.load("ur5")
+    q0 = m.random_configuration(n=5, seed=3)
+    for spread in (dict(client=client), {}):
+        seen = []
+        robodyn.simulate_many(m, q0, per_task=2, t_end=0.01, dt=1e-3, progress=seen.append, **spread)
+        # after each of the three tasks (2, 2 and 1 rollouts, finishing in any order)
+        assert len(seen) == 3 and sorted(seen) == seen and seen[-1] == 1.0 and 0 < seen[0] < 1
