@@ -54,7 +54,13 @@ def _symmetric_limit(limit: FloatArray, default: float) -> FloatArray:
     return np.where(np.isfinite(limit), limit, default)
 
 
-def _block(model: _core.Model, sampler: Any, seed: int, block: int, start: int, stop: int) -> dict[str, FloatArray]:
+def _limits(model: _core.Model) -> tuple[FloatArray, FloatArray]:
+    """The half-ranges of the sampled v and applied τ."""
+    velocity = _symmetric_limit(np.asarray(model.velocity_limit), DEFAULT_VELOCITY)
+    return velocity, _symmetric_limit(np.asarray(model.effort_limit), DEFAULT_TORQUE)
+
+
+def _block(model: _core.Model, sampler: Any, limits: tuple[FloatArray, FloatArray], seed: int, block: int, start: int, stop: int) -> dict[str, FloatArray]:
     """q, v, a and the applied τ of states [start, stop) of block `block` (whole blocks only)."""
     rng = np.random.default_rng(np.random.SeedSequence([seed, block]))
     count = stop - start
@@ -66,8 +72,7 @@ def _block(model: _core.Model, sampler: Any, seed: int, block: int, start: int, 
         q = model.integrate(center, rng.normal(0.0, sampler["std"], (count, model.nv)))
     else:
         q = np.asarray(sampler["q"][start:stop], dtype=np.float64)
-    velocity = _symmetric_limit(np.asarray(model.velocity_limit), DEFAULT_VELOCITY)
-    torque = _symmetric_limit(np.asarray(model.effort_limit), DEFAULT_TORQUE)
+    velocity, torque = limits
     return {
         "q": np.asarray(q, dtype=np.float64),
         "v": rng.uniform(-velocity, velocity, (count, model.nv)),
@@ -79,8 +84,9 @@ def _block(model: _core.Model, sampler: Any, seed: int, block: int, start: int, 
 def _fill_chunk(model: _core.Model, out: str, form: str, index: int, chunk: int, n: int, quantities: Sequence[str], sampler: Any, seed: int) -> int:
     """Samples chunk `index`, evaluates the quantities, writes them and marks the chunk done."""
     start, stop = index * chunk, min((index + 1) * chunk, n)
+    limits = _limits(model)
     parts = [
-        _block(model, sampler, seed, b, b * SEED_BLOCK, min((b + 1) * SEED_BLOCK, n))
+        _block(model, sampler, limits, seed, b, b * SEED_BLOCK, min((b + 1) * SEED_BLOCK, n))
         for b in range(start // SEED_BLOCK, (stop + SEED_BLOCK - 1) // SEED_BLOCK)
     ]
     arrays = {key: np.concatenate([p[key] for p in parts]) for key in parts[0]}
