@@ -155,3 +155,30 @@ mod x86 {
         tiled
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each lane type's scatter (the register transposes where the CPU has them) equals the value
+    /// by value one, for widths with and without whole tiles and at an offset into the rows.
+    fn equals_by_lane<S: Scatter>() {
+        for (count, size, offset) in [(3, 3, 0), (8, 8, 0), (17, 40, 5), (36, 108, 72)] {
+            let lanes: Vec<S> = (0..count)
+                .map(|j| S::from_lanes(|l| (100 * j + l) as f64 + 0.25))
+                .collect();
+            let mut tiled = vec![-1.0; S::LANES * size];
+            S::scatter(&lanes, &mut tiled, size, offset);
+            let mut by_lane = vec![-1.0; S::LANES * size];
+            scatter_by_lane(&lanes, &mut by_lane, size, offset);
+            assert_eq!(tiled, by_lane, "{} lanes, {count} values", S::LANES);
+        }
+    }
+
+    #[test]
+    fn scatter_equals_the_value_by_value_scatter() {
+        equals_by_lane::<f64>();
+        equals_by_lane::<AutoF64x4>();
+        equals_by_lane::<AutoF64x8>();
+    }
+}
