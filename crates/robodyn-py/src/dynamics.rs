@@ -94,23 +94,6 @@ fn external_forces<'w>(forces: &'w mut [Force], flat: &[f64]) -> &'w [Force] {
     forces
 }
 
-/// ∂q̈/∂q, ∂q̈/∂v, ∂q̈/∂τ = M⁻¹, from the rows [∂q̈/∂q, ∂q̈/∂v, M⁻¹] the algorithm solves.
-fn aba_derivatives(
-    model: &Model,
-    data: &mut Data,
-    state: algo::DynamicsState,
-    out: &mut [f64],
-) -> robodyn::Result<()> {
-    algo::aba_derivative_rows(model, data, state)?;
-    let nv = model.nv;
-    for (i, row) in data.derivative_rows.chunks_exact(3 * nv).enumerate() {
-        for (block, part) in row.chunks_exact(nv).enumerate() {
-            out[(block * nv + i) * nv..][..nv].copy_from_slice(part);
-        }
-    }
-    Ok(())
-}
-
 /// The Christoffel symbols at q, row-major (i, j, k), in a new buffer.
 pub(crate) fn christoffel_of(
     model: &Model,
@@ -233,7 +216,13 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let arguments = self.dynamics_arguments(q, v, ("tau", tau), f_ext)?;
         let names = keys!(py, "dqdd_dq", "dqdd_dv", "dqdd_dtau");
-        self.dynamics_derivatives(py, &arguments, names, aba_derivatives, None)
+        self.dynamics_derivatives(
+            py,
+            &arguments,
+            names,
+            algo::aba_derivatives_stacked,
+            Some(LaneKernel::AbaDerivatives),
+        )
     }
 
     /// Joint-space inertia matrix M(q), full and symmetric, armature included. (nv, nv).

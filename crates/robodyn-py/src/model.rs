@@ -89,6 +89,8 @@ pub(crate) enum LaneKernel {
     CompositeRigidBody,
     /// Inputs q, v, a: ∂τ/∂q, ∂τ/∂v and M stacked.
     RneaDerivatives,
+    /// Inputs q, v, τ: ∂q̈/∂q, ∂q̈/∂v and M⁻¹ stacked.
+    AbaDerivatives,
 }
 
 impl LaneKernel {
@@ -115,13 +117,16 @@ impl LaneKernel {
                 algo::rnea_derivatives_batch(model, lanes, dynamics, out)
             }
             LaneKernel::CompositeRigidBody => algo::crba_batch(model, lanes, q, out),
-            LaneKernel::ArticulatedBody => {
+            LaneKernel::ArticulatedBody | LaneKernel::AbaDerivatives => {
                 let forward = States {
                     a: None,
                     tau: input(2),
                     ..dynamics
                 };
-                algo::aba_batch(model, lanes, forward, out)
+                match self {
+                    LaneKernel::ArticulatedBody => algo::aba_batch(model, lanes, forward, out),
+                    _ => algo::aba_derivatives_batch(model, lanes, forward, out),
+                }
             }
         }
     }

@@ -30,8 +30,8 @@ fn lanes(c: &mut Criterion) {
     use rand::{rngs::StdRng, SeedableRng};
     use robodyn::algo::States;
     use robodyn::algo::{
-        aba_batch, crba_batch, newton_euler_batch, rnea_derivatives_batch, BatchWorkspace,
-        LaneWidth,
+        aba_batch, aba_derivatives_batch, crba_batch, newton_euler_batch, rnea_derivatives_batch,
+        BatchWorkspace, LaneWidth,
     };
     let mut group = c.benchmark_group("lanes");
     group.throughput(Throughput::Elements(BATCH as u64));
@@ -78,6 +78,9 @@ fn lanes(c: &mut Criterion) {
             });
             group.bench_function(id("rnea_derivatives"), |b| {
                 b.iter(|| rnea_derivatives_batch(&model, &mut workspace, dynamics, &mut matrices))
+            });
+            group.bench_function(id("aba_derivatives"), |b| {
+                b.iter(|| aba_derivatives_batch(&model, &mut workspace, forward, &mut matrices))
             });
         }
     }

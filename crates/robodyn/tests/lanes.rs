@@ -6,8 +6,9 @@ mod common;
 
 use common::*;
 use robodyn::algo::{
-    aba, aba_batch, bias_forces, crba, crba_batch, generalized_gravity, newton_euler_batch, rnea,
-    rnea_derivatives_batch, rnea_derivatives_stacked, BatchWorkspace, LaneWidth, States,
+    aba, aba_batch, aba_derivatives_batch, aba_derivatives_stacked, bias_forces, crba, crba_batch,
+    generalized_gravity, newton_euler_batch, rnea, rnea_derivatives_batch,
+    rnea_derivatives_stacked, BatchWorkspace, LaneWidth, States,
 };
 use robodyn::{Data, Error, Model};
 
@@ -214,6 +215,12 @@ fn a_singular_state_in_a_group_is_named_by_its_index() {
         Err((0, Error::InvalidValue { message, .. })) => assert!(message.contains("singular")),
         other => panic!("expected state 0 to be singular, got {other:?}"),
     }
+    // and so is its mass matrix, which the forward-dynamics derivatives factor
+    let mut stacked = vec![0.0; STATES * 3 * model.nv * model.nv];
+    match aba_derivatives_batch(&model, &mut workspace, states, &mut stacked) {
+        Err((0, Error::InvalidValue { message, .. })) => assert!(message.contains("singular")),
+        other => panic!("expected state 0 to be singular, got {other:?}"),
+    }
     let states = States {
         q: &q,
         v: Some(&v),
@@ -273,6 +280,38 @@ fn inverse_dynamics_derivatives_in_lanes_equal_the_one_state_call_bit_for_bit() 
                 let row = |x: &[f64]| x[k * nv..(k + 1) * nv].to_vec();
                 let one = (&q[k * nq..(k + 1) * nq], &row(&v)[..], &row(&a)[..], None);
                 rnea_derivatives_stacked(&model, &mut data, one, &mut expected).unwrap();
+                let same = bit_equal(stacked, &expected);
+                assert!(same, "{name}, {width:?}, state {k}");
+            }
+        }
+    }
+}
+
+#[test]
+fn forward_dynamics_derivatives_in_lanes_equal_the_one_state_call_bit_for_bit() {
+    for (name, model) in test_models() {
+        let (q, v, tau) = batch(&model);
+        let mut data = Data::new(&model);
+        let size = 3 * model.nv * model.nv;
+        let states = States {
+            q: &q,
+            v: Some(&v),
+            a: None,
+            tau: Some(&tau),
+        };
+        for width in LaneWidth::ALL {
+            let Ok(mut workspace) = BatchWorkspace::with_width(&model, width) else {
+                continue;
+            };
+            let mut out = vec![f64::NAN; STATES * size];
+            aba_derivatives_batch(&model, &mut workspace, states, &mut out).unwrap();
+            assert_groups_ran_in_lanes(&workspace, width.states(), name);
+            let mut expected = vec![0.0; size];
+            for (k, stacked) in out.chunks(size).enumerate() {
+                let (nq, nv) = (model.nq, model.nv);
+                let row = |x: &[f64]| x[k * nv..(k + 1) * nv].to_vec();
+                let one = (&q[k * nq..(k + 1) * nq], &row(&v)[..], &row(&tau)[..], None);
+                aba_derivatives_stacked(&model, &mut data, one, &mut expected).unwrap();
                 let same = bit_equal(stacked, &expected);
                 assert!(same, "{name}, {width:?}, state {k}");
             }

@@ -34,9 +34,10 @@
 //! Cost: O(n · depth) for RNEA's; ABA's add O(n Σ depth) for the solves.
 
 use crate::algo::crba::{
-    add_composites, composite_mass_matrix, world_inertias_of, CompositeBuffers,
+    add_composites, composite_mass_matrix, mass_matrix_of_composites, world_inertias_of,
+    CompositeBuffers,
 };
-use crate::algo::ltdl::{factor_mass_matrix, solve_rows};
+use crate::algo::ltdl::{factor_into, factor_mass_matrix, solve_rows, solve_rows_with};
 use crate::algo::rnea::check_external_forces;
 use crate::error::{check_length, check_vector, Result};
 use crate::model::Model;
@@ -237,12 +238,8 @@ pub fn aba_derivative_rows(
 
     // q̈ = M⁻¹ (τ − b), b = ID(q, q̇, 0)
     one_state(|| acceleration_terms(model, &mut buffers, None));
-    for i in 1..model.nbodies() {
-        for k in model.v_range(i) {
-            data.tau[k] = data.s_world[k].dot(&data.f_world[i]);
-        }
-    }
-    add_rotor_torques(model, &mut DerivativeBuffers::of(data), v, None);
+    joint_torques(model, &mut buffers);
+    add_rotor_torques(model, &mut buffers, v, None);
     let mut mass_matrix = std::mem::take(&mut data.mass_matrix);
     composite_mass_matrix(model, data, mass_matrix.as_mut_slice());
     data.mass_matrix = mass_matrix;
@@ -255,23 +252,103 @@ pub fn aba_derivative_rows(
 
     // [∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂τ] = M⁻¹ [−∂τ/∂q, −∂τ/∂q̇, 1] at q̈, solved row by row
     let nv = model.nv;
-    let mut rows = NegatedRows {
-        rows: std::mem::take(&mut data.derivative_rows),
+    let mut rows = std::mem::take(&mut data.derivative_rows);
+    rows.fill(0.0);
+    let mut negated = NegatedRows {
+        rows: &mut rows,
         nv,
     };
-    rows.rows.fill(0.0);
     let mut buffers = DerivativeBuffers::of(data);
     one_state(|| acceleration_terms(model, &mut buffers, Some(qdd.as_slice())));
-    one_state(|| derivative_products::<_, false>(model, &mut buffers, v, &mut rows));
+    one_state(|| derivative_products::<_, false>(model, &mut buffers, v, &mut negated));
     add_rotor_torques(model, &mut buffers, v, Some(qdd.as_slice()));
     data.qdd = qdd;
-    let (mut rows, width) = (rows.rows, 3 * nv);
-    for k in 0..nv {
-        rows[k * width + 2 * nv + k] = 1.0;
-    }
+    add_identity(&mut rows, nv);
     solve_rows(model, data, &mut rows);
     data.derivative_rows = rows;
     Ok(())
+}
+
+/// [`aba_derivative_rows`] of one state into `out`: ∂q̈/∂q, ∂q̈/∂q̇ and M⁻¹, each nv × nv
+/// row-major, one after the other.
+pub fn aba_derivatives_stacked(
+    model: &Model,
+    data: &mut Data,
+    state: DynamicsState,
+    out: &mut [f64],
+) -> Result<()> {
+    let nv = model.nv;
+    check_length("out", out.len(), 3 * nv * nv)?;
+    aba_derivative_rows(model, data, state)?;
+    // row i = [∂q̈_i/∂q, ∂q̈_i/∂q̇, (M⁻¹)_i]: each third to row i of its block
+    for (i, row) in data.derivative_rows.chunks_exact(3 * nv).enumerate() {
+        for (block, part) in row.chunks_exact(nv).enumerate() {
+            out[(block * nv + i) * nv..][..nv].copy_from_slice(part);
+        }
+    }
+    Ok(())
+}
+
+/// What the ABA derivatives solve with, in `f64` or lanes: M's factors (column-major), q̈, and
+/// the rows [∂q̈/∂q, ∂q̈/∂q̇, M⁻¹] (nv rows of 3 nv).
+pub(crate) struct SolveBuffers<'b, S> {
+    pub factor: &'b mut [S],
+    pub qdd: &'b mut [S],
+    pub rows: &'b mut [S],
+}
+
+/// The passes of [`aba_derivative_rows`] on checked inputs (no external forces), inlined into
+/// one for the lanes, in the same order (so each lane equals the one-state call bit for bit);
+/// an error where a lane's M is refused.
+#[inline(always)]
+pub(crate) fn aba_derivative_passes<S: Real>(
+    model: &Model,
+    b: &mut DerivativeBuffers<S>,
+    solve: SolveBuffers<S>,
+    (q, v, tau): (&[S], &[S], &[S]),
+) -> std::result::Result<(), ()> {
+    velocity_terms(model, b, q, v, None);
+    // q̈ = M⁻¹ (τ − b), b = ID(q, q̇, 0)
+    acceleration_terms(model, b, None);
+    joint_torques(model, b);
+    add_rotor_torques(model, b, v, None);
+    mass_matrix_of_composites(model, b.i_c, b.s_world, b.mass_matrix);
+    factor_into(model, b.mass_matrix, solve.factor)?;
+    for (qdd, (applied, bias)) in solve.qdd.iter_mut().zip(tau.iter().zip(b.tau.iter())) {
+        *qdd = *applied - *bias;
+    }
+    solve_rows_with(model, solve.factor, solve.qdd);
+    // [∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂τ] = M⁻¹ [−∂τ/∂q, −∂τ/∂q̇, 1] at q̈, solved row by row
+    let nv = model.nv;
+    solve.rows.fill(S::splat(0.0));
+    let mut negated = NegatedRows {
+        rows: &mut *solve.rows,
+        nv,
+    };
+    acceleration_terms(model, b, Some(&*solve.qdd));
+    derivative_products::<_, false>(model, b, v, &mut negated);
+    add_rotor_torques(model, b, v, Some(&*solve.qdd));
+    add_identity(solve.rows, nv);
+    solve_rows_with(model, solve.factor, solve.rows);
+    Ok(())
+}
+
+/// τ_k = S_kᵀ F_i for each coordinate k of each body i.
+#[inline(always)]
+fn joint_torques<S: Real>(model: &Model, b: &mut DerivativeBuffers<S>) {
+    for i in 1..model.nbodies() {
+        for k in model.v_range(i) {
+            b.tau[k] = b.s_world[k].dot(&b.f_world[i]);
+        }
+    }
+}
+
+/// The identity's 1 in the last third of each of the nv rows of 3 nv.
+#[inline(always)]
+fn add_identity<S: Real>(rows: &mut [S], nv: usize) {
+    for k in 0..nv {
+        rows[k * 3 * nv + 2 * nv + k] = S::splat(1.0);
+    }
 }
 
 /// Shapes and finiteness of (q, v, a or τ, f_ext).
@@ -416,15 +493,16 @@ impl<S: Real> TorqueDerivatives<S> for RowMajor<'_, S> {
     }
 }
 
-/// Negated into the rows [−∂τ/∂q, −∂τ/∂q̇, ·] (nv rows of 3 nv) that the ABA derivatives solve.
-struct NegatedRows {
-    rows: Vec<f64>,
+/// Negated into the rows [−∂τ/∂q, −∂τ/∂q̇, ·] (nv rows of 3 nv) that the ABA derivatives solve,
+/// in `f64` or lanes.
+struct NegatedRows<'a, S> {
+    rows: &'a mut [S],
     nv: usize,
 }
 
-impl TorqueDerivatives<f64> for NegatedRows {
+impl<S: Real> TorqueDerivatives<S> for NegatedRows<'_, S> {
     #[inline(always)]
-    fn add(&mut self, row: usize, column: usize, by_q: f64, by_v: f64) {
+    fn add(&mut self, row: usize, column: usize, by_q: S, by_v: S) {
         let start = row * 3 * self.nv + column;
         self.rows[start] -= by_q;
         self.rows[start + self.nv] -= by_v;

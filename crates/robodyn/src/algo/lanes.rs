@@ -15,7 +15,7 @@ mod scatter;
 
 use crate::algo::aba::aba;
 use crate::algo::crba::crba_into;
-use crate::algo::derivatives::rnea_derivatives_stacked;
+use crate::algo::derivatives::{aba_derivatives_stacked, rnea_derivatives_stacked};
 use crate::algo::rnea::newton_euler;
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::model::Model;
@@ -143,6 +143,8 @@ enum Algorithm {
     CompositeRigidBody,
     /// ∂τ/∂q, ∂τ/∂q̇ and M of τ = ID(q, v, a), stacked.
     RneaDerivatives,
+    /// ∂q̈/∂q, ∂q̈/∂q̇ and M⁻¹ of q̈ = FD(q, v, τ), stacked.
+    AbaDerivatives,
 }
 
 impl Algorithm {
@@ -155,7 +157,7 @@ impl Algorithm {
     fn output_size(self, model: &Model) -> usize {
         match self {
             Algorithm::CompositeRigidBody => model.nv * model.nv,
-            Algorithm::RneaDerivatives => 3 * model.nv * model.nv,
+            Algorithm::RneaDerivatives | Algorithm::AbaDerivatives => 3 * model.nv * model.nv,
             _ => model.nv,
         }
     }
@@ -231,6 +233,22 @@ pub fn rnea_derivatives_batch(
     run_batch(Algorithm::RneaDerivatives, model, workspace, states, out)
 }
 
+/// The ABA derivatives over a batch: per state, ∂q̈/∂q, ∂q̈/∂q̇ and M⁻¹ (each nv × nv row-major,
+/// stacked: `out` is n × 3 × nv × nv) at (q, v, τ) (`states.v` and `states.tau` are required),
+/// checked and grouped as [`newton_euler_batch`].
+pub fn aba_derivatives_batch(
+    model: &Model,
+    workspace: &mut BatchWorkspace,
+    states: States,
+    out: &mut [f64],
+) -> BatchResult {
+    require(
+        &[("v", states.v), ("tau", states.tau)],
+        "the derivatives of forward dynamics",
+    )?;
+    run_batch(Algorithm::AbaDerivatives, model, workspace, states, out)
+}
+
 /// An error if one of `inputs` is missing.
 fn require(inputs: &[(&str, Option<&[f64]>)], what: &str) -> BatchResult {
     match inputs.iter().find(|(_, values)| values.is_none()) {
@@ -297,6 +315,12 @@ fn run_batch(
                 let (v, a) = (state.v.unwrap_or_default(), state.a.unwrap_or_default());
                 let one = (state.q, v, a, None);
                 rnea_derivatives_stacked(model, data, one, out).map_err(|e| (k, e))?;
+                continue;
+            }
+            Algorithm::AbaDerivatives => {
+                let (v, tau) = (state.v.unwrap_or_default(), state.tau.unwrap_or_default());
+                let one = (state.q, v, tau, None);
+                aba_derivatives_stacked(model, data, one, out).map_err(|e| (k, e))?;
                 continue;
             }
         };
@@ -385,6 +409,12 @@ mod tests {
                 a,
                 tau: None,
             },
+            Algorithm::AbaDerivatives => States {
+                q: &q,
+                v,
+                a: None,
+                tau: a,
+            },
         };
         let size = algorithm.output_size(&model);
         let mut lanes = vec![0.0; n * size];
@@ -413,6 +443,7 @@ mod tests {
             Algorithm::ArticulatedBody,
             Algorithm::CompositeRigidBody,
             Algorithm::RneaDerivatives,
+            Algorithm::AbaDerivatives,
         ] {
             lanes_equal_one_state::<AutoF64x4>(algorithm);
             lanes_equal_one_state::<AutoF64x8>(algorithm);

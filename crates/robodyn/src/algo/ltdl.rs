@@ -18,37 +18,55 @@
 use crate::algo::SINGULARITY_TOLERANCE;
 use crate::error::{Error, Result};
 use crate::model::Model;
+use crate::spatial::Real;
 use crate::Data;
+use simba::simd::SimdBool;
 
 /// Factors `data.mass_matrix` into `data.mass_matrix_factor` (D on the diagonal, L strictly
 /// below it; nothing above is read). A pivot D_k not above [`SINGULARITY_TOLERANCE`] times M's
 /// largest diagonal entry is refused: M is then singular (a massless subtree without armature).
 pub fn factor_mass_matrix(model: &Model, data: &mut Data) -> Result<()> {
-    let factor = &mut data.mass_matrix_factor;
-    factor
-        .as_mut_slice()
-        .copy_from_slice(data.mass_matrix.as_slice());
-    let scale = (0..model.nv).map(|k| factor[(k, k)]).fold(0.0, f64::max);
-    for k in (0..model.nv).rev() {
-        let pivot = factor[(k, k)];
-        if pivot.is_nan() || pivot <= SINGULARITY_TOLERANCE * scale || pivot <= 0.0 {
-            return Err(Error::InvalidValue {
-                argument: "q".into(),
-                message: "the mass matrix is singular at this configuration (a massless \
-                          subtree without armature)"
-                    .into(),
-            });
+    let (mass_matrix, factor) = (data.mass_matrix.as_slice(), &mut data.mass_matrix_factor);
+    factor_into(model, mass_matrix, factor.as_mut_slice()).map_err(|()| Error::InvalidValue {
+        argument: "q".into(),
+        message: "the mass matrix is singular at this configuration (a massless subtree without \
+                  armature)"
+            .into(),
+    })
+}
+
+/// [`factor_mass_matrix`] of the column-major `mass_matrix` into `factor`, in `f64` or lanes;
+/// an error if a pivot of any lane is refused.
+#[inline(always)]
+pub(crate) fn factor_into<S: Real>(
+    model: &Model,
+    mass_matrix: &[S],
+    factor: &mut [S],
+) -> std::result::Result<(), ()> {
+    let nv = model.nv;
+    factor.copy_from_slice(mass_matrix);
+    let scale = (0..nv).fold(S::splat(0.0), |largest, k| {
+        largest.simd_max(factor[k + k * nv])
+    });
+    let threshold = S::splat(SINGULARITY_TOLERANCE) * scale;
+    for k in (0..nv).rev() {
+        // column-major storage: F[r, c] at r + c nv
+        let pivot = factor[k + k * nv];
+        // refused where not above the threshold and zero (NaN is not above either)
+        let accepted = pivot.simd_gt(threshold) & pivot.simd_gt(S::splat(0.0));
+        if !accepted.all() {
+            return Err(());
         }
         let mut ancestor = model.dof_parent[k];
         while let Some(i) = ancestor {
             // eliminate coordinate k from row i and the rows of i's ancestors
-            let a = factor[(k, i)] / pivot;
+            let a = factor[k + i * nv] / pivot;
             let mut above = Some(i);
             while let Some(j) = above {
-                factor[(i, j)] -= a * factor[(k, j)];
+                factor[i + j * nv] -= a * factor[k + j * nv];
                 above = model.dof_parent[j];
             }
-            factor[(k, i)] = a;
+            factor[k + i * nv] = a;
             ancestor = model.dof_parent[i];
         }
     }
@@ -90,19 +108,25 @@ unsafe fn solve_rows_avx512(model: &Model, data: &Data, rows: &mut [f64]) {
 
 #[inline(always)]
 fn solve_rows_generic(model: &Model, data: &Data, rows: &mut [f64]) {
-    let (factor, nv) = (&data.mass_matrix_factor, model.nv);
+    solve_rows_with(model, data.mass_matrix_factor.as_slice(), rows);
+}
+
+/// [`solve_rows`] with the column-major `factor` of [`factor_into`], in `f64` or lanes.
+#[inline(always)]
+pub(crate) fn solve_rows_with<S: Real>(model: &Model, factor: &[S], rows: &mut [S]) {
+    let nv = model.nv;
     let width = rows.len() / nv.max(1);
     // Lᵀ y = b: k from the leaves, y_k then leaves its share in the rows of its ancestors
     for k in (0..nv).rev() {
         let mut ancestor = model.dof_parent[k];
         while let Some(i) = ancestor {
-            subtract_row(rows, width, (i, k), factor[(k, i)]);
+            subtract_row(rows, width, (i, k), factor[k + i * nv]);
             ancestor = model.dof_parent[i];
         }
     }
     // D z = y
     for k in 0..nv {
-        let inverse_pivot = 1.0 / factor[(k, k)];
+        let inverse_pivot = S::splat(1.0) / factor[k + k * nv];
         for value in &mut rows[k * width..(k + 1) * width] {
             *value *= inverse_pivot;
         }
@@ -111,7 +135,7 @@ fn solve_rows_generic(model: &Model, data: &Data, rows: &mut [f64]) {
     for k in 0..nv {
         let mut ancestor = model.dof_parent[k];
         while let Some(i) = ancestor {
-            subtract_row(rows, width, (k, i), factor[(k, i)]);
+            subtract_row(rows, width, (k, i), factor[k + i * nv]);
             ancestor = model.dof_parent[i];
         }
     }
@@ -119,7 +143,7 @@ fn solve_rows_generic(model: &Model, data: &Data, rows: &mut [f64]) {
 
 /// Row `target` −= `scale` · row `source` (two different rows of `width` values each).
 #[inline(always)]
-fn subtract_row(rows: &mut [f64], width: usize, (target, source): (usize, usize), scale: f64) {
+fn subtract_row<S: Real>(rows: &mut [S], width: usize, (target, source): (usize, usize), scale: S) {
     let (target_row, source_row) = if target < source {
         let (head, tail) = rows.split_at_mut(source * width);
         (
@@ -134,7 +158,7 @@ fn subtract_row(rows: &mut [f64], width: usize, (target, source): (usize, usize)
         )
     };
     for (t, s) in target_row.iter_mut().zip(source_row) {
-        *t -= scale * s;
+        *t -= scale * *s;
     }
 }
 

@@ -30,8 +30,8 @@ pub use centroidal::centroidal_momentum_matrix;
 pub use coriolis::{christoffel_symbols, coriolis_matrix};
 pub use crba::{crba, crba_into};
 pub use derivatives::{
-    aba_derivative_rows, aba_derivatives, rnea_derivatives, rnea_derivatives_row_major,
-    rnea_derivatives_stacked, DynamicsState,
+    aba_derivative_rows, aba_derivatives, aba_derivatives_stacked, rnea_derivatives,
+    rnea_derivatives_row_major, rnea_derivatives_stacked, DynamicsState,
 };
 pub use energy::{center_of_mass, center_of_mass_jacobian, kinetic_energy, potential_energy};
 pub use frame_derivatives::{center_of_mass_velocity_derivatives, frame_motion_derivatives};
@@ -40,8 +40,8 @@ pub use inverse_kinematics::{inverse_kinematics, IkOptions, IkSolution};
 pub use jacobian::{jacobian, Reference};
 pub use kinematics::{forward_kinematics, frame_placement, frame_pose};
 pub use lanes::{
-    aba_batch, crba_batch, newton_euler_batch, rnea_derivatives_batch, BatchResult, BatchWorkspace,
-    LaneWidth, States,
+    aba_batch, aba_derivatives_batch, crba_batch, newton_euler_batch, rnea_derivatives_batch,
+    BatchResult, BatchWorkspace, LaneWidth, States,
 };
 pub use manipulability::manipulability;
 pub use minv::inverse_mass_matrix;

@@ -7,7 +7,9 @@ use crate::algo::aba::{articulated_body_passes, AbaBuffers};
 use crate::algo::crba::{
     add_composites, mass_matrix_of_composites, world_inertias_of, CompositeBuffers,
 };
-use crate::algo::derivatives::{derivative_passes, DerivativeBuffers, RowMajor};
+use crate::algo::derivatives::{
+    aba_derivative_passes, derivative_passes, DerivativeBuffers, RowMajor, SolveBuffers,
+};
 use crate::algo::rnea::{newton_euler_passes, NewtonEulerBuffers};
 use crate::model::Model;
 use crate::spatial::{
@@ -44,6 +46,9 @@ pub(super) struct Lanes<S> {
     coriolis_factors: Vec<CoriolisFactor<S>>,
     dtau_dq: Vec<S>,
     dtau_dv: Vec<S>,
+    bias: Vec<S>,
+    factor: Vec<S>,
+    rows: Vec<S>,
     out: Vec<S>,
 }
 
@@ -78,8 +83,59 @@ impl<S: Real> Lanes<S> {
             coriolis_factors: vec![CoriolisFactor::splat(&CoriolisFactor::ZERO); bodies],
             dtau_dq: vec![zero; model.nv * model.nv],
             dtau_dv: vec![zero; model.nv * model.nv],
+            bias: vec![zero; model.nv],
+            factor: vec![zero; model.nv * model.nv],
+            rows: vec![zero; 3 * model.nv * model.nv],
             out: vec![zero; model.nv],
         }
+    }
+}
+
+/// The lane buffers the derivative passes work in, and beside them the inputs and the
+/// buffers the callers of those passes use.
+struct DerivativeInputs<'b, S> {
+    q: &'b [S],
+    v: &'b [S],
+    a: &'b [S],
+    tau: &'b [S],
+    dtau_dq: &'b mut [S],
+    dtau_dv: &'b mut [S],
+    factor: &'b mut [S],
+    qdd: &'b mut [S],
+    rows: &'b mut [S],
+}
+
+impl<S: Real> Lanes<S> {
+    /// The derivative passes' buffers and the rest, borrowed apart.
+    #[inline(always)]
+    fn derivative_buffers(&mut self) -> (DerivativeBuffers<'_, S>, DerivativeInputs<'_, S>) {
+        let buffers = DerivativeBuffers {
+            x_up: &mut self.x_up,
+            x_world: &mut self.x_world,
+            i_c: &mut self.composites,
+            s_world: &mut self.subspaces,
+            v_world: &mut self.velocities,
+            a_world: &mut self.accelerations,
+            motion_terms: &mut self.motion_terms,
+            i_world: &mut self.body_inertias,
+            f_velocity: &mut self.velocity_forces,
+            f_world: &mut self.forces,
+            coriolis_factors: &mut self.coriolis_factors,
+            tau: &mut self.bias,
+            mass_matrix: &mut self.mass_matrix,
+        };
+        let inputs = DerivativeInputs {
+            q: &self.q,
+            v: &self.v,
+            a: &self.a,
+            tau: &self.tau,
+            dtau_dq: &mut self.dtau_dq,
+            dtau_dv: &mut self.dtau_dv,
+            factor: &mut self.factor,
+            qdd: &mut self.out,
+            rows: &mut self.rows,
+        };
+        (buffers, inputs)
     }
 }
 
@@ -108,7 +164,7 @@ pub(super) unsafe fn groups_eight(
 }
 
 /// `algorithm` on the groups of states that fill `out`, `S::LANES` at a time. An error gives the
-/// first state of a group where a lane failed (a singular articulated inertia).
+/// first state of a group where a lane failed (a singular articulated inertia or mass matrix).
 #[inline(always)]
 pub(super) fn groups<S: Scatter>(
     algorithm: Algorithm,
@@ -174,37 +230,40 @@ pub(super) fn groups<S: Scatter>(
                 continue;
             }
             Algorithm::RneaDerivatives => {
-                let mut buffers = DerivativeBuffers {
-                    x_up: &mut lanes.x_up,
-                    x_world: &mut lanes.x_world,
-                    i_c: &mut lanes.composites,
-                    s_world: &mut lanes.subspaces,
-                    v_world: &mut lanes.velocities,
-                    a_world: &mut lanes.accelerations,
-                    motion_terms: &mut lanes.motion_terms,
-                    i_world: &mut lanes.body_inertias,
-                    f_velocity: &mut lanes.velocity_forces,
-                    f_world: &mut lanes.forces,
-                    coriolis_factors: &mut lanes.coriolis_factors,
-                    tau: &mut lanes.out,
-                    mass_matrix: &mut lanes.mass_matrix,
-                };
                 let zero = S::splat(0.0);
                 lanes.dtau_dq.fill(zero);
                 lanes.dtau_dv.fill(zero);
+                let (mut buffers, inputs) = lanes.derivative_buffers();
                 let mut sink = RowMajor {
-                    by_q: &mut lanes.dtau_dq,
-                    by_v: &mut lanes.dtau_dv,
+                    by_q: inputs.dtau_dq,
+                    by_v: inputs.dtau_dv,
                     nv,
                 };
-                let inputs = (&lanes.q[..], &lanes.v[..], &lanes.a[..], None);
-                derivative_passes(model, &mut buffers, inputs, &mut sink);
+                let state = (inputs.q, inputs.v, inputs.a, None);
+                derivative_passes(model, &mut buffers, state, &mut sink);
                 let block = nv * nv;
                 for (part, lanes) in [&lanes.dtau_dq, &lanes.dtau_dv, &lanes.mass_matrix]
                     .into_iter()
                     .enumerate()
                 {
                     S::scatter(lanes, out, size, part * block);
+                }
+                continue;
+            }
+            Algorithm::AbaDerivatives => {
+                let (mut buffers, inputs) = lanes.derivative_buffers();
+                let solve = SolveBuffers {
+                    factor: inputs.factor,
+                    qdd: inputs.qdd,
+                    rows: inputs.rows,
+                };
+                let state = (inputs.q, inputs.v, inputs.tau);
+                aba_derivative_passes(model, &mut buffers, solve, state).map_err(|()| first)?;
+                // row i = [∂q̈_i/∂q, ∂q̈_i/∂q̇, (M⁻¹)_i]: each third to row i of its block
+                for (i, row) in lanes.rows.chunks_exact(3 * nv).enumerate() {
+                    for (block, part) in row.chunks_exact(nv).enumerate() {
+                        S::scatter(part, out, size, (block * nv + i) * nv);
+                    }
                 }
                 continue;
             }
