@@ -101,12 +101,17 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
         for x, w in zip(pin_states, pin_velocities):
             pin.computeRNEADerivatives(pm, pd, x, w, w)
 
+    def pin_aba_derivatives_loop():
+        for x, w in zip(pin_states, pin_velocities):
+            pin.computeABADerivatives(pm, pd, x, w, w)
+
     batches = {
         "gravity": (lambda: m.generalized_gravity(states), pin_gravity_loop),
         "rnea": (lambda: m.inverse_dynamics(states, velocities, velocities), pin_rnea_loop),
         "crba": (lambda: m.mass_matrix(states), pin_crba_loop),
         "aba": (lambda: m.forward_dynamics(states, velocities, velocities), pin_aba_loop),
         "rnea_derivatives": (lambda: m.inverse_dynamics_derivatives(states, velocities, velocities), pin_rnea_derivatives_loop),
+        "aba_derivatives": (lambda: m.forward_dynamics_derivatives(states, velocities, velocities), pin_aba_derivatives_loop),
     }
     rows += [(f"{name} {algorithm} ({batch} states)", *best_times(ours, theirs, 1, 5)) for algorithm, (ours, theirs) in batches.items()]
     return rows

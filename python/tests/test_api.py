@@ -240,7 +240,7 @@ def test_mimic_joints_are_reported():
 @pytest.mark.parametrize("n", [1, 7, 37, 1001])
 def test_batches_in_lanes_equal_the_loop_bit_for_bit(floating, n):
     """Inverse dynamics, bias forces, gravity, forward dynamics, the mass matrix and the
-    derivatives of inverse dynamics run a batch several states per instruction (the widest lanes this CPU has) and leftover states one at a time: every state's
+    derivatives of inverse and forward dynamics run a batch several states per instruction (the widest lanes this CPU has) and leftover states one at a time: every state's
     result is the one-state call's, bit for bit, whatever the batch size."""
     for m in (floating, robodyn.load("ur5")):
         q, v, a, _, _ = batch_of_states(m, n, seed=n)
@@ -254,11 +254,12 @@ def test_batches_in_lanes_equal_the_loop_bit_for_bit(floating, n):
             batch = getattr(m, name)(*args)
             loop = np.stack([getattr(m, name)(*(x[k] for x in args)) for k in range(n)])
             np.testing.assert_array_equal(batch, loop, err_msg=f"{m.name} {name} n={n}")
-        batch = m.inverse_dynamics_derivatives(q, v, a)
-        for k in range(n):
-            one = m.inverse_dynamics_derivatives(q[k], v[k], a[k])
-            for key, value in one.items():
-                np.testing.assert_array_equal(batch[key][k], value, err_msg=f"{m.name} {key} {k}")
+        for name in ("inverse_dynamics_derivatives", "forward_dynamics_derivatives"):
+            batch = getattr(m, name)(q, v, a)
+            for k in range(n):
+                one = getattr(m, name)(q[k], v[k], a[k])
+                for key, value in one.items():
+                    np.testing.assert_array_equal(batch[key][k], value, err_msg=f"{m.name} {key} {k}")
 
 
 def test_an_overflow_in_lanes_names_its_batch_element():
