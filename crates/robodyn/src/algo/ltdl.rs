@@ -21,6 +21,7 @@ use crate::model::Model;
 use crate::spatial::Real;
 use crate::Data;
 use simba::simd::SimdBool;
+use std::ops::Range;
 
 /// Factors `data.mass_matrix` into `data.mass_matrix_factor` (D on the diagonal, L strictly
 /// below it; nothing above is read). A pivot D_k not above [`SINGULARITY_TOLERANCE`] times M's
@@ -111,23 +112,43 @@ fn solve_rows_generic(model: &Model, data: &Data, rows: &mut [f64]) {
     solve_rows_with(model, data.mass_matrix_factor.as_slice(), rows);
 }
 
-/// [`solve_rows`] with the column-major `factor` of [`factor_into`], in `f64` or lanes.
+/// [`solve_rows`] with the column-major `factor` of [`factor_into`], in `f64` or lanes. Wide
+/// rows are solved a block of columns at a time, each block's part of the rows small enough to
+/// stay in a core's L2 cache through the three sweeps (each column is solved by the same
+/// operations in the same order either way).
 #[inline(always)]
 pub(crate) fn solve_rows_with<S: Real>(model: &Model, factor: &[S], rows: &mut [S]) {
+    const CACHED_BYTES: usize = 128 * 1024;
+    let nv = model.nv.max(1);
+    let width = rows.len() / nv;
+    let block = (CACHED_BYTES / (nv * std::mem::size_of::<S>())).max(8);
+    for start in (0..width).step_by(block) {
+        solve_columns(model, factor, rows, width, start..width.min(start + block));
+    }
+}
+
+/// The sweeps of [`solve_rows_with`] on `columns` of the rows (of `width` values each).
+#[inline(always)]
+fn solve_columns<S: Real>(
+    model: &Model,
+    factor: &[S],
+    rows: &mut [S],
+    width: usize,
+    columns: Range<usize>,
+) {
     let nv = model.nv;
-    let width = rows.len() / nv.max(1);
     // Lᵀ y = b: k from the leaves, y_k then leaves its share in the rows of its ancestors
     for k in (0..nv).rev() {
         let mut ancestor = model.dof_parent[k];
         while let Some(i) = ancestor {
-            subtract_row(rows, width, (i, k), factor[k + i * nv]);
+            subtract_row(rows, width, &columns, (i, k), factor[k + i * nv]);
             ancestor = model.dof_parent[i];
         }
     }
     // D z = y
     for k in 0..nv {
         let inverse_pivot = S::splat(1.0) / factor[k + k * nv];
-        for value in &mut rows[k * width..(k + 1) * width] {
+        for value in &mut rows[k * width + columns.start..k * width + columns.end] {
             *value *= inverse_pivot;
         }
     }
@@ -135,26 +156,34 @@ pub(crate) fn solve_rows_with<S: Real>(model: &Model, factor: &[S], rows: &mut [
     for k in 0..nv {
         let mut ancestor = model.dof_parent[k];
         while let Some(i) = ancestor {
-            subtract_row(rows, width, (k, i), factor[k + i * nv]);
+            subtract_row(rows, width, &columns, (k, i), factor[k + i * nv]);
             ancestor = model.dof_parent[i];
         }
     }
 }
 
-/// Row `target` −= `scale` · row `source` (two different rows of `width` values each).
+/// Row `target` −= `scale` · row `source` on `columns` (two different rows of `width` values
+/// each).
 #[inline(always)]
-fn subtract_row<S: Real>(rows: &mut [S], width: usize, (target, source): (usize, usize), scale: S) {
+fn subtract_row<S: Real>(
+    rows: &mut [S],
+    width: usize,
+    columns: &Range<usize>,
+    (target, source): (usize, usize),
+    scale: S,
+) {
+    let (start, end) = (columns.start, columns.end);
     let (target_row, source_row) = if target < source {
         let (head, tail) = rows.split_at_mut(source * width);
         (
-            &mut head[target * width..(target + 1) * width],
-            &tail[..width],
+            &mut head[target * width + start..target * width + end],
+            &tail[start..end],
         )
     } else {
         let (head, tail) = rows.split_at_mut(target * width);
         (
-            &mut tail[..width],
-            &head[source * width..(source + 1) * width],
+            &mut tail[start..end],
+            &head[source * width + start..source * width + end],
         )
     };
     for (t, s) in target_row.iter_mut().zip(source_row) {
