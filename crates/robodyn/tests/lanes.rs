@@ -1,6 +1,6 @@
 //! Batches in lanes (`algo::lanes`) against the one-state calls: every width, every test model,
 //! inverse dynamics, bias forces, gravity, forward dynamics, the mass matrix and the derivatives
-//! of inverse dynamics, bit for bit.
+//! of inverse and forward dynamics, bit for bit.
 
 mod common;
 
@@ -255,31 +255,36 @@ fn mass_matrices_in_lanes_equal_crba_bit_for_bit() {
     }
 }
 
-#[test]
-fn inverse_dynamics_derivatives_in_lanes_equal_the_one_state_call_bit_for_bit() {
+/// A derivatives batch function, and the one-state function whose results it must equal.
+type BatchOf = fn(&Model, &mut BatchWorkspace, States, &mut [f64]) -> robodyn::algo::BatchResult;
+type OneOf = fn(&Model, &mut Data, robodyn::algo::DynamicsState, &mut [f64]) -> robodyn::Result<()>;
+
+/// `batch` at every width on every test model against `one` state by state, the third input
+/// given as a (RNEA) or τ (ABA).
+fn derivatives_equal_one_state(batch_of: BatchOf, one: OneOf, third_is_tau: bool) {
     for (name, model) in test_models() {
-        let (q, v, a) = batch(&model);
+        let (q, v, x) = batch(&model);
         let mut data = Data::new(&model);
         let size = 3 * model.nv * model.nv;
         let states = States {
             q: &q,
             v: Some(&v),
-            a: Some(&a),
-            tau: None,
+            a: Some(&x).filter(|_| !third_is_tau).map(|x| &x[..]),
+            tau: Some(&x).filter(|_| third_is_tau).map(|x| &x[..]),
         };
         for width in LaneWidth::ALL {
             let Ok(mut workspace) = BatchWorkspace::with_width(&model, width) else {
                 continue;
             };
             let mut out = vec![f64::NAN; STATES * size];
-            rnea_derivatives_batch(&model, &mut workspace, states, &mut out).unwrap();
+            batch_of(&model, &mut workspace, states, &mut out).unwrap();
             assert_groups_ran_in_lanes(&workspace, width.states(), name);
             let mut expected = vec![0.0; size];
             for (k, stacked) in out.chunks(size).enumerate() {
                 let (nq, nv) = (model.nq, model.nv);
                 let row = |x: &[f64]| x[k * nv..(k + 1) * nv].to_vec();
-                let one = (&q[k * nq..(k + 1) * nq], &row(&v)[..], &row(&a)[..], None);
-                rnea_derivatives_stacked(&model, &mut data, one, &mut expected).unwrap();
+                let state = (&q[k * nq..(k + 1) * nq], &row(&v)[..], &row(&x)[..], None);
+                one(&model, &mut data, state, &mut expected).unwrap();
                 let same = bit_equal(stacked, &expected);
                 assert!(same, "{name}, {width:?}, state {k}");
             }
@@ -288,33 +293,11 @@ fn inverse_dynamics_derivatives_in_lanes_equal_the_one_state_call_bit_for_bit() 
 }
 
 #[test]
+fn inverse_dynamics_derivatives_in_lanes_equal_the_one_state_call_bit_for_bit() {
+    derivatives_equal_one_state(rnea_derivatives_batch, rnea_derivatives_stacked, false);
+}
+
+#[test]
 fn forward_dynamics_derivatives_in_lanes_equal_the_one_state_call_bit_for_bit() {
-    for (name, model) in test_models() {
-        let (q, v, tau) = batch(&model);
-        let mut data = Data::new(&model);
-        let size = 3 * model.nv * model.nv;
-        let states = States {
-            q: &q,
-            v: Some(&v),
-            a: None,
-            tau: Some(&tau),
-        };
-        for width in LaneWidth::ALL {
-            let Ok(mut workspace) = BatchWorkspace::with_width(&model, width) else {
-                continue;
-            };
-            let mut out = vec![f64::NAN; STATES * size];
-            aba_derivatives_batch(&model, &mut workspace, states, &mut out).unwrap();
-            assert_groups_ran_in_lanes(&workspace, width.states(), name);
-            let mut expected = vec![0.0; size];
-            for (k, stacked) in out.chunks(size).enumerate() {
-                let (nq, nv) = (model.nq, model.nv);
-                let row = |x: &[f64]| x[k * nv..(k + 1) * nv].to_vec();
-                let one = (&q[k * nq..(k + 1) * nq], &row(&v)[..], &row(&tau)[..], None);
-                aba_derivatives_stacked(&model, &mut data, one, &mut expected).unwrap();
-                let same = bit_equal(stacked, &expected);
-                assert!(same, "{name}, {width:?}, state {k}");
-            }
-        }
-    }
+    derivatives_equal_one_state(aba_derivatives_batch, aba_derivatives_stacked, true);
 }
