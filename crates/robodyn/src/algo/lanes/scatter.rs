@@ -16,13 +16,6 @@ pub(super) trait Scatter: Real {
     fn scatter(lanes: &[Self], rows: &mut [f64], size: usize, offset: usize);
 }
 
-impl Scatter for f64 {
-    #[inline(always)]
-    fn scatter(lanes: &[Self], rows: &mut [f64], _size: usize, offset: usize) {
-        rows[offset..offset + lanes.len()].copy_from_slice(lanes);
-    }
-}
-
 impl Scatter for AutoF64x4 {
     #[inline(always)]
     fn scatter(lanes: &[Self], rows: &mut [f64], size: usize, offset: usize) {
@@ -177,7 +170,6 @@ mod tests {
 
     #[test]
     fn scatter_equals_the_value_by_value_scatter() {
-        equals_by_lane::<f64>();
         equals_by_lane::<AutoF64x4>();
         equals_by_lane::<AutoF64x8>();
     }
