@@ -4,6 +4,8 @@ mod common;
 
 use common::*;
 use nalgebra::{DMatrix, DVector};
+use rand::Rng;
+use robodyn::algo::ltdl::{factor_mass_matrix, solve_rows};
 use robodyn::algo::*;
 use robodyn::Data;
 
@@ -93,6 +95,32 @@ fn aba_inverts_rnea() {
                 &format!("{name}: aba(rnea(a))"),
                 qdd.as_slice(),
                 a.as_slice(),
+                IDENTITY_TOLERANCE,
+            );
+        }
+    }
+}
+
+/// The tree-sparse solve with M's factors, on rows of every width its column blocks come in
+/// (32, 16, 8, 4, 2 and 1 columns), gives X with M X = B.
+#[test]
+fn factored_solve_on_rows_solves_with_the_mass_matrix() {
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let mut data = Data::new(&model);
+        let (q, _, _) = state(&model, &mut rng);
+        crba(&model, &mut data, q.as_slice()).unwrap();
+        factor_mass_matrix(&model, &mut data).unwrap();
+        for width in [1, 2, 3, 7, 15, 31, 63] {
+            let b = DMatrix::from_fn(model.nv, width, |_, _| rng.random_range(-1.0..1.0));
+            // row i of B, then of X, at i * width
+            let mut rows: Vec<f64> = b.transpose().as_slice().to_vec();
+            solve_rows(&model, &data, &mut rows);
+            let x = DMatrix::from_row_slice(model.nv, width, &rows);
+            assert_close(
+                &format!("{name}, {width} columns: M X"),
+                (&data.mass_matrix * x).as_slice(),
+                b.as_slice(),
                 IDENTITY_TOLERANCE,
             );
         }

@@ -112,82 +112,167 @@ fn solve_rows_generic(model: &Model, data: &Data, rows: &mut [f64]) {
     solve_rows_with(model, data.mass_matrix_factor.as_slice(), rows);
 }
 
-/// [`solve_rows`] with the column-major `factor` of [`factor_into`], in `f64` or lanes. Wide
-/// rows are solved a block of columns at a time, each block's part of the rows small enough to
-/// stay in a core's L2 cache through the three sweeps (each column is solved by the same
-/// operations in the same order either way).
+/// [`solve_rows`] with the column-major `factor` of [`factor_into`], in `f64` or lanes. The
+/// columns are solved a block at a time (256 bytes of each row, the block of one row held in
+/// registers while it is updated or used), so a block's rows stay in the L1 cache through the
+/// sweeps; each column is solved by the same operations in the same order in any block.
 #[inline(always)]
 pub(crate) fn solve_rows_with<S: Real>(model: &Model, factor: &[S], rows: &mut [S]) {
-    const CACHED_BYTES: usize = 128 * 1024;
-    let nv = model.nv.max(1);
-    let width = rows.len() / nv;
-    let block = (CACHED_BYTES / (nv * std::mem::size_of::<S>())).max(8);
-    for start in (0..width).step_by(block) {
-        solve_columns(model, factor, rows, width, start..width.min(start + block));
+    let width = rows.len() / model.nv.max(1);
+    let mut start = 0;
+    if std::mem::size_of::<S>() == 8 {
+        start = solve_blocks::<S, 32>(model, factor, rows, width, start);
+        start = solve_blocks::<S, 16>(model, factor, rows, width, start);
     }
+    if std::mem::size_of::<S>() <= 32 {
+        start = solve_blocks::<S, 8>(model, factor, rows, width, start);
+    }
+    start = solve_blocks::<S, 4>(model, factor, rows, width, start);
+    start = solve_blocks::<S, 2>(model, factor, rows, width, start);
+    solve_blocks::<S, 1>(model, factor, rows, width, start);
 }
 
-/// The sweeps of [`solve_rows_with`] on `columns` of the rows (of `width` values each).
+/// Solves the blocks of `W` columns from column `start` on while whole ones fit in the rows'
+/// `width`; returns the first column left.
 #[inline(always)]
-fn solve_columns<S: Real>(
+fn solve_blocks<S: Real, const W: usize>(
     model: &Model,
     factor: &[S],
     rows: &mut [S],
     width: usize,
-    columns: Range<usize>,
-) {
-    let nv = model.nv;
-    // Lᵀ y = b: k from the leaves, y_k then leaves its share in the rows of its ancestors
-    for k in (0..nv).rev() {
-        let mut ancestor = model.dof_parent[k];
-        while let Some(i) = ancestor {
-            subtract_row(rows, width, &columns, (i, k), factor[k + i * nv]);
-            ancestor = model.dof_parent[i];
-        }
+    mut start: usize,
+) -> usize {
+    while start + W <= width {
+        let block = Block::<W> { width, start };
+        solve_transposed::<S, W>(model, factor, rows, block);
+        solve_lower::<S, W>(model, factor, rows, block);
+        start += W;
     }
-    // D z = y
-    for k in 0..nv {
+    start
+}
+
+/// `W` columns from `start` of rows of `width` values.
+#[derive(Clone, Copy)]
+struct Block<const W: usize> {
+    width: usize,
+    start: usize,
+}
+
+impl<const W: usize> Block<W> {
+    /// The block's part of `row`.
+    #[inline(always)]
+    fn of(self, row: usize) -> Range<usize> {
+        let first = row * self.width + self.start;
+        first..first + W
+    }
+
+    /// The block's part of `row`, as values.
+    #[inline(always)]
+    fn load<S: Real>(self, rows: &[S], row: usize) -> [S; W] {
+        rows[self.of(row)].try_into().expect("a block of W columns")
+    }
+
+    /// z_k = y_k / D_k on the block, D in the diagonal of the column-major `factor`.
+    #[inline(always)]
+    fn scaled<S: Real>(self, rows: &[S], factor: &[S], nv: usize, k: usize) -> [S; W] {
         let inverse_pivot = S::splat(1.0) / factor[k + k * nv];
-        for value in &mut rows[k * width + columns.start..k * width + columns.end] {
-            *value *= inverse_pivot;
-        }
-    }
-    // L x = z: from the root, x_k = z_k − Σ L_ki x_i over k's ancestors i
-    for k in 0..nv {
-        let mut ancestor = model.dof_parent[k];
-        while let Some(i) = ancestor {
-            subtract_row(rows, width, &columns, (k, i), factor[k + i * nv]);
-            ancestor = model.dof_parent[i];
-        }
+        self.load(rows, k).map(|y: S| y * inverse_pivot)
     }
 }
 
-/// Row `target` −= `scale` · row `source` on `columns` (two different rows of `width` values
-/// each).
+/// Lᵀ y = b on a block: k from the leaves, y_k (final once k's descendants are done) then leaves
+/// its share L_ki y_k in the row of each ancestor i. A coordinate and its parent just before it
+/// (the inside of a chain) go together, so each ancestor row is read and written once for both.
 #[inline(always)]
-fn subtract_row<S: Real>(
+fn solve_transposed<S: Real, const W: usize>(
+    model: &Model,
+    factor: &[S],
     rows: &mut [S],
-    width: usize,
-    columns: &Range<usize>,
-    (target, source): (usize, usize),
-    scale: S,
+    block: Block<W>,
 ) {
-    let (start, end) = (columns.start, columns.end);
-    let (target_row, source_row) = if target < source {
-        let (head, tail) = rows.split_at_mut(source * width);
-        (
-            &mut head[target * width + start..target * width + end],
-            &tail[start..end],
-        )
-    } else {
-        let (head, tail) = rows.split_at_mut(target * width);
-        (
-            &mut tail[start..end],
-            &head[source * width + start..source * width + end],
-        )
-    };
-    for (t, s) in target_row.iter_mut().zip(source_row) {
-        *t -= scale * *s;
+    let nv = model.nv;
+    let mut k = nv;
+    while k > 0 {
+        k -= 1;
+        let y_k: [S; W] = block.load(rows, k);
+        let paired = k > 0 && model.dof_parent[k] == Some(k - 1);
+        if !paired {
+            let mut ancestor = model.dof_parent[k];
+            while let Some(i) = ancestor {
+                let l_ki = factor[k + i * nv];
+                for (target, y) in rows[block.of(i)].iter_mut().zip(y_k) {
+                    *target -= l_ki * y;
+                }
+                ancestor = model.dof_parent[i];
+            }
+            continue;
+        }
+        // the parent p = k − 1 is final after k's share
+        let p = k - 1;
+        let l_kp = factor[k + p * nv];
+        let mut y_p: [S; W] = block.load(rows, p);
+        for (y, y_from_k) in y_p.iter_mut().zip(y_k) {
+            *y -= l_kp * y_from_k;
+        }
+        rows[block.of(p)].copy_from_slice(&y_p);
+        let mut ancestor = model.dof_parent[p];
+        while let Some(i) = ancestor {
+            let (l_ki, l_pi) = (factor[k + i * nv], factor[p + i * nv]);
+            for ((target, y_from_k), y_from_p) in rows[block.of(i)].iter_mut().zip(y_k).zip(y_p) {
+                *target = *target - l_ki * y_from_k - l_pi * y_from_p;
+            }
+            ancestor = model.dof_parent[i];
+        }
+        k = p;
+    }
+}
+
+/// D z = y and L x = z on a block, from the root: x_k = z_k / D_k − Σ L_ki x_i over k's
+/// ancestors i. A coordinate and its child just after it go together, each ancestor row read
+/// once for both; the child then takes its parent's share last.
+#[inline(always)]
+fn solve_lower<S: Real, const W: usize>(
+    model: &Model,
+    factor: &[S],
+    rows: &mut [S],
+    block: Block<W>,
+) {
+    let nv = model.nv;
+    let mut k = 0;
+    while k < nv {
+        let mut x_k = block.scaled(rows, factor, nv, k);
+        let paired = k + 1 < nv && model.dof_parent[k + 1] == Some(k);
+        if !paired {
+            let mut ancestor = model.dof_parent[k];
+            while let Some(i) = ancestor {
+                let l_ki = factor[k + i * nv];
+                for (x, x_i) in x_k.iter_mut().zip(&rows[block.of(i)]) {
+                    *x -= l_ki * *x_i;
+                }
+                ancestor = model.dof_parent[i];
+            }
+            rows[block.of(k)].copy_from_slice(&x_k);
+            k += 1;
+            continue;
+        }
+        let c = k + 1;
+        let mut x_c = block.scaled(rows, factor, nv, c);
+        let mut ancestor = model.dof_parent[k];
+        while let Some(i) = ancestor {
+            let (l_ki, l_ci) = (factor[k + i * nv], factor[c + i * nv]);
+            for ((x, y), x_i) in x_k.iter_mut().zip(&mut x_c).zip(&rows[block.of(i)]) {
+                *x -= l_ki * *x_i;
+                *y -= l_ci * *x_i;
+            }
+            ancestor = model.dof_parent[i];
+        }
+        let l_ck = factor[c + k * nv];
+        for (y, x) in x_c.iter_mut().zip(x_k) {
+            *y -= l_ck * x;
+        }
+        rows[block.of(k)].copy_from_slice(&x_k);
+        rows[block.of(c)].copy_from_slice(&x_c);
+        k += 2;
     }
 }
 
