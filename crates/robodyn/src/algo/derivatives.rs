@@ -109,17 +109,90 @@ fn rnea_derivative_passes(
     let mut b = DerivativeBuffers::of(data);
     // one state: the passes as separate functions (inlined into one, as the lanes need, the f64
     // code ran about 2 % more instructions)
-    one_state(|| velocity_terms(model, &mut b, q, v, f_ext));
-    one_state(|| acceleration_terms(model, &mut b, Some(a)));
-    one_state(|| derivative_products::<_, true>(model, &mut b, v, out));
-    add_rotor_torques(model, &mut b, v, Some(a));
+    let (b, a) = (&mut b, Some(a));
+    one_state(VelocityTerms {
+        model,
+        b,
+        q,
+        v,
+        f_ext,
+    });
+    one_state(AccelerationTerms { model, b, a });
+    one_state(DerivativeProducts::<_, true> { model, b, v, out });
+    add_rotor_torques(model, b, v, a);
     Ok(())
 }
 
-/// Runs `pass` as a function of its own.
+/// Runs `pass` as a function of its own, compiled for AVX2 and FMA where the processor has them
+/// (the same operations in the same order, so the same result bit for bit: no product is fused).
 #[inline(never)]
-fn one_state(pass: impl FnOnce()) {
-    pass()
+fn one_state(pass: impl OneStatePass) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the processor has AVX2 and FMA, just checked.
+        return unsafe { one_state_avx2(pass) };
+    }
+    pass.run()
+}
+
+/// [`one_state`]'s pass compiled for AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn one_state_avx2(pass: impl OneStatePass) {
+    pass.run()
+}
+
+/// A pass of the one-state derivatives with its arguments; `run` is inlined into [`one_state`]'s
+/// builds (a closure would not be, and would keep the baseline instruction set).
+trait OneStatePass {
+    fn run(self);
+}
+
+/// [`velocity_terms`] of one state.
+struct VelocityTerms<'p, 'b> {
+    model: &'p Model,
+    b: &'p mut DerivativeBuffers<'b, f64>,
+    q: &'p [f64],
+    v: &'p [f64],
+    f_ext: Option<&'p [Force]>,
+}
+
+impl OneStatePass for VelocityTerms<'_, '_> {
+    #[inline(always)]
+    fn run(self) {
+        velocity_terms(self.model, self.b, self.q, self.v, self.f_ext)
+    }
+}
+
+/// [`acceleration_terms`] of one state.
+struct AccelerationTerms<'p, 'b> {
+    model: &'p Model,
+    b: &'p mut DerivativeBuffers<'b, f64>,
+    a: Option<&'p [f64]>,
+}
+
+impl OneStatePass for AccelerationTerms<'_, '_> {
+    #[inline(always)]
+    fn run(self) {
+        acceleration_terms(self.model, self.b, self.a)
+    }
+}
+
+/// [`derivative_products`] of one state.
+struct DerivativeProducts<'p, 'b, T, const MASS_MATRIX: bool> {
+    model: &'p Model,
+    b: &'p mut DerivativeBuffers<'b, f64>,
+    v: &'p [f64],
+    out: &'p mut T,
+}
+
+impl<T: TorqueDerivatives<f64>, const MASS_MATRIX: bool> OneStatePass
+    for DerivativeProducts<'_, '_, T, MASS_MATRIX>
+{
+    #[inline(always)]
+    fn run(self) {
+        derivative_products::<_, MASS_MATRIX>(self.model, self.b, self.v, self.out)
+    }
 }
 
 /// [`rnea_derivatives`] of one state into `out`: ∂τ/∂q, ∂τ/∂q̇ and M, each nv × nv row-major,
@@ -234,10 +307,17 @@ pub fn aba_derivative_rows(
 ) -> Result<()> {
     check_arguments(model, q, v, ("tau", tau), f_ext)?;
     let mut buffers = DerivativeBuffers::of(data);
-    one_state(|| velocity_terms(model, &mut buffers, q, v, f_ext));
+    let b = &mut buffers;
+    one_state(VelocityTerms {
+        model,
+        b,
+        q,
+        v,
+        f_ext,
+    });
 
     // q̈ = M⁻¹ (τ − b), b = ID(q, q̇, 0)
-    one_state(|| acceleration_terms(model, &mut buffers, None));
+    one_state(AccelerationTerms { model, b, a: None });
     joint_torques(model, &mut buffers);
     add_rotor_torques(model, &mut buffers, v, None);
     let mut mass_matrix = std::mem::take(&mut data.mass_matrix);
@@ -259,8 +339,9 @@ pub fn aba_derivative_rows(
         nv,
     };
     let mut buffers = DerivativeBuffers::of(data);
-    one_state(|| acceleration_terms(model, &mut buffers, Some(qdd.as_slice())));
-    one_state(|| derivative_products::<_, false>(model, &mut buffers, v, &mut negated));
+    let (b, a, out) = (&mut buffers, Some(qdd.as_slice()), &mut negated);
+    one_state(AccelerationTerms { model, b, a });
+    one_state(DerivativeProducts::<_, false> { model, b, v, out });
     add_rotor_torques(model, &mut buffers, v, Some(qdd.as_slice()));
     data.qdd = qdd;
     add_identity(&mut rows, nv);
