@@ -211,7 +211,11 @@ impl<S: Real> CoriolisFactor<S> {
         let (w, u, h) = (&v.angular, &v.linear, &inertia.first_moment);
         // ω×Ī column by column, C; ω×Ī − Īω× = C + Cᵀ
         let i = &inertia.rotational;
-        let columns = [0, 1, 2].map(|c| cross(w, &Vector3::new(i[(0, c)], i[(1, c)], i[(2, c)])));
+        let columns = [
+            cross(w, &Vector3::new(i[(0, 0)], i[(1, 0)], i[(2, 0)])),
+            cross(w, &Vector3::new(i[(0, 1)], i[(1, 1)], i[(2, 1)])),
+            cross(w, &Vector3::new(i[(0, 2)], i[(1, 2)], i[(2, 2)])),
+        ];
         let diagonal = S::splat(2.0) * (u.x * h.x + u.y * h.y + u.z * h.z);
         // symmetric: the upper triangle, mirrored
         let mut rotational = *i;
