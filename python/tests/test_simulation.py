@@ -233,6 +233,37 @@ def test_batched_rollouts_match_single_runs():
             assert run.steps == single.steps == 300
 
 
+@pytest.mark.parametrize("integrator", ["euler", "semi_implicit_euler", "rk4", "rk45"])
+def test_rollouts_in_lockstep_equal_single_runs_bit_for_bit(integrator):
+    # native controllers without wrenches: the rollouts of a batch advance in lockstep, their
+    # forward dynamics in lanes; 11 rollouts make full lane groups and leftovers on each thread
+    m = robodyn.load("ur5")
+    m.damping = [0.01] * m.nv
+    n = 11
+    q0 = m.random_configuration(n=n, seed=4)
+    v0 = np.linspace(-1, 1, n * m.nv).reshape(n, m.nv)
+    inertia = np.diag(m.mass_matrix(m.neutral()))
+    controller = robodyn.PD(100 * inertia, 20 * inertia, q_ref=m.neutral(), gravity_compensation=True)
+    # 120 steps: the guard's step-doubling checks at steps 1, 50 and 100 run too
+    options = dict(t_end=0.024, dt=2e-4, integrator=integrator, controller=controller)
+    runs = robodyn.simulate(m, q0, v0, **options)
+    for k, run in enumerate(runs):
+        single = robodyn.simulate(m, q0[k], v0[k], **options)
+        for field in ("t", "q", "v", "a", "tau", "tau_passive"):
+            np.testing.assert_array_equal(getattr(run, field), getattr(single, field), err_msg=field)
+        assert (run.steps, run.evaluations) == (single.steps, single.evaluations)
+
+
+def test_a_diverging_rollout_in_lockstep_is_named():
+    m = robodyn.load("ur5")
+    m.gravity = [0.0, 0.0, 0.0]
+    q0 = np.stack([m.neutral()] * 5)
+    q0[3, 1] = 1.0  # only rollout 3 moves (the others rest exactly), under far too stiff a PD
+    controller = robodyn.PD([1e7] * m.nv, [0.0] * m.nv, q_ref=m.neutral())
+    with pytest.raises(robodyn.SimulationError, match="rollout 3: .*dt = 5e-2 s is far too large"):
+        robodyn.simulate(m, q0, np.zeros((5, m.nv)), t_end=1.0, dt=0.05, controller=controller)
+
+
 def test_files_plots_and_animation(tmp_path):
     from PIL import Image
 

@@ -11,8 +11,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 use robodyn::integrate::{
-    simulate as run, ControlLaw, Controller, DesiredMotion, ExternalWrenches, Integrator,
-    LimitModel, NativeController, PassiveForces, SimulationOptions, StepWorkspace, Trajectory,
+    simulate as run, simulate_lockstep, ControlLaw, Controller, DesiredMotion, ExternalWrenches,
+    Integrator, LimitModel, NativeController, PassiveForces, SimulationOptions, StepWorkspace,
+    Trajectory,
 };
 use robodyn::spatial::Force;
 use robodyn::{Error, Model};
@@ -307,6 +308,26 @@ pub fn simulate<'py>(
         )
     };
     let runs: Vec<Trajectory> = match (&native, python_wrenches) {
+        (Some(native), None)
+            if progress.is_none() && constant_wrenches.is_none() && rollouts > 1 =>
+        {
+            // all native and no wrenches: release the GIL, a group of rollouts per thread in
+            // lockstep (their forward dynamics in lanes)
+            let group = rollouts.div_ceil(rayon::current_num_threads()).max(1);
+            let firsts: Vec<usize> = (0..rollouts).step_by(group).collect();
+            let result: robodyn::Result<Vec<Vec<Trajectory>>> = py.detach(|| {
+                firsts
+                    .into_par_iter()
+                    .map(|first| {
+                        let starts: Vec<_> =
+                            (first..rollouts.min(first + group)).map(state).collect();
+                        simulate_lockstep(m, &starts, &options, native)
+                            .map_err(|(r, e)| batch_error(batch, first + r, e))
+                    })
+                    .collect()
+            });
+            result.map_err(to_py_err)?.into_iter().flatten().collect()
+        }
         (Some(native), None) if progress.is_none() => {
             // all native: release the GIL, rollouts in parallel
             let result: robodyn::Result<Vec<Trajectory>> = py.detach(|| {

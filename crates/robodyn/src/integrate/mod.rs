@@ -29,5 +29,5 @@ pub mod step;
 pub use control::{ControlLaw, Controller, DesiredMotion, ExternalWrenches, NativeController};
 pub use forces::{LimitModel, PassiveForces};
 pub use schemes::Integrator;
-pub use simulator::{simulate, SimulationOptions, Statistics, Trajectory};
+pub use simulator::{simulate, simulate_lockstep, SimulationOptions, Statistics, Trajectory};
 pub use step::StepWorkspace;

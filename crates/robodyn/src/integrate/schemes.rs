@@ -229,26 +229,65 @@ impl Stepper {
     where
         F: FnMut(f64, &[f64], &[f64], &mut [f64]) -> Result<()>,
     {
+        self.first_stage(start);
+        for s in 1..tableau.a.len() {
+            let t = self.stage_state(model, tableau, start, h, s)?;
+            let (q, v, a) = self.stage_evaluation(s);
+            acceleration(t, q, v, a)?;
+            self.stage_rate(model, s);
+        }
+        self.step_result(model, tableau, start, h)
+    }
+
+    /// Stage 1 of a Runge–Kutta step from `start`: ξ = 0, so Ξ₁ = v₀ and A₁ = a₀.
+    pub fn first_stage(&mut self, start: &State) {
         let nv = self.nv;
-        // stage 1: ξ = 0, so Ξ₁ = v₀ and A₁ = a₀
         self.tangent_rates[..nv].copy_from_slice(&start.v);
         self.accelerations[..nv].copy_from_slice(&start.a);
-        for (s, weights) in tableau.a.iter().enumerate().skip(1) {
-            // ξ_s = h Σ a_sj Ξ_j;  v_s = v₀ + h Σ a_sj A_j;  q_s = q₀ ⊕ ξ_s
-            self.weighted_sums(weights, h, &start.v);
-            model.integrate(&start.q, &self.xi, &mut self.stage_q)?;
-            let t = start.t + tableau.c[s] * h;
-            let a_s = &mut self.accelerations[s * nv..(s + 1) * nv];
-            acceleration(t, &self.stage_q, &self.stage_v, a_s)?;
-            // Ξ_s = dexp⁻¹_{-ξ_s}(v_s)
-            tangent_rate(
-                model,
-                &self.xi,
-                &self.stage_v,
-                &mut self.tangent_rates[s * nv..(s + 1) * nv],
-            );
-        }
-        // ξ₁ = h Σ b_s Ξ_s;  v₁ = v₀ + h Σ b_s A_s;  q₁ = q₀ ⊕ ξ₁
+    }
+
+    /// The state of stage `s` ≥ 1 (in [`Self::stage_evaluation`]) and its time:
+    /// ξ_s = h Σ a_sj Ξ_j, v_s = v₀ + h Σ a_sj A_j, q_s = q₀ ⊕ ξ_s.
+    pub fn stage_state(
+        &mut self,
+        model: &Model,
+        tableau: &Tableau,
+        start: &State,
+        h: f64,
+        s: usize,
+    ) -> Result<f64> {
+        self.weighted_sums(tableau.a[s], h, &start.v);
+        model.integrate(&start.q, &self.xi, &mut self.stage_q)?;
+        Ok(start.t + tableau.c[s] * h)
+    }
+
+    /// Stage `s`'s q_s and v_s, and where its acceleration A_s goes.
+    pub fn stage_evaluation(&mut self, s: usize) -> (&[f64], &[f64], &mut [f64]) {
+        let nv = self.nv;
+        let a_s = &mut self.accelerations[s * nv..(s + 1) * nv];
+        (&self.stage_q, &self.stage_v, a_s)
+    }
+
+    /// Ξ_s = dexp⁻¹_{-ξ_s}(v_s), once A_s is in.
+    pub fn stage_rate(&mut self, model: &Model, s: usize) {
+        let nv = self.nv;
+        tangent_rate(
+            model,
+            &self.xi,
+            &self.stage_v,
+            &mut self.tangent_rates[s * nv..(s + 1) * nv],
+        );
+    }
+
+    /// The step's result once every stage is in: ξ₁ = h Σ b_s Ξ_s, v₁ = v₀ + h Σ b_s A_s,
+    /// q₁ = q₀ ⊕ ξ₁.
+    pub fn step_result(
+        &mut self,
+        model: &Model,
+        tableau: &Tableau,
+        start: &State,
+        h: f64,
+    ) -> Result<()> {
         self.weighted_sums(tableau.b, h, &start.v);
         self.xi_end.copy_from_slice(&self.xi);
         self.v_end.copy_from_slice(&self.stage_v);

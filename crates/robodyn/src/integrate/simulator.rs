@@ -18,8 +18,10 @@ use crate::Data;
 use guard::{fixed_step, EnergyAccount, STEP_CHECK_INTERVAL};
 
 mod guard;
+mod lockstep;
 
 pub use guard::{ENERGY_GROWTH_BOUND, SPEED_BOUND};
+pub use lockstep::{simulate_lockstep, RolloutError};
 
 /// The most samples one simulation records, so that a tiny `dt` fails clearly instead of
 /// exhausting memory.
@@ -165,6 +167,17 @@ struct Dynamics<'a> {
 impl Dynamics<'_> {
     /// q̈ = ABA(q, v, τ_control + τ_passive, f_ext) into `a`; τ and τ_passive stay in `self`.
     fn acceleration(&mut self, t: f64, q: &[f64], v: &[f64], a: &mut [f64]) -> Result<()> {
+        self.torques(t, q, v)?;
+        let f_ext = self.wrenches.is_some().then_some(&self.forces[..]);
+        let qdd = aba(self.model, &mut self.data, q, v, &self.tau_total, f_ext)
+            .map_err(|e| at_time(t, e))?;
+        a.copy_from_slice(qdd.as_slice());
+        Ok(())
+    }
+
+    /// What acts at (t, q, v), the start of an evaluation of q̈: τ (the controller's) and
+    /// τ_passive, their sum in `tau_total`, and the wrenches in `forces`.
+    fn torques(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<()> {
         self.evaluations += 1;
         let model = self.model;
         self.controller.torque(model, t, q, v, &mut self.tau)?;
@@ -177,20 +190,12 @@ impl Dynamics<'_> {
         {
             *total = control + passive;
         }
-        let f_ext = match self.wrenches.as_mut() {
-            Some(wrenches) => {
-                wrenches.wrenches(t, q, v, &mut self.forces)?;
-                for force in &self.forces {
-                    check_vector("external wrench", &force.to_array(), 6)
-                        .map_err(|e| at_time(t, e))?;
-                }
-                Some(&self.forces[..])
+        if let Some(wrenches) = self.wrenches.as_mut() {
+            wrenches.wrenches(t, q, v, &mut self.forces)?;
+            for force in &self.forces {
+                check_vector("external wrench", &force.to_array(), 6).map_err(|e| at_time(t, e))?;
             }
-            None => None,
-        };
-        let qdd =
-            aba(model, &mut self.data, q, v, &self.tau_total, f_ext).map_err(|e| at_time(t, e))?;
-        a.copy_from_slice(qdd.as_slice());
+        }
         Ok(())
     }
 
@@ -204,6 +209,18 @@ impl Dynamics<'_> {
         a: &mut [f64],
     ) -> Result<()> {
         self.acceleration(t, q, v, a)?;
+        self.keep(trajectory, t, q, v, a)
+    }
+
+    /// Checks the sample whose q̈ and torques were just evaluated and adds it to `trajectory`.
+    fn keep(
+        &mut self,
+        trajectory: &mut Trajectory,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+    ) -> Result<()> {
         self.check_sample(t, q, v, a)?;
         trajectory.t.push(t);
         trajectory.q.extend_from_slice(q);
@@ -230,69 +247,33 @@ pub fn simulate<'a>(
     wrenches: Option<&'a mut dyn ExternalWrenches>,
     progress: Option<Progress<'a>>,
 ) -> Result<Trajectory> {
-    let samples = options.check()?;
-    model
-        .check_configuration(q0)
-        .map_err(|e| e.for_argument("q0"))?;
-    check_vector("v0", v0, model.nv)?;
-    let mut simulation = Simulation {
-        model,
-        options,
-        samples,
-        dynamics: Dynamics {
-            model,
-            passive: options.passive,
-            controller,
-            wrenches,
-            data: Data::new(model),
-            forces: vec![Force::ZERO; model.nbodies() - 1],
-            tau: vec![0.0; model.nv],
-            tau_passive: vec![0.0; model.nv],
-            tau_total: vec![0.0; model.nv],
-            evaluations: 0,
-            energy: EnergyAccount::new(model),
-        },
-        stepper: Stepper::new(model),
-        check_stepper: Stepper::new(model),
-        state: State::new(model),
-        sample: State::new(model),
-        middle: State::new(model),
-        delta: vec![0.0; model.nv],
-        trajectory: Trajectory::with_capacity(samples, model)?,
-        progress,
-        statistics: Statistics::default(),
-    };
-    simulation.state.q.copy_from_slice(q0);
-    simulation.state.v.copy_from_slice(v0);
-    let start = &mut simulation.state;
-    simulation.dynamics.record(
-        &mut simulation.trajectory,
-        0.0,
-        &start.q,
-        &start.v,
-        &mut start.a,
-    )?;
+    let mut simulation = Simulation::start(model, (q0, v0), options, controller, wrenches)?;
+    simulation.progress = progress;
     simulation.report(0)?;
     match options.integrator {
-        Integrator::Rk45 { rtol, atol } => {
-            simulation
-                .adaptive((rtol, atol))
-                .map_err(|error| match error {
-                    Error::Diverged { time, message } => Error::Diverged {
-                        time,
-                        message: format!(
-                        "{message}; if the motion should stay bounded, tighter rtol and atol or \
-                             a smaller max_step may keep it so"
-                    ),
-                    },
-                    other => other,
-                })?
-        }
+        Integrator::Rk45 { .. } => simulate_adaptive(&mut simulation)?,
         _ => simulation.fixed_step()?,
     }
-    simulation.statistics.evaluations = simulation.dynamics.evaluations;
-    simulation.trajectory.statistics = simulation.statistics;
-    Ok(simulation.trajectory)
+    Ok(simulation.finish())
+}
+
+/// The steps of an RK45 simulation, a divergence's message saying what may keep it bounded.
+fn simulate_adaptive(simulation: &mut Simulation) -> Result<()> {
+    let Integrator::Rk45 { rtol, atol } = simulation.options.integrator else {
+        return simulation.fixed_step();
+    };
+    simulation
+        .adaptive((rtol, atol))
+        .map_err(|error| match error {
+            Error::Diverged { time, message } => Error::Diverged {
+                time,
+                message: format!(
+                    "{message}; if the motion should stay bounded, tighter rtol and atol or a \
+                     smaller max_step may keep it so"
+                ),
+            },
+            other => other,
+        })
 }
 
 /// Everything one simulation works with.
@@ -316,7 +297,67 @@ struct Simulation<'a> {
     statistics: Statistics,
 }
 
-impl Simulation<'_> {
+impl<'a> Simulation<'a> {
+    /// A simulation of `model` from (q₀, v₀) at t = 0, its first sample recorded.
+    fn start(
+        model: &'a Model,
+        (q0, v0): (&[f64], &[f64]),
+        options: &'a SimulationOptions,
+        controller: &'a mut dyn Controller,
+        wrenches: Option<&'a mut dyn ExternalWrenches>,
+    ) -> Result<Self> {
+        let samples = options.check()?;
+        model
+            .check_configuration(q0)
+            .map_err(|e| e.for_argument("q0"))?;
+        check_vector("v0", v0, model.nv)?;
+        let mut simulation = Simulation {
+            model,
+            options,
+            samples,
+            dynamics: Dynamics {
+                model,
+                passive: options.passive,
+                controller,
+                wrenches,
+                data: Data::new(model),
+                forces: vec![Force::ZERO; model.nbodies() - 1],
+                tau: vec![0.0; model.nv],
+                tau_passive: vec![0.0; model.nv],
+                tau_total: vec![0.0; model.nv],
+                evaluations: 0,
+                energy: EnergyAccount::new(model),
+            },
+            stepper: Stepper::new(model),
+            check_stepper: Stepper::new(model),
+            state: State::new(model),
+            sample: State::new(model),
+            middle: State::new(model),
+            delta: vec![0.0; model.nv],
+            trajectory: Trajectory::with_capacity(samples, model)?,
+            progress: None,
+            statistics: Statistics::default(),
+        };
+        simulation.state.q.copy_from_slice(q0);
+        simulation.state.v.copy_from_slice(v0);
+        let start = &mut simulation.state;
+        simulation.dynamics.record(
+            &mut simulation.trajectory,
+            0.0,
+            &start.q,
+            &start.v,
+            &mut start.a,
+        )?;
+        Ok(simulation)
+    }
+
+    /// The recorded trajectory with its statistics.
+    fn finish(mut self) -> Trajectory {
+        self.statistics.evaluations = self.dynamics.evaluations;
+        self.trajectory.statistics = self.statistics;
+        self.trajectory
+    }
+
     /// Calls the progress callback after sample `k` about a hundred times per run.
     fn report(&mut self, k: usize) -> Result<()> {
         let stride = (self.samples / 100).max(1);
