@@ -3,7 +3,8 @@ a 10 000-state batch against a Python loop, a 10 s UR5 rollout (RK4, PD) against
 rollouts of 1 s against mujoco.rollout, printed as ratios (< 1 means robodyn is faster).
 
 Run: .venv/bin/python benchmarks/compare.py [--batch 10000] [--robots ur5 panda talos]
-Needs the bench extras (pip install '.[bench]'). Times are the best of several repeats.
+Needs the bench extras (pip install '.[bench]'). Times are the best of several repeats; a batch
+round repeats the batch for at least BATCH_ROUND_S (a Python loop takes that long once).
 
 MuJoCo loads the same URDFs (visual and collision elements removed) with a fixed base, so its
 table uses fixed-base robodyn models. MuJoCo has no separate RNEA/CRBA entry points that start
@@ -41,6 +42,23 @@ def best_times(ours, theirs, number: int, repeat: int = 7) -> tuple[float, float
         best_ours = min(best_ours, timeit.timeit(ours, number=number))
         best_theirs = min(best_theirs, timeit.timeit(theirs, number=number))
     return best_ours / number, best_theirs / number
+
+
+#: A batch round lasts at least this long (s): a batch of a few milliseconds timed once is
+#: mostly the machine's noise (a sleeping core waking, the first touch of the result).
+BATCH_ROUND_S = 0.02
+
+
+def batch_times(ours, theirs, repeat: int = 5) -> tuple[float, float]:
+    """Best per-call times in seconds of a batch and of the loop it replaces: each side calls
+    itself enough times per round for `BATCH_ROUND_S` (the loops take that long once), the rounds
+    interleaved as in `best_times`."""
+    numbers = [max(1, round(BATCH_ROUND_S / timeit.timeit(f, number=1))) for f in (ours, theirs)]
+    best = [float("inf"), float("inf")]
+    for _ in range(repeat):
+        for k, f in enumerate((ours, theirs)):
+            best[k] = min(best[k], timeit.timeit(f, number=numbers[k]) / numbers[k])
+    return best[0], best[1]
 
 
 def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
@@ -113,7 +131,7 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
         "rnea_derivatives": (lambda: m.inverse_dynamics_derivatives(states, velocities, velocities), pin_rnea_derivatives_loop),
         "aba_derivatives": (lambda: m.forward_dynamics_derivatives(states, velocities, velocities), pin_aba_derivatives_loop),
     }
-    rows += [(f"{name} {algorithm} ({batch} states)", *best_times(ours, theirs, 1, 5)) for algorithm, (ours, theirs) in batches.items()]
+    rows += [(f"{name} {algorithm} ({batch} states)", *batch_times(ours, theirs)) for algorithm, (ours, theirs) in batches.items()]
     return rows
 
 
@@ -175,8 +193,8 @@ def compare_mujoco(name: str, batch: int) -> list[tuple[str, float, float]]:
             d.qpos[:] = x
             mj_crba()
 
-    rows.append((f"{name} gravity ({batch} states)", *best_times(lambda: m.generalized_gravity(states), mj_gravity_loop, 1, 5)))
-    rows.append((f"{name} crba ({batch} states)", *best_times(lambda: m.mass_matrix(states), mj_crba_loop, 1, 5)))
+    rows.append((f"{name} gravity ({batch} states)", *batch_times(lambda: m.generalized_gravity(states), mj_gravity_loop)))
+    rows.append((f"{name} crba ({batch} states)", *batch_times(lambda: m.mass_matrix(states), mj_crba_loop)))
     return rows
 
 
