@@ -274,19 +274,13 @@ fn invert_leading_block<S: Real>(m: &mut Matrix6<S>, n: usize) -> S::SimdBool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::bundled_model;
+    use crate::io::bundled::floating_ur5_state;
 
     /// A single call, built for AVX2 and FMA where the processor has them, equals the baseline
     /// build of the same passes bit for bit (the claim of `one_state_passes`).
     #[test]
     fn the_dispatched_passes_equal_the_baseline_build_bit_for_bit() {
-        let mut model = bundled_model("ur5", true).unwrap();
-        model.armature.fill(0.1);
-        let mut q: Vec<f64> = (0..model.nq).map(|k| 0.3 + 0.1 * k as f64).collect();
-        let norm = q[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
-        q[3..7].iter_mut().for_each(|x| *x /= norm);
-        let v: Vec<f64> = (0..model.nv).map(|k| 0.2 * k as f64 - 0.5).collect();
-        let tau: Vec<f64> = (0..model.nv).map(|k| 1.5 - 0.3 * k as f64).collect();
+        let (model, q, v, tau) = floating_ur5_state();
         let mut dispatched = Data::new(&model);
         aba(&model, &mut dispatched, &q, &v, &tau, None).unwrap();
         let mut data = Data::new(&model);

@@ -687,20 +687,14 @@ fn add_rotor_torques<S: Real>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::bundled_model;
+    use crate::io::bundled::floating_ur5_state;
 
     /// A single call's passes, built for AVX2 and FMA where the processor has them, equal the
     /// baseline build of the same passes bit for bit (the claim of `one_state`).
     #[test]
     fn the_dispatched_passes_equal_the_baseline_build_bit_for_bit() {
-        let mut model = bundled_model("ur5", true).unwrap();
-        model.armature.fill(0.1);
+        let (model, q, v, a) = floating_ur5_state();
         let nv = model.nv;
-        let mut q: Vec<f64> = (0..model.nq).map(|k| 0.3 + 0.1 * k as f64).collect();
-        let norm = q[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
-        q[3..7].iter_mut().for_each(|x| *x /= norm);
-        let v: Vec<f64> = (0..nv).map(|k| 0.2 * k as f64 - 0.5).collect();
-        let a: Vec<f64> = (0..nv).map(|k| 1.5 - 0.3 * k as f64).collect();
         let mut dispatched = vec![vec![0.0; nv * nv]; 2];
         let mut data = Data::new(&model);
         let [by_q, by_v] = &mut dispatched[..] else {

@@ -280,19 +280,14 @@ fn solve_lower<S: Real, const W: usize>(
 mod tests {
     use super::*;
     use crate::algo::crba::crba;
-    use crate::io::bundled_model;
+    use crate::io::bundled::floating_ur5_state;
 
     /// The AVX-512 and AVX2 builds of the solve and the baseline one give the same result bit for bit (the
     /// claim of `solve_rows`), for row widths that do and do not fill whole vectors.
     #[test]
     fn solve_paths_agree_bit_for_bit() {
-        // floating (a six-coordinate joint in the chain); armature makes its massless base regular
-        let mut model = bundled_model("ur5", true).unwrap();
-        model.armature.fill(0.1);
+        let (model, q, ..) = floating_ur5_state();
         let mut data = Data::new(&model);
-        let mut q: Vec<f64> = (0..model.nq).map(|k| 0.3 + 0.1 * k as f64).collect();
-        let norm = q[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
-        q[3..7].iter_mut().for_each(|x| *x /= norm);
         crba(&model, &mut data, &q).unwrap();
         factor_mass_matrix(&model, &mut data).unwrap();
         for width in [1, 3, 4, 7, 3 * model.nv + 1] {

@@ -57,3 +57,18 @@ pub fn bundled_model(name: &str, floating_base: bool) -> Result<Model> {
     model.gravity = Vec3::from(gravity);
     Ok(model)
 }
+
+/// For the unit tests: the bundled UR5 on a floating base (a six-coordinate joint in the chain)
+/// with armature (which makes its massless base regular), a configuration whose quaternion is a
+/// unit one, and two nv vectors (a velocity, and an acceleration or torque).
+#[cfg(test)]
+pub(crate) fn floating_ur5_state() -> (Model, Vec<f64>, Vec<f64>, Vec<f64>) {
+    let mut model = bundled_model("ur5", true).expect("the bundled UR5 loads");
+    model.armature.fill(0.1);
+    let mut q: Vec<f64> = (0..model.nq).map(|k| 0.3 + 0.1 * k as f64).collect();
+    let norm = q[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
+    q[3..7].iter_mut().for_each(|x| *x /= norm);
+    let v = (0..model.nv).map(|k| 0.2 * k as f64 - 0.5).collect();
+    let x = (0..model.nv).map(|k| 1.5 - 0.3 * k as f64).collect();
+    (model, q, v, x)
+}
