@@ -34,19 +34,7 @@ pub fn aba<'d>(
     if let Some(forces) = f_ext {
         check_external_forces(model, forces)?;
     }
-    let buffers = AbaBuffers {
-        x_up: &mut data.x_up,
-        v: &mut data.v,
-        c: &mut data.c,
-        a: &mut data.a,
-        i_a: &mut data.i_a,
-        p_a: &mut data.p_a,
-        u: &mut data.u,
-        u_tau: &mut data.u_tau,
-        d_inv: &mut data.d_inv,
-        qdd: data.qdd.as_mut_slice(),
-    };
-    one_state_passes(model, (q, v, tau, f_ext), buffers)
+    one_state_passes(model, (q, v, tau, f_ext), AbaBuffers::of(data))
         .map_err(|joint| singular_joint(model, joint))?;
     Ok(&data.qdd)
 }
@@ -103,6 +91,24 @@ pub(crate) struct AbaBuffers<'b, S> {
     pub u_tau: &'b mut [[S; 6]],
     pub d_inv: &'b mut [Matrix6<S>],
     pub qdd: &'b mut [S],
+}
+
+impl<'b> AbaBuffers<'b, f64> {
+    /// `data`'s fields.
+    fn of(data: &'b mut Data) -> Self {
+        AbaBuffers {
+            x_up: &mut data.x_up,
+            v: &mut data.v,
+            c: &mut data.c,
+            a: &mut data.a,
+            i_a: &mut data.i_a,
+            p_a: &mut data.p_a,
+            u: &mut data.u,
+            u_tau: &mut data.u_tau,
+            d_inv: &mut data.d_inv,
+            qdd: data.qdd.as_mut_slice(),
+        }
+    }
 }
 
 /// The three passes of Table 7.1 on checked inputs, in `f64` or in lanes (the same operations
@@ -284,19 +290,7 @@ mod tests {
         let mut dispatched = Data::new(&model);
         aba(&model, &mut dispatched, &q, &v, &tau, None).unwrap();
         let mut data = Data::new(&model);
-        let buffers = AbaBuffers {
-            x_up: &mut data.x_up,
-            v: &mut data.v,
-            c: &mut data.c,
-            a: &mut data.a,
-            i_a: &mut data.i_a,
-            p_a: &mut data.p_a,
-            u: &mut data.u,
-            u_tau: &mut data.u_tau,
-            d_inv: &mut data.d_inv,
-            qdd: data.qdd.as_mut_slice(),
-        };
-        articulated_body_passes(&model, &q, &v, &tau, None, buffers).unwrap();
+        articulated_body_passes(&model, &q, &v, &tau, None, AbaBuffers::of(&mut data)).unwrap();
         assert_eq!(dispatched.qdd, data.qdd);
     }
 }

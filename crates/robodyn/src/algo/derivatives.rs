@@ -45,7 +45,13 @@ use crate::spatial::{
     splat_vector, zero_vector, CoriolisFactor, Force, Inertia, Motion, Real, Transform,
 };
 use crate::Data;
-use nalgebra::DMatrix;
+use destinations::{Matrices, NegatedRows};
+use one_state::{one_state, AccelerationTerms, DerivativeProducts, VelocityTerms};
+
+mod destinations;
+mod one_state;
+
+pub(crate) use destinations::{RowMajor, TorqueDerivatives};
 
 /// ∂τ/∂q, ∂τ/∂q̇ and ∂τ/∂q̈ = M of τ = ID(q, q̇, q̈, f_ext), with τ itself: written into
 /// `data.dtau_dq`, `data.dtau_dv`, `data.mass_matrix` and `data.tau`. `f_ext` as in `rnea` (one
@@ -121,78 +127,6 @@ fn rnea_derivative_passes(
     one_state(DerivativeProducts::<_, true> { model, b, v, out });
     add_rotor_torques(model, b, v, a);
     Ok(())
-}
-
-/// Runs `pass` as a function of its own, compiled for AVX2 and FMA where the processor has them
-/// (the same operations in the same order, so the same result bit for bit: no product is fused).
-#[inline(never)]
-fn one_state(pass: impl OneStatePass) {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-        // SAFETY: the processor has AVX2 and FMA, just checked.
-        return unsafe { one_state_avx2(pass) };
-    }
-    pass.run()
-}
-
-/// [`one_state`]'s pass compiled for AVX2 and FMA.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn one_state_avx2(pass: impl OneStatePass) {
-    pass.run()
-}
-
-/// A pass of the one-state derivatives with its arguments; `run` is inlined into [`one_state`]'s
-/// builds (a closure would not be, and would keep the baseline instruction set).
-trait OneStatePass {
-    fn run(self);
-}
-
-/// [`velocity_terms`] of one state.
-struct VelocityTerms<'p, 'b> {
-    model: &'p Model,
-    b: &'p mut DerivativeBuffers<'b, f64>,
-    q: &'p [f64],
-    v: &'p [f64],
-    f_ext: Option<&'p [Force]>,
-}
-
-impl OneStatePass for VelocityTerms<'_, '_> {
-    #[inline(always)]
-    fn run(self) {
-        velocity_terms(self.model, self.b, self.q, self.v, self.f_ext)
-    }
-}
-
-/// [`acceleration_terms`] of one state.
-struct AccelerationTerms<'p, 'b> {
-    model: &'p Model,
-    b: &'p mut DerivativeBuffers<'b, f64>,
-    a: Option<&'p [f64]>,
-}
-
-impl OneStatePass for AccelerationTerms<'_, '_> {
-    #[inline(always)]
-    fn run(self) {
-        acceleration_terms(self.model, self.b, self.a)
-    }
-}
-
-/// [`derivative_products`] of one state.
-struct DerivativeProducts<'p, 'b, T, const MASS_MATRIX: bool> {
-    model: &'p Model,
-    b: &'p mut DerivativeBuffers<'b, f64>,
-    v: &'p [f64],
-    out: &'p mut T,
-}
-
-impl<T: TorqueDerivatives<f64>, const MASS_MATRIX: bool> OneStatePass
-    for DerivativeProducts<'_, '_, T, MASS_MATRIX>
-{
-    #[inline(always)]
-    fn run(self) {
-        derivative_products::<_, MASS_MATRIX>(self.model, self.b, self.v, self.out)
-    }
 }
 
 /// [`rnea_derivatives`] of one state into `out`: ∂τ/∂q, ∂τ/∂q̇ and M, each nv × nv row-major,
@@ -539,57 +473,6 @@ fn acceleration_terms<S: Real>(model: &Model, b: &mut DerivativeBuffers<S>, a: O
     }
 }
 
-/// Where the entries of ∂τ/∂q and ∂τ/∂q̇ go, added to a zeroed buffer (a joint's own block gets
-/// the recursion's term and its rotor's).
-pub(crate) trait TorqueDerivatives<S> {
-    fn add(&mut self, row: usize, column: usize, by_q: S, by_v: S);
-}
-
-/// Into two nv × nv matrices: `data.dtau_dq`, `data.dtau_dv`.
-struct Matrices(DMatrix<f64>, DMatrix<f64>);
-
-impl TorqueDerivatives<f64> for Matrices {
-    #[inline(always)]
-    fn add(&mut self, row: usize, column: usize, by_q: f64, by_v: f64) {
-        // column-major storage
-        let index = row + column * self.0.nrows();
-        self.0.as_mut_slice()[index] += by_q;
-        self.1.as_mut_slice()[index] += by_v;
-    }
-}
-
-/// Into two nv × nv row-major buffers, in `f64` or lanes.
-pub(crate) struct RowMajor<'a, S> {
-    pub by_q: &'a mut [S],
-    pub by_v: &'a mut [S],
-    pub nv: usize,
-}
-
-impl<S: Real> TorqueDerivatives<S> for RowMajor<'_, S> {
-    #[inline(always)]
-    fn add(&mut self, row: usize, column: usize, by_q: S, by_v: S) {
-        let index = row * self.nv + column;
-        self.by_q[index] += by_q;
-        self.by_v[index] += by_v;
-    }
-}
-
-/// Negated into the rows [−∂τ/∂q, −∂τ/∂q̇, ·] (nv rows of 3 nv) that the ABA derivatives solve,
-/// in `f64` or lanes.
-struct NegatedRows<'a, S> {
-    rows: &'a mut [S],
-    nv: usize,
-}
-
-impl<S: Real> TorqueDerivatives<S> for NegatedRows<'_, S> {
-    #[inline(always)]
-    fn add(&mut self, row: usize, column: usize, by_q: S, by_v: S) {
-        let start = row * 3 * self.nv + column;
-        self.rows[start] -= by_q;
-        self.rows[start + self.nv] -= by_v;
-    }
-}
-
 /// τ, M (when `MASS_MATRIX`: the ABA derivatives have it already) and both derivatives from the
 /// terms and composites above: one coordinate k of body i against the coordinates on its path to
 /// the root; then the rotors' armature on M and their velocity term's Jacobian on ∂τ/∂q̇.
@@ -681,35 +564,5 @@ fn add_rotor_torques<S: Real>(
             }
             b.tau[row] += S::splat(model.armature[row]) * rate;
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::io::bundled::floating_ur5_state;
-
-    /// A single call's passes, built for AVX2 and FMA where the processor has them, equal the
-    /// baseline build of the same passes bit for bit (the claim of `one_state`).
-    #[test]
-    fn the_dispatched_passes_equal_the_baseline_build_bit_for_bit() {
-        let (model, q, v, a) = floating_ur5_state();
-        let nv = model.nv;
-        let mut dispatched = vec![vec![0.0; nv * nv]; 2];
-        let mut data = Data::new(&model);
-        let [by_q, by_v] = &mut dispatched[..] else {
-            unreachable!()
-        };
-        rnea_derivatives_row_major(&model, &mut data, (&q, &v, &a, None), by_q, by_v).unwrap();
-        let mut baseline = vec![vec![0.0; nv * nv]; 2];
-        let [by_q, by_v] = &mut baseline[..] else {
-            unreachable!()
-        };
-        let mut rows = RowMajor { by_q, by_v, nv };
-        let mut other = Data::new(&model);
-        let mut buffers = DerivativeBuffers::of(&mut other);
-        derivative_passes(&model, &mut buffers, (&q, &v, &a, None), &mut rows);
-        assert_eq!(dispatched, baseline);
-        assert_eq!(data.tau, other.tau);
     }
 }
