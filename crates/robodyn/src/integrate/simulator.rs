@@ -250,30 +250,8 @@ pub fn simulate<'a>(
     let mut simulation = Simulation::start(model, (q0, v0), options, controller, wrenches)?;
     simulation.progress = progress;
     simulation.report(0)?;
-    match options.integrator {
-        Integrator::Rk45 { .. } => simulate_adaptive(&mut simulation)?,
-        _ => simulation.fixed_step()?,
-    }
+    simulation.run()?;
     Ok(simulation.finish())
-}
-
-/// The steps of an RK45 simulation, a divergence's message saying what may keep it bounded.
-fn simulate_adaptive(simulation: &mut Simulation) -> Result<()> {
-    let Integrator::Rk45 { rtol, atol } = simulation.options.integrator else {
-        return simulation.fixed_step();
-    };
-    simulation
-        .adaptive((rtol, atol))
-        .map_err(|error| match error {
-            Error::Diverged { time, message } => Error::Diverged {
-                time,
-                message: format!(
-                    "{message}; if the motion should stay bounded, tighter rtol and atol or a \
-                     smaller max_step may keep it so"
-                ),
-            },
-            other => other,
-        })
 }
 
 /// Everything one simulation works with.
@@ -349,6 +327,24 @@ impl<'a> Simulation<'a> {
             &mut start.a,
         )?;
         Ok(simulation)
+    }
+
+    /// Every step after the first sample, by the options' scheme; an RK45 divergence's message
+    /// says what may keep the motion bounded.
+    fn run(&mut self) -> Result<()> {
+        let Integrator::Rk45 { rtol, atol } = self.options.integrator else {
+            return self.fixed_step();
+        };
+        self.adaptive((rtol, atol)).map_err(|error| match error {
+            Error::Diverged { time, message } => Error::Diverged {
+                time,
+                message: format!(
+                    "{message}; if the motion should stay bounded, tighter rtol and atol or a \
+                     smaller max_step may keep it so"
+                ),
+            },
+            other => other,
+        })
     }
 
     /// The recorded trajectory with its statistics.

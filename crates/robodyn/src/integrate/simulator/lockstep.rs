@@ -35,7 +35,7 @@ pub fn simulate_lockstep<C: Controller + Clone>(
             .into_iter()
             .enumerate()
             .map(|(k, mut simulation)| {
-                super::simulate_adaptive(&mut simulation).map_err(|e| (k, e))?;
+                simulation.run().map_err(|e| (k, e))?;
                 Ok(simulation.finish())
             })
             .collect();
