@@ -15,7 +15,7 @@ use crate::integrate::schemes::{Integrator, State, Stepper};
 use crate::model::Model;
 use crate::spatial::Force;
 use crate::Data;
-use guard::{fixed_step, EnergyAccount, STEP_CHECK_INTERVAL};
+use guard::{EnergyAccount, STEP_CHECK_INTERVAL};
 
 mod guard;
 mod lockstep;
@@ -168,6 +168,11 @@ impl Dynamics<'_> {
     /// q̈ = ABA(q, v, τ_control + τ_passive, f_ext) into `a`; τ and τ_passive stay in `self`.
     fn acceleration(&mut self, t: f64, q: &[f64], v: &[f64], a: &mut [f64]) -> Result<()> {
         self.torques(t, q, v)?;
+        self.forward_dynamics(t, q, v, a)
+    }
+
+    /// q̈ = ABA(q, v, `tau_total`, `forces`) into `a`, once [`Self::torques`] has run at (t, q, v).
+    fn forward_dynamics(&mut self, t: f64, q: &[f64], v: &[f64], a: &mut [f64]) -> Result<()> {
         let f_ext = self.wrenches.is_some().then_some(&self.forces[..]);
         let qdd = aba(self.model, &mut self.data, q, v, &self.tau_total, f_ext)
             .map_err(|e| at_time(t, e))?;
@@ -365,42 +370,9 @@ impl<'a> Simulation<'a> {
         }
     }
 
-    /// Steps of dt from sample to sample; every scheme starts from the acceleration recorded at
-    /// the step's start. The first step, and every `STEP_CHECK_INTERVAL`-th, is checked against
-    /// two half steps; a divergence reports the step that would keep the motion stable.
+    /// Steps of dt from sample to sample: [`lockstep::fixed_steps`] of this simulation alone.
     fn fixed_step(&mut self) -> Result<()> {
-        for k in 1..self.samples {
-            let t_next = self.options.sample_time(k, self.samples);
-            let h = t_next - self.state.t;
-            self.fixed_sample(k, t_next, h)
-                .map_err(|error| self.with_suggested_step(error, h))?;
-            self.report(k)?;
-        }
-        Ok(())
-    }
-
-    /// The step to sample `k` at `t_next`: taken, checked, recorded, and then made the state.
-    fn fixed_sample(&mut self, k: usize, t_next: f64, h: f64) -> Result<()> {
-        fixed_step(
-            self.model,
-            self.options.integrator,
-            &mut self.dynamics,
-            &mut self.stepper,
-            &self.state,
-            h,
-        )?;
-        if k == 1 || k.is_multiple_of(STEP_CHECK_INTERVAL) {
-            self.check_step(h)?;
-        }
-        self.statistics.steps += 1;
-        let next = &mut self.sample;
-        next.t = t_next;
-        next.q.copy_from_slice(&self.stepper.q_end);
-        next.v.copy_from_slice(&self.stepper.v_end);
-        self.dynamics
-            .record(&mut self.trajectory, t_next, &next.q, &next.v, &mut next.a)?;
-        std::mem::swap(&mut self.state, &mut self.sample);
-        Ok(())
+        lockstep::fixed_steps(std::slice::from_mut(self)).map_err(|(_, error)| error)
     }
 
     /// Dormand–Prince steps of the size its error estimate allows; samples by dense output.

@@ -1,9 +1,11 @@
-//! Rollouts in lockstep: fixed-step simulations of one model from several starts advance
+//! Fixed steps in lockstep: fixed-step simulations of one model from several starts advance
 //! together, stage by stage, so that each stage's forward dynamics runs for all of them at once,
-//! several states per instruction ([`crate::algo::lanes::aba_batch`]). Everything else is each
-//! rollout's own, as in [`super::simulate`]: its controller and passive forces, the divergence
-//! guard and its step-doubling checks, the recording. The lanes compute exactly what the
-//! one-state ABA computes, so every rollout equals its own `simulate` bit for bit.
+//! several states per instruction ([`crate::algo::lanes::aba_batch`]); a single simulation's
+//! steps are the case of one (its forward dynamics then one call, with its wrenches if any).
+//! Everything else is each rollout's own, as in [`super::simulate`]: its controller and passive
+//! forces, the divergence guard and its step-doubling checks, the recording. The lanes compute
+//! exactly what the one-state ABA computes, so every rollout equals its own `simulate` bit for
+//! bit.
 
 use super::{at_time, Simulation, SimulationOptions, Trajectory, STEP_CHECK_INTERVAL};
 use crate::algo::lanes::{aba_batch, BatchWorkspace, States};
@@ -40,18 +42,31 @@ pub fn simulate_lockstep<C: Controller + Clone>(
             })
             .collect();
     }
+    fixed_steps(&mut simulations)?;
+    Ok(simulations.into_iter().map(Simulation::finish).collect())
+}
+
+/// The fixed steps of `simulations` (one model, one scheme, started together) from sample to
+/// sample, in lockstep; every scheme starts from the acceleration recorded at the step's start.
+/// The first step, and every `STEP_CHECK_INTERVAL`-th, is checked against two half steps; a
+/// divergence reports the step that would keep the motion stable.
+pub(super) fn fixed_steps(simulations: &mut [Simulation]) -> Result<(), RolloutError> {
+    let Some(first) = simulations.first() else {
+        return Ok(());
+    };
+    let (model, options, samples) = (first.model, first.options, first.samples);
     let mut group = Group::new(model, simulations.len());
-    for k in 1..simulations.first().map_or(0, |s| s.samples) {
-        let t_next = options.sample_time(k, simulations[0].samples);
+    for k in 1..samples {
+        let t_next = options.sample_time(k, samples);
         let h = t_next - simulations[0].state.t;
         group
-            .step(&mut simulations, k, t_next, h)
-            .map_err(|(r, error)| {
-                let simulation = &mut simulations[r];
-                (r, simulation.with_suggested_step(error, h))
-            })?;
+            .step(simulations, k, t_next, h)
+            .map_err(|(r, error)| (r, simulations[r].with_suggested_step(error, h)))?;
+        for (r, simulation) in simulations.iter_mut().enumerate() {
+            simulation.report(k).map_err(|e| (r, e))?;
+        }
     }
-    Ok(simulations.into_iter().map(Simulation::finish).collect())
+    Ok(())
 }
 
 /// The rollouts' states and accelerations side by side, one row each, and the lanes' workspace.
@@ -105,7 +120,8 @@ impl Group {
                         dynamics.torques(t, q, v).map_err(|e| (r, e))?;
                         self.gather(model, r, (q, v, &dynamics.tau_total));
                     }
-                    self.accelerations(model, simulations[0].state.t + tableau.c[s] * h)?;
+                    let t = simulations[0].state.t + tableau.c[s] * h;
+                    self.accelerations(simulations, t)?;
                     for (r, simulation) in simulations.iter_mut().enumerate() {
                         let (_, _, a) = simulation.stepper.stage_evaluation(s);
                         a.copy_from_slice(self.row_of_qdd(model, r));
@@ -148,7 +164,7 @@ impl Group {
                 .map_err(|e| (r, e))?;
             self.gather(model, r, (&sample.q, &sample.v, &dynamics.tau_total));
         }
-        self.accelerations(model, t_next)?;
+        self.accelerations(simulations, t_next)?;
         for (r, simulation) in simulations.iter_mut().enumerate() {
             let Simulation {
                 sample,
@@ -174,8 +190,26 @@ impl Group {
         self.tau[r * nv..(r + 1) * nv].copy_from_slice(tau);
     }
 
-    /// q̈ = ABA(q, v, τ) of every row, at time `t` (for the error of a failing rollout).
-    fn accelerations(&mut self, model: &Model, t: f64) -> Result<(), RolloutError> {
+    /// q̈ = ABA(q, v, τ) of every row, at time `t` (for the error of a failing rollout): in lanes,
+    /// or through each rollout's own ABA where there is one rollout or wrenches act.
+    fn accelerations(
+        &mut self,
+        simulations: &mut [Simulation],
+        t: f64,
+    ) -> Result<(), RolloutError> {
+        let model = simulations[0].model;
+        let (nq, nv) = (model.nq, model.nv);
+        if simulations.len() == 1 || simulations.iter().any(|s| s.dynamics.wrenches.is_some()) {
+            for (r, simulation) in simulations.iter_mut().enumerate() {
+                let (q, v) = (&self.q[r * nq..(r + 1) * nq], &self.v[r * nv..(r + 1) * nv]);
+                let a = &mut self.qdd[r * nv..(r + 1) * nv];
+                simulation
+                    .dynamics
+                    .forward_dynamics(t, q, v, a)
+                    .map_err(|e| (r, e))?;
+            }
+            return Ok(());
+        }
         let states = States {
             q: &self.q,
             v: Some(&self.v),
