@@ -8,8 +8,8 @@
 //! `difference(q, integrate(q, v)) = v`.
 
 use crate::spatial::{
-    log_rotation, rotate_back, skew, splat_vector, zero_vector, Force, Mat3, Mat6, Motion, Real,
-    Transform, Vec3,
+    cross, log_rotation, rotate_back, skew, splat_vector, zero_vector, Force, Mat3, Mat6, Motion,
+    Real, Transform, Vec3,
 };
 use nalgebra::{Matrix3, Matrix6, Quaternion, UnitQuaternion, Vector3, Vector6};
 use rand::Rng;
@@ -140,6 +140,34 @@ impl Joint {
             Joint::Spherical => Motion::new(unit(k), Vec3::zeros()),
             Joint::Free if k < 3 => Motion::new(Vec3::zeros(), unit(k)),
             Joint::Free => Motion::new(unit(k), Vec3::zeros()),
+        }
+    }
+
+    /// Column `k` of `S` in the coordinates `x` maps from (the world's, for `x = X_{i←0}`):
+    /// `X⁻¹ S_k = (Eᵀ ω_k, Eᵀ v_k + r × Eᵀ ω_k)`. About or along coordinate axis c of the joint
+    /// frame, `Eᵀ e_c` is row c of E: a revolute joint turns about it (v = r × ω), a prismatic
+    /// one slides along it — no rotation product.
+    #[inline(always)]
+    pub fn subspace_column_from<S: Real>(&self, k: usize, x: &Transform<S>) -> Motion<S> {
+        let e = &x.rotation;
+        // Eᵀ a, a row of E when a is a coordinate axis
+        let back = |a: &Vec3| match coordinate_axis(a) {
+            Some(c) => Vector3::new(e[(c, 0)], e[(c, 1)], e[(c, 2)]),
+            None => rotate_back(e, &splat_vector(a)),
+        };
+        match self {
+            Joint::Revolute { axis } => {
+                let angular = back(axis);
+                Motion {
+                    linear: cross(&x.translation, &angular),
+                    angular,
+                }
+            }
+            Joint::Prismatic { axis } => Motion {
+                angular: zero_vector(),
+                linear: back(axis),
+            },
+            _ => x.inverse_apply_motion(&Motion::splat(&self.subspace_column(k))),
         }
     }
 

@@ -168,6 +168,29 @@ fn transform_after_is_the_joint_transform_times_the_tree_transform() {
     }
 }
 
+#[test]
+fn subspace_column_from_a_frame_is_the_inverse_transform_of_the_column() {
+    let mut rng = rng();
+    for joint in joints_and_shortcuts() {
+        let x = Transform::from_pose(
+            &random_rotation(&mut rng),
+            &Vec3::new(rng.random(), rng.random(), rng.random()),
+        );
+        for k in 0..joint.nv() {
+            let expected = x.inverse_apply_motion(&joint.subspace_column(k));
+            let column = joint.subspace_column_from(k, &x);
+            let difference = (column - expected)
+                .to_array()
+                .iter()
+                .fold(0.0_f64, |m, d| m.max(d.abs()));
+            assert!(
+                difference < COMPOSITION_TOLERANCE,
+                "{joint:?} column {k}: {column:?} vs {expected:?}"
+            );
+        }
+    }
+}
+
 fn random_rotation(rng: &mut impl Rng) -> nalgebra::Matrix3<f64> {
     let axis = nalgebra::Unit::new_normalize(Vec3::new(
         rng.random::<f64>() - 0.5,

@@ -101,8 +101,7 @@ pub(crate) fn world_inertias_of<S: Real>(model: &Model, q: &[S], out: CompositeB
         let x_world = &out.x_world[i];
         out.composites[i] = x_world.transpose_apply_inertia(&Inertia::splat(&model.inertias[i]));
         for (k, dof) in model.v_range(i).enumerate() {
-            let column = Motion::splat(&model.joints[i].subspace_column(k));
-            out.subspaces[dof] = x_world.inverse_apply_motion(&column);
+            out.subspaces[dof] = model.joints[i].subspace_column_from(k, x_world);
         }
     }
 }

@@ -114,7 +114,7 @@ pub fn center_of_mass_jacobian<'d>(
         let subtree = data.i_c[i];
         for (k, column) in model.v_range(i).enumerate() {
             // (ω, v_O) = X_{i←0}⁻¹ S_k;  J_com[:, k] = (m_sub v_O + ω × h_sub) / m
-            let s = data.x_world[i].inverse_apply_motion(&model.joints[i].subspace_column(k));
+            let s = model.joints[i].subspace_column_from(k, &data.x_world[i]);
             let column_value =
                 (s.linear * subtree.mass + s.angular.cross(&subtree.first_moment)) / total;
             data.jacobian

@@ -52,7 +52,7 @@ pub fn frame_motion_derivatives(
         let i = data.support[k];
         let (mut v_joint, mut a_joint) = (Motion::ZERO, Motion::ZERO);
         for (c, dof) in model.v_range(i).enumerate() {
-            let s = data.x_world[i].inverse_apply_motion(&model.joints[i].subspace_column(c));
+            let s = model.joints[i].subspace_column_from(c, &data.x_world[i]);
             data.s_world[dof] = s;
             v_joint += s * v[dof];
             a_joint += s * a[dof];

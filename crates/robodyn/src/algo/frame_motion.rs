@@ -166,7 +166,7 @@ pub fn jacobian_time_variation<'d>(
         let body_velocity = data.x_world[j].inverse_apply_motion(&data.v[j]);
         for (k, column) in model.v_range(j).enumerate() {
             // s = X_{j←0}⁻¹ S_k;  ṡ = v_j × s
-            let s = data.x_world[j].inverse_apply_motion(&joint.subspace_column(k));
+            let s = joint.subspace_column_from(k, &data.x_world[j]);
             let s_dot = body_velocity.cross_motion(&s);
             let (linear, angular): (Vec3, Vec3) = match reference {
                 Reference::Spatial => (s_dot.linear, s_dot.angular),

@@ -47,7 +47,7 @@ pub fn jacobian<'d>(
         let joint = &model.joints[j];
         for (k, column) in model.v_range(j).enumerate() {
             // (ω, v_O) = X_{j←0}⁻¹ S_k
-            let s = data.x_world[j].inverse_apply_motion(&joint.subspace_column(k));
+            let s = joint.subspace_column_from(k, &data.x_world[j]);
             let (linear, angular) = match reference {
                 Reference::Spatial => (s.linear, s.angular),
                 // v_p = v_O + ω × p

@@ -65,9 +65,13 @@ pub(crate) fn update_support_placements(model: &Model, data: &mut Data, q: &[f64
         data.support.push(j);
         j = model.parent[j];
     }
-    for &i in data.support.iter().rev() {
-        // X_{i←λ(i)} = X_J(q_i) X_T(i);  X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}
+    // the joints first, independent of one another, then the chain that needs them
+    for &i in &data.support {
+        // X_{i←λ(i)} = X_J(q_i) X_T(i)
         data.x_up[i] = model.joints[i].transform_after(&q[model.q_range(i)], &model.x_tree[i]);
+    }
+    for &i in data.support.iter().rev() {
+        // X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}
         data.x_world[i] = data.x_up[i] * data.x_world[model.parent[i]];
     }
 }

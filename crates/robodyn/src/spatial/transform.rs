@@ -90,18 +90,31 @@ impl<S: Real> Transform<S> {
     #[inline(always)]
     pub fn rotated_about_axis(&self, k: usize, angle: S) -> Transform<S> {
         let (s, c) = super::trig::sin_cos(angle);
-        let (first, second) = ((k + 1) % 3, (k + 2) % 3);
-        let mut rotation = self.rotation;
+        // the axis as a constant, so that the rows turned are registers, not indexed stores
+        match k {
+            0 => self.rotated_about::<0>(s, c),
+            1 => self.rotated_about::<1>(s, c),
+            _ => self.rotated_about::<2>(s, c),
+        }
+    }
+
+    /// [`Transform::rotated_about_axis`] for the axis `K`, given the angle's sine and cosine.
+    #[inline(always)]
+    fn rotated_about<const K: usize>(&self, s: S, c: S) -> Transform<S> {
+        let (first, second) = ((K + 1) % 3, (K + 2) % 3);
+        let e = &self.rotation;
+        let mut rows = [[S::zero(); 3]; 3];
         for column in 0..3 {
-            let (a, b) = (
-                self.rotation[(first, column)],
-                self.rotation[(second, column)],
-            );
-            rotation[(first, column)] = c * a + s * b;
-            rotation[(second, column)] = c * b - s * a;
+            let (a, b) = (e[(first, column)], e[(second, column)]);
+            rows[K][column] = e[(K, column)];
+            rows[first][column] = c * a + s * b;
+            rows[second][column] = c * b - s * a;
         }
         Transform {
-            rotation,
+            rotation: Matrix3::new(
+                rows[0][0], rows[0][1], rows[0][2], rows[1][0], rows[1][1], rows[1][2], rows[2][0],
+                rows[2][1], rows[2][2],
+            ),
             translation: self.translation,
         }
     }
