@@ -27,10 +27,12 @@ import pinocchio as pin
 import robodyn
 from robodyn.convert import PinocchioLayout
 
+# each robot's file, whether its base floats, and the frame whose pose and Jacobian are timed
+# (its tool or fingertip, as in pinocchio_native.sh)
 ROBOTS = {
-    "ur5": ("ur_description/urdf/ur5_robot.urdf", False),
-    "panda": ("panda_description/urdf/panda.urdf", False),
-    "talos": ("talos_data/robots/talos_full_v2.urdf", True),
+    "ur5": ("ur_description/urdf/ur5_robot.urdf", False, "tool0"),
+    "panda": ("panda_description/urdf/panda.urdf", False, "panda_hand_tcp"),
+    "talos": ("talos_data/robots/talos_full_v2.urdf", True, "gripper_left_fingertip_1_link"),
 }
 
 
@@ -62,7 +64,7 @@ def batch_times(ours, theirs, repeat: int = 5) -> tuple[float, float]:
 
 
 def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
-    path, floating = ROBOTS[name]
+    path, floating, frame = ROBOTS[name]
     urdf = robodyn._example_robot_data_dir() / path
     m = robodyn.load(urdf, floating_base=floating)
     pm = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer()) if floating else pin.buildModelFromUrdf(str(urdf))
@@ -72,7 +74,6 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
     q = m.random_configuration(seed=1)
     v, a = rng.uniform(-1, 1, m.nv), rng.uniform(-1, 1, m.nv)
     pq, pv, pa = mapping.q_to_pinocchio(q), mapping.v_to_pinocchio(v), mapping.v_to_pinocchio(a)
-    frame = m.frame_names[-1]
     frame_id = pm.getFrameId(frame)
 
     def pin_jacobian():
@@ -142,7 +143,7 @@ def mujoco_model(urdf: Path) -> mujoco.MjModel:
 
 
 def compare_mujoco(name: str, batch: int) -> list[tuple[str, float, float]]:
-    path, _ = ROBOTS[name]
+    path = ROBOTS[name][0]
     urdf = robodyn._example_robot_data_dir() / path
     m = robodyn.load(urdf)
     mj = mujoco_model(urdf)
@@ -229,7 +230,7 @@ def compare_rollout(name: str) -> list[tuple[str, float, float]]:
     """A 10 s rollout at dt = 1 ms with RK4 and a PD controller with gravity compensation holding
     the neutral configuration from a displaced start: robodyn.simulate (recording every step, with
     energies) against one mj_step(nstep=10000) call."""
-    path, _ = ROBOTS[name]
+    path = ROBOTS[name][0]
     urdf = robodyn._example_robot_data_dir() / path
     m = robodyn.load(urdf)
     q0 = np.full(m.nv, 0.3)
@@ -264,7 +265,7 @@ def compare_batched_rollouts(name: str) -> list[tuple[str, float, float]]:
     recorded: one batched robodyn.simulate call against mujoco.rollout with one MjData per core."""
     from mujoco import rollout
 
-    path, _ = ROBOTS[name]
+    path = ROBOTS[name][0]
     urdf = robodyn._example_robot_data_dir() / path
     m = robodyn.load(urdf)
     inertia = np.diag(m.mass_matrix(np.full(m.nv, 0.3)))

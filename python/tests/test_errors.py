@@ -114,6 +114,11 @@ def test_unknown_frame_and_reference(model):
         model.frame_pose(q, "gripper")
     with pytest.raises(ValueError, match="argument 'frame': expected a frame name or an index below"):
         model.jacobian(q, 999)
+    for wrong in (2.5, None, b"tool0"):
+        with pytest.raises(ValueError, match="argument 'frame': expected a frame name or an index below"):
+            model.jacobian(q, wrong)
+    tool = model.frame_names.index("tool0")
+    np.testing.assert_array_equal(model.jacobian(q, np.int64(tool)), model.jacobian(q, "tool0"))
     with pytest.raises(ValueError, match="argument 'reference': expected 'world', 'local' or 'spatial', got 'body'"):
         model.jacobian(q, "tool0", "body")
 

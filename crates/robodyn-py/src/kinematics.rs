@@ -93,15 +93,22 @@ impl PyModel {
             &[6, self.model.nv],
             out,
             &|m, w, i, out| {
-                algo::jacobian(m, &mut w.data, i[0], frame, reference)?;
-                // only the columns of the frame's support are not zero
-                let (jacobian, nv) = (&w.data.jacobian, m.nv);
+                // row-major (6, nv): only the columns of the frame's support are not zero
+                let nv = m.nv;
                 out.fill(0.0);
-                for column in w.data.support.iter().flat_map(|&j| m.v_range(j)) {
-                    for (row, value) in jacobian.column(column).iter().enumerate() {
-                        out[row * nv + column] = *value;
-                    }
-                }
+                algo::jacobian_columns(
+                    m,
+                    &mut w.data,
+                    i[0],
+                    frame,
+                    reference,
+                    |c, linear, angular| {
+                        for row in 0..3 {
+                            out[row * nv + c] = linear[row];
+                            out[(row + 3) * nv + c] = angular[row];
+                        }
+                    },
+                )?;
                 Ok(())
             },
             None,

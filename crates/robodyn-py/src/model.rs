@@ -414,7 +414,9 @@ impl PyModel {
     }
 
     pub(crate) fn frame_index(&self, frame: &Bound<PyAny>) -> PyResult<usize> {
-        if let Ok(name) = frame.extract::<&str>() {
+        // a type test first: a failed extraction builds a Python exception, dearer than the call
+        if let Ok(name) = frame.cast::<PyString>() {
+            let name = name.to_str()?;
             return match self.frame_indices.get(name) {
                 Some(&index) => Ok(index),
                 None => self.model.frame_index(name).map_err(to_py_err),

@@ -11,6 +11,7 @@
 use crate::algo::kinematics::{check_frame, frame_placement, update_support_placements};
 use crate::error::Result;
 use crate::model::Model;
+use crate::spatial::Vec3;
 use crate::Data;
 use nalgebra::DMatrix;
 
@@ -35,6 +36,36 @@ pub fn jacobian<'d>(
     frame: usize,
     reference: Reference,
 ) -> Result<&'d DMatrix<f64>> {
+    let mut jacobian = std::mem::take(&mut data.jacobian);
+    jacobian.as_mut_slice().fill(0.0);
+    let result = jacobian_columns(
+        model,
+        data,
+        q,
+        frame,
+        reference,
+        |column, linear, angular| {
+            jacobian.fixed_view_mut::<3, 1>(0, column).copy_from(linear);
+            jacobian
+                .fixed_view_mut::<3, 1>(3, column)
+                .copy_from(angular);
+        },
+    );
+    data.jacobian = jacobian;
+    result.map(|()| &data.jacobian)
+}
+
+/// The columns of J(q) that are not zero (those of the joints between the frame and the world),
+/// each handed to `column(index, linear, angular)`: for a caller that stores J its own way
+/// (row-major, for NumPy). Writes `data.support`, and `data.x_up`, `data.x_world` along it.
+pub fn jacobian_columns(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    frame: usize,
+    reference: Reference,
+    mut column: impl FnMut(usize, &Vec3, &Vec3),
+) -> Result<()> {
     model.check_configuration(q)?;
     check_frame(model, frame)?;
     update_support_placements(model, data, q, model.frames[frame].body);
@@ -42,10 +73,9 @@ pub fn jacobian<'d>(
     // p: the frame's origin in world coordinates
     let origin = pose.translation;
 
-    data.jacobian.as_mut_slice().fill(0.0);
     for &j in &data.support {
         let joint = &model.joints[j];
-        for (k, column) in model.v_range(j).enumerate() {
+        for (k, index) in model.v_range(j).enumerate() {
             // (ω, v_O) = X_{j←0}⁻¹ S_k
             let s = joint.subspace_column_from(k, &data.x_world[j]);
             let (linear, angular) = match reference {
@@ -57,13 +87,8 @@ pub fn jacobian<'d>(
                     pose.rotation * s.angular,
                 ),
             };
-            data.jacobian
-                .fixed_view_mut::<3, 1>(0, column)
-                .copy_from(&linear);
-            data.jacobian
-                .fixed_view_mut::<3, 1>(3, column)
-                .copy_from(&angular);
+            column(index, &linear, &angular);
         }
     }
-    Ok(&data.jacobian)
+    Ok(())
 }

@@ -37,7 +37,7 @@ pub use energy::{center_of_mass, center_of_mass_jacobian, kinetic_energy, potent
 pub use frame_derivatives::{center_of_mass_velocity_derivatives, frame_motion_derivatives};
 pub use frame_motion::{frame_acceleration, frame_velocity, jacobian_time_variation};
 pub use inverse_kinematics::{inverse_kinematics, IkOptions, IkSolution};
-pub use jacobian::{jacobian, Reference};
+pub use jacobian::{jacobian, jacobian_columns, Reference};
 pub use kinematics::{forward_kinematics, frame_placement, frame_pose};
 pub use lanes::{
     aba_batch, aba_derivatives_batch, crba_batch, newton_euler_batch, rnea_derivatives_batch,
