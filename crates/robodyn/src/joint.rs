@@ -7,6 +7,7 @@
 //! differences act on the joint's Lie group (quaternions for the spherical and free joints), so
 //! `difference(q, integrate(q, v)) = v`.
 
+use crate::spatial::trig::sin_cos;
 use crate::spatial::{
     cross, log_rotation, rotate_back, skew, splat_vector, zero_vector, Force, Mat3, Mat6, Motion,
     Real, Transform, Vec3,
@@ -112,12 +113,27 @@ impl Joint {
     /// its translation; a prismatic joint moves the translation only.
     #[inline(always)]
     pub fn transform_after<S: Real>(&self, q: &[S], x_tree: &Transform) -> Transform<S> {
+        let turn = q
+            .first()
+            .map_or((S::zero(), S::one()), |&angle| sin_cos(angle));
+        self.transform_after_turn(q, turn, x_tree)
+    }
+
+    /// [`Joint::transform_after`] given `(sin, cos)` of `q[0]` (used by a revolute joint only),
+    /// computed beforehand: forward kinematics evaluates several joints' at once.
+    #[inline(always)]
+    pub fn transform_after_turn<S: Real>(
+        &self,
+        q: &[S],
+        (s, c): (S, S),
+        x_tree: &Transform,
+    ) -> Transform<S> {
         let x_tree = Transform::splat(x_tree);
         match self {
             Joint::Fixed => x_tree,
             Joint::Revolute { axis } => match coordinate_axis(axis) {
-                Some(k) => x_tree.rotated_about_axis(k, q[0]),
-                None => self.transform(q) * x_tree,
+                Some(k) => x_tree.rotated_about_axis(k, s, c),
+                None => Transform::from_axis_sin_cos(axis, s, c) * x_tree,
             },
             Joint::Prismatic { axis } => Transform {
                 rotation: x_tree.rotation,

@@ -3,7 +3,7 @@
 //! Reference: Featherstone, *Rigid Body Dynamics Algorithms* (2008), §4.4 (`jcalc`) and the
 //! first lines of Table 5.1: `X_J = jcalc(q_i)`, `X_{i←λ(i)} = X_J X_T(i)`, and the world
 //! transform `X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}`; the ECE 470 notes ("forward kinematics": chained `T`).
-//! Cost: one 3x3 rotation product per body.
+//! Cost: one 3x3 rotation product per body; the joints' sines and cosines several at once.
 
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -15,12 +15,24 @@ pub(crate) fn update_joint_transforms(model: &Model, data: &mut Data, q: &[f64])
     joint_transforms(model, q, &mut data.x_up);
 }
 
+/// How many bodies' joint sines [`joint_transforms`] evaluates together.
+const TURNS_AT_ONCE: usize = 16;
+
 /// `X_{i←λ(i)}` of every body for `q`, in `f64` or lanes (assumed already checked).
 #[inline(always)]
 pub(crate) fn joint_transforms<S: Real>(model: &Model, q: &[S], x_up: &mut [Transform<S>]) {
-    for i in 1..model.nbodies() {
-        // X_{i←λ(i)} = X_J(q_i) X_T(i)
-        x_up[i] = model.joints[i].transform_after(&q[model.q_range(i)], &model.x_tree[i]);
+    let mut turns = [(S::zero(), S::one()); TURNS_AT_ONCE];
+    for first in (1..model.nbodies()).step_by(TURNS_AT_ONCE) {
+        let bodies = first..model.nbodies().min(first + TURNS_AT_ONCE);
+        // (sin, cos) of each body's first coordinate: a revolute joint's angle (the others'
+        // are not used), several at once
+        let turns = &mut turns[..bodies.len()];
+        S::sin_cos_at(q, &model.idx_q[bodies.clone()], turns);
+        for (i, &turn) in bodies.zip(turns.iter()) {
+            // X_{i←λ(i)} = X_J(q_i) X_T(i)
+            let joint = &model.joints[i];
+            x_up[i] = joint.transform_after_turn(&q[model.q_range(i)], turn, &model.x_tree[i]);
+        }
     }
 }
 
@@ -65,10 +77,20 @@ pub(crate) fn update_support_placements(model: &Model, data: &mut Data, q: &[f64
         data.support.push(j);
         j = model.parent[j];
     }
-    // the joints first, independent of one another, then the chain that needs them
-    for &i in &data.support {
-        // X_{i←λ(i)} = X_J(q_i) X_T(i)
-        data.x_up[i] = model.joints[i].transform_after(&q[model.q_range(i)], &model.x_tree[i]);
+    // the joints first, independent of one another (their sines several at once), then the
+    // chain that needs them
+    let (mut indices, mut turns) = ([0; TURNS_AT_ONCE], [(0.0, 1.0); TURNS_AT_ONCE]);
+    for bodies in data.support.chunks(TURNS_AT_ONCE) {
+        for (index, &i) in indices.iter_mut().zip(bodies) {
+            *index = model.idx_q[i];
+        }
+        let turns = &mut turns[..bodies.len()];
+        f64::sin_cos_at(q, &indices[..bodies.len()], turns);
+        for (&i, &turn) in bodies.iter().zip(turns.iter()) {
+            // X_{i←λ(i)} = X_J(q_i) X_T(i)
+            let joint = &model.joints[i];
+            data.x_up[i] = joint.transform_after_turn(&q[model.q_range(i)], turn, &model.x_tree[i]);
+        }
     }
     for &i in data.support.iter().rev() {
         // X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}

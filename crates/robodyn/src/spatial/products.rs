@@ -13,12 +13,22 @@ pub trait Real: SimdRealField<Element = f64> + Copy {
     /// The lanes `(f(0), f(1), ...)`, built in registers (replacing lanes one by one goes
     /// through memory).
     fn from_lanes(f: impl Fn(usize) -> f64) -> Self;
+
+    /// `out[k] = (sin, cos)` of `q[indices[k]]` by [`super::trig::sin_cos`], the same digits
+    /// however it is evaluated: `f64` takes four values per evaluation in AVX2 lanes where the CPU
+    /// has them ([`super::trig::sin_cos_at`]); lanes, already one value per state, one at a time.
+    fn sin_cos_at(q: &[Self], indices: &[usize], out: &mut [(Self, Self)]);
 }
 
 impl Real for f64 {
     #[inline(always)]
     fn from_lanes(f: impl Fn(usize) -> f64) -> Self {
         f(0)
+    }
+
+    #[inline(always)]
+    fn sin_cos_at(q: &[f64], indices: &[usize], out: &mut [(f64, f64)]) {
+        super::trig::sin_cos_at(q, indices, out);
     }
 }
 
@@ -29,6 +39,13 @@ where
     #[inline(always)]
     fn from_lanes(f: impl Fn(usize) -> f64) -> Self {
         simba::simd::AutoSimd(std::array::from_fn(f))
+    }
+
+    #[inline(always)]
+    fn sin_cos_at(q: &[Self], indices: &[usize], out: &mut [(Self, Self)]) {
+        for (turn, &index) in out.iter_mut().zip(indices) {
+            *turn = super::trig::sin_cos(q[index]);
+        }
     }
 }
 

@@ -64,6 +64,12 @@ impl<S: Real> Transform<S> {
     #[inline(always)]
     pub fn from_axis_angle(axis: &Vec3, angle: S) -> Self {
         let (s, c) = super::trig::sin_cos(angle);
+        Transform::from_axis_sin_cos(axis, s, c)
+    }
+
+    /// [`Transform::from_axis_angle`] given the angle's sine `s` and cosine `c`.
+    #[inline(always)]
+    pub fn from_axis_sin_cos(axis: &Vec3, s: S, c: S) -> Self {
         let t = S::one() - c;
         let a: Vector3<S> = super::splat_vector(axis);
         // E = c 1 - s a× + (1 - c) a aᵀ
@@ -84,12 +90,12 @@ impl<S: Real> Transform<S> {
         }
     }
 
-    /// `X_J X` for `X_J` a rotation by `angle` about coordinate axis `k` (0, 1, 2 for x, y, z) of
-    /// this transform's target frame: E' = E_J E turns the two rows of E other than k (E_J's
-    /// rows are [c s; −s c] on them, as `from_axis_angle` gives), r' = r (X_J moves no origin).
+    /// `X_J X` for `X_J` a rotation about coordinate axis `k` (0, 1, 2 for x, y, z) of this
+    /// transform's target frame by the angle of sine `s` and cosine `c`: E' = E_J E turns the two
+    /// rows of E other than k (E_J's rows are [c s; −s c] on them, as `from_axis_angle` gives),
+    /// r' = r (X_J moves no origin).
     #[inline(always)]
-    pub fn rotated_about_axis(&self, k: usize, angle: S) -> Transform<S> {
-        let (s, c) = super::trig::sin_cos(angle);
+    pub fn rotated_about_axis(&self, k: usize, s: S, c: S) -> Transform<S> {
         // the axis as a constant, so that the rows turned are registers, not indexed stores
         match k {
             0 => self.rotated_about::<0>(s, c),
