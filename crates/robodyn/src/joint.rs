@@ -161,29 +161,30 @@ impl Joint {
 
     /// Column `k` of `S` in the coordinates `x` maps from (the world's, for `x = X_{i←0}`):
     /// `X⁻¹ S_k = (Eᵀ ω_k, Eᵀ v_k + r × Eᵀ ω_k)`. About or along coordinate axis c of the joint
-    /// frame, `Eᵀ e_c` is row c of E: a revolute joint turns about it (v = r × ω), a prismatic
-    /// one slides along it — no rotation product.
+    /// frame, `Eᵀ e_c` is row c of E: a joint turns about it (v = r × ω) or slides along it —
+    /// no rotation product. Spherical and free joints' columns are all such axes.
     #[inline(always)]
     pub fn subspace_column_from<S: Real>(&self, k: usize, x: &Transform<S>) -> Motion<S> {
         let e = &x.rotation;
+        let row = |c: usize| Vector3::new(e[(c, 0)], e[(c, 1)], e[(c, 2)]);
         // Eᵀ a, a row of E when a is a coordinate axis
-        let back = |a: &Vec3| match coordinate_axis(a) {
-            Some(c) => Vector3::new(e[(c, 0)], e[(c, 1)], e[(c, 2)]),
-            None => rotate_back(e, &splat_vector(a)),
+        let back =
+            |a: &Vec3| coordinate_axis(a).map_or_else(|| rotate_back(e, &splat_vector(a)), row);
+        let turning = |angular: Vector3<S>| Motion {
+            linear: cross(&x.translation, &angular),
+            angular,
+        };
+        let sliding = |linear: Vector3<S>| Motion {
+            angular: zero_vector(),
+            linear,
         };
         match self {
-            Joint::Revolute { axis } => {
-                let angular = back(axis);
-                Motion {
-                    linear: cross(&x.translation, &angular),
-                    angular,
-                }
-            }
-            Joint::Prismatic { axis } => Motion {
-                angular: zero_vector(),
-                linear: back(axis),
-            },
-            _ => x.inverse_apply_motion(&Motion::splat(&self.subspace_column(k))),
+            Joint::Fixed => Motion::zeros(),
+            Joint::Revolute { axis } => turning(back(axis)),
+            Joint::Prismatic { axis } => sliding(back(axis)),
+            Joint::Spherical => turning(row(k)),
+            Joint::Free if k < 3 => sliding(row(k)),
+            Joint::Free => turning(row(k - 3)),
         }
     }
 
