@@ -120,6 +120,11 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
         for x, w in zip(pin_states, pin_velocities):
             pin.computeRNEADerivatives(pm, pd, x, w, w)
 
+    def pin_frame_pose_loop():
+        for x in pin_states:
+            pin.forwardKinematics(pm, pd, x)
+            pin.updateFramePlacement(pm, pd, frame_id)
+
     def pin_aba_derivatives_loop():
         for x, w in zip(pin_states, pin_velocities):
             pin.computeABADerivatives(pm, pd, x, w, w)
@@ -131,6 +136,7 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
         "aba": (lambda: m.forward_dynamics(states, velocities, velocities), pin_aba_loop),
         "rnea_derivatives": (lambda: m.inverse_dynamics_derivatives(states, velocities, velocities), pin_rnea_derivatives_loop),
         "aba_derivatives": (lambda: m.forward_dynamics_derivatives(states, velocities, velocities), pin_aba_derivatives_loop),
+        "frame_pose": (lambda: m.frame_pose(states, frame), pin_frame_pose_loop),
     }
     rows += [(f"{name} {algorithm} ({batch} states)", *batch_times(ours, theirs)) for algorithm, (ours, theirs) in batches.items()]
     return rows

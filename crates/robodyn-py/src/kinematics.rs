@@ -43,11 +43,11 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let frame = self.frame_index(frame)?;
         let kernel: &Kernel = &|m, w, i, out| {
-            let pose = algo::frame_pose(m, &mut w.data, i[0], frame)?;
-            write_pose(&pose, out);
+            algo::frame_pose(m, &mut w.data, i[0], frame)?.write_homogeneous(out);
             Ok(())
         };
-        self.evaluate_into(py, &[self.q_arg("q", q)?], &[4, 4], out, kernel, None)
+        let lanes = Some(LaneKernel::FramePose(frame));
+        self.evaluate_into(py, &[self.q_arg("q", q)?], &[4, 4], out, kernel, lanes)
     }
 
     /// The pose in the world of every body, the world first: (nbodies, 4, 4) homogeneous
@@ -65,7 +65,7 @@ impl PyModel {
             &|m, w, i, out| {
                 let placements = algo::forward_kinematics(m, &mut w.data, i[0])?;
                 for (placement, pose) in placements.iter().zip(out.chunks_exact_mut(16)) {
-                    write_pose(placement, pose);
+                    placement.write_homogeneous(pose);
                 }
                 Ok(())
             },
@@ -467,15 +467,5 @@ impl PyModel {
         )?;
         result.set_item("residual", packed.get_item(column(nq + 2))?)?;
         Ok(result)
-    }
-}
-
-/// Writes the pose a placement `X_{B←A}` describes (B in A) as a row-major 4x4 matrix.
-fn write_pose(placement: &robodyn::spatial::Transform, out: &mut [f64]) {
-    let pose = placement.to_homogeneous();
-    for (r, row) in out.chunks_exact_mut(4).enumerate() {
-        for (c, value) in row.iter_mut().enumerate() {
-            *value = pose[(r, c)];
-        }
     }
 }

@@ -91,6 +91,8 @@ pub(crate) enum LaneKernel {
     RneaDerivatives,
     /// Inputs q, v, τ: ∂q̈/∂q, ∂q̈/∂v and M⁻¹ stacked.
     AbaDerivatives,
+    /// Input q: the pose of a frame (its index), 4 × 4.
+    FramePose(usize),
 }
 
 impl LaneKernel {
@@ -117,6 +119,7 @@ impl LaneKernel {
                 algo::rnea_derivatives_batch(model, lanes, dynamics, out)
             }
             LaneKernel::CompositeRigidBody => algo::crba_batch(model, lanes, q, out),
+            LaneKernel::FramePose(frame) => algo::frame_pose_batch(model, lanes, q, frame, out),
             LaneKernel::ArticulatedBody | LaneKernel::AbaDerivatives => {
                 let forward = States {
                     a: None,

@@ -50,6 +50,13 @@ proptest! {
     }
 
     #[test]
+    fn homogeneous_rows_are_the_homogeneous_matrix(x in transform()) {
+        let mut rows = [0.0; 16];
+        x.write_homogeneous(&mut rows);
+        prop_assert_eq!(nalgebra::Matrix4::from_row_slice(&rows), x.to_homogeneous());
+    }
+
+    #[test]
     fn composition_matches_matrix_product(a in transform(), b in transform()) {
         prop_assert!(((a * b).to_matrix() - a.to_matrix() * b.to_matrix()).norm() < 1e-10);
     }

@@ -71,30 +71,48 @@ pub fn forward_kinematics<'d>(
 /// Writes `data.support` (the bodies from `body` to the world) and `data.x_up`, `data.x_world`
 /// along it only: what a single frame needs.
 pub(crate) fn update_support_placements(model: &Model, data: &mut Data, q: &[f64], body: usize) {
-    data.support.clear();
+    support_of(model, body, &mut data.support);
+    support_placements(model, q, &data.support, &mut data.x_up, &mut data.x_world);
+}
+
+/// The bodies from `body` to the world (the world left out), into `support`.
+pub(crate) fn support_of(model: &Model, body: usize, support: &mut Vec<usize>) {
+    support.clear();
     let mut j = body;
     while j != 0 {
-        data.support.push(j);
+        support.push(j);
         j = model.parent[j];
     }
+}
+
+/// `X_{i←λ(i)}` and `X_{i←0}` of the bodies of `support` (from a body to the world), in `f64` or
+/// lanes.
+#[inline(always)]
+pub(crate) fn support_placements<S: Real>(
+    model: &Model,
+    q: &[S],
+    support: &[usize],
+    x_up: &mut [Transform<S>],
+    x_world: &mut [Transform<S>],
+) {
     // the joints first, independent of one another (their sines several at once), then the
     // chain that needs them
-    let (mut indices, mut turns) = ([0; TURNS_AT_ONCE], [(0.0, 1.0); TURNS_AT_ONCE]);
-    for bodies in data.support.chunks(TURNS_AT_ONCE) {
+    let (mut indices, mut turns) = ([0; TURNS_AT_ONCE], [(S::zero(), S::one()); TURNS_AT_ONCE]);
+    for bodies in support.chunks(TURNS_AT_ONCE) {
         for (index, &i) in indices.iter_mut().zip(bodies) {
             *index = model.idx_q[i];
         }
         let turns = &mut turns[..bodies.len()];
-        f64::sin_cos_at(q, &indices[..bodies.len()], turns);
+        S::sin_cos_at(q, &indices[..bodies.len()], turns);
         for (&i, &turn) in bodies.iter().zip(turns.iter()) {
             // X_{i←λ(i)} = X_J(q_i) X_T(i)
             let joint = &model.joints[i];
-            data.x_up[i] = joint.transform_after_turn(&q[model.q_range(i)], turn, &model.x_tree[i]);
+            x_up[i] = joint.transform_after_turn(&q[model.q_range(i)], turn, &model.x_tree[i]);
         }
     }
-    for &i in data.support.iter().rev() {
+    for &i in support.iter().rev() {
         // X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}
-        data.x_world[i] = data.x_up[i] * data.x_world[model.parent[i]];
+        x_world[i] = x_up[i] * x_world[model.parent[i]];
     }
 }
 

@@ -16,6 +16,7 @@ mod scatter;
 use crate::algo::aba::aba;
 use crate::algo::crba::crba_into;
 use crate::algo::derivatives::{aba_derivatives_stacked, rnea_derivatives_stacked};
+use crate::algo::kinematics::{check_frame, frame_pose};
 use crate::algo::rnea::newton_euler;
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::model::Model;
@@ -145,6 +146,9 @@ enum Algorithm {
     RneaDerivatives,
     /// ∂q̈/∂q, ∂q̈/∂q̇ and M⁻¹ of q̈ = FD(q, v, τ), stacked.
     AbaDerivatives,
+    /// The pose of frame `frame` in the world, a 4 × 4 homogeneous matrix (forward kinematics
+    /// along the frame's support).
+    FramePose { frame: usize },
 }
 
 impl Algorithm {
@@ -158,6 +162,7 @@ impl Algorithm {
         match self {
             Algorithm::CompositeRigidBody => model.nv * model.nv,
             Algorithm::RneaDerivatives | Algorithm::AbaDerivatives => 3 * model.nv * model.nv,
+            Algorithm::FramePose { .. } => 16,
             _ => model.nv,
         }
     }
@@ -249,6 +254,29 @@ pub fn aba_derivatives_batch(
     run_batch(Algorithm::AbaDerivatives, model, workspace, states, out)
 }
 
+/// The pose of frame `frame` for every configuration of `q` (n × nq): `poses` (n × 4 × 4, each
+/// the homogeneous matrix `[R p; 0 1]` row by row), checked and grouped as [`newton_euler_batch`].
+pub fn frame_pose_batch(
+    model: &Model,
+    workspace: &mut BatchWorkspace,
+    q: &[f64],
+    frame: usize,
+    poses: &mut [f64],
+) -> BatchResult {
+    check_frame(model, frame).map_err(|e| (0, e))?;
+    let states = States {
+        q,
+        ..States::default()
+    };
+    run_batch(
+        Algorithm::FramePose { frame },
+        model,
+        workspace,
+        states,
+        poses,
+    )
+}
+
 /// An error if one of `inputs` is missing.
 fn require(inputs: &[(&str, Option<&[f64]>)], what: &str) -> BatchResult {
     match inputs.iter().find(|(_, values)| values.is_none()) {
@@ -273,7 +301,7 @@ fn run_batch(
     out: &mut [f64],
 ) -> BatchResult {
     let (nv, size) = (model.nv, algorithm.output_size(model));
-    if nv == 0 {
+    if nv == 0 && !matches!(algorithm, Algorithm::FramePose { .. }) {
         return Ok(());
     }
     let n = out.len() / size;
@@ -321,6 +349,11 @@ fn run_batch(
                 let (v, tau) = (state.v.unwrap_or_default(), state.tau.unwrap_or_default());
                 let one = (state.q, v, tau, None);
                 aba_derivatives_stacked(model, data, one, out).map_err(|e| (k, e))?;
+                continue;
+            }
+            Algorithm::FramePose { frame } => {
+                let pose = frame_pose(model, data, state.q, frame).map_err(|e| (k, e))?;
+                pose.write_homogeneous(out);
                 continue;
             }
         };
@@ -415,6 +448,10 @@ mod tests {
                 a: None,
                 tau: a,
             },
+            Algorithm::FramePose { .. } => States {
+                q: &q,
+                ..States::default()
+            },
         };
         let size = algorithm.output_size(&model);
         let mut lanes = vec![0.0; n * size];
@@ -444,6 +481,7 @@ mod tests {
             Algorithm::CompositeRigidBody,
             Algorithm::RneaDerivatives,
             Algorithm::AbaDerivatives,
+            Algorithm::FramePose { frame: 7 },
         ] {
             lanes_equal_one_state::<AutoF64x4>(algorithm);
             lanes_equal_one_state::<AutoF64x8>(algorithm);

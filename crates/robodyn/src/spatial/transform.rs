@@ -241,6 +241,33 @@ impl<S: Real> Transform<S> {
     }
 }
 
+impl<S: Real> Transform<S> {
+    /// [`Transform::to_homogeneous`] written row by row into `out` (16 values), in `f64` or lanes.
+    #[inline(always)]
+    pub fn write_homogeneous(&self, out: &mut [S]) {
+        let (e, r) = (&self.rotation, &self.translation);
+        let (zero, one) = (S::zero(), S::one());
+        out[..16].copy_from_slice(&[
+            e[(0, 0)],
+            e[(1, 0)],
+            e[(2, 0)],
+            r.x, //
+            e[(0, 1)],
+            e[(1, 1)],
+            e[(2, 1)],
+            r.y, //
+            e[(0, 2)],
+            e[(1, 2)],
+            e[(2, 2)],
+            r.z, //
+            zero,
+            zero,
+            zero,
+            one,
+        ]);
+    }
+}
+
 impl Transform {
     /// The pose of B in A as a 4x4 homogeneous matrix `[Eᵀ r; 0 1]` (maps B points to A points).
     #[inline]

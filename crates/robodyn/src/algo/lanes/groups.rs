@@ -10,6 +10,7 @@ use crate::algo::crba::{
 use crate::algo::derivatives::{
     aba_derivative_passes, derivative_passes, DerivativeBuffers, RowMajor, SolveBuffers,
 };
+use crate::algo::kinematics::{support_of, support_placements};
 use crate::algo::rnea::{newton_euler_passes, NewtonEulerBuffers};
 use crate::model::Model;
 use crate::spatial::{
@@ -50,6 +51,8 @@ pub(super) struct Lanes<S> {
     factor: Vec<S>,
     rows: Vec<S>,
     out: Vec<S>,
+    support: Vec<usize>,
+    pose: Vec<S>,
 }
 
 impl<S: Real> Lanes<S> {
@@ -87,6 +90,8 @@ impl<S: Real> Lanes<S> {
             factor: vec![zero; model.nv * model.nv],
             rows: vec![zero; 3 * model.nv * model.nv],
             out: vec![zero; model.nv],
+            support: Vec::with_capacity(bodies),
+            pose: vec![zero; 16],
         }
     }
 }
@@ -265,6 +270,16 @@ pub(super) fn groups<S: Scatter>(
                         S::scatter(part, out, size, (block * nv + i) * nv);
                     }
                 }
+                continue;
+            }
+            Algorithm::FramePose { frame } => {
+                let (frame, x_world) = (&model.frames[frame], &mut lanes.x_world);
+                support_of(model, frame.body, &mut lanes.support);
+                support_placements(model, &lanes.q, &lanes.support, &mut lanes.x_up, x_world);
+                // X_{frame←0} = X_{frame←body} X_{body←0}
+                let pose = Transform::splat(&frame.placement) * x_world[frame.body];
+                pose.write_homogeneous(&mut lanes.pose);
+                S::scatter(&lanes.pose, out, size, 0);
                 continue;
             }
         }
