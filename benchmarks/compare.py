@@ -125,6 +125,10 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
             pin.forwardKinematics(pm, pd, x)
             pin.updateFramePlacement(pm, pd, frame_id)
 
+    def pin_jacobian_loop():
+        for x in pin_states:
+            pin.computeFrameJacobian(pm, pd, x, frame_id, pin.LOCAL_WORLD_ALIGNED)
+
     def pin_aba_derivatives_loop():
         for x, w in zip(pin_states, pin_velocities):
             pin.computeABADerivatives(pm, pd, x, w, w)
@@ -137,6 +141,7 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
         "rnea_derivatives": (lambda: m.inverse_dynamics_derivatives(states, velocities, velocities), pin_rnea_derivatives_loop),
         "aba_derivatives": (lambda: m.forward_dynamics_derivatives(states, velocities, velocities), pin_aba_derivatives_loop),
         "frame_pose": (lambda: m.frame_pose(states, frame), pin_frame_pose_loop),
+        "jacobian": (lambda: m.jacobian(states, frame), pin_jacobian_loop),
     }
     rows += [(f"{name} {algorithm} ({batch} states)", *batch_times(ours, theirs)) for algorithm, (ours, theirs) in batches.items()]
     return rows

@@ -124,8 +124,10 @@ def test_batches_equal_the_loop_bit_for_bit(floating):
         loop = np.stack([np.asarray(getattr(m, name)(*(x[k] for x in args))) for k in range(n)])
         assert batch.shape == loop.shape, name
         np.testing.assert_array_equal(batch, loop, err_msg=name)
-    batch = m.jacobian(q, frame, "local")
-    np.testing.assert_array_equal(batch, np.stack([m.jacobian(x, frame, "local") for x in q]))
+    for reference in ("world", "local", "spatial"):
+        batch = m.jacobian(q, frame, reference)
+        loop = np.stack([m.jacobian(x, frame, reference) for x in q])
+        np.testing.assert_array_equal(batch, loop, err_msg=reference)
     batch = m.frame_pose(q, frame)
     np.testing.assert_array_equal(batch, np.stack([m.frame_pose(x, frame) for x in q]))
     batch = m.frame_acceleration(q, v, a, frame)

@@ -94,24 +94,14 @@ impl PyModel {
             out,
             &|m, w, i, out| {
                 // row-major (6, nv): only the columns of the frame's support are not zero
-                let nv = m.nv;
                 out.fill(0.0);
-                algo::jacobian_columns(
-                    m,
-                    &mut w.data,
-                    i[0],
-                    frame,
-                    reference,
-                    |c, linear, angular| {
-                        for row in 0..3 {
-                            out[row * nv + c] = linear[row];
-                            out[(row + 3) * nv + c] = angular[row];
-                        }
-                    },
-                )?;
+                let column = |c, linear: &_, angular: &_| {
+                    algo::write_jacobian_column(out, m.nv, c, linear, angular)
+                };
+                algo::jacobian_columns(m, &mut w.data, i[0], frame, reference, column)?;
                 Ok(())
             },
-            None,
+            Some(LaneKernel::Jacobian(frame, reference)),
         )
     }
 

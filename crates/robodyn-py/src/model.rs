@@ -93,6 +93,8 @@ pub(crate) enum LaneKernel {
     AbaDerivatives,
     /// Input q: the pose of a frame (its index), 4 × 4.
     FramePose(usize),
+    /// Input q: the Jacobian of a frame (its index) in a reference's coordinates, 6 × nv.
+    Jacobian(usize, algo::Reference),
 }
 
 impl LaneKernel {
@@ -120,6 +122,9 @@ impl LaneKernel {
             }
             LaneKernel::CompositeRigidBody => algo::crba_batch(model, lanes, q, out),
             LaneKernel::FramePose(frame) => algo::frame_pose_batch(model, lanes, q, frame, out),
+            LaneKernel::Jacobian(frame, reference) => {
+                algo::jacobian_batch(model, lanes, q, (frame, reference), out)
+            }
             LaneKernel::ArticulatedBody | LaneKernel::AbaDerivatives => {
                 let forward = States {
                     a: None,

@@ -8,12 +8,12 @@
 //! `data.x_world` along it, and `data.jacobian`. Cost: O(depth) plus one column per ancestor
 //! degree of freedom.
 
-use crate::algo::kinematics::{check_frame, frame_placement, update_support_placements};
+use crate::algo::kinematics::{check_frame, placement_of_frame, update_support_placements};
 use crate::error::Result;
 use crate::model::Model;
-use crate::spatial::Vec3;
+use crate::spatial::{cross, rotate, Real, Transform, Vec3};
 use crate::Data;
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, Vector3};
 
 /// The coordinates a Jacobian's columns are expressed in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -64,31 +64,44 @@ pub fn jacobian_columns(
     q: &[f64],
     frame: usize,
     reference: Reference,
-    mut column: impl FnMut(usize, &Vec3, &Vec3),
+    column: impl FnMut(usize, &Vec3, &Vec3),
 ) -> Result<()> {
     model.check_configuration(q)?;
     check_frame(model, frame)?;
     update_support_placements(model, data, q, model.frames[frame].body);
-    let pose = frame_placement(model, data, frame);
-    // p: the frame's origin in world coordinates
-    let origin = pose.translation;
+    let placements = (&data.support[..], &data.x_world[..]);
+    columns_of(model, placements, frame, reference, column);
+    Ok(())
+}
 
-    for &j in &data.support {
+/// [`jacobian_columns`] from the placements of the frame's support (`x_world` on `support`), in
+/// `f64` or lanes.
+#[inline(always)]
+pub(crate) fn columns_of<S: Real>(
+    model: &Model,
+    (support, x_world): (&[usize], &[Transform<S>]),
+    frame: usize,
+    reference: Reference,
+    mut column: impl FnMut(usize, &Vector3<S>, &Vector3<S>),
+) {
+    // X_{frame←0}; p: the frame's origin in world coordinates
+    let pose = placement_of_frame(model, x_world, frame);
+    let origin = pose.translation;
+    for &j in support {
         let joint = &model.joints[j];
         for (k, index) in model.v_range(j).enumerate() {
             // (ω, v_O) = X_{j←0}⁻¹ S_k
-            let s = joint.subspace_column_from(k, &data.x_world[j]);
+            let s = joint.subspace_column_from(k, &x_world[j]);
             let (linear, angular) = match reference {
                 Reference::Spatial => (s.linear, s.angular),
                 // v_p = v_O + ω × p
-                Reference::World => (s.linear + s.angular.cross(&origin), s.angular),
+                Reference::World => (s.linear + cross(&s.angular, &origin), s.angular),
                 Reference::Local => (
-                    pose.rotation * (s.linear + s.angular.cross(&origin)),
-                    pose.rotation * s.angular,
+                    rotate(&pose.rotation, &(s.linear + cross(&s.angular, &origin))),
+                    rotate(&pose.rotation, &s.angular),
                 ),
             };
             column(index, &linear, &angular);
         }
     }
-    Ok(())
 }

@@ -142,6 +142,17 @@ pub(crate) fn check_frame(model: &Model, frame: usize) -> Result<()> {
 /// `X_{frame←0}` of frame `frame` from the body placements in `data.x_world` (call
 /// [`forward_kinematics`] first). Its pose in the world is [`Transform::to_homogeneous`].
 pub fn frame_placement(model: &Model, data: &Data, frame: usize) -> Transform {
+    placement_of_frame(model, &data.x_world, frame)
+}
+
+/// `X_{frame←0} = X_{frame←body} X_{body←0}` from the body placements `x_world`, in `f64` or
+/// lanes.
+#[inline(always)]
+pub(crate) fn placement_of_frame<S: Real>(
+    model: &Model,
+    x_world: &[Transform<S>],
+    frame: usize,
+) -> Transform<S> {
     let f = &model.frames[frame];
-    f.placement * data.x_world[f.body]
+    Transform::splat(&f.placement) * x_world[f.body]
 }

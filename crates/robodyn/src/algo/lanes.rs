@@ -16,12 +16,15 @@ mod scatter;
 use crate::algo::aba::aba;
 use crate::algo::crba::crba_into;
 use crate::algo::derivatives::{aba_derivatives_stacked, rnea_derivatives_stacked};
+use crate::algo::jacobian::{jacobian_columns, Reference};
 use crate::algo::kinematics::{check_frame, frame_pose};
 use crate::algo::rnea::newton_euler;
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::model::Model;
+use crate::spatial::{Real, Vec3};
 use crate::Data;
 use groups::{groups_eight, groups_four, Lanes};
+use nalgebra::Vector3;
 use simba::simd::{AutoF64x4, AutoF64x8};
 
 /// How many states a batch kernel runs at once.
@@ -149,6 +152,8 @@ enum Algorithm {
     /// The pose of frame `frame` in the world, a 4 × 4 homogeneous matrix (forward kinematics
     /// along the frame's support).
     FramePose { frame: usize },
+    /// The Jacobian of frame `frame` (6 × nv, row-major) in `reference`'s coordinates.
+    Jacobian { frame: usize, reference: Reference },
 }
 
 impl Algorithm {
@@ -163,6 +168,7 @@ impl Algorithm {
             Algorithm::CompositeRigidBody => model.nv * model.nv,
             Algorithm::RneaDerivatives | Algorithm::AbaDerivatives => 3 * model.nv * model.nv,
             Algorithm::FramePose { .. } => 16,
+            Algorithm::Jacobian { .. } => 6 * model.nv,
             _ => model.nv,
         }
     }
@@ -277,6 +283,25 @@ pub fn frame_pose_batch(
     )
 }
 
+/// The Jacobian of frame `frame` in `reference`'s coordinates for every configuration of `q`
+/// (n × nq): `jacobians` (n × 6 × nv, each row-major), checked and grouped as
+/// [`newton_euler_batch`].
+pub fn jacobian_batch(
+    model: &Model,
+    workspace: &mut BatchWorkspace,
+    q: &[f64],
+    (frame, reference): (usize, Reference),
+    jacobians: &mut [f64],
+) -> BatchResult {
+    check_frame(model, frame).map_err(|e| (0, e))?;
+    let states = States {
+        q,
+        ..States::default()
+    };
+    let algorithm = Algorithm::Jacobian { frame, reference };
+    run_batch(algorithm, model, workspace, states, jacobians)
+}
+
 /// An error if one of `inputs` is missing.
 fn require(inputs: &[(&str, Option<&[f64]>)], what: &str) -> BatchResult {
     match inputs.iter().find(|(_, values)| values.is_none()) {
@@ -301,7 +326,7 @@ fn run_batch(
     out: &mut [f64],
 ) -> BatchResult {
     let (nv, size) = (model.nv, algorithm.output_size(model));
-    if nv == 0 && !matches!(algorithm, Algorithm::FramePose { .. }) {
+    if size == 0 {
         return Ok(());
     }
     let n = out.len() / size;
@@ -356,10 +381,35 @@ fn run_batch(
                 pose.write_homogeneous(out);
                 continue;
             }
+            Algorithm::Jacobian { frame, reference } => {
+                out.fill(0.0);
+                let column = |c: usize, linear: &Vec3, angular: &Vec3| {
+                    write_jacobian_column(out, nv, c, linear, angular)
+                };
+                jacobian_columns(model, data, state.q, frame, reference, column)
+                    .map_err(|e| (k, e))?;
+                continue;
+            }
         };
         out.copy_from_slice(result.map_err(|e| (k, e))?.as_slice());
     }
     Ok(())
+}
+
+/// Column `c` of a row-major 6 × nv Jacobian, `[linear; angular]`, in `f64` or lanes (what
+/// [`jacobian_columns`] hands on, written as NumPy lays J out).
+#[inline(always)]
+pub fn write_jacobian_column<S: Real>(
+    jacobian: &mut [S],
+    nv: usize,
+    c: usize,
+    linear: &Vector3<S>,
+    angular: &Vector3<S>,
+) {
+    for row in 0..3 {
+        jacobian[row * nv + c] = linear[row];
+        jacobian[(row + 3) * nv + c] = angular[row];
+    }
 }
 
 /// State k of the batch.
@@ -448,7 +498,7 @@ mod tests {
                 a: None,
                 tau: a,
             },
-            Algorithm::FramePose { .. } => States {
+            Algorithm::FramePose { .. } | Algorithm::Jacobian { .. } => States {
                 q: &q,
                 ..States::default()
             },
@@ -482,6 +532,18 @@ mod tests {
             Algorithm::RneaDerivatives,
             Algorithm::AbaDerivatives,
             Algorithm::FramePose { frame: 7 },
+            Algorithm::Jacobian {
+                frame: 7,
+                reference: Reference::World,
+            },
+            Algorithm::Jacobian {
+                frame: 5,
+                reference: Reference::Local,
+            },
+            Algorithm::Jacobian {
+                frame: 7,
+                reference: Reference::Spatial,
+            },
         ] {
             lanes_equal_one_state::<AutoF64x4>(algorithm);
             lanes_equal_one_state::<AutoF64x8>(algorithm);

@@ -2,7 +2,7 @@
 //! generic passes, scattered back; compiled once per instruction set.
 
 use super::scatter::Scatter;
-use super::{Algorithm, States};
+use super::{write_jacobian_column, Algorithm, States};
 use crate::algo::aba::{articulated_body_passes, AbaBuffers};
 use crate::algo::crba::{
     add_composites, mass_matrix_of_composites, world_inertias_of, CompositeBuffers,
@@ -10,7 +10,8 @@ use crate::algo::crba::{
 use crate::algo::derivatives::{
     aba_derivative_passes, derivative_passes, DerivativeBuffers, RowMajor, SolveBuffers,
 };
-use crate::algo::kinematics::{support_of, support_placements};
+use crate::algo::jacobian::columns_of;
+use crate::algo::kinematics::{placement_of_frame, support_of, support_placements};
 use crate::algo::rnea::{newton_euler_passes, NewtonEulerBuffers};
 use crate::model::Model;
 use crate::spatial::{
@@ -53,6 +54,7 @@ pub(super) struct Lanes<S> {
     out: Vec<S>,
     support: Vec<usize>,
     pose: Vec<S>,
+    jacobian: Vec<S>,
 }
 
 impl<S: Real> Lanes<S> {
@@ -92,6 +94,7 @@ impl<S: Real> Lanes<S> {
             out: vec![zero; model.nv],
             support: Vec::with_capacity(bodies),
             pose: vec![zero; 16],
+            jacobian: vec![zero; 6 * model.nv],
         }
     }
 }
@@ -273,13 +276,24 @@ pub(super) fn groups<S: Scatter>(
                 continue;
             }
             Algorithm::FramePose { frame } => {
-                let (frame, x_world) = (&model.frames[frame], &mut lanes.x_world);
-                support_of(model, frame.body, &mut lanes.support);
+                let x_world = &mut lanes.x_world;
+                support_of(model, model.frames[frame].body, &mut lanes.support);
                 support_placements(model, &lanes.q, &lanes.support, &mut lanes.x_up, x_world);
-                // X_{frame←0} = X_{frame←body} X_{body←0}
-                let pose = Transform::splat(&frame.placement) * x_world[frame.body];
-                pose.write_homogeneous(&mut lanes.pose);
+                placement_of_frame(model, x_world, frame).write_homogeneous(&mut lanes.pose);
                 S::scatter(&lanes.pose, out, size, 0);
+                continue;
+            }
+            Algorithm::Jacobian { frame, reference } => {
+                let x_world = &mut lanes.x_world;
+                support_of(model, model.frames[frame].body, &mut lanes.support);
+                support_placements(model, &lanes.q, &lanes.support, &mut lanes.x_up, x_world);
+                let jacobian = &mut lanes.jacobian;
+                jacobian.fill(S::splat(0.0));
+                let placements = (&lanes.support[..], &x_world[..]);
+                columns_of(model, placements, frame, reference, |c, linear, angular| {
+                    write_jacobian_column(jacobian, nv, c, linear, angular)
+                });
+                S::scatter(jacobian, out, size, 0);
                 continue;
             }
         }
