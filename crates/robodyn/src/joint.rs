@@ -20,17 +20,40 @@ mod jacobians;
 /// Below this rotation angle the SE(3)/SO(3) exponential and logarithm use their Taylor series.
 const SMALL_ANGLE: f64 = 1e-6;
 
-/// Which coordinate axis (0, 1, 2 for x, y, z) a unit vector is exactly, if any. Asked for
-/// every joint of every call: which two components are zero first, then the third, in four
-/// comparisons (a search over the three axes had cost a tenth of a Jacobian).
-#[inline(always)]
-fn coordinate_axis(axis: &Vec3) -> Option<usize> {
-    match (axis.x == 0.0, axis.y == 0.0, axis.z == 0.0) {
-        (true, true, false) if axis.z == 1.0 => Some(2),
-        (true, false, true) if axis.y == 1.0 => Some(1),
-        (false, true, true) if axis.x == 1.0 => Some(0),
-        _ => None,
+/// A unit vector that is exactly a coordinate axis or its opposite.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct CoordinateAxis {
+    /// 0, 1, 2 for x, y, z.
+    index: usize,
+    /// Whether it points the negative way.
+    negative: bool,
+}
+
+impl CoordinateAxis {
+    /// `x`, or `−x` for an axis that points the negative way.
+    #[inline(always)]
+    fn signed<T: std::ops::Neg<Output = T>>(self, x: T) -> T {
+        if self.negative {
+            -x
+        } else {
+            x
+        }
     }
+}
+
+/// Which coordinate axis a unit vector is exactly, or its opposite, if any. Asked for every joint
+/// of every call: which two components are zero first, then the third (a search over the three
+/// axes had cost a tenth of a Jacobian).
+#[inline(always)]
+fn coordinate_axis(axis: &Vec3) -> Option<CoordinateAxis> {
+    let (index, value) = match (axis.x == 0.0, axis.y == 0.0, axis.z == 0.0) {
+        (true, true, false) => (2, axis.z),
+        (true, false, true) => (1, axis.y),
+        (false, true, true) => (0, axis.x),
+        _ => return None,
+    };
+    let negative = value == -1.0;
+    (value == 1.0 || negative).then_some(CoordinateAxis { index, negative })
 }
 
 /// A joint between a body and its parent.
@@ -141,7 +164,8 @@ impl Joint {
         match self {
             Joint::Fixed => x_tree,
             Joint::Revolute { axis } => match coordinate_axis(axis) {
-                Some(k) => x_tree.rotated_about_axis(k, s, c),
+                // about −e_k by θ is about e_k by −θ
+                Some(k) => x_tree.rotated_about_axis(k.index, k.signed(s), c),
                 None => Transform::from_axis_sin_cos(axis, s, c) * x_tree,
             },
             Joint::Prismatic { axis } => Transform {
@@ -176,9 +200,11 @@ impl Joint {
     pub fn subspace_column_from<S: Real>(&self, k: usize, x: &Transform<S>) -> Motion<S> {
         let e = &x.rotation;
         let row = |c: usize| Vector3::new(e[(c, 0)], e[(c, 1)], e[(c, 2)]);
-        // Eᵀ a, a row of E when a is a coordinate axis
-        let back =
-            |a: &Vec3| coordinate_axis(a).map_or_else(|| rotate_back(e, &splat_vector(a)), row);
+        // Eᵀ a, a row of E (or its opposite) when a is a coordinate axis (or its opposite)
+        let back = |a: &Vec3| match coordinate_axis(a) {
+            Some(k) => k.signed(row(k.index)),
+            None => rotate_back(e, &splat_vector(a)),
+        };
         let turning = |angular: Vector3<S>| Motion {
             linear: cross(&x.translation, &angular),
             angular,
@@ -205,11 +231,11 @@ impl Joint {
         match self {
             Joint::Fixed => Force::new(zero_vector(), zero_vector()),
             Joint::Revolute { axis } => match coordinate_axis(axis) {
-                Some(c) => inertia_column(inertia, c),
+                Some(c) => c.signed(inertia_column(inertia, c.index)),
                 None => inertia_times_axis(inertia, 0, axis),
             },
             Joint::Prismatic { axis } => match coordinate_axis(axis) {
-                Some(c) => inertia_column(inertia, 3 + c),
+                Some(c) => c.signed(inertia_column(inertia, 3 + c.index)),
                 None => inertia_times_axis(inertia, 3, axis),
             },
             Joint::Spherical => inertia_column(inertia, k),
@@ -585,21 +611,24 @@ mod tests {
 
     #[test]
     fn coordinate_axes_are_exactly_the_unit_vectors() {
+        let axis = |index, negative| Some(CoordinateAxis { index, negative });
         let cases = [
-            (Vec3::new(1.0, 0.0, 0.0), Some(0)),
-            (Vec3::new(0.0, 1.0, 0.0), Some(1)),
-            (Vec3::new(0.0, 0.0, 1.0), Some(2)),
-            (Vec3::new(-0.0, 0.0, 1.0), Some(2)),
-            (Vec3::new(0.0, -0.0, 1.0), Some(2)),
-            (Vec3::new(0.0, 0.0, -1.0), None),
+            (Vec3::new(1.0, 0.0, 0.0), axis(0, false)),
+            (Vec3::new(0.0, 1.0, 0.0), axis(1, false)),
+            (Vec3::new(0.0, 0.0, 1.0), axis(2, false)),
+            (Vec3::new(-0.0, 0.0, 1.0), axis(2, false)),
+            (Vec3::new(0.0, -0.0, 1.0), axis(2, false)),
+            (Vec3::new(0.0, 0.0, -1.0), axis(2, true)),
+            (Vec3::new(-1.0, -0.0, 0.0), axis(0, true)),
             (Vec3::new(0.0, 1.0, 1e-300), None),
             (Vec3::new(1.0 - f64::EPSILON, 0.0, 0.0), None),
+            (Vec3::new(0.0, -1.0 - f64::EPSILON, 0.0), None),
             (Vec3::new(0.6, 0.0, 0.8), None),
             (Vec3::new(f64::NAN, 0.0, 1.0), None),
             (Vec3::new(0.0, 0.0, 0.0), None),
         ];
-        for (axis, expected) in cases {
-            assert_eq!(coordinate_axis(&axis), expected, "{axis:?}");
+        for (vector, expected) in cases {
+            assert_eq!(coordinate_axis(&vector), expected, "{vector:?}");
         }
     }
 }
