@@ -24,15 +24,29 @@ pub(crate) fn joint_transforms<S: Real>(model: &Model, q: &[S], x_up: &mut [Tran
     let mut turns = [(S::zero(), S::one()); TURNS_AT_ONCE];
     for first in (1..model.nbodies()).step_by(TURNS_AT_ONCE) {
         let bodies = first..model.nbodies().min(first + TURNS_AT_ONCE);
-        // (sin, cos) of each body's first coordinate: a revolute joint's angle (the others'
-        // are not used), several at once
-        let turns = &mut turns[..bodies.len()];
-        S::sin_cos_at(q, &model.idx_q[bodies.clone()], turns);
-        for (i, &turn) in bodies.zip(turns.iter()) {
-            // X_{i←λ(i)} = X_J(q_i) X_T(i)
-            let joint = &model.joints[i];
-            x_up[i] = joint.transform_after_turn(&q[model.q_range(i)], turn, &model.x_tree[i]);
-        }
+        // consecutive bodies: their first coordinates are a slice of idx_q
+        let coordinates = &model.idx_q[bodies.clone()];
+        transforms_of_chunk(model, q, bodies, coordinates, &mut turns, x_up);
+    }
+}
+
+/// `X_{i←λ(i)} = X_J(q_i) X_T(i)` of the bodies of `bodies`, whose first coordinates are
+/// `coordinates` (a revolute joint's angle; the others' sines are not used): the sines and
+/// cosines of all of them first ([`Real::sin_cos_at`]), then the transforms.
+#[inline(always)]
+fn transforms_of_chunk<S: Real>(
+    model: &Model,
+    q: &[S],
+    bodies: impl Iterator<Item = usize>,
+    coordinates: &[usize],
+    turns: &mut [(S, S)],
+    x_up: &mut [Transform<S>],
+) {
+    let turns = &mut turns[..coordinates.len()];
+    S::sin_cos_at(q, coordinates, turns);
+    for (i, &turn) in bodies.zip(turns.iter()) {
+        let joint = &model.joints[i];
+        x_up[i] = joint.transform_after_turn(&q[model.q_range(i)], turn, &model.x_tree[i]);
     }
 }
 
@@ -102,13 +116,15 @@ pub(crate) fn support_placements<S: Real>(
         for (index, &i) in indices.iter_mut().zip(bodies) {
             *index = model.idx_q[i];
         }
-        let turns = &mut turns[..bodies.len()];
-        S::sin_cos_at(q, &indices[..bodies.len()], turns);
-        for (&i, &turn) in bodies.iter().zip(turns.iter()) {
-            // X_{i←λ(i)} = X_J(q_i) X_T(i)
-            let joint = &model.joints[i];
-            x_up[i] = joint.transform_after_turn(&q[model.q_range(i)], turn, &model.x_tree[i]);
-        }
+        let coordinates = &indices[..bodies.len()];
+        transforms_of_chunk(
+            model,
+            q,
+            bodies.iter().copied(),
+            coordinates,
+            &mut turns,
+            x_up,
+        );
     }
     for &i in support.iter().rev() {
         // X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}
