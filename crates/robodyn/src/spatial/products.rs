@@ -43,9 +43,7 @@ where
 
     #[inline(always)]
     fn sin_cos_at(q: &[Self], indices: &[usize], out: &mut [(Self, Self)]) {
-        for (turn, &index) in out.iter_mut().zip(indices) {
-            *turn = super::trig::sin_cos(q[index]);
-        }
+        super::trig::sin_cos_one_by_one(q, indices, out);
     }
 }
 

@@ -87,7 +87,8 @@ pub fn sin_cos<S: Real>(x: S) -> (S, S) {
 
 /// `out[k] = (sin, cos)` of `q[indices[k]]`: four values per evaluation in AVX2 lanes where the
 /// CPU has them (each lane gets the digits of [`sin_cos`] of its value alone), else one by one.
-/// A joint's sine costs as much as the rest of its transform; four at once cut it by about three.
+/// A joint's sine costs as much as the rest of its transform; four at once halve a forward
+/// kinematics' time spent on them.
 #[inline(never)]
 pub fn sin_cos_at(q: &[f64], indices: &[usize], out: &mut [(f64, f64)]) {
     #[cfg(target_arch = "x86_64")]
@@ -98,8 +99,9 @@ pub fn sin_cos_at(q: &[f64], indices: &[usize], out: &mut [(f64, f64)]) {
     sin_cos_one_by_one(q, indices, out);
 }
 
-/// [`sin_cos_at`] one value at a time.
-fn sin_cos_one_by_one(q: &[f64], indices: &[usize], out: &mut [(f64, f64)]) {
+/// [`sin_cos_at`] one value at a time, in `f64` or lanes.
+#[inline(always)]
+pub(crate) fn sin_cos_one_by_one<S: Real>(q: &[S], indices: &[usize], out: &mut [(S, S)]) {
     for (turn, &index) in out.iter_mut().zip(indices) {
         *turn = sin_cos(q[index]);
     }
