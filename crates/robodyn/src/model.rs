@@ -103,6 +103,12 @@ pub struct Model {
     /// The parent of each velocity coordinate: the one before it in its joint, or the last of the
     /// nearest ancestor body's joint (`None` at a root); nv. M_ij ≠ 0 only along these chains.
     pub dof_parent: Vec<Option<usize>>,
+    /// Derived from `dof_parent`, nv: the first coordinate of the run ending at coordinate k in
+    /// which each coordinate is the parent of the next (`dof_parent[c] = c - 1`). The ancestors
+    /// of a coordinate are a few such runs, so a loop over them need not wait on each parent's
+    /// load before the next column (see [`Model::ancestor_runs`]). Not stored in snapshots.
+    #[serde(skip)]
+    pub dof_run_start: Vec<usize>,
     /// Position limits, length nq (±inf where none).
     pub lower_position_limit: DVector<f64>,
     pub upper_position_limit: DVector<f64>,
@@ -154,6 +160,16 @@ impl Model {
                         .join(", ")
                 ),
             })
+    }
+
+    /// The coordinates from `top` to the root (`top`, its parent, …), as runs of consecutive
+    /// coordinates, nearest first, each a non-empty `start..end`.
+    #[inline(always)]
+    pub fn ancestor_runs(&self, top: usize) -> AncestorRuns<'_> {
+        AncestorRuns {
+            model: self,
+            top: Some(top),
+        }
     }
 
     /// The range of body i's coordinates in q.
@@ -392,6 +408,37 @@ pub struct ModelBuilder {
     model: Model,
 }
 
+/// [`Model::dof_run_start`] from the coordinates' parents.
+pub(crate) fn dof_run_starts(dof_parent: &[Option<usize>]) -> Vec<usize> {
+    let mut starts: Vec<usize> = Vec::with_capacity(dof_parent.len());
+    for (k, parent) in dof_parent.iter().enumerate() {
+        let start = match parent {
+            Some(p) if p + 1 == k => starts[*p],
+            _ => k,
+        };
+        starts.push(start);
+    }
+    starts
+}
+
+/// Iterator of [`Model::ancestor_runs`].
+pub struct AncestorRuns<'m> {
+    model: &'m Model,
+    top: Option<usize>,
+}
+
+impl Iterator for AncestorRuns<'_> {
+    type Item = std::ops::Range<usize>;
+
+    #[inline(always)]
+    fn next(&mut self) -> Option<Self::Item> {
+        let end = self.top?;
+        let start = self.model.dof_run_start[end];
+        self.top = self.model.dof_parent[start];
+        Some(start..end + 1)
+    }
+}
+
 impl ModelBuilder {
     /// A model holding only the world (body 0), named `world_name`.
     pub fn new(name: &str, world_name: &str) -> Self {
@@ -409,6 +456,7 @@ impl ModelBuilder {
                 idx_q: vec![0],
                 idx_v: vec![0],
                 dof_parent: Vec::new(),
+                dof_run_start: Vec::new(),
                 lower_position_limit: DVector::zeros(0),
                 upper_position_limit: DVector::zeros(0),
                 velocity_limit: DVector::zeros(0),
@@ -471,6 +519,7 @@ impl ModelBuilder {
             m.dof_parent.push(previous);
             previous = Some(k);
         }
+        m.dof_run_start = dof_run_starts(&m.dof_parent);
         m.nq += nq;
         m.nv += nv;
         // quaternion coordinates carry no limits

@@ -405,3 +405,34 @@ fn crba_into_writes_crba_s_matrix_which_is_exactly_symmetric() {
         assert!(error.contains("out"), "{error}");
     }
 }
+
+/// `Model::ancestor_runs` lists a coordinate's path to the root (itself, its parent, …) as runs
+/// of consecutive coordinates, nearest first, on every test model and after a snapshot.
+#[test]
+fn ancestor_runs_are_the_parent_chain() {
+    for (name, model) in test_models() {
+        let reloaded = robodyn::io::model_from_bytes(&robodyn::io::model_to_bytes(&model)).unwrap();
+        assert_eq!(reloaded.dof_run_start, model.dof_run_start, "{name}");
+        for top in 0..model.nv {
+            let mut chain = vec![];
+            let mut next = Some(top);
+            while let Some(k) = next {
+                chain.push(k);
+                next = model.dof_parent[k];
+            }
+            let runs: Vec<_> = model.ancestor_runs(top).collect();
+            let walked: Vec<usize> = runs.iter().flat_map(|run| run.clone().rev()).collect();
+            assert_eq!(walked, chain, "{name}, coordinate {top}");
+            for run in &runs {
+                assert!(!run.is_empty(), "{name}: empty run");
+                for c in run.start + 1..run.end {
+                    assert_eq!(
+                        model.dof_parent[c],
+                        Some(c - 1),
+                        "{name}: {run:?} is not a chain"
+                    );
+                }
+            }
+        }
+    }
+}

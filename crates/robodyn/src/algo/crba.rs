@@ -58,14 +58,15 @@ pub(crate) fn mass_matrix_of_composites<S: Real>(
         for row in model.v_range(i) {
             // F = I^c_i S_i
             let f = composite.mul_motion(&subspaces[row]);
-            // the row itself, then up its coordinates' path: the joint's earlier ones, the ancestors'
-            let mut column = Some(row);
-            while let Some(col) = column {
-                // column-major storage: H[row, col] at row + col nv
-                let h = subspaces[col].dot(&f);
-                mass_matrix[row + col * nv] = h;
-                mass_matrix[col + row * nv] = h;
-                column = model.dof_parent[col];
+            // the row itself, then up its coordinates' path (the joint's earlier ones, the
+            // ancestors'), in runs of consecutive columns
+            for run in model.ancestor_runs(row) {
+                for col in run {
+                    // column-major storage: H[row, col] at row + col nv
+                    let h = subspaces[col].dot(&f);
+                    mass_matrix[row + col * nv] = h;
+                    mass_matrix[col + row * nv] = h;
+                }
             }
             mass_matrix[row + row * nv] += S::splat(model.armature[row]);
         }

@@ -8,7 +8,7 @@
 //! they become a model, so damaged bytes are an error, never a crash later.
 
 use crate::error::{Error, Result};
-use crate::model::Model;
+use crate::model::{dof_run_starts, Model};
 
 /// What every snapshot starts with.
 const TAG: &[u8; 8] = b"robodyn\0";
@@ -56,9 +56,10 @@ pub fn model_from_bytes(bytes: &[u8]) -> Result<Model> {
             env!("CARGO_PKG_VERSION")
         )));
     }
-    let model: Model = postcard::from_bytes(payload)
+    let mut model: Model = postcard::from_bytes(payload)
         .map_err(|e| refuse(format!("the snapshot (robodyn {version}) is damaged: {e}")))?;
     check_structure(&model)?;
+    model.dof_run_start = dof_run_starts(&model.dof_parent);
     Ok(model)
 }
 
