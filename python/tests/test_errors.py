@@ -121,6 +121,9 @@ def test_unknown_frame_and_reference(model):
     np.testing.assert_array_equal(model.jacobian(q, np.int64(tool)), model.jacobian(q, "tool0"))
     with pytest.raises(ValueError, match="argument 'reference': expected 'world', 'local' or 'spatial', got 'body'"):
         model.jacobian(q, "tool0", "body")
+    for wrong in (3, None, b"world"):
+        with pytest.raises(ValueError, match="argument 'reference': expected 'world', 'local' or 'spatial', got "):
+            model.frame_velocity(q, q, "tool0", wrong)
 
 
 def test_bad_properties(model):

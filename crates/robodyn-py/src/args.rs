@@ -6,7 +6,7 @@ use nalgebra::DVector;
 use numpy::{AllowTypeChange, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyBool;
+use pyo3::types::{PyBool, PyString};
 use robodyn::algo::Reference;
 use std::borrow::Cow;
 
@@ -121,15 +121,22 @@ pub(crate) fn shape_text(shape: &[usize]) -> String {
     }
 }
 
-/// The Jacobian/velocity reference named by the user.
-pub(crate) fn parse_reference(reference: &str) -> PyResult<Reference> {
-    match reference {
-        "world" => Ok(Reference::World),
-        "local" => Ok(Reference::Local),
-        "spatial" => Ok(Reference::Spatial),
-        other => Err(PyValueError::new_err(format!(
-            "argument 'reference': expected 'world', 'local' or 'spatial', got '{other}'"
+/// The Jacobian/velocity reference named by the user: "world", "local" or "spatial" (read in
+/// place, no string copied: it is an argument of every Jacobian call).
+pub(crate) fn reference_of(name: &str, value: &Bound<PyAny>) -> PyResult<Reference> {
+    let named = value
+        .cast::<PyString>()
+        .ok()
+        .map(|text| text.to_str())
+        .transpose()?;
+    match named {
+        Some("world") => Ok(Reference::World),
+        Some("local") => Ok(Reference::Local),
+        Some("spatial") => Ok(Reference::Spatial),
+        Some(other) => Err(PyValueError::new_err(format!(
+            "argument '{name}': expected 'world', 'local' or 'spatial', got '{other}'"
         ))),
+        None => Err(expected(name, "'world', 'local' or 'spatial'", value)),
     }
 }
 
@@ -311,7 +318,7 @@ pub(crate) mod named {
         floating_base: flag -> bool;
         check_inertia: flag -> bool;
         method: text -> String;
-        reference: text -> String;
+        reference: reference_of -> robodyn::algo::Reference;
         source: text -> String;
         text: text -> String;
         path: path -> std::path::PathBuf;

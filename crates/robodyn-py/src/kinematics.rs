@@ -76,17 +76,16 @@ impl PyModel {
     /// frame's origin and angular velocity in world axes: the geometric Jacobian), "local" (the
     /// same in the frame's axes) or "spatial" (spatial velocity in world coordinates). `out` as
     /// in `inverse_dynamics`.
-    #[pyo3(signature = (q, frame, reference="world".to_string(), out=None), text_signature = "($self, q, frame, reference='world', out=None)")]
+    #[pyo3(signature = (q, frame, reference=algo::Reference::World, out=None), text_signature = "($self, q, frame, reference='world', out=None)")]
     fn jacobian<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
         frame: &Bound<'py, PyAny>,
-        #[pyo3(from_py_with = named::reference)] reference: String,
+        #[pyo3(from_py_with = named::reference)] reference: algo::Reference,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let frame = self.frame_index(frame)?;
-        let reference = parse_reference(&reference)?;
         self.evaluate_into(
             py,
             &[self.q_arg("q", q)?],
@@ -107,16 +106,16 @@ impl PyModel {
 
     /// Time derivative J̇(q, v) of a frame's Jacobian, (6, nv), same references as `jacobian`;
     /// J̇ v equals `frame_acceleration(q, v, 0, frame, reference)`.
-    #[pyo3(signature = (q, v, frame, reference="world".to_string()), text_signature = "($self, q, v, frame, reference='world')")]
+    #[pyo3(signature = (q, v, frame, reference=algo::Reference::World), text_signature = "($self, q, v, frame, reference='world')")]
     fn jacobian_time_variation<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
         v: &Bound<'py, PyAny>,
         frame: &Bound<'py, PyAny>,
-        #[pyo3(from_py_with = named::reference)] reference: String,
+        #[pyo3(from_py_with = named::reference)] reference: algo::Reference,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (frame, reference) = (self.frame_index(frame)?, parse_reference(&reference)?);
+        let frame = self.frame_index(frame)?;
         self.evaluate(
             py,
             &[self.q_arg("q", q)?, self.v_arg("v", v)?],
@@ -134,16 +133,16 @@ impl PyModel {
 
     /// Derivatives of a frame's velocity (`frame_velocity`, same `reference`): dict of `dv_dq`
     /// (tangent space, right perturbations q ⊕ δ) and `dv_dv` (= J), each (6, nv).
-    #[pyo3(signature = (q, v, frame, reference="world".to_string()), text_signature = "($self, q, v, frame, reference='world')")]
+    #[pyo3(signature = (q, v, frame, reference=algo::Reference::World), text_signature = "($self, q, v, frame, reference='world')")]
     fn frame_velocity_derivatives<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
         v: &Bound<'py, PyAny>,
         frame: &Bound<'py, PyAny>,
-        #[pyo3(from_py_with = named::reference)] reference: String,
+        #[pyo3(from_py_with = named::reference)] reference: algo::Reference,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (frame, reference) = (self.frame_index(frame)?, parse_reference(&reference)?);
+        let frame = self.frame_index(frame)?;
         let zeros = vec![0.0; self.model.nv];
         let arguments = [self.q_arg("q", q)?, self.v_arg("v", v)?];
         let stack = self.evaluate(py, &arguments, &[2, 6, self.model.nv], &|m, w, i, out| {
@@ -158,7 +157,7 @@ impl PyModel {
     /// Derivatives of a frame's velocity and classical acceleration (`frame_acceleration`, same
     /// `reference`): dict of `dv_dq`, `dv_dv` (= J), `da_dq`, `da_dv`, `da_da` (= J), each
     /// (6, nv), q in the tangent space.
-    #[pyo3(signature = (q, v, a, frame, reference="world".to_string()), text_signature = "($self, q, v, a, frame, reference='world')")]
+    #[pyo3(signature = (q, v, a, frame, reference=algo::Reference::World), text_signature = "($self, q, v, a, frame, reference='world')")]
     fn frame_acceleration_derivatives<'py>(
         &self,
         py: Python<'py>,
@@ -166,9 +165,9 @@ impl PyModel {
         v: &Bound<'py, PyAny>,
         a: &Bound<'py, PyAny>,
         frame: &Bound<'py, PyAny>,
-        #[pyo3(from_py_with = named::reference)] reference: String,
+        #[pyo3(from_py_with = named::reference)] reference: algo::Reference,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (frame, reference) = (self.frame_index(frame)?, parse_reference(&reference)?);
+        let frame = self.frame_index(frame)?;
         let arguments = self.dynamics_arguments(q, v, ("a", a), None)?;
         let stack = self.evaluate(py, &arguments, &[5, 6, self.model.nv], &|m, w, i, out| {
             let data = &mut w.data;
@@ -211,16 +210,16 @@ impl PyModel {
 
     /// Velocity of a frame, (6,) [linear; angular] = J(q) v: "world" (its origin's velocity and
     /// angular velocity in world axes), "local" (the same in its axes) or "spatial".
-    #[pyo3(signature = (q, v, frame, reference="world".to_string()), text_signature = "($self, q, v, frame, reference='world')")]
+    #[pyo3(signature = (q, v, frame, reference=algo::Reference::World), text_signature = "($self, q, v, frame, reference='world')")]
     fn frame_velocity<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
         v: &Bound<'py, PyAny>,
         frame: &Bound<'py, PyAny>,
-        #[pyo3(from_py_with = named::reference)] reference: String,
+        #[pyo3(from_py_with = named::reference)] reference: algo::Reference,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (frame, reference) = (self.frame_index(frame)?, parse_reference(&reference)?);
+        let frame = self.frame_index(frame)?;
         self.evaluate(
             py,
             &[self.q_arg("q", q)?, self.v_arg("v", v)?],
@@ -243,7 +242,7 @@ impl PyModel {
     /// classical acceleration of its origin and its angular acceleration, world axes), "local"
     /// (the same in its axes) or "spatial" (Featherstone's spatial acceleration, world
     /// coordinates). With a = 0 it is J̇ v.
-    #[pyo3(signature = (q, v, a, frame, reference="world".to_string()), text_signature = "($self, q, v, a, frame, reference='world')")]
+    #[pyo3(signature = (q, v, a, frame, reference=algo::Reference::World), text_signature = "($self, q, v, a, frame, reference='world')")]
     fn frame_acceleration<'py>(
         &self,
         py: Python<'py>,
@@ -251,9 +250,9 @@ impl PyModel {
         v: &Bound<'py, PyAny>,
         a: &Bound<'py, PyAny>,
         frame: &Bound<'py, PyAny>,
-        #[pyo3(from_py_with = named::reference)] reference: String,
+        #[pyo3(from_py_with = named::reference)] reference: algo::Reference,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (frame, reference) = (self.frame_index(frame)?, parse_reference(&reference)?);
+        let frame = self.frame_index(frame)?;
         let arguments = self.dynamics_arguments(q, v, ("a", a), None)?;
         self.evaluate(py, &arguments, &[6], &|m, w, i, out| {
             out.copy_from_slice(&algo::frame_acceleration(
