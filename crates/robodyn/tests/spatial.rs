@@ -79,7 +79,8 @@ proptest! {
         let moved = x.transpose_apply_matrix(&articulated);
         let expected = x.to_matrix().transpose() * articulated * x.to_matrix();
         prop_assert!((moved - expected).norm() < 1e-9 * expected.norm().max(1.0));
-        prop_assert!((moved - moved.transpose()).norm() < 1e-12 * expected.norm().max(1.0));
+        // computed on one triangle and mirrored
+        prop_assert_eq!(moved, moved.transpose());
     }
 
     #[test]

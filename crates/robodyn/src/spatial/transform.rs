@@ -1,8 +1,8 @@
 //! Plücker coordinate transforms (Featherstone §2.8).
 
 use super::{
-    block, compose, compose_transposed, cross, from_blocks, rotate, rotate_back, skew, transposed,
-    Force, Inertia, Mat3, Mat6, Motion, Real, Vec3,
+    block, compose, compose_transposed, cross, from_blocks, matrix3, rotate, rotate_back, skew,
+    transposed, Force, Inertia, Mat3, Mat6, Motion, Real, Vec3,
 };
 use nalgebra::{Matrix3, Matrix6, Vector3};
 use std::ops::Mul;
@@ -191,21 +191,21 @@ impl<S: Real> Transform<S> {
     /// inertia, which has no rigid body's structure), by 3x3 blocks instead of two 6x6 products.
     /// With `I = [A B; Bᵀ C]` and `X = diag(E, E) [1 0; -r× 1]`: rotate, `Â = Eᵀ A E`,
     /// `B̂ = Eᵀ B E`, `Ĉ = Eᵀ C E`; then shift, `C' = Ĉ`, `B' = B̂ + r× Ĉ`,
-    /// `A' = Â - B̂ r× + r× B̂ᵀ - r× Ĉ r×`.
+    /// `A' = Â - B̂ r× + r× B̂ᵀ - r× Ĉ r× = Â + P + Pᵀ + r× (r× Ĉ)ᵀ` with `P = r× B̂ᵀ` (as
+    /// `(r×)ᵀ = -r×`). `A`, `C` are read from their upper triangles; `A'`, `C'` are computed on
+    /// theirs and mirrored, so the result is exactly symmetric.
     #[inline(always)]
     pub fn transpose_apply_matrix(&self, inertia: &Matrix6<S>) -> Matrix6<S> {
-        let e = &self.rotation;
-        let (a, b, c) = (
-            rotated(e, &block(inertia, 0, 0)),
-            rotated(e, &block(inertia, 0, 3)),
-            rotated(e, &block(inertia, 3, 3)),
-        );
-        let r = skew(&self.translation);
-        // r× Ĉ, and B̂ r× whose transpose is -r× B̂ᵀ
-        let r_c = compose(&r, &c);
-        let b_r = compose(&b, &r);
+        let (e, r) = (&self.rotation, &self.translation);
+        let a = rotated_symmetric(e, &block(inertia, 0, 0));
+        let b = rotated(e, &block(inertia, 0, 3));
+        let c = rotated_symmetric(e, &block(inertia, 3, 3));
+        let r_c = cross_columns(r, &c);
         let coupling = b + r_c;
-        let angular = a - b_r - transposed(&b_r) - compose(&r_c, &r);
+        let p = cross_columns(r, &transposed(&b));
+        let q = cross_columns(r, &transposed(&r_c));
+        let angular =
+            symmetric3(|row, col| a[(row, col)] + p[(row, col)] + p[(col, row)] + q[(row, col)]);
         from_blocks(&angular, &coupling, &transposed(&coupling), &c)
     }
 
@@ -309,4 +309,44 @@ impl<S: Real> Mul for Transform<S> {
 #[inline(always)]
 fn rotated<S: Real>(e: &Matrix3<S>, m: &Matrix3<S>) -> Matrix3<S> {
     compose_transposed(e, &compose(m, e))
+}
+
+/// `Eᵀ M E` for a symmetric `M`, from its upper triangle: the six entries on and above the
+/// diagonal, `(Eᵀ M E)_ab = e_a · (M e_b)` with `e_a` column a of E, mirrored.
+#[inline(always)]
+fn rotated_symmetric<S: Real>(e: &Matrix3<S>, m: &Matrix3<S>) -> Matrix3<S> {
+    let upper = |row: usize, col: usize| {
+        if row <= col {
+            m[(row, col)]
+        } else {
+            m[(col, row)]
+        }
+    };
+    let m_e = matrix3(|row, col| {
+        upper(row, 0) * e[(0, col)] + upper(row, 1) * e[(1, col)] + upper(row, 2) * e[(2, col)]
+    });
+    symmetric3(|a, b| e[(0, a)] * m_e[(0, b)] + e[(1, a)] * m_e[(1, b)] + e[(2, a)] * m_e[(2, b)])
+}
+
+/// The symmetric 3x3 matrix of `entry(row, col)` evaluated on and above the diagonal.
+#[inline(always)]
+fn symmetric3<S: Real>(entry: impl Fn(usize, usize) -> S) -> Matrix3<S> {
+    let (xx, xy, xz, yy, yz, zz) = (
+        entry(0, 0),
+        entry(0, 1),
+        entry(0, 2),
+        entry(1, 1),
+        entry(1, 2),
+        entry(2, 2),
+    );
+    Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
+}
+
+/// `r× M`, column by column: column j is `r × m_j`.
+#[inline(always)]
+fn cross_columns<S: Real>(r: &Vector3<S>, m: &Matrix3<S>) -> Matrix3<S> {
+    matrix3(|row, col| {
+        let (next, last) = ((row + 1) % 3, (row + 2) % 3);
+        r[next] * m[(last, col)] - r[last] * m[(next, col)]
+    })
 }
