@@ -177,14 +177,19 @@ pub(crate) fn articulated_body_passes<S: Real>(
             let mut i_a = out.i_a[i];
             let mut p_a = out.p_a[i];
             for r in 0..nv_i {
+                // W_r = Σ_c D⁻¹_rc U_c, so that U D⁻¹ Uᵀ = Σ_r U_r W_rᵀ
+                let mut w_r = out.u[i][0] * d[(r, 0)];
                 let mut d_inv_u = S::splat(0.0);
                 for c in 0..nv_i {
-                    // rank-one update in place: I^a −= D⁻¹_rc U_r U_cᵀ
-                    subtract_outer(&mut i_a, d[(r, c)], &out.u[i][r], &out.u[i][c]);
+                    if c > 0 {
+                        w_r += out.u[i][c] * d[(r, c)];
+                    }
                     d_inv_u += d[(r, c)] * out.u_tau[i][c];
                 }
+                subtract_outer_upper(&mut i_a, &out.u[i][r], &w_r);
                 p_a += out.u[i][r] * d_inv_u;
             }
+            mirror_upper(&mut i_a);
             p_a += mat6_mul_motion(&i_a, &out.c[i]);
             // I^A_λ(i) += X_iᵀ I^a X_i;  p^A_λ(i) += X_iᵀ p^a
             let carried = out.x_up[i].transpose_apply_matrix(&i_a);
@@ -230,14 +235,24 @@ pub(crate) fn articulated_body_passes<S: Real>(
     Ok(())
 }
 
-/// `I −= d x yᵀ` for two forces taken as `[angular; linear]` 6-vectors.
+/// `I −= x yᵀ` on and above the diagonal, for two forces taken as `[angular; linear]`
+/// 6-vectors (the sum of such terms, `U D⁻¹ Uᵀ`, is symmetric: see [`mirror_upper`]).
 #[inline(always)]
-fn subtract_outer<S: Real>(inertia: &mut Matrix6<S>, d: S, x: &Force<S>, y: &Force<S>) {
+fn subtract_outer_upper<S: Real>(inertia: &mut Matrix6<S>, x: &Force<S>, y: &Force<S>) {
     let (x, y) = (x.plucker(), y.plucker());
     for (col, y_col) in y.iter().enumerate() {
-        let scale = -(d * *y_col);
-        for (row, x_row) in x.iter().enumerate() {
-            inertia[(row, col)] += scale * *x_row;
+        for (row, x_row) in x.iter().enumerate().take(col + 1) {
+            inertia[(row, col)] -= *x_row * *y_col;
+        }
+    }
+}
+
+/// The lower triangle of `m` set from the upper one.
+#[inline(always)]
+fn mirror_upper<S: Real>(m: &mut Matrix6<S>) {
+    for col in 0..6 {
+        for row in col + 1..6 {
+            m[(row, col)] = m[(col, row)];
         }
     }
 }
@@ -292,5 +307,17 @@ mod tests {
         let mut data = Data::new(&model);
         articulated_body_passes(&model, &q, &v, &tau, None, AbaBuffers::of(&mut data)).unwrap();
         assert_eq!(dispatched.qdd, data.qdd);
+    }
+
+    /// The articulated inertias stay exactly symmetric: the rank-one updates are made on the
+    /// upper triangle and mirrored, the transform to the parent mirrors its result.
+    #[test]
+    fn articulated_inertias_are_exactly_symmetric() {
+        let (model, q, v, tau) = floating_ur5_state();
+        let mut data = Data::new(&model);
+        aba(&model, &mut data, &q, &v, &tau, None).unwrap();
+        for (i, inertia) in data.i_a.iter().enumerate().skip(1) {
+            assert_eq!(*inertia, inertia.transpose(), "body {i}");
+        }
     }
 }
