@@ -178,6 +178,22 @@ impl Joint {
         }
     }
 
+    /// The coordinate axis k when `X_J(q) X_T` turns about e_k only, for this `X_T`: a revolute
+    /// joint about ±e_k, or a prismatic joint (whose X_J does not turn), after an `X_T` that
+    /// does not rotate. Transforms by it can then leave out the products with the rotation's
+    /// zeros (`Transform::apply_motion_turned` and the like).
+    #[inline(always)]
+    pub fn turn_axis(&self, x_tree: &Transform) -> Option<usize> {
+        if x_tree.rotation != Mat3::identity() {
+            return None;
+        }
+        match self {
+            Joint::Revolute { axis } => coordinate_axis(axis).map(|k| k.index),
+            Joint::Prismatic { .. } => Some(2),
+            _ => None,
+        }
+    }
+
     /// Column `k` of the motion subspace `S`, in the child frame.
     #[inline(always)]
     pub fn subspace_column(&self, k: usize) -> Motion {

@@ -172,6 +172,12 @@ impl Model {
         }
     }
 
+    /// [`Joint::turn_axis`] of body i's joint and tree transform.
+    #[inline(always)]
+    pub fn turn_axis(&self, i: usize) -> Option<usize> {
+        self.joints[i].turn_axis(&self.x_tree[i])
+    }
+
     /// The range of body i's coordinates in q.
     pub fn q_range(&self, i: usize) -> std::ops::Range<usize> {
         self.idx_q[i]..self.idx_q[i] + self.joints[i].nq()

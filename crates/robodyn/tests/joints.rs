@@ -216,3 +216,29 @@ fn inertia_times_subspace_is_the_product_with_the_subspace_column() {
         }
     }
 }
+
+/// `Joint::turn_axis`: a coordinate axis only for a revolute joint about ±e_k or a prismatic
+/// joint, and only after a tree transform that does not rotate.
+#[test]
+fn turn_axis_needs_a_coordinate_axis_and_an_unrotated_tree() {
+    let shifted = Transform::from_translation(&Vec3::new(0.1, -0.2, 0.3));
+    let turned = Transform::from_pose(
+        &robodyn::spatial::rotation_from_rpy(0.0, 0.3, 0.0),
+        &Vec3::zeros(),
+    );
+    let revolute = |x: f64, y: f64, z: f64| Joint::Revolute {
+        axis: Vec3::new(x, y, z),
+    };
+    assert_eq!(revolute(1.0, 0.0, 0.0).turn_axis(&shifted), Some(0));
+    assert_eq!(revolute(0.0, -1.0, 0.0).turn_axis(&shifted), Some(1));
+    assert_eq!(revolute(0.0, 0.0, 1.0).turn_axis(&shifted), Some(2));
+    assert_eq!(revolute(0.0, 0.0, 1.0).turn_axis(&turned), None);
+    assert_eq!(revolute(0.6, 0.8, 0.0).turn_axis(&shifted), None);
+    let prismatic = Joint::Prismatic {
+        axis: Vec3::new(0.6, 0.8, 0.0),
+    };
+    assert_eq!(prismatic.turn_axis(&shifted), Some(2));
+    assert_eq!(prismatic.turn_axis(&turned), None);
+    assert_eq!(Joint::Spherical.turn_axis(&shifted), None);
+    assert_eq!(Joint::Free.turn_axis(&shifted), None);
+}

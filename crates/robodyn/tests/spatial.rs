@@ -4,6 +4,7 @@ use proptest::prelude::*;
 use robodyn::spatial::{
     rotation_from_rpy, CoriolisFactor, Force, Inertia, Mat3, Motion, Transform, Vec3,
 };
+use robodyn::Joint;
 
 const TOLERANCE: f64 = 1e-12;
 
@@ -25,6 +26,32 @@ fn inertia() -> impl Strategy<Value = Inertia> {
 }
 
 proptest! {
+    /// A joint's transform that turns about a coordinate axis only (a revolute joint about ±e_k
+    /// after a tree transform that does not rotate) gives the same products by the turned paths,
+    /// which leave out the rotation's zeros, as by the general ones.
+    #[test]
+    fn turned_products_equal_the_general_ones(
+        angle in -4.0f64..4.0, k in 0usize..3, negative in any::<bool>(), r in vec3(),
+        i in inertia(), j in inertia(), w in vec3(), v in vec3(),
+    ) {
+        let mut axis = Vec3::zeros();
+        axis[k] = if negative { -1.0 } else { 1.0 };
+        let joint = Joint::Revolute { axis };
+        let tree = Transform::from_translation(&r);
+        prop_assert_eq!(joint.turn_axis(&tree), Some(k));
+        let x = joint.transform_after_turn(&[angle], angle.sin_cos(), &tree);
+        let turn = Some(k);
+        let (m, f) = (Motion::new(w, v), Force::new(v, w));
+        let u = nalgebra::Vector6::new(w.x, w.y, w.z, v.x, v.y, v.z);
+        let articulated = i.to_matrix() + j.to_matrix() - u * u.transpose() * 0.1;
+        prop_assert_eq!(x.apply_motion_turned(turn, &m), x.apply_motion(&m));
+        prop_assert_eq!(x.transpose_apply_force_turned(turn, &f), x.transpose_apply_force(&f));
+        prop_assert_eq!(
+            x.transpose_apply_matrix_turned(turn, &articulated),
+            x.transpose_apply_matrix(&articulated)
+        );
+    }
+
     #[test]
     fn transform_times_inverse_is_identity(x in transform(), w in vec3(), v in vec3()) {
         let m = Motion::new(w, v);

@@ -129,7 +129,8 @@ pub(crate) fn articulated_body_passes<S: Real>(
     for i in 1..model.nbodies() {
         let v_j = model.joints[i].motion(&v[model.v_range(i)]);
         // v_i = X_i v_λ(i) + v_J;  c_i = v_i × v_J
-        let v_i = out.x_up[i].apply_motion(&out.v[model.parent[i]]) + v_j;
+        let turn = model.turn_axis(i);
+        let v_i = out.x_up[i].apply_motion_turned(turn, &out.v[model.parent[i]]) + v_j;
         out.c[i] = v_i.cross_motion(&v_j);
         let inertia = Inertia::<S>::splat(&model.inertias[i]);
         out.i_a[i] = splat_matrix6(&model.inertias[i].to_matrix());
@@ -192,7 +193,8 @@ pub(crate) fn articulated_body_passes<S: Real>(
             mirror_upper(&mut i_a);
             p_a += mat6_mul_motion(&i_a, &out.c[i]);
             // I^A_λ(i) += X_iᵀ I^a X_i;  p^A_λ(i) += X_iᵀ p^a
-            let carried = out.x_up[i].transpose_apply_matrix(&i_a);
+            let turn = model.turn_axis(i);
+            let carried = out.x_up[i].transpose_apply_matrix_turned(turn, &i_a);
             for (sum, x) in out.i_a[parent]
                 .as_mut_slice()
                 .iter_mut()
@@ -200,7 +202,7 @@ pub(crate) fn articulated_body_passes<S: Real>(
             {
                 *sum += *x;
             }
-            let p_parent = out.x_up[i].transpose_apply_force(&p_a);
+            let p_parent = out.x_up[i].transpose_apply_force_turned(turn, &p_a);
             out.p_a[parent] += p_parent;
         }
     }
@@ -214,7 +216,8 @@ pub(crate) fn articulated_body_passes<S: Real>(
         let joint = &model.joints[i];
         let dofs = model.v_range(i);
         // a'_i = X_i a_λ(i) + c_i
-        let mut a_i = out.x_up[i].apply_motion(&out.a[model.parent[i]]) + out.c[i];
+        let turn = model.turn_axis(i);
+        let mut a_i = out.x_up[i].apply_motion_turned(turn, &out.a[model.parent[i]]) + out.c[i];
         // q̈_i = D_i⁻¹ (u_i - U_iᵀ a'_i)
         let nv_i = joint.nv();
         let mut rhs = [S::splat(0.0); 6];

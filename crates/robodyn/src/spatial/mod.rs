@@ -12,6 +12,7 @@ mod motion;
 mod products;
 mod transform;
 pub mod trig;
+mod turn;
 
 pub use force::Force;
 pub use inertia::{CoriolisFactor, Inertia};

@@ -1,5 +1,6 @@
 //! Plücker coordinate transforms (Featherstone §2.8).
 
+use super::turn::{with_rotation, AnyRotation, Rotation};
 use super::{
     block, compose, compose_transposed, cross, from_blocks, matrix3, rotate, rotate_back, skew,
     transposed, Force, Inertia, Mat3, Mat6, Motion, Real, Vec3,
@@ -146,9 +147,21 @@ impl<S: Real> Transform<S> {
     /// `X m`: `ω' = E ω`, `v' = E (v - r × ω)`.
     #[inline(always)]
     pub fn apply_motion(&self, m: &Motion<S>) -> Motion<S> {
+        self.apply_motion_by::<AnyRotation>(m)
+    }
+
+    /// [`Transform::apply_motion`] for a rotation that turns about coordinate axis `turn` only
+    /// (`None`: any; see [`crate::Model::turn_axis`]): the same value, fewer products.
+    #[inline(always)]
+    pub fn apply_motion_turned(&self, turn: Option<usize>, m: &Motion<S>) -> Motion<S> {
+        with_rotation!(turn, self.apply_motion_by(m))
+    }
+
+    #[inline(always)]
+    fn apply_motion_by<R: Rotation>(&self, m: &Motion<S>) -> Motion<S> {
         Motion {
-            angular: rotate(&self.rotation, &m.angular),
-            linear: rotate(
+            angular: R::rotate(&self.rotation, &m.angular),
+            linear: R::rotate(
                 &self.rotation,
                 &(m.linear - cross(&self.translation, &m.angular)),
             ),
@@ -180,9 +193,21 @@ impl<S: Real> Transform<S> {
     /// `Xᵀ f` (B forces to A): `f = Eᵀ f'`, `n = Eᵀ n' + r × f`.
     #[inline(always)]
     pub fn transpose_apply_force(&self, f: &Force<S>) -> Force<S> {
-        let linear = rotate_back(&self.rotation, &f.linear);
+        self.transpose_apply_force_by::<AnyRotation>(f)
+    }
+
+    /// [`Transform::transpose_apply_force`] for a rotation about coordinate axis `turn` only, as
+    /// [`Transform::apply_motion_turned`].
+    #[inline(always)]
+    pub fn transpose_apply_force_turned(&self, turn: Option<usize>, f: &Force<S>) -> Force<S> {
+        with_rotation!(turn, self.transpose_apply_force_by(f))
+    }
+
+    #[inline(always)]
+    fn transpose_apply_force_by<R: Rotation>(&self, f: &Force<S>) -> Force<S> {
+        let linear = R::rotate_back(&self.rotation, &f.linear);
         Force {
-            angular: rotate_back(&self.rotation, &f.angular) + cross(&self.translation, &linear),
+            angular: R::rotate_back(&self.rotation, &f.angular) + cross(&self.translation, &linear),
             linear,
         }
     }
@@ -196,10 +221,28 @@ impl<S: Real> Transform<S> {
     /// theirs and mirrored, so the result is exactly symmetric.
     #[inline(always)]
     pub fn transpose_apply_matrix(&self, inertia: &Matrix6<S>) -> Matrix6<S> {
+        self.transpose_apply_matrix_by::<AnyRotation>(inertia)
+    }
+
+    /// [`Transform::transpose_apply_matrix`] for a rotation about coordinate axis `turn` only,
+    /// as [`Transform::apply_motion_turned`].
+    #[inline(always)]
+    pub fn transpose_apply_matrix_turned(
+        &self,
+        turn: Option<usize>,
+        inertia: &Matrix6<S>,
+    ) -> Matrix6<S> {
+        with_rotation!(turn, self.transpose_apply_matrix_by(inertia))
+    }
+
+    #[inline(always)]
+    fn transpose_apply_matrix_by<R: Rotation>(&self, inertia: &Matrix6<S>) -> Matrix6<S> {
         let (e, r) = (&self.rotation, &self.translation);
-        let a = rotated_symmetric(e, &block(inertia, 0, 0));
-        let b = rotated(e, &block(inertia, 0, 3));
-        let c = rotated_symmetric(e, &block(inertia, 3, 3));
+        // Â, Ĉ from the upper triangles of A, C, kept on theirs
+        let rotated_symmetric = |m: &Matrix3<S>| upper_mirrored(&R::rotated(e, &upper_mirrored(m)));
+        let a = rotated_symmetric(&block(inertia, 0, 0));
+        let b = R::rotated(e, &block(inertia, 0, 3));
+        let c = rotated_symmetric(&block(inertia, 3, 3));
         let r_c = cross_columns(r, &c);
         let coupling = b + r_c;
         let p = cross_columns(r, &transposed(&b));
@@ -305,27 +348,10 @@ impl<S: Real> Mul for Transform<S> {
     }
 }
 
-/// `Eᵀ M E`.
+/// A symmetric matrix from the upper triangle of `m`.
 #[inline(always)]
-fn rotated<S: Real>(e: &Matrix3<S>, m: &Matrix3<S>) -> Matrix3<S> {
-    compose_transposed(e, &compose(m, e))
-}
-
-/// `Eᵀ M E` for a symmetric `M`, from its upper triangle: the six entries on and above the
-/// diagonal, `(Eᵀ M E)_ab = e_a · (M e_b)` with `e_a` column a of E, mirrored.
-#[inline(always)]
-fn rotated_symmetric<S: Real>(e: &Matrix3<S>, m: &Matrix3<S>) -> Matrix3<S> {
-    let upper = |row: usize, col: usize| {
-        if row <= col {
-            m[(row, col)]
-        } else {
-            m[(col, row)]
-        }
-    };
-    let m_e = matrix3(|row, col| {
-        upper(row, 0) * e[(0, col)] + upper(row, 1) * e[(1, col)] + upper(row, 2) * e[(2, col)]
-    });
-    symmetric3(|a, b| e[(0, a)] * m_e[(0, b)] + e[(1, a)] * m_e[(1, b)] + e[(2, a)] * m_e[(2, b)])
+fn upper_mirrored<S: Real>(m: &Matrix3<S>) -> Matrix3<S> {
+    symmetric3(|row, col| m[(row, col)])
 }
 
 /// The symmetric 3x3 matrix of `entry(row, col)` evaluated on and above the diagonal.
