@@ -32,7 +32,7 @@ proptest! {
     #[test]
     fn turned_products_equal_the_general_ones(
         angle in -4.0f64..4.0, k in 0usize..3, negative in any::<bool>(), r in vec3(),
-        i in inertia(), j in inertia(), w in vec3(), v in vec3(),
+        i in inertia(), j in inertia(), w in vec3(), v in vec3(), y in transform(),
     ) {
         let mut axis = Vec3::zeros();
         axis[k] = if negative { -1.0 } else { 1.0 };
@@ -44,6 +44,7 @@ proptest! {
         let (m, f) = (Motion::new(w, v), Force::new(v, w));
         let u = nalgebra::Vector6::new(w.x, w.y, w.z, v.x, v.y, v.z);
         let articulated = i.to_matrix() + j.to_matrix() - u * u.transpose() * 0.1;
+        prop_assert_eq!(x.compose_turned(turn, &y), x * y);
         prop_assert_eq!(x.apply_motion_turned(turn, &m), x.apply_motion(&m));
         prop_assert_eq!(x.transpose_apply_force_turned(turn, &f), x.transpose_apply_force(&f));
         prop_assert_eq!(

@@ -339,10 +339,23 @@ impl Transform {
 impl<S: Real> Mul for Transform<S> {
     type Output = Transform<S>;
     #[inline(always)]
-    #[allow(clippy::suspicious_arithmetic_impl)] // composing adds the rotated translation
     fn mul(self, rhs: Transform<S>) -> Transform<S> {
+        self.compose_by::<AnyRotation>(&rhs)
+    }
+}
+
+impl<S: Real> Transform<S> {
+    /// `self * rhs` for `self`'s rotation turning about coordinate axis `turn` only, as
+    /// [`Transform::apply_motion_turned`].
+    #[inline(always)]
+    pub fn compose_turned(&self, turn: Option<usize>, rhs: &Transform<S>) -> Transform<S> {
+        with_rotation!(turn, self.compose_by(rhs))
+    }
+
+    #[inline(always)]
+    fn compose_by<R: Rotation>(&self, rhs: &Transform<S>) -> Transform<S> {
         Transform {
-            rotation: compose(&self.rotation, &rhs.rotation),
+            rotation: R::compose(&self.rotation, &rhs.rotation),
             translation: rhs.translation + rotate_back(&rhs.rotation, &self.translation),
         }
     }

@@ -19,6 +19,8 @@ pub(crate) trait Rotation {
     fn rotate_back<S: Real>(e: &Matrix3<S>, v: &Vector3<S>) -> Vector3<S>;
     /// `Eᵀ M E`.
     fn rotated<S: Real>(e: &Matrix3<S>, m: &Matrix3<S>) -> Matrix3<S>;
+    /// `E M`.
+    fn compose<S: Real>(e: &Matrix3<S>, m: &Matrix3<S>) -> Matrix3<S>;
 }
 
 /// Any rotation.
@@ -38,6 +40,11 @@ impl Rotation for AnyRotation {
     #[inline(always)]
     fn rotated<S: Real>(e: &Matrix3<S>, m: &Matrix3<S>) -> Matrix3<S> {
         compose_transposed(e, &compose(m, e))
+    }
+
+    #[inline(always)]
+    fn compose<S: Real>(e: &Matrix3<S>, m: &Matrix3<S>) -> Matrix3<S> {
+        compose(e, m)
     }
 }
 
@@ -78,6 +85,16 @@ impl<const K: usize> Rotation for TurnAbout<K> {
         super::matrix3(|row, col| match row {
             r if r == K => m_e[(K, col)],
             r => e[(f, r)] * m_e[(f, col)] + e[(s, r)] * m_e[(s, col)],
+        })
+    }
+
+    #[inline(always)]
+    fn compose<S: Real>(e: &Matrix3<S>, m: &Matrix3<S>) -> Matrix3<S> {
+        let (f, s) = (Self::FIRST, Self::SECOND);
+        // row K of M stays, rows f and s turn
+        super::matrix3(|row, col| match row {
+            r if r == K => m[(K, col)],
+            r => e[(r, f)] * m[(f, col)] + e[(r, s)] * m[(s, col)],
         })
     }
 }
