@@ -99,7 +99,9 @@ def test_batches_and_bad_methods():
     np.testing.assert_array_equal(model.mass_matrix(q, method="jacobians")[2], model.mass_matrix(q[2], method="jacobians"))
     with pytest.raises(ValueError, match="argument 'method': expected crba, rnea or jacobians, got 'lagrange'"):
         model.mass_matrix(q, method="lagrange")
-    with pytest.raises(ValueError, match="argument 'method'"):
+    with pytest.raises(ValueError, match="argument 'method': expected rnea or jacobians, got 'crba'"):
         model.generalized_gravity(q, method="crba")
+    with pytest.raises(ValueError, match="argument 'method': expected a string, got 3"):
+        model.mass_matrix(q, method=3)
     with pytest.raises(ValueError, match="argument 'v'"):
         model.coriolis_matrix(q[0], [0.0] * 5)

@@ -159,6 +159,39 @@ pub(crate) fn parse_task(task: &Bound<PyAny>) -> PyResult<Vec<usize>> {
 }
 
 /// "argument 'method': expected ..., got '...'".
+/// The name given as a `method` argument, read in place: no string is made on the usual path
+/// (the default included), only for a name no function knows.
+pub(crate) enum MethodName {
+    Crba,
+    Rnea,
+    Jacobians,
+    Other(String),
+}
+
+impl MethodName {
+    pub(crate) fn as_str(&self) -> &str {
+        match self {
+            MethodName::Crba => "crba",
+            MethodName::Rnea => "rnea",
+            MethodName::Jacobians => "jacobians",
+            MethodName::Other(name) => name,
+        }
+    }
+}
+
+pub(crate) fn method_name(name: &str, value: &Bound<PyAny>) -> PyResult<MethodName> {
+    let text = value
+        .cast::<PyString>()
+        .map_err(|_| expected(name, "a string", value))?
+        .to_str()?;
+    Ok(match text {
+        "crba" => MethodName::Crba,
+        "rnea" => MethodName::Rnea,
+        "jacobians" => MethodName::Jacobians,
+        other => MethodName::Other(other.to_string()),
+    })
+}
+
 pub(crate) fn unknown_method(method: &str, expected: &str) -> PyErr {
     PyValueError::new_err(format!(
         "argument 'method': expected {expected}, got '{method}'"
@@ -317,7 +350,7 @@ pub(crate) mod named {
         position_only: flag -> bool;
         floating_base: flag -> bool;
         check_inertia: flag -> bool;
-        method: text -> String;
+        method: method_name -> super::MethodName;
         reference: reference_of -> robodyn::algo::Reference;
         source: text -> String;
         text: text -> String;

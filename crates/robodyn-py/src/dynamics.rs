@@ -230,25 +230,25 @@ impl PyModel {
     /// (column k = τ(q, 0, e_k) − g(q), n RNEA calls: the UR5 dynamics notes) or "jacobians"
     /// (Σ m J_vᵀ J_v + J_ωᵀ I J_ω over the bodies: the TU Berlin and UR5 dynamics notes).
     /// `out` as in `inverse_dynamics`.
-    #[pyo3(signature = (q, method="crba".to_string(), out=None), text_signature = "($self, q, method='crba', out=None)")]
+    #[pyo3(signature = (q, method=MethodName::Crba, out=None), text_signature = "($self, q, method='crba', out=None)")]
     fn mass_matrix<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
-        #[pyo3(from_py_with = named::method)] method: String,
+        #[pyo3(from_py_with = named::method)] method: MethodName,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let algorithm: MatrixOfQ = match method.as_str() {
-            "crba" => {
+        let algorithm: MatrixOfQ = match method {
+            MethodName::Crba => {
                 // straight into the result: CRBA mirrors M, so it is exactly symmetric
                 let (shape, arguments) = ([self.model.nv; 2], [self.q_arg("q", q)?]);
                 let kernel: &Kernel = &|m, w, i, out| algo::crba_into(m, &mut w.data, i[0], out);
                 let lanes = Some(LaneKernel::CompositeRigidBody);
                 return self.evaluate_into(py, &arguments, &shape, out, kernel, lanes);
             }
-            "rnea" => algo::mass_matrix_by_rnea,
-            "jacobians" => algo::mass_matrix_by_jacobians,
-            other => return Err(unknown_method(other, "crba, rnea or jacobians")),
+            MethodName::Rnea => algo::mass_matrix_by_rnea,
+            MethodName::Jacobians => algo::mass_matrix_by_jacobians,
+            other => return Err(unknown_method(other.as_str(), "crba, rnea or jacobians")),
         };
         self.matrix_of_q_into(py, q, self.model.nv, out, algorithm)
     }
@@ -312,19 +312,19 @@ impl PyModel {
     /// Generalized gravity g(q). (nv,). `method`: "rnea" (RNEA with v = a = 0) or "jacobians"
     /// (−Σ J_cᵀ m g over the bodies' centres of mass: the TU Berlin notes "Gravity"). `out` as in
     /// `inverse_dynamics`.
-    #[pyo3(signature = (q, method="rnea".to_string(), out=None), text_signature = "($self, q, method='rnea', out=None)")]
+    #[pyo3(signature = (q, method=MethodName::Rnea, out=None), text_signature = "($self, q, method='rnea', out=None)")]
     fn generalized_gravity<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
-        #[pyo3(from_py_with = named::method)] method: String,
+        #[pyo3(from_py_with = named::method)] method: MethodName,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         type Method = for<'d> fn(&Model, &'d mut Data, &[f64]) -> robodyn::Result<&'d DVector<f64>>;
-        let (algorithm, lanes): (Method, Option<LaneKernel>) = match method.as_str() {
-            "rnea" => (algo::generalized_gravity, Some(LaneKernel::NewtonEuler)),
-            "jacobians" => (algo::generalized_gravity_by_jacobians, None),
-            other => return Err(unknown_method(other, "rnea or jacobians")),
+        let (algorithm, lanes): (Method, Option<LaneKernel>) = match method {
+            MethodName::Rnea => (algo::generalized_gravity, Some(LaneKernel::NewtonEuler)),
+            MethodName::Jacobians => (algo::generalized_gravity_by_jacobians, None),
+            other => return Err(unknown_method(other.as_str(), "rnea or jacobians")),
         };
         self.evaluate_into(
             py,
