@@ -258,16 +258,16 @@ impl<S: Real> Transform<S> {
         let (e, r, m) = (&self.rotation, &self.translation, inertia.mass);
         // h' = Eᵀ h_B (the first moment in A's axes, about B's origin)
         let h = rotate_back(e, &inertia.first_moment);
-        // Ī_A = Eᵀ Ī_B E + (2 r·h' + m|r|²) 1 - (r h'ᵀ + h' rᵀ + m r rᵀ), symmetric: the upper
-        // triangle is computed and mirrored
+        // Ī_A = Eᵀ Ī_B E + (2 r·h' + m|r|²) 1 - (r h'ᵀ + h' rᵀ + m r rᵀ)
+        //     = Eᵀ Ī_B E + 2 (r·u) 1 - (r uᵀ + u rᵀ)   with u = h' + (m/2) r,
+        // symmetric: the upper triangle is computed and mirrored
         let rotated = compose_transposed(e, &compose(&inertia.rotational, e));
-        let two = S::splat(2.0);
-        let diagonal =
-            two * (r.x * h.x + r.y * h.y + r.z * h.z) + m * (r.x * r.x + r.y * r.y + r.z * r.z);
+        let u = h + r * (m * S::splat(0.5));
+        let diagonal = S::splat(2.0) * (r.x * u.x + r.y * u.y + r.z * u.z);
         let mut rotational = rotated;
         for row in 0..3 {
             for col in row..3 {
-                let shift = r[row] * h[col] + h[row] * r[col] + m * r[row] * r[col];
+                let shift = r[row] * u[col] + u[row] * r[col];
                 let mut value = rotated[(row, col)] - shift;
                 if row == col {
                     value += diagonal;
