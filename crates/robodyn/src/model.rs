@@ -215,12 +215,15 @@ impl Model {
     /// Checks a configuration: length nq, finite, unit quaternions.
     pub fn check_configuration(&self, q: &[f64]) -> Result<()> {
         check_vector("q", q, self.nq)?;
-        // only the quaternion joints (spherical, free) have more coordinates than velocities
-        if self.nq == self.nv {
-            return Ok(());
-        }
+        // only the quaternion joints (spherical, free) have more coordinates than velocities,
+        // one more each: the search ends at the last of them (a floating base's is the first)
+        let mut quaternions = self.nq - self.nv;
         for i in 1..self.nbodies() {
+            if quaternions == 0 {
+                break;
+            }
             if let Some(offset) = self.joints[i].quaternion_offset() {
+                quaternions -= 1;
                 let start = self.idx_q[i] + offset;
                 let norm = q[start..start + 4]
                     .iter()

@@ -436,3 +436,33 @@ fn ancestor_runs_are_the_parent_chain() {
         }
     }
 }
+
+/// Every quaternion of a configuration is checked, the last joint's as well as the floating
+/// base's (the check stops after the last quaternion joint).
+#[test]
+fn every_quaternion_is_checked() {
+    let (_, tree) = test_models()
+        .into_iter()
+        .find(|(name, _)| *name == "tree")
+        .unwrap();
+    let quaternion_starts: Vec<(String, usize)> = (1..tree.nbodies())
+        .filter_map(|i| {
+            let offset = tree.joints[i].quaternion_offset()?;
+            Some((tree.joint_names[i].clone(), tree.idx_q[i] + offset))
+        })
+        .collect();
+    assert_eq!(
+        quaternion_starts.len(),
+        2,
+        "a free base and a spherical joint"
+    );
+    for (joint, start) in quaternion_starts {
+        let mut q = tree.neutral();
+        q[start + 3] = 2.0;
+        let error = tree
+            .check_configuration(q.as_slice())
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains(&format!("joint '{joint}'")), "{error}");
+    }
+}
