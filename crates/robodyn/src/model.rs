@@ -419,15 +419,19 @@ pub struct ModelBuilder {
 
 /// [`Model::dof_run_start`] from the coordinates' parents.
 pub(crate) fn dof_run_starts(dof_parent: &[Option<usize>]) -> Vec<usize> {
-    let mut starts: Vec<usize> = Vec::with_capacity(dof_parent.len());
+    let mut starts = Vec::with_capacity(dof_parent.len());
     for (k, parent) in dof_parent.iter().enumerate() {
-        let start = match parent {
-            Some(p) if p + 1 == k => starts[*p],
-            _ => k,
-        };
-        starts.push(start);
+        starts.push(run_start(&starts, *parent, k));
     }
     starts
+}
+
+/// The start of coordinate k's run, given the runs of the coordinates before it.
+fn run_start(starts: &[usize], parent: Option<usize>, k: usize) -> usize {
+    match parent {
+        Some(p) if p + 1 == k => starts[p],
+        _ => k,
+    }
 }
 
 /// Iterator of [`Model::ancestor_runs`].
@@ -526,9 +530,10 @@ impl ModelBuilder {
         let mut previous = (ancestor != 0).then(|| m.idx_v[ancestor] + m.joints[ancestor].nv() - 1);
         for k in m.nv..m.nv + nv {
             m.dof_parent.push(previous);
+            m.dof_run_start
+                .push(run_start(&m.dof_run_start, previous, k));
             previous = Some(k);
         }
-        m.dof_run_start = dof_run_starts(&m.dof_parent);
         m.nq += nq;
         m.nv += nv;
         // quaternion coordinates carry no limits
