@@ -158,7 +158,6 @@ pub(crate) fn parse_task(task: &Bound<PyAny>) -> PyResult<Vec<usize>> {
     }
 }
 
-/// "argument 'method': expected ..., got '...'".
 /// The name given as a `method` argument, read in place: no string is made on the usual path
 /// (the default included), only for a name no function knows.
 pub(crate) enum MethodName {
@@ -179,6 +178,7 @@ impl MethodName {
     }
 }
 
+/// A `method` argument: a string, its name one of [`MethodName`]'s or another.
 pub(crate) fn method_name(name: &str, value: &Bound<PyAny>) -> PyResult<MethodName> {
     let text = value
         .cast::<PyString>()
@@ -192,6 +192,7 @@ pub(crate) fn method_name(name: &str, value: &Bound<PyAny>) -> PyResult<MethodNa
     })
 }
 
+/// "argument 'method': expected ..., got '...'".
 pub(crate) fn unknown_method(method: &str, expected: &str) -> PyErr {
     PyValueError::new_err(format!(
         "argument 'method': expected {expected}, got '{method}'"
