@@ -1,6 +1,6 @@
 //! Plücker coordinate transforms (Featherstone §2.8).
 
-use super::turn::{with_rotation, AnyRotation, Rotation};
+use super::turn::{with_rotation, AnyRotation, Rotation, TurnAbout};
 use super::{
     block, compose, compose_transposed, cross, from_blocks, matrix3, rotate, rotate_back, skew,
     transposed, Force, Inertia, Mat3, Mat6, Motion, Real, Vec3,
@@ -108,20 +108,8 @@ impl<S: Real> Transform<S> {
     /// [`Transform::rotated_about_axis`] for the axis `K`, given the angle's sine and cosine.
     #[inline(always)]
     fn rotated_about<const K: usize>(&self, s: S, c: S) -> Transform<S> {
-        let (first, second) = ((K + 1) % 3, (K + 2) % 3);
-        let e = &self.rotation;
-        let mut rows = [[S::zero(); 3]; 3];
-        for column in 0..3 {
-            let (a, b) = (e[(first, column)], e[(second, column)]);
-            rows[K][column] = e[(K, column)];
-            rows[first][column] = c * a + s * b;
-            rows[second][column] = c * b - s * a;
-        }
         Transform {
-            rotation: Matrix3::new(
-                rows[0][0], rows[0][1], rows[0][2], rows[1][0], rows[1][1], rows[1][2], rows[2][0],
-                rows[2][1], rows[2][2],
-            ),
+            rotation: TurnAbout::<K>::compose(&TurnAbout::<K>::matrix(s, c), &self.rotation),
             translation: self.translation,
         }
     }

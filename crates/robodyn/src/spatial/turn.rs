@@ -55,6 +55,21 @@ impl<const K: usize> TurnAbout<K> {
     /// The two coordinates the turn mixes.
     const FIRST: usize = (K + 1) % 3;
     const SECOND: usize = (K + 2) % 3;
+
+    /// The turn by the angle of sine `s` and cosine `c` as a joint's `E_J`: rows `[c s; −s c]`
+    /// on the two other coordinates (as `Transform::from_axis_angle` gives), 1 on axis K.
+    #[inline(always)]
+    pub(crate) fn matrix<S: Real>(s: S, c: S) -> Matrix3<S> {
+        let (f, second) = (Self::FIRST, Self::SECOND);
+        super::matrix3(|row, col| match (row, col) {
+            (r, k) if r == K && k == K => S::one(),
+            (r, k) if r == f && k == f => c,
+            (r, k) if r == f && k == second => s,
+            (r, k) if r == second && k == f => -s,
+            (r, k) if r == second && k == second => c,
+            _ => S::zero(),
+        })
+    }
 }
 
 impl<const K: usize> Rotation for TurnAbout<K> {
