@@ -26,11 +26,20 @@ pub struct Data {
     /// Generalized forces; nv. Written by `rnea`.
     pub tau: DVector<f64>,
     /// Composite rigid-body inertia of the subtree rooted at body i, in world coordinates;
-    /// nbodies. Written by `crba`; `center_of_mass_jacobian` writes only its mass and first moment.
+    /// nbodies. Written by `crba` on a model it computes in world coordinates (see `algo::crba`),
+    /// `centroidal_momentum_matrix`, `coriolis_matrix` and the derivatives;
+    /// `center_of_mass_jacobian` writes only its mass and first moment.
     pub i_c: Vec<Inertia>,
     /// Motion subspace column of each velocity coordinate in world coordinates (the spatial
-    /// Jacobian's columns); nv. Written by `crba`.
+    /// Jacobian's columns); nv. Written with `i_c`.
     pub s_world: Vec<Motion>,
+    /// Composite rigid-body inertia of the subtree rooted at body i, in body i's own frame;
+    /// nbodies. Written by `crba` on a model it computes in body coordinates.
+    pub i_c_body: Vec<Inertia>,
+    /// `F = I^c_i S_k` of each velocity coordinate k (of body i's joint), in the frame of the
+    /// last body `crba` carried it to (body coordinates: the root's child); nv. Written with
+    /// `i_c_body`.
+    pub f_subspace: Vec<Force>,
     /// Spatial velocity of body i in world coordinates; nbodies. Written by `coriolis_matrix`.
     pub v_world: Vec<Motion>,
     /// Rate Ṡ = v_i × ⁰S of each world-frame subspace column; nv. Written by `coriolis_matrix`.
@@ -137,6 +146,8 @@ impl Data {
             tau: DVector::zeros(nv),
             i_c: vec![Inertia::ZERO; nb],
             s_world: vec![Motion::ZERO; nv],
+            i_c_body: vec![Inertia::ZERO; nb],
+            f_subspace: vec![Force::ZERO; nv],
             v_world: vec![Motion::ZERO; nb],
             s_dot_world: vec![Motion::ZERO; nv],
             coriolis: DMatrix::zeros(nv, nv),

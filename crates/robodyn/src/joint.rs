@@ -260,6 +260,25 @@ impl Joint {
         }
     }
 
+    /// Where column `k` of `S` is a coordinate axis of `[angular; linear]` or its opposite (every
+    /// column of a spherical or free joint; a revolute or prismatic joint about ±e_c): its index
+    /// in `[angular; linear]` and whether it is the opposite. `S_kᵀ f` is then that component of
+    /// `f` (negated), the same value as [`Joint::project_force`] without the products by zero.
+    #[inline(always)]
+    pub fn subspace_component(&self, k: usize) -> Option<(usize, bool)> {
+        let signed = |offset: usize, axis: &Vec3| {
+            coordinate_axis(axis).map(|c| (offset + c.index, c.negative))
+        };
+        match self {
+            Joint::Fixed => None,
+            Joint::Revolute { axis } => signed(0, axis),
+            Joint::Prismatic { axis } => signed(3, axis),
+            Joint::Spherical => Some((k, false)),
+            Joint::Free if k < 3 => Some((3 + k, false)),
+            Joint::Free => Some((k - 3, false)),
+        }
+    }
+
     /// `S_kᵀ f`: the component of force `f` (child frame) along velocity coordinate `k`.
     #[inline(always)]
     pub fn project_force<S: Real>(&self, k: usize, f: &Force<S>) -> S {

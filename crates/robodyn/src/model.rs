@@ -109,6 +109,12 @@ pub struct Model {
     /// load before the next column (see [`Model::ancestor_runs`]). Not stored in snapshots.
     #[serde(skip)]
     pub dof_run_start: Vec<usize>,
+    /// Derived from `parent` and `idx_v` when the model is built, nbodies: one past the last
+    /// velocity coordinate of body i's subtree, whose coordinates are then `idx_v[i]..end` —
+    /// when the bodies are in depth-first order (each subtree's bodies follow its root without
+    /// a gap, as every loader adds them); `None` otherwise. Not stored in snapshots.
+    #[serde(skip)]
+    pub subtree_dof_end: Option<Vec<usize>>,
     /// Position limits, length nq (±inf where none).
     pub lower_position_limit: DVector<f64>,
     pub upper_position_limit: DVector<f64>,
@@ -426,6 +432,30 @@ pub(crate) fn dof_run_starts(dof_parent: &[Option<usize>]) -> Vec<usize> {
     starts
 }
 
+/// [`Model::subtree_dof_end`] from the bodies' parents and first coordinates (`nv` in all).
+pub(crate) fn subtree_dof_ends(parent: &[usize], idx_v: &[usize], nv: usize) -> Option<Vec<usize>> {
+    // depth-first order: each body's parent is on the path from the world to the body before it
+    let mut path = vec![0];
+    for (body, &p) in parent.iter().enumerate().skip(1) {
+        while *path.last()? != p {
+            path.pop();
+        }
+        path.push(body);
+    }
+    // then a subtree's bodies are the next `size` ones, its coordinates end where the body
+    // after them begins
+    let mut size = vec![1; parent.len()];
+    for body in (1..parent.len()).rev() {
+        size[parent[body]] += size[body];
+    }
+    let first_coordinate = |body: usize| idx_v.get(body).copied().unwrap_or(nv);
+    Some(
+        (0..parent.len())
+            .map(|body| first_coordinate(body + size[body]))
+            .collect(),
+    )
+}
+
 /// The start of coordinate k's run, given the runs of the coordinates before it.
 fn run_start(starts: &[usize], parent: Option<usize>, k: usize) -> usize {
     match parent {
@@ -470,6 +500,7 @@ impl ModelBuilder {
                 idx_v: vec![0],
                 dof_parent: Vec::new(),
                 dof_run_start: Vec::new(),
+                subtree_dof_end: None,
                 lower_position_limit: DVector::zeros(0),
                 upper_position_limit: DVector::zeros(0),
                 velocity_limit: DVector::zeros(0),
@@ -622,7 +653,9 @@ impl ModelBuilder {
     }
 
     /// The finished model.
-    pub fn build(self) -> Model {
+    pub fn build(mut self) -> Model {
+        let m = &mut self.model;
+        m.subtree_dof_end = subtree_dof_ends(&m.parent, &m.idx_v, m.nv);
         self.model
     }
 }

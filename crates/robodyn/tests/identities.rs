@@ -406,6 +406,106 @@ fn crba_into_writes_crba_s_matrix_which_is_exactly_symmetric() {
     }
 }
 
+/// CRBA's two forms (`algo::crba`), in body coordinates for bodies in depth-first order (every
+/// loader's) and in world coordinates otherwise, give the same M; `Model::subtree_dof_end`
+/// lists each subtree's coordinates, and a snapshot derives it again.
+#[test]
+fn crba_in_body_and_world_coordinates_agree() {
+    let mut rng = rng();
+    for (name, model) in test_models() {
+        let ends = model
+            .subtree_dof_end
+            .as_ref()
+            .expect("loaders add bodies depth first");
+        let reloaded = robodyn::io::model_from_bytes(&robodyn::io::model_to_bytes(&model)).unwrap();
+        assert_eq!(reloaded.subtree_dof_end.as_ref(), Some(ends), "{name}");
+        for (i, &end) in ends.iter().enumerate().skip(1) {
+            for j in 1..model.nbodies() {
+                // body j is in body i's subtree when i is on j's path to the world
+                let mut on_path = j;
+                while on_path > i {
+                    on_path = model.parent[on_path];
+                }
+                let listed = model.v_range(j).all(|d| (model.idx_v[i]..end).contains(&d));
+                assert_eq!(
+                    listed,
+                    on_path == i || model.v_range(j).is_empty(),
+                    "{name}: {i}, {j}"
+                );
+            }
+        }
+        let world_form = not_depth_first(&model);
+        let (mut data, mut world_data) = (Data::new(&model), Data::new(&world_form));
+        for _ in 0..3 {
+            let q = model.random_configuration(&mut rng);
+            let m = crba(&model, &mut data, q.as_slice()).unwrap();
+            let m_world = crba(&world_form, &mut world_data, q.as_slice()).unwrap();
+            let label = format!("{name}: M in body and world coordinates");
+            assert_close(
+                &label,
+                m.as_slice(),
+                m_world.as_slice(),
+                CLOSED_FORM_TOLERANCE,
+            );
+            assert_eq!(m, &m.transpose(), "{name}");
+        }
+    }
+}
+
+/// A model built with its bodies breadth first (not depth first) has no `subtree_dof_end`, and
+/// its M is the depth-first model's with the coordinates reordered.
+#[test]
+fn bodies_out_of_depth_first_order_take_the_world_form() {
+    let tree = test_model("tree");
+    let depth = |mut i: usize| {
+        let mut depth = 0;
+        while i != 0 {
+            i = tree.parent[i];
+            depth += 1;
+        }
+        depth
+    };
+    let mut order: Vec<usize> = (1..tree.nbodies()).collect();
+    order.sort_by_key(|&i| depth(i));
+    let mut builder = robodyn::ModelBuilder::new("breadth first", "world");
+    let (mut index, mut q_of, mut v_of) = (vec![0; tree.nbodies()], vec![], vec![]);
+    for &i in &order {
+        let body = robodyn::NewBody {
+            parent: index[tree.parent[i]],
+            joint: tree.joints[i],
+            joint_name: &tree.joint_names[i],
+            x_tree: tree.x_tree[i],
+            properties: Default::default(),
+            name: &tree.body_names[i],
+            inertia: tree.inertias[i],
+        };
+        index[i] = builder.add_body(body).unwrap();
+        q_of.extend(tree.q_range(i));
+        v_of.extend(tree.v_range(i));
+    }
+    let mut shuffled = builder.build();
+    assert_eq!(shuffled.subtree_dof_end, None);
+    for (new, &old) in v_of.iter().enumerate() {
+        shuffled.armature[new] = tree.armature[old];
+    }
+    let q = tree.random_configuration(&mut rng());
+    let q_shuffled: Vec<f64> = q_of.iter().map(|&old| q[old]).collect();
+    let m = crba(&tree, &mut Data::new(&tree), q.as_slice())
+        .unwrap()
+        .clone();
+    let m_shuffled = crba(&shuffled, &mut Data::new(&shuffled), &q_shuffled)
+        .unwrap()
+        .clone();
+    let reordered = DMatrix::from_fn(tree.nv, tree.nv, |r, c| m[(v_of[r], v_of[c])]);
+    let label = "M of the tree built breadth first";
+    assert_close(
+        label,
+        m_shuffled.as_slice(),
+        reordered.as_slice(),
+        CLOSED_FORM_TOLERANCE,
+    );
+}
+
 /// `Model::ancestor_runs` lists a coordinate's path to the root (itself, its parent, …) as runs
 /// of consecutive coordinates, nearest first, on every test model and after a snapshot.
 #[test]
@@ -441,10 +541,7 @@ fn ancestor_runs_are_the_parent_chain() {
 /// base's (the check stops after the last quaternion joint).
 #[test]
 fn every_quaternion_is_checked() {
-    let (_, tree) = test_models()
-        .into_iter()
-        .find(|(name, _)| *name == "tree")
-        .unwrap();
+    let tree = test_model("tree");
     let quaternion_starts: Vec<(String, usize)> = (1..tree.nbodies())
         .filter_map(|i| {
             let offset = tree.joints[i].quaternion_offset()?;

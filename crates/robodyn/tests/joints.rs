@@ -5,7 +5,7 @@ mod common;
 
 use common::{rng, FD_STEP, FD_TOLERANCE};
 use rand::Rng;
-use robodyn::spatial::{mat6_mul_motion, Transform, Vec3};
+use robodyn::spatial::{mat6_mul_motion, Force, Transform, Vec3};
 use robodyn::Joint;
 
 const ROUND_TRIP_TOLERANCE: f64 = 1e-10;
@@ -214,6 +214,52 @@ fn inertia_times_subspace_is_the_product_with_the_subspace_column() {
                 "{joint:?} column {k}"
             );
         }
+    }
+}
+
+/// `Joint::subspace_component`: where a column of S is a coordinate axis (or its opposite), the
+/// component it names is `S_kᵀ f` exactly; a general axis has none.
+#[test]
+fn subspace_components_are_the_projections() {
+    let f = Force::new(Vec3::new(0.3, -1.7, 2.9), Vec3::new(-4.1, 0.6, 1.3));
+    let axis = |x: f64, y: f64, z: f64| Vec3::new(x, y, z);
+    let joints = [
+        Joint::Revolute {
+            axis: axis(1.0, 0.0, 0.0),
+        },
+        Joint::Revolute {
+            axis: axis(0.0, -1.0, 0.0),
+        },
+        Joint::Revolute {
+            axis: axis(0.0, 0.0, 1.0),
+        },
+        Joint::Prismatic {
+            axis: axis(0.0, 1.0, 0.0),
+        },
+        Joint::Prismatic {
+            axis: axis(-1.0, 0.0, 0.0),
+        },
+        Joint::Spherical,
+        Joint::Free,
+    ];
+    for joint in joints {
+        for k in 0..joint.nv() {
+            let (index, negative) = joint.subspace_component(k).expect("a coordinate axis");
+            let value = f.plucker()[index];
+            let value = if negative { -value } else { value };
+            assert_eq!(value, joint.project_force(k, &f), "{joint:?}, column {k}");
+        }
+    }
+    let general = [
+        Joint::Revolute {
+            axis: axis(0.6, 0.8, 0.0),
+        },
+        Joint::Prismatic {
+            axis: axis(0.0, 0.6, -0.8),
+        },
+    ];
+    for joint in general {
+        assert_eq!(joint.subspace_component(0), None, "{joint:?}");
     }
 }
 

@@ -51,6 +51,10 @@ proptest! {
             x.transpose_apply_matrix_turned(turn, &articulated),
             x.transpose_apply_matrix(&articulated)
         );
+        prop_assert_eq!(x.transpose_apply_inertia_turned(turn, &i), x.transpose_apply_inertia(&i));
+        let mut forces = [f, Force::new(w, v)];
+        x.transpose_apply_forces_turned(turn, &mut forces);
+        prop_assert_eq!(forces, [x.transpose_apply_force(&f), x.transpose_apply_force(&Force::new(w, v))]);
     }
 
     #[test]

@@ -2,18 +2,25 @@
 //!
 //! Reference: Featherstone, *Rigid Body Dynamics Algorithms* (2008), §6.2 and Table 6.2:
 //! `H_ij = S_iᵀ I^c_i S_j` for j an ancestor of i (or i itself), with `I^c_i` the composite inertia
-//! of the subtree rooted at body i. Table 6.2 evaluates it in body coordinates, carrying the force
-//! `F = I^c_i S_i` up the tree; here every quantity is expressed once in world coordinates, where
-//! composite inertias add without transforms and each `H_ij` is a single dot product (the form
-//! Pinocchio uses). The UR5 dynamics notes obtain the same M from n RNEA calls; the tests check it.
-//! Input: q (nq). Writes `data.x_up`, `data.x_world`, `data.s_world`, `data.i_c` (world
-//! coordinates), `data.mass_matrix` (full, symmetric, armature on the diagonal).
-//! Cost: O(n) transforms plus one 6-vector dot product per pair (joint, ancestor joint).
+//! of the subtree rooted at body i. Two forms, the same M:
+//! - Table 6.2 in body coordinates (bodies in depth-first order, as every loader gives, so that a
+//!   subtree's coordinates are consecutive): composites and forces `F = I^c_i S_i` carried to the
+//!   parent joint by joint. A joint that turns about a coordinate axis makes each carry a turned
+//!   product (`spatial::turn`), and a coordinate axis makes `S_jᵀ F` one component of F.
+//! - Otherwise every quantity once in world coordinates, where composites add without transforms
+//!   and each `H_ij` is a 6-vector dot product.
+//!
+//! The UR5 dynamics notes obtain the same M from n RNEA calls; the tests check it.
+//! Input: q (nq). Writes `data.x_up`; `data.i_c_body`, `data.f_subspace` (body coordinates) or
+//! `data.x_world`, `data.s_world`, `data.i_c` (world coordinates); `data.mass_matrix` (full,
+//! symmetric, armature on the diagonal).
+//! Cost: O(n) transforms plus a force carried (body coordinates) or a dot product (world
+//! coordinates) per pair (joint, ancestor joint).
 
-use crate::algo::kinematics::body_placements;
+use crate::algo::kinematics::{body_placements, joint_transforms};
 use crate::error::{check_length, Result};
 use crate::model::Model;
-use crate::spatial::{Inertia, Motion, Real, Transform};
+use crate::spatial::{Force, Inertia, Motion, Real, Transform};
 use crate::Data;
 use nalgebra::DMatrix;
 
@@ -31,10 +38,57 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMat
 pub fn crba_into(model: &Model, data: &mut Data, q: &[f64], out: &mut [f64]) -> Result<()> {
     model.check_configuration(q)?;
     check_length("out", out.len(), model.nv * model.nv)?;
-    world_inertias_and_subspaces(model, data, q);
-    add_composite_inertias(model, data);
-    composite_mass_matrix(model, data, out);
+    let buffers = MassMatrixBuffers {
+        x_up: &mut data.x_up,
+        x_world: &mut data.x_world,
+        world_composites: &mut data.i_c,
+        subspaces: &mut data.s_world,
+        body_composites: &mut data.i_c_body,
+        forces: &mut data.f_subspace,
+        mass_matrix: out,
+    };
+    mass_matrix_of(model, q, buffers);
     Ok(())
+}
+
+/// What the CRBA writes in either form: one state's, borrowed from [`Data`], or several states'
+/// in lanes ([`crate::algo::lanes`]).
+pub(crate) struct MassMatrixBuffers<'b, S> {
+    pub x_up: &'b mut [Transform<S>],
+    pub x_world: &'b mut [Transform<S>],
+    pub world_composites: &'b mut [Inertia<S>],
+    pub subspaces: &'b mut [Motion<S>],
+    pub body_composites: &'b mut [Inertia<S>],
+    pub forces: &'b mut [Force<S>],
+    pub mass_matrix: &'b mut [S],
+}
+
+/// M into `out.mass_matrix` (column-major, nv × nv), in `f64` or lanes: in body coordinates
+/// when the bodies are in depth-first order, else in world coordinates.
+#[inline(always)]
+pub(crate) fn mass_matrix_of<S: Real>(model: &Model, q: &[S], out: MassMatrixBuffers<S>) {
+    match model.subtree_dof_end.as_deref() {
+        Some(subtree_dof_end) => {
+            let buffers = BodyFrameBuffers {
+                x_up: out.x_up,
+                composites: out.body_composites,
+                forces: out.forces,
+                mass_matrix: out.mass_matrix,
+            };
+            body_frame_mass_matrix(model, subtree_dof_end, q, buffers);
+        }
+        None => {
+            let buffers = CompositeBuffers {
+                x_up: out.x_up,
+                x_world: out.x_world,
+                composites: out.world_composites,
+                subspaces: out.subspaces,
+            };
+            world_inertias_of(model, q, buffers);
+            add_composites(model, out.world_composites);
+            mass_matrix_of_composites(model, out.world_composites, out.subspaces, out.mass_matrix);
+        }
+    }
 }
 
 /// M into `mass_matrix` (column-major, nv × nv) from the world-frame composites in `data.i_c`
@@ -120,6 +174,71 @@ pub(crate) fn add_composites<S: Real>(model: &Model, composites: &mut [Inertia<S
         if parent != 0 {
             let subtree = composites[i];
             composites[parent] += subtree;
+        }
+    }
+}
+
+/// What the body-coordinate CRBA writes: one state's, or several states' in lanes.
+pub(crate) struct BodyFrameBuffers<'b, S> {
+    pub x_up: &'b mut [Transform<S>],
+    pub composites: &'b mut [Inertia<S>],
+    pub forces: &'b mut [Force<S>],
+    pub mass_matrix: &'b mut [S],
+}
+
+/// M by Table 6.2 in body coordinates, in `f64` or lanes, for bodies in depth-first order
+/// (`subtree_dof_end`: each subtree's coordinates are `idx_v[i]..subtree_dof_end[i]`). Leaves to
+/// root, body i's composite is complete when it is reached; then
+/// `F_k = I^c_i S_k` for its own coordinates k, `H_dk = S_kᵀ F_d` for every coordinate d of its
+/// subtree (whose forces are in i's coordinates by now), and the subtree's inertia and forces
+/// are carried to the parent: `I^c_λ(i) += X_{i←λ(i)}ᵀ I^c_i X_{i←λ(i)}`, `F_d ← X_{i←λ(i)}ᵀ F_d`.
+/// Each body's transform acts on all its subtree's forces at once (independent products), and a
+/// joint that turns about a coordinate axis (`Model::turn_axis`) makes both products turned ones.
+#[inline(always)]
+pub(crate) fn body_frame_mass_matrix<S: Real>(
+    model: &Model,
+    subtree_dof_end: &[usize],
+    q: &[S],
+    out: BodyFrameBuffers<S>,
+) {
+    let nv = model.nv;
+    joint_transforms(model, q, out.x_up);
+    for (composite, inertia) in out.composites.iter_mut().zip(&model.inertias) {
+        *composite = Inertia::splat(inertia);
+    }
+    out.mass_matrix.fill(S::splat(0.0));
+    for i in (1..model.nbodies()).rev() {
+        let joint = &model.joints[i];
+        let subtree = model.idx_v[i]..subtree_dof_end[i];
+        // F_k = I^c_i S_k for the joint's own coordinates
+        for (k, dof) in model.v_range(i).enumerate() {
+            let column = Motion::splat(&joint.subspace_column(k));
+            out.forces[dof] = out.composites[i].mul_motion(&column);
+        }
+        // H_dk = H_kd = S_kᵀ F_d for the subtree's coordinates d (a component of F_d where S_k
+        // is a coordinate axis)
+        for (k, col) in model.v_range(i).enumerate() {
+            let component = joint.subspace_component(k);
+            for (d, force) in subtree.clone().zip(&out.forces[subtree.clone()]) {
+                let h = match component {
+                    Some((c, false)) => force.component(c),
+                    Some((c, true)) => -force.component(c),
+                    None => joint.project_force(k, force),
+                };
+                out.mass_matrix[d + col * nv] = h;
+                out.mass_matrix[col + d * nv] = h;
+            }
+        }
+        for dof in model.v_range(i) {
+            out.mass_matrix[dof + dof * nv] += S::splat(model.armature[dof]);
+        }
+        // the subtree's inertia and forces into the parent's coordinates
+        let parent = model.parent[i];
+        if parent != 0 {
+            let (x_up, turn) = (&out.x_up[i], model.turn_axis(i));
+            let carried = x_up.transpose_apply_inertia_turned(turn, &out.composites[i]);
+            out.composites[parent] += carried;
+            x_up.transpose_apply_forces_turned(turn, &mut out.forces[subtree]);
         }
     }
 }

@@ -161,7 +161,8 @@ impl Algorithm {
     /// inertias (36 values per body) no longer fit in the vector registers at eight lanes, and
     /// the spills cost more than the wider instructions gain (on this project's AMD EPYC, whose
     /// AVX-512 executes as two 256-bit halves, it ran 1.6x slower than at four lanes): it runs
-    /// at four.
+    /// at four. So does CRBA, whose body-coordinate form carries every force of a subtree through
+    /// memory at each joint (at eight lanes 1.1–1.3x slower than at four).
     /// The values of one state's result.
     fn output_size(self, model: &Model) -> usize {
         match self {
@@ -175,7 +176,9 @@ impl Algorithm {
 
     fn width(self, widest: LaneWidth) -> LaneWidth {
         match (self, widest) {
-            (Algorithm::ArticulatedBody, LaneWidth::Eight) if LaneWidth::Four.available() => {
+            (Algorithm::ArticulatedBody | Algorithm::CompositeRigidBody, LaneWidth::Eight)
+                if LaneWidth::Four.available() =>
+            {
                 LaneWidth::Four
             }
             (_, width) => width,

@@ -8,7 +8,7 @@
 //! they become a model, so damaged bytes are an error, never a crash later.
 
 use crate::error::{Error, Result};
-use crate::model::{dof_run_starts, Model};
+use crate::model::{dof_run_starts, subtree_dof_ends, Model};
 
 /// What every snapshot starts with.
 const TAG: &[u8; 8] = b"robodyn\0";
@@ -60,6 +60,7 @@ pub fn model_from_bytes(bytes: &[u8]) -> Result<Model> {
         .map_err(|e| refuse(format!("the snapshot (robodyn {version}) is damaged: {e}")))?;
     check_structure(&model)?;
     model.dof_run_start = dof_run_starts(&model.dof_parent);
+    model.subtree_dof_end = subtree_dof_ends(&model.parent, &model.idx_v, model.nv);
     Ok(model)
 }
 

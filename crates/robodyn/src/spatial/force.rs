@@ -25,6 +25,15 @@ impl<S: Real> Force<S> {
         [n.x, n.y, n.z, f.x, f.y, f.z]
     }
 
+    /// Component `index` of [`Force::plucker`].
+    #[inline(always)]
+    pub fn component(&self, index: usize) -> S {
+        match index {
+            0..3 => self.angular[index],
+            _ => self.linear[index - 3],
+        }
+    }
+
     /// A constant force in every lane.
     #[inline(always)]
     pub fn splat(f: &Force) -> Self {

@@ -2,8 +2,8 @@
 
 use super::turn::{with_rotation, AnyRotation, Rotation, TurnAbout};
 use super::{
-    block, compose, compose_transposed, cross, from_blocks, matrix3, rotate, rotate_back, skew,
-    transposed, Force, Inertia, Mat3, Mat6, Motion, Real, Vec3,
+    block, cross, from_blocks, matrix3, rotate, rotate_back, skew, transposed, Force, Inertia,
+    Mat3, Mat6, Motion, Real, Vec3,
 };
 use nalgebra::{Matrix3, Matrix6, Vector3};
 use std::ops::Mul;
@@ -191,6 +191,19 @@ impl<S: Real> Transform<S> {
         with_rotation!(turn, self.transpose_apply_force_by(f))
     }
 
+    /// [`Transform::transpose_apply_force_turned`] of every force of `forces`, in place.
+    #[inline(always)]
+    pub fn transpose_apply_forces_turned(&self, turn: Option<usize>, forces: &mut [Force<S>]) {
+        with_rotation!(turn, self.transpose_apply_forces_by(forces))
+    }
+
+    #[inline(always)]
+    fn transpose_apply_forces_by<R: Rotation>(&self, forces: &mut [Force<S>]) {
+        for f in forces {
+            *f = self.transpose_apply_force_by::<R>(f);
+        }
+    }
+
     #[inline(always)]
     fn transpose_apply_force_by<R: Rotation>(&self, f: &Force<S>) -> Force<S> {
         let linear = R::rotate_back(&self.rotation, &f.linear);
@@ -243,13 +256,29 @@ impl<S: Real> Transform<S> {
     /// `Xᵀ I X`: a rigid-body inertia given in B coordinates, expressed in A coordinates.
     #[inline(always)]
     pub fn transpose_apply_inertia(&self, inertia: &Inertia<S>) -> Inertia<S> {
+        self.transpose_apply_inertia_by::<AnyRotation>(inertia)
+    }
+
+    /// [`Transform::transpose_apply_inertia`] for a rotation about coordinate axis `turn` only,
+    /// as [`Transform::apply_motion_turned`].
+    #[inline(always)]
+    pub fn transpose_apply_inertia_turned(
+        &self,
+        turn: Option<usize>,
+        inertia: &Inertia<S>,
+    ) -> Inertia<S> {
+        with_rotation!(turn, self.transpose_apply_inertia_by(inertia))
+    }
+
+    #[inline(always)]
+    fn transpose_apply_inertia_by<R: Rotation>(&self, inertia: &Inertia<S>) -> Inertia<S> {
         let (e, r, m) = (&self.rotation, &self.translation, inertia.mass);
         // h' = Eᵀ h_B (the first moment in A's axes, about B's origin)
-        let h = rotate_back(e, &inertia.first_moment);
+        let h = R::rotate_back(e, &inertia.first_moment);
         // Ī_A = Eᵀ Ī_B E + (2 r·h' + m|r|²) 1 - (r h'ᵀ + h' rᵀ + m r rᵀ)
         //     = Eᵀ Ī_B E + 2 (r·u) 1 - (r uᵀ + u rᵀ)   with u = h' + (m/2) r,
         // symmetric: the upper triangle is computed and mirrored
-        let rotated = compose_transposed(e, &compose(&inertia.rotational, e));
+        let rotated = R::rotated(e, &inertia.rotational);
         let u = h + r * (m * S::splat(0.5));
         let diagonal = S::splat(2.0) * (r.x * u.x + r.y * u.y + r.z * u.z);
         let mut rotational = rotated;

@@ -92,25 +92,32 @@ impl<const K: usize> Rotation for TurnAbout<K> {
     #[inline(always)]
     fn rotated<S: Real>(e: &Matrix3<S>, m: &Matrix3<S>) -> Matrix3<S> {
         let (f, s) = (Self::FIRST, Self::SECOND);
-        // M E: columns f and s turn, column K stays; then Eᵀ (M E): rows f and s turn
-        let m_e = super::matrix3(|row, col| match col {
-            c if c == K => m[(row, K)],
-            c => m[(row, f)] * e[(f, c)] + m[(row, s)] * e[(s, c)],
-        });
-        super::matrix3(|row, col| match row {
-            r if r == K => m_e[(K, col)],
-            r => e[(f, r)] * m_e[(f, col)] + e[(s, r)] * m_e[(s, col)],
-        })
+        // M E: columns f and s turn, column K stays (entry by entry, not by a closure: a
+        // closure is not always inlined into a kernel compiled for wider lanes)
+        let mut m_e = *m;
+        for row in 0..3 {
+            m_e[(row, f)] = m[(row, f)] * e[(f, f)] + m[(row, s)] * e[(s, f)];
+            m_e[(row, s)] = m[(row, f)] * e[(f, s)] + m[(row, s)] * e[(s, s)];
+        }
+        // then Eᵀ (M E): rows f and s turn
+        let mut out = m_e;
+        for col in 0..3 {
+            out[(f, col)] = e[(f, f)] * m_e[(f, col)] + e[(s, f)] * m_e[(s, col)];
+            out[(s, col)] = e[(f, s)] * m_e[(f, col)] + e[(s, s)] * m_e[(s, col)];
+        }
+        out
     }
 
     #[inline(always)]
     fn compose<S: Real>(e: &Matrix3<S>, m: &Matrix3<S>) -> Matrix3<S> {
         let (f, s) = (Self::FIRST, Self::SECOND);
-        // row K of M stays, rows f and s turn
-        super::matrix3(|row, col| match row {
-            r if r == K => m[(K, col)],
-            r => e[(r, f)] * m[(f, col)] + e[(r, s)] * m[(s, col)],
-        })
+        // row K of M stays, rows f and s turn (entry by entry, as in `rotated`)
+        let mut out = *m;
+        for col in 0..3 {
+            out[(f, col)] = e[(f, f)] * m[(f, col)] + e[(f, s)] * m[(s, col)];
+            out[(s, col)] = e[(s, f)] * m[(f, col)] + e[(s, s)] * m[(s, col)];
+        }
+        out
     }
 }
 

@@ -72,6 +72,20 @@ pub fn test_models() -> Vec<(&'static str, Model)> {
     ]
 }
 
+/// The test model called `name`.
+pub fn test_model(name: &str) -> Model {
+    let mut models = test_models().into_iter();
+    models.find(|(model, _)| *model == name).unwrap().1
+}
+
+/// `model` as if its bodies were not in depth-first order (`subtree_dof_end` cleared): the
+/// algorithms with two forms (CRBA) take their world-coordinate one.
+pub fn not_depth_first(model: &Model) -> Model {
+    let mut model = model.clone();
+    model.subtree_dof_end = None;
+    model
+}
+
 pub fn rng() -> StdRng {
     StdRng::seed_from_u64(2026)
 }

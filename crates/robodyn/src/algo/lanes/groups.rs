@@ -4,9 +4,7 @@
 use super::scatter::Scatter;
 use super::{write_jacobian_column, Algorithm, States};
 use crate::algo::aba::{articulated_body_passes, AbaBuffers};
-use crate::algo::crba::{
-    add_composites, mass_matrix_of_composites, world_inertias_of, CompositeBuffers,
-};
+use crate::algo::crba::{mass_matrix_of, MassMatrixBuffers};
 use crate::algo::derivatives::{
     aba_derivative_passes, derivative_passes, DerivativeBuffers, RowMajor, SolveBuffers,
 };
@@ -41,6 +39,8 @@ pub(super) struct Lanes<S> {
     x_world: Vec<Transform<S>>,
     composites: Vec<Inertia<S>>,
     subspaces: Vec<Motion<S>>,
+    body_composites: Vec<Inertia<S>>,
+    subspace_forces: Vec<Force<S>>,
     mass_matrix: Vec<S>,
     motion_terms: Vec<[Motion<S>; 3]>,
     body_inertias: Vec<Inertia<S>>,
@@ -81,6 +81,8 @@ impl<S: Real> Lanes<S> {
             x_world: vec![Transform::splat(&Transform::IDENTITY); bodies],
             composites: vec![Inertia::splat(&Inertia::ZERO); bodies],
             subspaces: vec![Motion::zeros(); model.nv],
+            body_composites: vec![Inertia::splat(&Inertia::ZERO); bodies],
+            subspace_forces: vec![zero_force; model.nv],
             mass_matrix: vec![zero; model.nv * model.nv],
             motion_terms: vec![[Motion::zeros(); 3]; model.nv],
             body_inertias: vec![Inertia::splat(&Inertia::ZERO); bodies],
@@ -224,16 +226,16 @@ pub(super) fn groups<S: Scatter>(
                     .map_err(|_| first)?;
             }
             Algorithm::CompositeRigidBody => {
-                let buffers = CompositeBuffers {
+                let buffers = MassMatrixBuffers {
                     x_up: &mut lanes.x_up,
                     x_world: &mut lanes.x_world,
-                    composites: &mut lanes.composites,
+                    world_composites: &mut lanes.composites,
                     subspaces: &mut lanes.subspaces,
+                    body_composites: &mut lanes.body_composites,
+                    forces: &mut lanes.subspace_forces,
+                    mass_matrix: &mut lanes.mass_matrix,
                 };
-                world_inertias_of(model, &lanes.q, buffers);
-                add_composites(model, &mut lanes.composites);
-                let (composites, subspaces) = (&lanes.composites, &lanes.subspaces);
-                mass_matrix_of_composites(model, composites, subspaces, &mut lanes.mass_matrix);
+                mass_matrix_of(model, &lanes.q, buffers);
                 S::scatter(&lanes.mass_matrix, out, size, 0);
                 continue;
             }
