@@ -77,6 +77,9 @@ impl Default for JointProperties {
 
 /// A rigid multibody tree. Bodies are numbered so that `parent[i] < i`; body 0 is the world and
 /// has no joint (`Joint::Fixed`). Body `i ≥ 1` moves relative to its parent through `joints[i]`.
+/// The tree's structure (`parent`, `joints`, `idx_q`, `idx_v`, `dof_parent` and what is derived
+/// from them) is made by [`ModelBuilder`] and must not be edited afterwards: add bodies with a
+/// builder instead. Values (inertias, tree transforms, limits, armature, gravity) may be edited.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Model {
     pub name: String,
