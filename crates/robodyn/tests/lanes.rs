@@ -45,30 +45,48 @@ fn one_state(model: &Model, data: &mut Data, states: &States, k: usize) -> Vec<f
     .to_vec()
 }
 
-/// The batch of `states` at `width`, or `None` where this CPU lacks the width.
-fn batch_at(model: &Model, width: LaneWidth, states: States) -> Option<Vec<f64>> {
-    let Ok(mut workspace) = BatchWorkspace::with_width(model, width) else {
-        assert!(!width.available(), "{width:?} is available but refused");
-        return None;
+/// A workspace at `width` (as chosen for the CPU), or with every kernel at exactly `width`.
+fn workspace_at(model: &Model, width: LaneWidth, exact: bool) -> Option<BatchWorkspace> {
+    let workspace = match exact {
+        false => BatchWorkspace::with_width(model, width),
+        true => BatchWorkspace::with_kernel_width(model, width),
     };
+    assert!(
+        workspace.is_ok() || !width.available(),
+        "{width:?} is available but refused"
+    );
+    workspace.ok()
+}
+
+/// The states that run in lanes at `width`: forward dynamics and the mass matrix run at four
+/// lanes where eight are available, unless the workspace is `exact`.
+fn group_of(width: LaneWidth, narrower_at_eight: bool, exact: bool) -> usize {
+    match width {
+        LaneWidth::Eight if narrower_at_eight && !exact => 4,
+        width => width.states(),
+    }
+}
+
+/// The batch of `states` at `width` (every kernel at exactly `width` if `exact`), or `None`
+/// where this CPU lacks the width.
+fn batch_at(model: &Model, width: LaneWidth, exact: bool, states: States) -> Option<Vec<f64>> {
+    let mut workspace = workspace_at(model, width, exact)?;
     let mut out = vec![f64::NAN; STATES * model.nv];
     match states.tau {
         Some(_) => aba_batch(model, &mut workspace, states, &mut out),
         None => newton_euler_batch(model, &mut workspace, states, &mut out),
     }
     .unwrap();
-    // the full groups ran in lanes (forward dynamics at four lanes at most)
-    let group = match (states.tau, width) {
-        (Some(_), LaneWidth::Eight) => 4,
-        (_, width) if width.states() > 1 => width.states(),
-        _ => STATES + 1,
-    };
-    assert_eq!(
-        workspace.states_in_lanes(),
-        STATES - STATES % group,
-        "{width:?}"
-    );
+    let group = group_of(width, states.tau.is_some(), exact);
+    assert_groups_ran_in_lanes(&workspace, group, &format!("{width:?}"));
     Some(out)
+}
+
+/// Every width, each as chosen for the CPU and with every kernel at exactly that width.
+fn widths_and_kernels() -> impl Iterator<Item = (LaneWidth, bool)> {
+    LaneWidth::ALL
+        .into_iter()
+        .flat_map(|width| [(width, false), (width, true)])
 }
 
 /// The same numbers, bit for bit (signed zeros and NaN payloads included).
@@ -119,8 +137,8 @@ fn every_lane_width_equals_the_one_state_call_bit_for_bit() {
                 tau: Some(&a),
             },
         ] {
-            for width in LaneWidth::ALL {
-                let Some(out) = batch_at(&model, width, states) else {
+            for (width, exact) in widths_and_kernels() {
+                let Some(out) = batch_at(&model, width, exact, states) else {
                     continue;
                 };
                 exercised += 1;
@@ -129,14 +147,14 @@ fn every_lane_width_equals_the_one_state_call_bit_for_bit() {
                     let same = bit_equal(row, &expected);
                     assert!(
                         same,
-                        "{name}, {width:?}, state {k}: {row:?} != {expected:?}"
+                        "{name}, {width:?}, exact {exact}, state {k}: {row:?} != {expected:?}"
                     );
                 }
             }
         }
     }
-    // the one-state width runs everywhere
-    assert!(exercised >= 4 * test_models().len());
+    // the one-state width runs everywhere, as chosen and exactly
+    assert!(exercised >= 8 * test_models().len());
 }
 
 #[test]
@@ -244,22 +262,17 @@ fn mass_matrices_in_lanes_equal_crba_bit_for_bit() {
         let (q, _, _) = batch(&model);
         let mut data = Data::new(&model);
         let size = model.nv * model.nv;
-        for width in LaneWidth::ALL {
-            let Ok(mut workspace) = BatchWorkspace::with_width(&model, width) else {
+        for (width, exact) in widths_and_kernels() {
+            let Some(mut workspace) = workspace_at(&model, width, exact) else {
                 continue;
             };
             let mut out = vec![f64::NAN; STATES * size];
             crba_batch(&model, &mut workspace, &q, &mut out).unwrap();
-            // at four lanes where eight are available (as ABA)
-            let group = match width {
-                LaneWidth::Eight => 4,
-                width => width.states(),
-            };
-            assert_groups_ran_in_lanes(&workspace, group, name);
+            assert_groups_ran_in_lanes(&workspace, group_of(width, true, exact), name);
             for (k, m) in out.chunks(size).enumerate() {
                 let expected = crba(&model, &mut data, &q[k * model.nq..(k + 1) * model.nq]);
                 let same = bit_equal(m, expected.unwrap().as_slice());
-                assert!(same, "{name}, {width:?}, state {k}");
+                assert!(same, "{name}, {width:?}, exact {exact}, state {k}");
             }
         }
     }
