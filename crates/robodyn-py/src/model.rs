@@ -19,8 +19,8 @@ use robodyn::algo::{self, BatchResult, BatchWorkspace, States};
 use robodyn::integrate::StepWorkspace;
 use robodyn::spatial::Force;
 use robodyn::{Data, Error, Model};
+use rustc_hash::FxHashMap;
 use std::borrow::Cow;
-use std::collections::HashMap;
 use std::sync::Mutex;
 
 /// What a kernel works in: the algorithm workspace and a buffer for external forces.
@@ -214,14 +214,15 @@ pub(crate) struct PyModel {
     pub(crate) workspace: Mutex<Workspace>,
     /// Workspaces for the threads of a batch, kept between calls (making one allocates).
     pub(crate) batch_workspaces: Mutex<Vec<Workspace>>,
-    /// Frame name to index, for the calls that take a frame by name.
-    pub(crate) frame_indices: HashMap<String, usize>,
+    /// Frame name to index, for the calls that take a frame by name (a fast hash: the names are
+    /// the model's own, and SipHash had cost a tenth of a Talos Jacobian call's fixed cost).
+    pub(crate) frame_indices: FxHashMap<String, usize>,
 }
 
 impl PyModel {
     pub(crate) fn wrap(model: Model) -> Self {
         let workspace = Mutex::new(Workspace::new(&model));
-        let mut frame_indices = HashMap::new();
+        let mut frame_indices = FxHashMap::default();
         for (index, frame) in model.frames.iter().enumerate() {
             // the first frame of a name wins, as in Model::frame_index
             frame_indices.entry(frame.name.clone()).or_insert(index);
