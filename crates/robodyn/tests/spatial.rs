@@ -57,6 +57,41 @@ proptest! {
         prop_assert_eq!(forces, [x.transpose_apply_force(&f), x.transpose_apply_force(&Force::new(w, v))]);
     }
 
+    /// Forces kept by component and carried four at a time equal each force carried alone, bit
+    /// for bit, turned or not; the values outside the groups are untouched.
+    #[test]
+    fn forces_carried_in_rows_equal_each_carried_alone(
+        angle in -4.0f64..4.0, k in 0usize..3, r in vec3(), y in transform(), turned in any::<bool>(),
+        values in prop::collection::vec(-2.0f64..2.0, 6 * 14), count in 1usize..12, g in 0usize..3,
+        e in 0usize..12,
+    ) {
+        let mut axis = Vec3::zeros();
+        axis[k] = 1.0;
+        let (x, turn) = match turned {
+            true => (Joint::Revolute { axis }.transform_after_turn(&[angle], angle.sin_cos(), &Transform::from_translation(&r)), Some(k)),
+            false => (y, None),
+        };
+        // `count` forces after three unused values in each of six rows
+        let stride = count + 3;
+        let mut rows = values[..6 * stride].to_vec();
+        // whole groups of four, ending anywhere from the fourth value on
+        let groups = 1 + g % (stride / 4);
+        let end = 4 * groups + e % (stride - 4 * groups + 1);
+        let force = |rows: &[f64], d: usize| {
+            let c = |c: usize| rows[c * stride + d];
+            Force::new(Vec3::new(c(0), c(1), c(2)), Vec3::new(c(3), c(4), c(5)))
+        };
+        let carried: Vec<Force> = (end - 4 * groups..end).map(|d| x.transpose_apply_force(&force(&rows, d))).collect();
+        let before = rows.clone();
+        x.transpose_apply_force_rows_turned(turn, &mut rows, stride, end, groups);
+        for d in 0..stride {
+            match (end - 4 * groups..end).contains(&d) {
+                true => prop_assert_eq!(force(&rows, d), carried[d + 4 * groups - end]),
+                false => prop_assert_eq!(force(&rows, d), force(&before, d)),
+            }
+        }
+    }
+
     #[test]
     fn transform_times_inverse_is_identity(x in transform(), w in vec3(), v in vec3()) {
         let m = Motion::new(w, v);

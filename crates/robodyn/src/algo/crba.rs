@@ -6,7 +6,8 @@
 //! - Table 6.2 in body coordinates (bodies in depth-first order, as every loader gives, so that a
 //!   subtree's coordinates are consecutive): composites and forces `F = I^c_i S_i` carried to the
 //!   parent joint by joint. A joint that turns about a coordinate axis makes each carry a turned
-//!   product (`spatial::turn`), and a coordinate axis makes `S_jᵀ F` one component of F.
+//!   product (`spatial::turn`), and a coordinate axis makes `S_jᵀ F` one component of F. One
+//!   state keeps its forces by component ([`ForceRows`]) and carries four per product.
 //! - Otherwise every quantity once in world coordinates, where composites add without transforms
 //!   and each `H_ij` is a 6-vector dot product.
 //!
@@ -20,9 +21,10 @@
 use crate::algo::kinematics::{body_placements, joint_transforms};
 use crate::error::{check_length, Result};
 use crate::model::Model;
-use crate::spatial::{Force, Inertia, Motion, Real, Transform};
+use crate::spatial::{Force, Inertia, Motion, Real, Transform, Vec3};
 use crate::Data;
 use nalgebra::DMatrix;
+use std::ops::Range;
 
 /// M(q), written into `data.mass_matrix`.
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMatrix<f64>> {
@@ -38,35 +40,64 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMat
 pub fn crba_into(model: &Model, data: &mut Data, q: &[f64], out: &mut [f64]) -> Result<()> {
     model.check_configuration(q)?;
     check_length("out", out.len(), model.nv * model.nv)?;
+    let forces = ForceRows::new(&mut data.f_subspace, model.nv);
     let buffers = MassMatrixBuffers {
         x_up: &mut data.x_up,
         x_world: &mut data.x_world,
         world_composites: &mut data.i_c,
         subspaces: &mut data.s_world,
         body_composites: &mut data.i_c_body,
-        forces: &mut data.f_subspace,
+        forces,
         mass_matrix: out,
     };
-    mass_matrix_of(model, q, buffers);
+    one_state_mass_matrix(model, q, buffers);
     Ok(())
+}
+
+/// [`mass_matrix_of`] of one state, built for AVX2 and FMA as well and chosen at run time: the
+/// forces' carries take four forces per product ([`ForceRows`]), in one AVX2 vector so built
+/// (the same operations in the same order, so the same result bit for bit: no product is fused).
+#[inline(never)]
+fn one_state_mass_matrix(model: &Model, q: &[f64], out: MassMatrixBuffers<f64, ForceRows>) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the processor has AVX2 and FMA, just checked.
+        return unsafe { one_state_mass_matrix_avx2(model, q, out) };
+    }
+    mass_matrix_of(model, q, out);
+}
+
+/// [`one_state_mass_matrix`] built for AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn one_state_mass_matrix_avx2(
+    model: &Model,
+    q: &[f64],
+    out: MassMatrixBuffers<f64, ForceRows>,
+) {
+    mass_matrix_of(model, q, out);
 }
 
 /// What the CRBA writes in either form: one state's, borrowed from [`Data`], or several states'
 /// in lanes ([`crate::algo::lanes`]).
-pub(crate) struct MassMatrixBuffers<'b, S> {
+pub(crate) struct MassMatrixBuffers<'b, S, F> {
     pub x_up: &'b mut [Transform<S>],
     pub x_world: &'b mut [Transform<S>],
     pub world_composites: &'b mut [Inertia<S>],
     pub subspaces: &'b mut [Motion<S>],
     pub body_composites: &'b mut [Inertia<S>],
-    pub forces: &'b mut [Force<S>],
+    pub forces: F,
     pub mass_matrix: &'b mut [S],
 }
 
 /// M into `out.mass_matrix` (column-major, nv × nv), in `f64` or lanes: in body coordinates
 /// when the bodies are in depth-first order, else in world coordinates.
 #[inline(always)]
-pub(crate) fn mass_matrix_of<S: Real>(model: &Model, q: &[S], out: MassMatrixBuffers<S>) {
+pub(crate) fn mass_matrix_of<S: Real, F: SubtreeForces<S>>(
+    model: &Model,
+    q: &[S],
+    out: MassMatrixBuffers<S, F>,
+) {
     match model.subtree_dof_end.as_deref() {
         Some(subtree_dof_end) => {
             let buffers = BodyFrameBuffers {
@@ -179,10 +210,10 @@ pub(crate) fn add_composites<S: Real>(model: &Model, composites: &mut [Inertia<S
 }
 
 /// What the body-coordinate CRBA writes: one state's, or several states' in lanes.
-pub(crate) struct BodyFrameBuffers<'b, S> {
+pub(crate) struct BodyFrameBuffers<'b, S, F> {
     pub x_up: &'b mut [Transform<S>],
     pub composites: &'b mut [Inertia<S>],
-    pub forces: &'b mut [Force<S>],
+    pub forces: F,
     pub mass_matrix: &'b mut [S],
 }
 
@@ -195,11 +226,11 @@ pub(crate) struct BodyFrameBuffers<'b, S> {
 /// Each body's transform acts on all its subtree's forces at once (independent products), and a
 /// joint that turns about a coordinate axis (`Model::turn_axis`) makes both products turned ones.
 #[inline(always)]
-pub(crate) fn body_frame_mass_matrix<S: Real>(
+pub(crate) fn body_frame_mass_matrix<S: Real, F: SubtreeForces<S>>(
     model: &Model,
     subtree_dof_end: &[usize],
     q: &[S],
-    out: BodyFrameBuffers<S>,
+    out: BodyFrameBuffers<S, F>,
 ) {
     let nv = model.nv;
     joint_transforms(model, q, out.x_up);
@@ -207,23 +238,24 @@ pub(crate) fn body_frame_mass_matrix<S: Real>(
         *composite = Inertia::splat(inertia);
     }
     out.mass_matrix.fill(S::splat(0.0));
+    let mut forces = out.forces;
     for i in (1..model.nbodies()).rev() {
         let joint = &model.joints[i];
         let subtree = model.idx_v[i]..subtree_dof_end[i];
         // F_k = I^c_i S_k for the joint's own coordinates
         for (k, dof) in model.v_range(i).enumerate() {
             let column = Motion::splat(&joint.subspace_column(k));
-            out.forces[dof] = out.composites[i].mul_motion(&column);
+            forces.set(dof, &out.composites[i].mul_motion(&column));
         }
         // H_dk = H_kd = S_kᵀ F_d for the subtree's coordinates d (a component of F_d where S_k
         // is a coordinate axis)
         for (k, col) in model.v_range(i).enumerate() {
             let component = joint.subspace_component(k);
-            for (d, force) in subtree.clone().zip(&out.forces[subtree.clone()]) {
+            for d in subtree.clone() {
                 let h = match component {
-                    Some((c, false)) => force.component(c),
-                    Some((c, true)) => -force.component(c),
-                    None => joint.project_force(k, force),
+                    Some((c, false)) => forces.component(c, d),
+                    Some((c, true)) => -forces.component(c, d),
+                    None => joint.project_force(k, &forces.force(d)),
                 };
                 out.mass_matrix[d + col * nv] = h;
                 out.mass_matrix[col + d * nv] = h;
@@ -238,7 +270,108 @@ pub(crate) fn body_frame_mass_matrix<S: Real>(
             let (x_up, turn) = (&out.x_up[i], model.turn_axis(i));
             let carried = x_up.transpose_apply_inertia_turned(turn, &out.composites[i]);
             out.composites[parent] += carried;
-            x_up.transpose_apply_forces_turned(turn, &mut out.forces[subtree]);
+            forces.carry(x_up, turn, subtree);
         }
+    }
+}
+
+/// Where the body-coordinate CRBA keeps the forces `F_d = I^c S_d` of the coordinates d: one
+/// state's by component ([`ForceRows`]), so that a joint carries four of its subtree's forces
+/// per product; lanes' as forces, one after the other (each lane is a state already).
+pub(crate) trait SubtreeForces<S: Real> {
+    /// `F_d = force`.
+    fn set(&mut self, d: usize, force: &Force<S>);
+
+    /// Component c of `F_d` (in [`Force::plucker`]'s order).
+    fn component(&self, c: usize, d: usize) -> S;
+
+    /// `F_d`.
+    fn force(&self, d: usize) -> Force<S>;
+
+    /// `F_d ← Xᵀ F_d` for the coordinates d of `subtree`, X turning about axis `turn` only where
+    /// it is `Some` ([`Transform::transpose_apply_force_turned`]).
+    fn carry(&mut self, x: &Transform<S>, turn: Option<usize>, subtree: Range<usize>);
+}
+
+impl<S: Real> SubtreeForces<S> for &mut [Force<S>] {
+    #[inline(always)]
+    fn set(&mut self, d: usize, force: &Force<S>) {
+        self[d] = *force;
+    }
+
+    #[inline(always)]
+    fn component(&self, c: usize, d: usize) -> S {
+        self[d].component(c)
+    }
+
+    #[inline(always)]
+    fn force(&self, d: usize) -> Force<S> {
+        self[d]
+    }
+
+    #[inline(always)]
+    fn carry(&mut self, x: &Transform<S>, turn: Option<usize>, subtree: Range<usize>) {
+        x.transpose_apply_forces_turned(turn, &mut self[subtree]);
+    }
+}
+
+/// One state's forces by component: `rows[c (nv + 3) + 3 + d]` is component c of `F_d`. Each
+/// row starts with three unused values, so that a subtree's forces are carried in whole groups
+/// of four ending at its last one; the places before its first hold forces of bodies not
+/// reached yet (written when they are) or the unused values.
+pub(crate) struct ForceRows<'r> {
+    rows: &'r mut [f64],
+    nv: usize,
+}
+
+impl<'r> ForceRows<'r> {
+    /// The values unused at the start of each row.
+    const PADDING: usize = 3;
+
+    /// The values the forces of `nv` coordinates take.
+    pub(crate) fn size(nv: usize) -> usize {
+        6 * (nv + Self::PADDING)
+    }
+
+    pub(crate) fn new(rows: &'r mut [f64], nv: usize) -> Self {
+        assert_eq!(
+            rows.len(),
+            Self::size(nv),
+            "rows of forces for {nv} coordinates"
+        );
+        ForceRows { rows, nv }
+    }
+
+    #[inline(always)]
+    fn at(&self, c: usize, d: usize) -> usize {
+        c * (self.nv + Self::PADDING) + Self::PADDING + d
+    }
+}
+
+impl SubtreeForces<f64> for ForceRows<'_> {
+    #[inline(always)]
+    fn set(&mut self, d: usize, force: &Force) {
+        for (c, value) in force.plucker().into_iter().enumerate() {
+            let at = self.at(c, d);
+            self.rows[at] = value;
+        }
+    }
+
+    #[inline(always)]
+    fn component(&self, c: usize, d: usize) -> f64 {
+        self.rows[self.at(c, d)]
+    }
+
+    #[inline(always)]
+    fn force(&self, d: usize) -> Force {
+        let c = |c: usize| self.component(c, d);
+        Force::new(Vec3::new(c(0), c(1), c(2)), Vec3::new(c(3), c(4), c(5)))
+    }
+
+    #[inline(always)]
+    fn carry(&mut self, x: &Transform, turn: Option<usize>, subtree: Range<usize>) {
+        let (stride, end) = (self.nv + Self::PADDING, Self::PADDING + subtree.end);
+        let groups = subtree.len().div_ceil(4);
+        x.transpose_apply_force_rows_turned(turn, self.rows, stride, end, groups);
     }
 }

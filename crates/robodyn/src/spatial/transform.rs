@@ -6,6 +6,7 @@ use super::{
     Mat3, Mat6, Motion, Real, Vec3,
 };
 use nalgebra::{Matrix3, Matrix6, Vector3};
+use simba::simd::AutoF64x4;
 use std::ops::Mul;
 
 /// Featherstone's `X = B_X_A`: the coordinate transform from frame A to frame B, stored as the
@@ -349,6 +350,58 @@ impl Transform {
         x.fixed_view_mut::<3, 3>(3, 0)
             .copy_from(&(-self.rotation * skew(&self.translation)));
         x
+    }
+
+    /// [`Transform::transpose_apply_force_turned`] in place of forces kept by component
+    /// (`rows[c * stride + d]` is component c, in [`Force::plucker`]'s order, of force d), four
+    /// at a time: the `groups` groups of four consecutive forces that end before force `end`.
+    /// A component of four forces is read as one vector (`f64x4`), so one product carries four
+    /// forces, each by the same operations as alone.
+    #[inline(always)]
+    pub fn transpose_apply_force_rows_turned(
+        &self,
+        turn: Option<usize>,
+        rows: &mut [f64],
+        stride: usize,
+        end: usize,
+        groups: usize,
+    ) {
+        with_rotation!(
+            turn,
+            self.transpose_apply_force_rows_by(rows, stride, end, groups)
+        )
+    }
+
+    #[inline(always)]
+    fn transpose_apply_force_rows_by<R: Rotation>(
+        &self,
+        rows: &mut [f64],
+        stride: usize,
+        end: usize,
+        groups: usize,
+    ) {
+        let splat = |x: f64| AutoF64x4::from([x; 4]);
+        let fours = Transform {
+            rotation: self.rotation.map(splat),
+            translation: self.translation.map(splat),
+        };
+        for group in 1..=groups {
+            let d = end - 4 * group;
+            // four values at once (an array taken whole is one load; built value by value, it
+            // was four)
+            let four = |c: usize| {
+                let values: [f64; 4] = rows[c * stride + d..][..4].try_into().expect("four");
+                AutoF64x4::from(values)
+            };
+            let f = Force::new(
+                Vector3::new(four(0), four(1), four(2)),
+                Vector3::new(four(3), four(4), four(5)),
+            );
+            let carried = fours.transpose_apply_force_by::<R>(&f).plucker();
+            for (c, value) in carried.into_iter().enumerate() {
+                rows[c * stride + d..][..4].copy_from_slice(&<[f64; 4]>::from(value));
+            }
+        }
     }
 }
 

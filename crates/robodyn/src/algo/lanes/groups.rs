@@ -232,7 +232,7 @@ pub(super) fn groups<S: Scatter>(
                     world_composites: &mut lanes.composites,
                     subspaces: &mut lanes.subspaces,
                     body_composites: &mut lanes.body_composites,
-                    forces: &mut lanes.subspace_forces,
+                    forces: lanes.subspace_forces.as_mut_slice(),
                     mass_matrix: &mut lanes.mass_matrix,
                 };
                 mass_matrix_of(model, &lanes.q, buffers);
