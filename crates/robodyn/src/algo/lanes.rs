@@ -171,14 +171,6 @@ enum Algorithm {
 }
 
 impl Algorithm {
-    /// The width to run at on a CPU that runs `widest`. The articulated-body algorithm's 6x6
-    /// inertias (36 values per body) no longer fit in the vector registers at eight lanes, and
-    /// the spills cost more than the wider instructions gain (on this project's AMD EPYC, whose
-    /// AVX-512 executes as two 256-bit halves, it ran 1.6x slower than at four lanes): it runs
-    /// at four. So does CRBA, whose body-coordinate form carries every force of a subtree through
-    /// memory at each joint (at eight lanes 1.1–1.3x slower than at four). Their eight-lane
-    /// kernels run where a workspace asks for every kernel at its width
-    /// ([`BatchWorkspace::with_kernel_width`], as the tests do).
     /// The values of one state's result.
     fn output_size(self, model: &Model) -> usize {
         match self {
@@ -190,6 +182,14 @@ impl Algorithm {
         }
     }
 
+    /// The width to run at on a CPU that runs `widest`. The articulated-body algorithm's 6x6
+    /// inertias (36 values per body) no longer fit in the vector registers at eight lanes, and
+    /// the spills cost more than the wider instructions gain (on this project's AMD EPYC, whose
+    /// AVX-512 executes as two 256-bit halves, it ran 1.6x slower than at four lanes): it runs
+    /// at four. So does CRBA, whose body-coordinate form carries every force of a subtree through
+    /// memory at each joint (at eight lanes 1.1–1.3x slower than at four). Their eight-lane
+    /// kernels run where a workspace asks for every kernel at its width
+    /// ([`BatchWorkspace::with_kernel_width`], as the tests do).
     fn width(self, widest: LaneWidth) -> LaneWidth {
         match (self, widest) {
             (Algorithm::ArticulatedBody | Algorithm::CompositeRigidBody, LaneWidth::Eight)
