@@ -541,10 +541,8 @@ where
 /// Column `c` of a 6x6 inertia, as a force.
 #[inline(always)]
 fn inertia_column<S: Real>(inertia: &Matrix6<S>, c: usize) -> Force<S> {
-    Force::new(
-        Vector3::new(inertia[(0, c)], inertia[(1, c)], inertia[(2, c)]),
-        Vector3::new(inertia[(3, c)], inertia[(4, c)], inertia[(5, c)]),
-    )
+    let entry = |r: usize| inertia[(r, c)];
+    Force::from_plucker([entry(0), entry(1), entry(2), entry(3), entry(4), entry(5)])
 }
 
 /// Columns `first..first + 3` of a 6x6 inertia times `axis`, as a force.
@@ -557,10 +555,7 @@ fn inertia_times_axis<S: Real>(inertia: &Matrix6<S>, first: usize, axis: &Vec3) 
             + inertia[(r, first + 1)] * a.y
             + inertia[(r, first + 2)] * a.z;
     }
-    Force::new(
-        Vector3::new(rows[0], rows[1], rows[2]),
-        Vector3::new(rows[3], rows[4], rows[5]),
-    )
+    Force::from_plucker(rows)
 }
 
 /// The unit quaternion of `[qx, qy, qz, qw]` (normalised).

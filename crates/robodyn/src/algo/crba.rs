@@ -21,7 +21,7 @@
 use crate::algo::kinematics::{body_placements, joint_transforms};
 use crate::error::{check_length, Result};
 use crate::model::Model;
-use crate::spatial::{Force, Inertia, Motion, Real, Transform, Vec3};
+use crate::spatial::{Force, Inertia, Motion, Real, Transform};
 use crate::Data;
 use nalgebra::DMatrix;
 use std::ops::Range;
@@ -371,7 +371,7 @@ impl SubtreeForces<f64> for ForceRows<'_> {
     #[inline(always)]
     fn force(&self, d: usize) -> Force {
         let c = |c: usize| self.component(c, d);
-        Force::new(Vec3::new(c(0), c(1), c(2)), Vec3::new(c(3), c(4), c(5)))
+        Force::from_plucker([c(0), c(1), c(2), c(3), c(4), c(5)])
     }
 
     #[inline(always)]

@@ -25,6 +25,13 @@ impl<S: Real> Force<S> {
         [n.x, n.y, n.z, f.x, f.y, f.z]
     }
 
+    /// Inverse of [`Force::plucker`]: the force of Plücker coordinates `[angular; linear]`.
+    #[inline(always)]
+    pub fn from_plucker(values: [S; 6]) -> Self {
+        let [nx, ny, nz, fx, fy, fz] = values;
+        Force::new(Vector3::new(nx, ny, nz), Vector3::new(fx, fy, fz))
+    }
+
     /// Component `index` of [`Force::plucker`].
     #[inline(always)]
     pub fn component(&self, index: usize) -> S {
@@ -85,7 +92,7 @@ impl Force {
     /// Inverse of [`Force::to_vector`].
     #[inline(always)]
     pub fn from_vector(f: &nalgebra::Vector6<f64>) -> Self {
-        Force::new(Vec3::new(f[0], f[1], f[2]), Vec3::new(f[3], f[4], f[5]))
+        Force::from_plucker([f[0], f[1], f[2], f[3], f[4], f[5]])
     }
 
     /// Flattened `[linear; angular]` (force; moment), robodyn's public order.

@@ -186,8 +186,5 @@ pub fn mat6_mul_motion<S: Real>(inertia: &Matrix6<S>, m: &Motion<S>) -> Force<S>
             + inertia[(r, 4)] * x[4]
             + inertia[(r, 5)] * x[5];
     }
-    Force::new(
-        Vector3::new(rows[0], rows[1], rows[2]),
-        Vector3::new(rows[3], rows[4], rows[5]),
-    )
+    Force::from_plucker(rows)
 }

@@ -393,10 +393,7 @@ impl Transform {
                 let values: [f64; 4] = rows[c * stride + d..][..4].try_into().expect("four");
                 AutoF64x4::from(values)
             };
-            let f = Force::new(
-                Vector3::new(four(0), four(1), four(2)),
-                Vector3::new(four(3), four(4), four(5)),
-            );
+            let f = Force::from_plucker([four(0), four(1), four(2), four(3), four(4), four(5)]);
             let carried = fours.transpose_apply_force_by::<R>(&f).plucker();
             for (c, value) in carried.into_iter().enumerate() {
                 rows[c * stride + d..][..4].copy_from_slice(&<[f64; 4]>::from(value));
