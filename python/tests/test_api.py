@@ -203,6 +203,33 @@ def test_any_array_like_is_accepted(ur5):
     np.testing.assert_array_equal(ur5.generalized_gravity(batch), np.stack([expected, expected]))
 
 
+class _Subclass(np.ndarray):
+    """An ndarray subclass: read like any float64 array, though not by the plain array's path."""
+
+
+def test_every_kind_of_float64_array_reads_the_same(ur5):
+    """A plain float64 ndarray is recognised by its type and NumPy's own descriptor; a subclass,
+    the other byte order, a descriptor with metadata or a 0-stride array take the general path,
+    and a read-only array the plain one: all must give the same numbers bit for bit."""
+    q = ur5.random_configuration(seed=12)
+    v = np.linspace(-1, 1, ur5.nv)
+    expected = ur5.inverse_dynamics(q, v, v)
+    read_only = q.copy()
+    read_only.flags.writeable = False
+    variants = {
+        "subclass": q.view(_Subclass),
+        "big-endian": q.astype(">f8"),
+        "metadata": q.astype(np.dtype(np.float64, metadata={"unit": "rad"})),
+        "read-only": read_only,
+    }
+    for name, variant in variants.items():
+        assert variant.dtype == np.float64 or variant.dtype.newbyteorder("=") == np.float64, name
+        np.testing.assert_array_equal(ur5.inverse_dynamics(variant, v, v), expected, err_msg=name)
+        np.testing.assert_array_equal(ur5.generalized_gravity(variant), ur5.generalized_gravity(q), err_msg=name)
+    constant = np.broadcast_to(np.float64(0.3), (ur5.nv,))  # stride 0: not contiguous, copied
+    np.testing.assert_array_equal(ur5.generalized_gravity(constant), ur5.generalized_gravity(np.full(ur5.nv, 0.3)))
+
+
 def test_random_configuration_respects_limits_and_seed(ur5, floating):
     q = ur5.random_configuration(n=500, seed=4)
     assert np.all(q >= ur5.lower_position_limit) and np.all(q <= ur5.upper_position_limit)

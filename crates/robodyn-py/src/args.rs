@@ -3,12 +3,21 @@
 
 use crate::to_py_err;
 use nalgebra::DVector;
-use numpy::{AllowTypeChange, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::ndarray::IxDyn;
+use numpy::npyffi::{
+    get_type_object, npy_intp, NpyTypes, PyArrayObject, PyArray_Descr, PY_ARRAY_API,
+};
+use numpy::{
+    dtype, AllowTypeChange, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods,
+};
 use pyo3::exceptions::PyValueError;
+use pyo3::ffi;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyString};
 use robodyn::algo::Reference;
 use std::borrow::Cow;
+use std::ffi::c_int;
+use std::sync::OnceLock;
 
 /// The shape of one sample of an argument: one or two dimensions, stored without allocating.
 #[derive(Clone, Copy)]
@@ -44,13 +53,63 @@ pub(crate) struct Argument<'py> {
     pub(crate) sample_shape: SampleShape,
 }
 
+/// The type object of `numpy.ndarray` and NumPy's float64 descriptor (native byte order), found
+/// once per process: a plain float64 array is then told by two pointer compares. NumPy's
+/// descriptors of its built-in types are its own static objects, so the pointer stays valid.
+static PLAIN_FLOAT64: OnceLock<(usize, usize)> = OnceLock::new();
+
+/// The pair of [`PLAIN_FLOAT64`].
+#[inline]
+fn plain_float64(py: Python) -> (usize, usize) {
+    *PLAIN_FLOAT64.get_or_init(|| {
+        // SAFETY: NumPy's API table, read with the GIL held
+        let array_type = unsafe { get_type_object(py, NpyTypes::PyArray_Type) };
+        (array_type as usize, dtype::<f64>(py).as_ptr() as usize)
+    })
+}
+
+/// `value` as a float64 array when it is a plain `ndarray` (not a subclass) of NumPy's own
+/// float64 descriptor; `None` for anything else, which then takes the full test.
+#[inline]
+fn plain_float64_array<'a, 'py>(
+    value: &'a Bound<'py, PyAny>,
+) -> Option<&'a Bound<'py, PyArrayDyn<f64>>> {
+    let (array_type, float64) = plain_float64(value.py());
+    let object = value.as_ptr();
+    // SAFETY: reads the type of a live object, then the descriptor of what is an ndarray
+    unsafe {
+        let is_plain = ffi::Py_TYPE(object) as usize == array_type
+            && (*object.cast::<PyArrayObject>()).fields.descr as usize == float64;
+        // SAFETY: an ndarray of float64, whatever its number of dimensions
+        is_plain.then(|| value.cast_unchecked::<PyArrayDyn<f64>>())
+    }
+}
+
 impl<'py> Argument<'py> {
+    #[inline]
     pub(crate) fn new(
         name: &'static str,
         value: &Bound<'py, PyAny>,
         sample_shape: SampleShape,
     ) -> PyResult<Self> {
         // a float64 ndarray is used as it is; anything else goes through numpy.asarray
+        match plain_float64_array(value) {
+            Some(array) => Ok(Argument {
+                name,
+                array: array.clone(),
+                sample_shape,
+            }),
+            None => Self::converted(name, value, sample_shape),
+        }
+    }
+
+    /// [`Self::new`] for a value that is not a plain float64 array.
+    #[inline(never)]
+    fn converted(
+        name: &'static str,
+        value: &Bound<'py, PyAny>,
+        sample_shape: SampleShape,
+    ) -> PyResult<Self> {
         if let Ok(array) = value.cast::<PyArrayDyn<f64>>() {
             return Ok(Argument {
                 name,
@@ -73,37 +132,97 @@ impl<'py> Argument<'py> {
     }
 
     /// The batch size, `None` for a single sample; errors if the shape fits neither.
+    #[inline]
     pub(crate) fn batch(&self) -> PyResult<Option<usize>> {
         let shape = self.array.shape();
         let sample = self.sample_shape.as_slice();
-        if shape == sample {
+        // entry by entry: a slice comparison calls memcmp for these few numbers
+        let ends_with_sample = |first: usize| {
+            shape.len() == first + sample.len()
+                && shape[first..].iter().zip(sample).all(|(n, m)| n == m)
+        };
+        if ends_with_sample(0) {
             Ok(None)
-        } else if shape.len() == sample.len() + 1 && shape[1..] == *sample {
+        } else if ends_with_sample(1) {
             Ok(Some(shape[0]))
         } else {
-            let batch_shape: Vec<String> = std::iter::once("N".to_string())
-                .chain(sample.iter().map(|n| n.to_string()))
-                .collect();
-            Err(PyValueError::new_err(format!(
-                "argument '{}': expected shape {} or ({}), got {}",
-                self.name,
-                shape_text(sample),
-                batch_shape.join(", "),
-                shape_text(shape)
-            )))
+            Err(self.shape_error())
         }
+    }
+
+    /// The error of a shape that is neither one sample nor a batch.
+    #[cold]
+    #[inline(never)]
+    fn shape_error(&self) -> PyErr {
+        let shape = self.array.shape();
+        let sample = self.sample_shape.as_slice();
+        let batch_shape: Vec<String> = std::iter::once("N".to_string())
+            .chain(sample.iter().map(|n| n.to_string()))
+            .collect();
+        PyValueError::new_err(format!(
+            "argument '{}': expected shape {} or ({}), got {}",
+            self.name,
+            shape_text(sample),
+            batch_shape.join(", "),
+            shape_text(shape)
+        ))
     }
 
     /// The values in C order, borrowed when the array is contiguous.
     pub(crate) fn values(&self) -> Cow<'_, [f64]> {
-        if self.array.is_c_contiguous() {
-            // SAFETY: no Rust code holds a mutable view of an input: the only array robodyn writes
-            // is the output, which each call creates itself.
-            if let Ok(slice) = unsafe { self.array.as_slice() } {
-                return Cow::Borrowed(slice);
-            }
+        match self.contiguous_values() {
+            Some(values) => Cow::Borrowed(values),
+            None => Cow::Owned(self.copied_values()),
         }
-        Cow::Owned(self.array.to_owned_array().iter().copied().collect())
+    }
+
+    /// The values in place when the array is C-contiguous.
+    #[inline]
+    pub(crate) fn contiguous_values(&self) -> Option<&[f64]> {
+        if !self.array.is_c_contiguous() {
+            return None;
+        }
+        // SAFETY: no Rust code holds a mutable view of an input: the only array robodyn writes is
+        // the output, which a call creates itself or checks to share no memory with an input.
+        unsafe { self.array.as_slice() }.ok()
+    }
+
+    /// A copy of the values in C order (of a strided array).
+    #[cold]
+    #[inline(never)]
+    pub(crate) fn copied_values(&self) -> Vec<f64> {
+        self.array.to_owned_array().iter().copied().collect()
+    }
+}
+
+/// A new C-ordered float64 array of zeros of `shape`, by NumPy's `PyArray_Zeros` with the
+/// descriptor found once ([`PLAIN_FLOAT64`]): rust-numpy's `zeros` looks the descriptor up and
+/// copies the shape on every call, a tenth of a small call's fixed cost.
+pub(crate) fn zeros<'py>(
+    py: Python<'py>,
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    const MOST_DIMENSIONS: usize = 4;
+    if shape.len() > MOST_DIMENSIONS {
+        return Ok(PyArrayDyn::zeros(py, IxDyn(shape), false));
+    }
+    let mut dims: [npy_intp; MOST_DIMENSIONS] = [0; MOST_DIMENSIONS];
+    for (dim, &n) in dims.iter_mut().zip(shape) {
+        *dim = n as npy_intp;
+    }
+    let (_, float64) = plain_float64(py);
+    // SAFETY: NumPy's API with the GIL held; PyArray_Zeros takes the reference to the descriptor
+    // given it, and returns a new array or null with the error set.
+    unsafe {
+        ffi::Py_IncRef(float64 as *mut ffi::PyObject);
+        let array = PY_ARRAY_API.PyArray_Zeros(
+            py,
+            shape.len() as c_int,
+            dims.as_mut_ptr(),
+            float64 as *mut PyArray_Descr,
+            0,
+        );
+        Bound::from_owned_ptr_or_err(py, array).map(|array| array.cast_into_unchecked())
     }
 }
 

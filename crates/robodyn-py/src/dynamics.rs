@@ -13,6 +13,7 @@ use robodyn::{Data, Model};
 
 impl PyModel {
     /// The arguments (q, v, x[, f_ext]) of a dynamics algorithm with optional external forces.
+    #[inline]
     pub(crate) fn dynamics_arguments<'py>(
         &self,
         q: &Bound<'py, PyAny>,

@@ -5,7 +5,7 @@
 use crate::args::*;
 use crate::to_py_err;
 use nalgebra::DMatrix;
-use numpy::ndarray::{Axis, IxDyn};
+use numpy::ndarray::Axis;
 use numpy::npyffi::NPY_ARRAY_WRITEABLE;
 use numpy::{
     PyArray1, PyArray2, PyArray3, PyArray4, PyArrayDyn, PyArrayMethods, PyUntypedArray,
@@ -20,7 +20,6 @@ use robodyn::integrate::StepWorkspace;
 use robodyn::spatial::Force;
 use robodyn::{Data, Error, Model};
 use rustc_hash::FxHashMap;
-use std::borrow::Cow;
 use std::sync::Mutex;
 
 /// What a kernel works in: the algorithm workspace and a buffer for external forces.
@@ -261,11 +260,18 @@ impl PyModel {
         lanes: Option<LaneKernel>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let batch = common_batch(arguments)?;
-        let values: [Cow<[f64]>; MAX_ARGUMENTS] = std::array::from_fn(|k| {
-            arguments
-                .get(k)
-                .map_or(Cow::Borrowed(&[][..]), |a| a.values())
-        });
+        // the inputs in place, or copies of the strided ones (plain loops: through an array of
+        // `Cow`s made by `array::from_fn`, each came back through memory and was copied again)
+        let mut copies: [Vec<f64>; MAX_ARGUMENTS] = Default::default();
+        for (copy, argument) in copies.iter_mut().zip(arguments) {
+            if argument.contiguous_values().is_none() {
+                *copy = argument.copied_values();
+            }
+        }
+        let mut values: [&[f64]; MAX_ARGUMENTS] = [&[]; MAX_ARGUMENTS];
+        for ((value, argument), copy) in values.iter_mut().zip(arguments).zip(&copies) {
+            *value = argument.contiguous_values().unwrap_or(copy);
+        }
         let values = &values[..arguments.len()];
         let target = match out {
             Some(out) => Some(output_array(out, batch, output_shape, arguments, values)?),
@@ -275,14 +281,12 @@ impl PyModel {
         let model = &self.model;
         match batch {
             None => {
-                let mut inputs: [&[f64]; MAX_ARGUMENTS] = [&[]; MAX_ARGUMENTS];
-                for (input, value) in inputs.iter_mut().zip(values) {
-                    *input = value.as_ref();
-                }
-                let inputs = &inputs[..values.len()];
+                let inputs = values;
                 let given = target.is_some();
-                let output = target
-                    .unwrap_or_else(|| PyArrayDyn::<f64>::zeros(py, IxDyn(output_shape), false));
+                let output = match target {
+                    Some(target) => target,
+                    None => zeros(py, output_shape)?,
+                };
                 // SAFETY: a new array nothing else refers to yet, or the caller's, checked to
                 // share no memory with an input
                 let out = unsafe { output.as_slice_mut() }
@@ -406,6 +410,7 @@ impl PyModel {
         })
     }
 
+    #[inline]
     pub(crate) fn q_arg<'py>(
         &self,
         name: &'static str,
@@ -414,6 +419,7 @@ impl PyModel {
         Argument::new(name, value, SampleShape::vector(self.model.nq))
     }
 
+    #[inline]
     pub(crate) fn v_arg<'py>(
         &self,
         name: &'static str,
@@ -444,7 +450,7 @@ impl PyModel {
 
 /// The inputs of a batch: each argument's values, flattened, and its size per sample.
 struct BatchInputs<'v> {
-    values: &'v [Cow<'v, [f64]>],
+    values: &'v [&'v [f64]],
     sizes: &'v [usize],
     output_size: usize,
 }
@@ -478,7 +484,7 @@ fn output_array<'py>(
     batch: Option<usize>,
     output_shape: &[usize],
     arguments: &[Argument],
-    values: &[Cow<[f64]>],
+    values: &[&[f64]],
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let expected: Vec<usize> = batch
         .into_iter()
@@ -522,7 +528,8 @@ fn output_array<'py>(
     let end = start + std::mem::size_of::<f64>() * array.len();
     for (argument, value) in arguments.iter().zip(values) {
         let (input_start, input_end) = (value.as_ptr() as usize, value.as_ptr_range().end as usize);
-        if matches!(value, Cow::Borrowed(_)) && input_start < end && start < input_end {
+        // (a copy of a strided input is the call's own and never overlaps)
+        if input_start < end && start < input_end {
             return Err(error(format!(
                 "shares memory with argument '{}'; pass a separate array",
                 argument.name
