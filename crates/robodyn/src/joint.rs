@@ -8,9 +8,10 @@
 //! `difference(q, integrate(q, v)) = v`.
 
 use crate::spatial::trig::sin_cos;
+use crate::spatial::turn::signed_permutation_column;
 use crate::spatial::{
     cross, log_rotation, rotate_back, skew, splat_vector, zero_vector, Force, Mat3, Mat6, Motion,
-    Real, Transform, Vec3,
+    Real, Transform, Turn, Vec3,
 };
 use nalgebra::{Matrix3, Matrix6, Quaternion, UnitQuaternion, Vector3, Vector6};
 use rand::Rng;
@@ -178,20 +179,22 @@ impl Joint {
         }
     }
 
-    /// The coordinate axis k when `X_J(q) X_T` turns about e_k only, for this `X_T`: a revolute
-    /// joint about ±e_k, or a prismatic joint (whose X_J does not turn), after an `X_T` that
-    /// does not rotate. Transforms by it can then leave out the products with the rotation's
-    /// zeros (`Transform::apply_motion_turned` and the like).
+    /// The pattern of `X_J(q) X_T`'s rotation when it turns about one coordinate axis after a
+    /// signed permutation, for this `X_T`: a revolute joint about ±e_k, or a prismatic joint
+    /// (whose X_J does not turn; k = 2), after an `X_T` whose rotation is exactly a signed
+    /// permutation (none, or quarter turns) that does not turn e_k into −e_k. Transforms by it can then leave out the products
+    /// with the rotation's zeros (`Transform::apply_motion_turned` and the like).
     #[inline(always)]
-    pub fn turn_axis(&self, x_tree: &Transform) -> Option<usize> {
-        if x_tree.rotation != Mat3::identity() {
-            return None;
-        }
-        match self {
-            Joint::Revolute { axis } => coordinate_axis(axis).map(|k| k.index),
-            Joint::Prismatic { .. } => Some(2),
-            _ => None,
-        }
+    pub fn turn(&self, x_tree: &Transform) -> Option<Turn> {
+        let axis = match self {
+            Joint::Revolute { axis } => coordinate_axis(axis)?.index,
+            Joint::Prismatic { .. } => 2,
+            _ => return None,
+        };
+        let column = signed_permutation_column(&x_tree.rotation, axis)?;
+        // row k of E = E_J E_T is E_T's: where it is −e_k, the general products
+        let keeps_axis = column != axis || x_tree.rotation[(axis, axis)] == 1.0;
+        keeps_axis.then_some(Turn { axis, column })
     }
 
     /// Column `k` of the motion subspace `S`, in the child frame.

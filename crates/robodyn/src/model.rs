@@ -3,7 +3,8 @@
 
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::joint::Joint;
-use crate::spatial::{Inertia, Mat3, Transform, Vec3};
+use crate::spatial::turn::snapped_signed_permutation;
+use crate::spatial::{Inertia, Mat3, Transform, Turn, Vec3};
 use crate::visual::Visual;
 use nalgebra::DVector;
 use rand::Rng;
@@ -118,6 +119,11 @@ pub struct Model {
     /// a gap, as every loader adds them); `None` otherwise. Not stored in snapshots.
     #[serde(skip)]
     pub subtree_dof_end: Option<Vec<usize>>,
+    /// Derived from `joints` and `x_tree` when the model is built, nbodies: [`Joint::turn`] of
+    /// each body (asked by every transform of every call, so found once). Not stored in
+    /// snapshots.
+    #[serde(skip)]
+    pub turns: Vec<Option<Turn>>,
     /// Position limits, length nq (±inf where none).
     pub lower_position_limit: DVector<f64>,
     pub upper_position_limit: DVector<f64>,
@@ -181,10 +187,11 @@ impl Model {
         }
     }
 
-    /// [`Joint::turn_axis`] of body i's joint and tree transform.
+    /// [`Joint::turn`] of body i's joint and tree transform.
     #[inline(always)]
-    pub fn turn_axis(&self, i: usize) -> Option<usize> {
-        self.joints[i].turn_axis(&self.x_tree[i])
+    pub fn turn(&self, i: usize) -> Option<Turn> {
+        // none where the model was not built (any rotation: the same values, more products)
+        self.turns.get(i).copied().flatten()
     }
 
     /// The range of body i's coordinates in q.
@@ -427,6 +434,15 @@ pub struct ModelBuilder {
 }
 
 /// [`Model::dof_run_start`] from the coordinates' parents.
+/// [`Joint::turn`] of each body.
+pub(crate) fn turns(joints: &[Joint], x_tree: &[Transform]) -> Vec<Option<Turn>> {
+    joints
+        .iter()
+        .zip(x_tree)
+        .map(|(joint, x)| joint.turn(x))
+        .collect()
+}
+
 pub(crate) fn dof_run_starts(dof_parent: &[Option<usize>]) -> Vec<usize> {
     let mut starts = Vec::with_capacity(dof_parent.len());
     for (k, parent) in dof_parent.iter().enumerate() {
@@ -504,6 +520,7 @@ impl ModelBuilder {
                 dof_parent: Vec::new(),
                 dof_run_start: Vec::new(),
                 subtree_dof_end: None,
+                turns: Vec::new(),
                 lower_position_limit: DVector::zeros(0),
                 upper_position_limit: DVector::zeros(0),
                 velocity_limit: DVector::zeros(0),
@@ -551,7 +568,9 @@ impl ModelBuilder {
         m.joints.push(joint);
         m.joint_names.push(joint_name.to_string());
         m.body_names.push(name.to_string());
-        m.x_tree.push(x_tree);
+        // quarter turns stored exactly, so that the joint's transforms leave out their zeros
+        let rotation = snapped_signed_permutation(&x_tree.rotation).unwrap_or(x_tree.rotation);
+        m.x_tree.push(Transform { rotation, ..x_tree });
         m.inertias.push(inertia);
         m.idx_q.push(m.nq);
         m.idx_v.push(m.nv);
@@ -659,6 +678,7 @@ impl ModelBuilder {
     pub fn build(mut self) -> Model {
         let m = &mut self.model;
         m.subtree_dof_end = subtree_dof_ends(&m.parent, &m.idx_v, m.nv);
+        m.turns = turns(&m.joints, &m.x_tree);
         self.model
     }
 }

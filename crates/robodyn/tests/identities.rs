@@ -408,7 +408,7 @@ fn crba_into_writes_crba_s_matrix_which_is_exactly_symmetric() {
 
 /// CRBA's two forms (`algo::crba`), in body coordinates for bodies in depth-first order (every
 /// loader's) and in world coordinates otherwise, give the same M; `Model::subtree_dof_end`
-/// lists each subtree's coordinates, and a snapshot derives it again.
+/// lists each subtree's coordinates, and a snapshot derives it (and `Model::turns`) again.
 #[test]
 fn crba_in_body_and_world_coordinates_agree() {
     let mut rng = rng();
@@ -419,6 +419,7 @@ fn crba_in_body_and_world_coordinates_agree() {
             .expect("loaders add bodies depth first");
         let reloaded = robodyn::io::model_from_bytes(&robodyn::io::model_to_bytes(&model)).unwrap();
         assert_eq!(reloaded.subtree_dof_end.as_ref(), Some(ends), "{name}");
+        assert_eq!(reloaded.turns, model.turns, "{name}");
         for (i, &end) in ends.iter().enumerate().skip(1) {
             for j in 1..model.nbodies() {
                 // body j is in body i's subtree when i is on j's path to the world

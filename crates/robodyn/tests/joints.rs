@@ -5,7 +5,7 @@ mod common;
 
 use common::{rng, FD_STEP, FD_TOLERANCE};
 use rand::Rng;
-use robodyn::spatial::{mat6_mul_motion, Force, Transform, Vec3};
+use robodyn::spatial::{mat6_mul_motion, Force, Mat3, Transform, Turn, Vec3};
 use robodyn::Joint;
 
 const ROUND_TRIP_TOLERANCE: f64 = 1e-10;
@@ -263,28 +263,39 @@ fn subspace_components_are_the_projections() {
     }
 }
 
-/// `Joint::turn_axis`: a coordinate axis only for a revolute joint about ±e_k or a prismatic
-/// joint, and only after a tree transform that does not rotate.
+/// `Joint::turn`: a revolute joint about ±e_k or a prismatic joint after a tree transform whose
+/// rotation is exactly a signed permutation (none, or quarter turns), reporting the column of
+/// the rotation's row k; not after any other rotation, nor one that turns e_k into −e_k.
 #[test]
-fn turn_axis_needs_a_coordinate_axis_and_an_unrotated_tree() {
-    let shifted = Transform::from_translation(&Vec3::new(0.1, -0.2, 0.3));
-    let turned = Transform::from_pose(
-        &robodyn::spatial::rotation_from_rpy(0.0, 0.3, 0.0),
-        &Vec3::zeros(),
-    );
+fn turn_needs_a_coordinate_axis_and_a_tree_of_quarter_turns() {
+    let translation = Vec3::new(0.1, -0.2, 0.3);
+    let tree = |rotation: Mat3| Transform::from_pose(&rotation, &translation);
+    let shifted = Transform::from_translation(&translation);
+    let tilted = tree(robodyn::spatial::rotation_from_rpy(0.0, 0.3, 0.0));
+    // a quarter turn about x, exactly: row z is −e_y, row y is e_z
+    let quarter_about_x = tree(Mat3::new(1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0));
+    // a half turn about x: row z is −e_z
+    let half_about_x = tree(Mat3::new(1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, -1.0));
     let revolute = |x: f64, y: f64, z: f64| Joint::Revolute {
         axis: Vec3::new(x, y, z),
     };
-    assert_eq!(revolute(1.0, 0.0, 0.0).turn_axis(&shifted), Some(0));
-    assert_eq!(revolute(0.0, -1.0, 0.0).turn_axis(&shifted), Some(1));
-    assert_eq!(revolute(0.0, 0.0, 1.0).turn_axis(&shifted), Some(2));
-    assert_eq!(revolute(0.0, 0.0, 1.0).turn_axis(&turned), None);
-    assert_eq!(revolute(0.6, 0.8, 0.0).turn_axis(&shifted), None);
+    let turn = |axis, column| Some(Turn { axis, column });
+    assert_eq!(revolute(1.0, 0.0, 0.0).turn(&shifted), turn(0, 0));
+    assert_eq!(revolute(0.0, -1.0, 0.0).turn(&shifted), turn(1, 1));
+    assert_eq!(revolute(0.0, 0.0, 1.0).turn(&shifted), turn(2, 2));
+    assert_eq!(revolute(0.0, 0.0, 1.0).turn(&quarter_about_x), turn(2, 1));
+    assert_eq!(revolute(0.0, 1.0, 0.0).turn(&quarter_about_x), turn(1, 2));
+    assert_eq!(revolute(1.0, 0.0, 0.0).turn(&quarter_about_x), turn(0, 0));
+    assert_eq!(revolute(1.0, 0.0, 0.0).turn(&half_about_x), turn(0, 0));
+    assert_eq!(revolute(0.0, 0.0, 1.0).turn(&half_about_x), None);
+    assert_eq!(revolute(0.0, 0.0, 1.0).turn(&tilted), None);
+    assert_eq!(revolute(0.6, 0.8, 0.0).turn(&shifted), None);
     let prismatic = Joint::Prismatic {
         axis: Vec3::new(0.6, 0.8, 0.0),
     };
-    assert_eq!(prismatic.turn_axis(&shifted), Some(2));
-    assert_eq!(prismatic.turn_axis(&turned), None);
-    assert_eq!(Joint::Spherical.turn_axis(&shifted), None);
-    assert_eq!(Joint::Free.turn_axis(&shifted), None);
+    assert_eq!(prismatic.turn(&shifted), turn(2, 2));
+    assert_eq!(prismatic.turn(&quarter_about_x), turn(2, 1));
+    assert_eq!(prismatic.turn(&tilted), None);
+    assert_eq!(Joint::Spherical.turn(&shifted), None);
+    assert_eq!(Joint::Free.turn(&shifted), None);
 }

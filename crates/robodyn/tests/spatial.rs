@@ -25,22 +25,75 @@ fn inertia() -> impl Strategy<Value = Inertia> {
     })
 }
 
+/// The `index`-th (mod 24) of the 24 rotations that are signed permutations: a permutation of
+/// the axes (6) with signs (8), those of determinant +1.
+fn quarter_turns(index: usize) -> Mat3 {
+    let permutations = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
+    let rotations: Vec<Mat3> = permutations
+        .iter()
+        .flat_map(|p| {
+            (0..8).map(move |signs: usize| {
+                Mat3::from_fn(|row, col| match col == p[row] {
+                    true if signs >> row & 1 == 1 => -1.0,
+                    true => 1.0,
+                    false => 0.0,
+                })
+            })
+        })
+        .filter(|e| e.determinant() > 0.0)
+        .collect();
+    assert_eq!(rotations.len(), 24);
+    rotations[index % 24]
+}
+
+/// A joint that turns about a coordinate axis after a tree transform of quarter turns: revolute
+/// about ±e_k, or prismatic (along a general axis), with its transform at `angle` (or `angle` m).
+fn turning_joint(
+    k: usize,
+    negative: bool,
+    prismatic: bool,
+    tree: &Transform,
+    angle: f64,
+) -> (Joint, Transform) {
+    let mut axis = Vec3::zeros();
+    axis[k] = if negative { -1.0 } else { 1.0 };
+    let joint = match prismatic {
+        true => Joint::Prismatic {
+            axis: Vec3::new(0.6, 0.0, -0.8),
+        },
+        false => Joint::Revolute { axis },
+    };
+    (
+        joint,
+        joint.transform_after_turn(&[angle], angle.sin_cos(), tree),
+    )
+}
+
 proptest! {
-    /// A joint's transform that turns about a coordinate axis only (a revolute joint about ±e_k
-    /// after a tree transform that does not rotate) gives the same products by the turned paths,
-    /// which leave out the rotation's zeros, as by the general ones.
+    /// A joint's transform that turns about a coordinate axis after quarter turns (a revolute
+    /// joint about ±e_k or a prismatic joint, after a tree transform whose rotation is a signed
+    /// permutation) gives the same products by the turned paths, which leave out the rotation's
+    /// zeros, as by the general ones.
     #[test]
     fn turned_products_equal_the_general_ones(
         angle in -4.0f64..4.0, k in 0usize..3, negative in any::<bool>(), r in vec3(),
+        quarter in 0usize..24, prismatic in any::<bool>(),
         i in inertia(), j in inertia(), w in vec3(), v in vec3(), y in transform(),
     ) {
-        let mut axis = Vec3::zeros();
-        axis[k] = if negative { -1.0 } else { 1.0 };
-        let joint = Joint::Revolute { axis };
-        let tree = Transform::from_translation(&r);
-        prop_assert_eq!(joint.turn_axis(&tree), Some(k));
-        let x = joint.transform_after_turn(&[angle], angle.sin_cos(), &tree);
-        let turn = Some(k);
+        let tree = Transform::from_pose(&quarter_turns(quarter), &r);
+        let (joint, x) = turning_joint(k, negative, prismatic, &tree, angle);
+        let turn = joint.turn(&tree);
+        // a tree that turns the axis into its opposite is the one case left to the general path
+        let axis = if prismatic { 2 } else { k };
+        prop_assert_eq!(turn.is_none(), tree.rotation[(axis, axis)] == -1.0);
+        prop_assume!(turn.is_some());
         let (m, f) = (Motion::new(w, v), Force::new(v, w));
         let u = nalgebra::Vector6::new(w.x, w.y, w.z, v.x, v.y, v.z);
         let articulated = i.to_matrix() + j.to_matrix() - u * u.transpose() * 0.1;
@@ -62,13 +115,13 @@ proptest! {
     #[test]
     fn forces_carried_in_rows_equal_each_carried_alone(
         angle in -4.0f64..4.0, k in 0usize..3, r in vec3(), y in transform(), turned in any::<bool>(),
-        values in prop::collection::vec(-2.0f64..2.0, 6 * 14), count in 1usize..12, g in 0usize..3,
-        e in 0usize..12,
+        quarter in 0usize..24, values in prop::collection::vec(-2.0f64..2.0, 6 * 14),
+        count in 1usize..12, g in 0usize..3, e in 0usize..12,
     ) {
-        let mut axis = Vec3::zeros();
-        axis[k] = 1.0;
+        let tree = Transform::from_pose(&quarter_turns(quarter), &r);
+        let (joint, turning) = turning_joint(k, false, false, &tree, angle);
         let (x, turn) = match turned {
-            true => (Joint::Revolute { axis }.transform_after_turn(&[angle], angle.sin_cos(), &Transform::from_translation(&r)), Some(k)),
+            true => (turning, joint.turn(&tree)),
             false => (y, None),
         };
         // `count` forces after three unused values in each of six rows

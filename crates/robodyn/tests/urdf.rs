@@ -1,6 +1,7 @@
 //! URDF loading: structure, conventions, and every kind of bad input giving a clear error.
 
 use robodyn::io::{bundled_model, bundled_names, load_urdf_file, load_urdf_str, LoadOptions};
+use robodyn::spatial::Turn;
 use robodyn::{Error, Joint};
 
 fn error_of(text: &str) -> String {
@@ -15,6 +16,59 @@ fn robot(body: &str) -> String {
 
 const LINK_A: &str = "<link name='a'/>";
 const LINK_B: &str = "<link name='b'/>";
+
+/// Quarter turns in `rpy` (π/2 rounded to a double: cos = 6e-17, not 0) are stored as the exact
+/// signed permutations they stand for, so that the joints after them take the turned products;
+/// an angle that is not a quarter turn, even a near one, is kept as written.
+#[test]
+fn quarter_turns_in_rpy_are_stored_exactly() {
+    let joint = |name: &str, parent: &str, child: &str, rpy: &str, axis: &str| {
+        format!(
+            "<joint name='{name}' type='revolute'><parent link='{parent}'/><child link='{child}'/>\
+             <origin rpy='{rpy}' xyz='0 0.1 0.2'/><axis xyz='{axis}'/>\
+             <limit lower='-3' upper='3' effort='1' velocity='1'/></joint>"
+        )
+    };
+    let link = |name: &str| {
+        format!(
+            "<link name='{name}'><inertial><mass value='1'/>\
+             <inertia ixx='0.1' iyy='0.1' izz='0.1' ixy='0' ixz='0' iyz='0'/></inertial></link>"
+        )
+    };
+    let text = robot(&format!(
+        "{}{}{}{}{}{}{}",
+        link("base"),
+        link("a"),
+        link("b"),
+        link("c"),
+        joint("j1", "base", "a", "-1.5707963267948966 0 0", "0 0 1"),
+        joint(
+            "j2",
+            "a",
+            "b",
+            "0 3.141592653589793 1.5707963267948966",
+            "0 1 0"
+        ),
+        joint("j3", "b", "c", "1.5708 0 0", "0 0 1"),
+    ));
+    let model = load_urdf_str(&text, "quarter.urdf", LoadOptions::default()).unwrap();
+    for i in [1, 2] {
+        let rotation = model.x_tree[i].rotation;
+        assert!(
+            rotation.iter().all(|x| [0.0, 1.0, -1.0].contains(x)),
+            "{rotation}"
+        );
+        assert!((rotation.determinant() - 1.0).abs() == 0.0);
+    }
+    // about x by −π/2: row z of the tree rotation is e_y
+    assert_eq!(model.turn(1), Some(Turn { axis: 2, column: 1 }));
+    assert!(model.turn(2).is_some());
+    assert!(model.x_tree[3]
+        .rotation
+        .iter()
+        .any(|x| x.abs() > 0.0 && x.abs() < 1.0));
+    assert_eq!(model.turn(3), None);
+}
 
 #[test]
 fn bundled_models_load_with_their_gravity() {

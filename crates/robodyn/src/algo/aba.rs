@@ -129,7 +129,7 @@ pub(crate) fn articulated_body_passes<S: Real>(
     for i in 1..model.nbodies() {
         let v_j = model.joints[i].motion(&v[model.v_range(i)]);
         // v_i = X_i v_λ(i) + v_J;  c_i = v_i × v_J
-        let turn = model.turn_axis(i);
+        let turn = model.turn(i);
         let v_i = out.x_up[i].apply_motion_turned(turn, &out.v[model.parent[i]]) + v_j;
         out.c[i] = v_i.cross_motion(&v_j);
         let inertia = Inertia::<S>::splat(&model.inertias[i]);
@@ -193,7 +193,7 @@ pub(crate) fn articulated_body_passes<S: Real>(
             mirror_upper(&mut i_a);
             p_a += mat6_mul_motion(&i_a, &out.c[i]);
             // I^A_λ(i) += X_iᵀ I^a X_i;  p^A_λ(i) += X_iᵀ p^a
-            let turn = model.turn_axis(i);
+            let turn = model.turn(i);
             let carried = out.x_up[i].transpose_apply_matrix_turned(turn, &i_a);
             for (sum, x) in out.i_a[parent]
                 .as_mut_slice()
@@ -216,7 +216,7 @@ pub(crate) fn articulated_body_passes<S: Real>(
         let joint = &model.joints[i];
         let dofs = model.v_range(i);
         // a'_i = X_i a_λ(i) + c_i
-        let turn = model.turn_axis(i);
+        let turn = model.turn(i);
         let mut a_i = out.x_up[i].apply_motion_turned(turn, &out.a[model.parent[i]]) + out.c[i];
         // q̈_i = D_i⁻¹ (u_i - U_iᵀ a'_i)
         let nv_i = joint.nv();

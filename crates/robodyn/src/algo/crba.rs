@@ -5,9 +5,10 @@
 //! of the subtree rooted at body i. Two forms, the same M:
 //! - Table 6.2 in body coordinates (bodies in depth-first order, as every loader gives, so that a
 //!   subtree's coordinates are consecutive): composites and forces `F = I^c_i S_i` carried to the
-//!   parent joint by joint. A joint that turns about a coordinate axis makes each carry a turned
-//!   product (`spatial::turn`), and a coordinate axis makes `S_jᵀ F` one component of F. One
-//!   state keeps its forces by component ([`ForceRows`]) and carries four per product.
+//!   parent joint by joint. A joint that turns about a coordinate axis (after quarter turns)
+//!   makes each carry a turned product (`spatial::turn`), and a coordinate axis makes `S_jᵀ F`
+//!   one component of F. One state keeps its forces by component ([`ForceRows`]) and carries
+//!   four per product.
 //! - Otherwise every quantity once in world coordinates, where composites add without transforms
 //!   and each `H_ij` is a 6-vector dot product.
 //!
@@ -21,7 +22,7 @@
 use crate::algo::kinematics::{body_placements, joint_transforms};
 use crate::error::{check_length, Result};
 use crate::model::Model;
-use crate::spatial::{Force, Inertia, Motion, Real, Transform};
+use crate::spatial::{Force, Inertia, Motion, Real, Transform, Turn};
 use crate::Data;
 use nalgebra::DMatrix;
 use std::ops::Range;
@@ -230,7 +231,8 @@ pub(crate) struct BodyFrameBuffers<'b, S, F> {
 /// subtree (whose forces are in i's coordinates by now), and the subtree's inertia and forces
 /// are carried to the parent: `I^c_λ(i) += X_{i←λ(i)}ᵀ I^c_i X_{i←λ(i)}`, `F_d ← X_{i←λ(i)}ᵀ F_d`.
 /// Each body's transform acts on all its subtree's forces at once (independent products), and a
-/// joint that turns about a coordinate axis (`Model::turn_axis`) makes both products turned ones.
+/// joint that turns about a coordinate axis after quarter turns (`Model::turn`) makes both
+/// products turned ones.
 #[inline(always)]
 pub(crate) fn body_frame_mass_matrix<S: Real, F: SubtreeForces<S>>(
     model: &Model,
@@ -273,7 +275,7 @@ pub(crate) fn body_frame_mass_matrix<S: Real, F: SubtreeForces<S>>(
         // the subtree's inertia and forces into the parent's coordinates
         let parent = model.parent[i];
         if parent != 0 {
-            let (x_up, turn) = (&out.x_up[i], model.turn_axis(i));
+            let (x_up, turn) = (&out.x_up[i], model.turn(i));
             let carried = x_up.transpose_apply_inertia_turned(turn, &out.composites[i]);
             out.composites[parent] += carried;
             forces.carry(x_up, turn, subtree);
@@ -294,9 +296,9 @@ pub(crate) trait SubtreeForces<S: Real> {
     /// `F_d`.
     fn force(&self, d: usize) -> Force<S>;
 
-    /// `F_d ← Xᵀ F_d` for the coordinates d of `subtree`, X turning about axis `turn` only where
-    /// it is `Some` ([`Transform::transpose_apply_force_turned`]).
-    fn carry(&mut self, x: &Transform<S>, turn: Option<usize>, subtree: Range<usize>);
+    /// `F_d ← Xᵀ F_d` for the coordinates d of `subtree`, X of the pattern `turn` where it is
+    /// `Some` ([`Transform::transpose_apply_force_turned`]).
+    fn carry(&mut self, x: &Transform<S>, turn: Option<Turn>, subtree: Range<usize>);
 }
 
 impl<S: Real> SubtreeForces<S> for &mut [Force<S>] {
@@ -316,7 +318,7 @@ impl<S: Real> SubtreeForces<S> for &mut [Force<S>] {
     }
 
     #[inline(always)]
-    fn carry(&mut self, x: &Transform<S>, turn: Option<usize>, subtree: Range<usize>) {
+    fn carry(&mut self, x: &Transform<S>, turn: Option<Turn>, subtree: Range<usize>) {
         x.transpose_apply_forces_turned(turn, &mut self[subtree]);
     }
 }
@@ -375,7 +377,7 @@ impl SubtreeForces<f64> for ForceRows<'_> {
     }
 
     #[inline(always)]
-    fn carry(&mut self, x: &Transform, turn: Option<usize>, subtree: Range<usize>) {
+    fn carry(&mut self, x: &Transform, turn: Option<Turn>, subtree: Range<usize>) {
         let (stride, end) = (self.nv + Self::PADDING, Self::PADDING + subtree.end);
         let groups = subtree.len().div_ceil(4);
         x.transpose_apply_force_rows_turned(turn, self.rows, stride, end, groups);

@@ -67,7 +67,7 @@ pub(crate) fn body_placements<S: Real>(
     joint_transforms(model, q, x_up);
     for i in 1..model.nbodies() {
         // X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}
-        x_world[i] = x_up[i].compose_turned(model.turn_axis(i), &x_world[model.parent[i]]);
+        x_world[i] = x_up[i].compose_turned(model.turn(i), &x_world[model.parent[i]]);
     }
 }
 
@@ -128,7 +128,7 @@ pub(crate) fn support_placements<S: Real>(
     }
     for &i in support.iter().rev() {
         // X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}
-        x_world[i] = x_up[i].compose_turned(model.turn_axis(i), &x_world[model.parent[i]]);
+        x_world[i] = x_up[i].compose_turned(model.turn(i), &x_world[model.parent[i]]);
     }
 }
 

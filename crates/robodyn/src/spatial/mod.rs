@@ -12,13 +12,14 @@ mod motion;
 mod products;
 mod transform;
 pub mod trig;
-mod turn;
+pub(crate) mod turn;
 
 pub use force::Force;
 pub use inertia::{CoriolisFactor, Inertia};
 pub use motion::Motion;
 pub use products::*;
 pub use transform::Transform;
+pub use turn::Turn;
 
 pub use nalgebra::{SimdRealField, SimdValue};
 

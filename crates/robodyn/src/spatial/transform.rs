@@ -1,6 +1,6 @@
 //! Plücker coordinate transforms (Featherstone §2.8).
 
-use super::turn::{with_rotation, AnyRotation, Rotation, TurnAbout};
+use super::turn::{with_axis_rotation, with_rotation, AnyRotation, Rotation, Turn, TurnAbout};
 use super::{
     block, cross, from_blocks, matrix3, rotate, rotate_back, skew, transposed, Force, Inertia,
     Mat3, Mat6, Motion, Real, Vec3,
@@ -110,7 +110,7 @@ impl<S: Real> Transform<S> {
     #[inline(always)]
     fn rotated_about<const K: usize>(&self, s: S, c: S) -> Transform<S> {
         Transform {
-            rotation: TurnAbout::<K>::compose(&TurnAbout::<K>::matrix(s, c), &self.rotation),
+            rotation: TurnAbout::<K, K>::compose(&TurnAbout::<K, K>::matrix(s, c), &self.rotation),
             translation: self.translation,
         }
     }
@@ -139,10 +139,10 @@ impl<S: Real> Transform<S> {
         self.apply_motion_by::<AnyRotation>(m)
     }
 
-    /// [`Transform::apply_motion`] for a rotation that turns about coordinate axis `turn` only
-    /// (`None`: any; see [`crate::Model::turn_axis`]): the same value, fewer products.
+    /// [`Transform::apply_motion`] for a rotation of the pattern `turn` (`None`: any; see
+    /// [`crate::Model::turn`]): the same value, fewer products.
     #[inline(always)]
-    pub fn apply_motion_turned(&self, turn: Option<usize>, m: &Motion<S>) -> Motion<S> {
+    pub fn apply_motion_turned(&self, turn: Option<Turn>, m: &Motion<S>) -> Motion<S> {
         with_rotation!(turn, self.apply_motion_by(m))
     }
 
@@ -185,16 +185,16 @@ impl<S: Real> Transform<S> {
         self.transpose_apply_force_by::<AnyRotation>(f)
     }
 
-    /// [`Transform::transpose_apply_force`] for a rotation about coordinate axis `turn` only, as
+    /// [`Transform::transpose_apply_force`] for a rotation of the pattern `turn`, as
     /// [`Transform::apply_motion_turned`].
     #[inline(always)]
-    pub fn transpose_apply_force_turned(&self, turn: Option<usize>, f: &Force<S>) -> Force<S> {
+    pub fn transpose_apply_force_turned(&self, turn: Option<Turn>, f: &Force<S>) -> Force<S> {
         with_rotation!(turn, self.transpose_apply_force_by(f))
     }
 
     /// [`Transform::transpose_apply_force_turned`] of every force of `forces`, in place.
     #[inline(always)]
-    pub fn transpose_apply_forces_turned(&self, turn: Option<usize>, forces: &mut [Force<S>]) {
+    pub fn transpose_apply_forces_turned(&self, turn: Option<Turn>, forces: &mut [Force<S>]) {
         with_rotation!(turn, self.transpose_apply_forces_by(forces))
     }
 
@@ -226,12 +226,12 @@ impl<S: Real> Transform<S> {
         self.transpose_apply_matrix_by::<AnyRotation>(inertia)
     }
 
-    /// [`Transform::transpose_apply_matrix`] for a rotation about coordinate axis `turn` only,
-    /// as [`Transform::apply_motion_turned`].
+    /// [`Transform::transpose_apply_matrix`] for a rotation of the pattern `turn`, as
+    /// [`Transform::apply_motion_turned`].
     #[inline(always)]
     pub fn transpose_apply_matrix_turned(
         &self,
-        turn: Option<usize>,
+        turn: Option<Turn>,
         inertia: &Matrix6<S>,
     ) -> Matrix6<S> {
         with_rotation!(turn, self.transpose_apply_matrix_by(inertia))
@@ -260,12 +260,12 @@ impl<S: Real> Transform<S> {
         self.transpose_apply_inertia_by::<AnyRotation>(inertia)
     }
 
-    /// [`Transform::transpose_apply_inertia`] for a rotation about coordinate axis `turn` only,
-    /// as [`Transform::apply_motion_turned`].
+    /// [`Transform::transpose_apply_inertia`] for a rotation of the pattern `turn`, as
+    /// [`Transform::apply_motion_turned`].
     #[inline(always)]
     pub fn transpose_apply_inertia_turned(
         &self,
-        turn: Option<usize>,
+        turn: Option<Turn>,
         inertia: &Inertia<S>,
     ) -> Inertia<S> {
         with_rotation!(turn, self.transpose_apply_inertia_by(inertia))
@@ -360,7 +360,7 @@ impl Transform {
     #[inline(always)]
     pub fn transpose_apply_force_rows_turned(
         &self,
-        turn: Option<usize>,
+        turn: Option<Turn>,
         rows: &mut [f64],
         stride: usize,
         end: usize,
@@ -412,11 +412,11 @@ impl<S: Real> Mul for Transform<S> {
 }
 
 impl<S: Real> Transform<S> {
-    /// `self * rhs` for `self`'s rotation turning about coordinate axis `turn` only, as
+    /// `self * rhs` for `self`'s rotation of the pattern `turn`, as
     /// [`Transform::apply_motion_turned`].
     #[inline(always)]
-    pub fn compose_turned(&self, turn: Option<usize>, rhs: &Transform<S>) -> Transform<S> {
-        with_rotation!(turn, self.compose_by(rhs))
+    pub fn compose_turned(&self, turn: Option<Turn>, rhs: &Transform<S>) -> Transform<S> {
+        with_axis_rotation!(turn, self.compose_by(rhs))
     }
 
     #[inline(always)]

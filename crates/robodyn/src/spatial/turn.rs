@@ -1,17 +1,19 @@
-//! Products with a rotation that turns about one coordinate axis only.
+//! Products with a rotation that turns about one coordinate axis, after a signed permutation.
 //!
-//! A revolute joint about ±e_k whose tree transform `X_T` does not rotate gives
-//! `X_up = X_J X_T` a rotation `E` with `E_kk = 1` and the rest of row and column k zero (exactly:
-//! `Transform::rotated_about_axis` writes them from the identity's). A product with such an `E`
-//! needs only the 2x2 block on the other two coordinates: 4 products instead of 9 for a vector,
-//! 12 instead of 27 for a matrix. Leaving out products with an exact zero leaves the value as it
-//! was (x + 0·y = x; two terms add the same in either order), so a transform gives the same
-//! result by either path.
+//! A revolute joint about ±e_k whose tree transform `X_T` rotates by a signed permutation `P` (no
+//! rotation, or quarter turns: what URDF `rpy` multiples of π/2 give, stored exactly by
+//! `ModelBuilder::add_body`) gives `X_up = X_J X_T` a rotation `E = E_J P` with row k equal to
+//! P's row k: one entry ±1, in some column c, and two exact zeros; the other two rows mix only
+//! the other two columns, and have exact zeros in column c ([`Turn`]). A product with such an
+//! `E` needs only those entries: 5 products instead of 9 for a vector, 15 instead of 27 for a
+//! matrix. Leaving out products with an exact zero leaves the value as it was (x + 0·y = x; two
+//! terms add the same in either order, and ±1·x is exact), so a transform gives the same result
+//! by either path.
 
 use super::{compose, compose_transposed, rotate, rotate_back, Real};
 use nalgebra::{Matrix3, Vector3};
 
-/// How a transform's rotation is applied: any rotation, or one about a coordinate axis only.
+/// How a transform's rotation is applied: any rotation, or one of a [`Turn`]'s pattern.
 pub(crate) trait Rotation {
     /// `E v`.
     fn rotate<S: Real>(e: &Matrix3<S>, v: &Vector3<S>) -> Vector3<S>;
@@ -48,16 +50,45 @@ impl Rotation for AnyRotation {
     }
 }
 
-/// A rotation about coordinate axis `K` only.
-pub(crate) struct TurnAbout<const K: usize>;
+/// Where a transform's rotation `E` has its nonzeros when it turns about coordinate axis `axis`
+/// after a signed permutation: row `axis` has its one nonzero (±1) in column `column`; the other
+/// two rows have theirs in the other two columns. Where `column == axis` that nonzero is +1
+/// (no permutation, or one that keeps the axis: then row `axis` is the identity's).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Turn {
+    /// The joint's axis k: 0, 1, 2 for x, y, z.
+    pub axis: usize,
+    /// The column of row k's nonzero.
+    pub column: usize,
+}
 
-impl<const K: usize> TurnAbout<K> {
-    /// The two coordinates the turn mixes.
+/// A rotation whose row `K` has its one nonzero in column `C` and whose other two rows have
+/// theirs in the other two columns ([`Turn`] with `axis = K`, `column = C`).
+pub(crate) struct TurnAbout<const K: usize, const C: usize>;
+
+impl<const K: usize, const C: usize> TurnAbout<K, C> {
+    /// The two rows the turn mixes.
     const FIRST: usize = (K + 1) % 3;
     const SECOND: usize = (K + 2) % 3;
+    /// The two columns they mix.
+    const A: usize = (C + 1) % 3;
+    const B: usize = (C + 2) % 3;
 
-    /// The turn by the angle of sine `s` and cosine `c` as a joint's `E_J`: rows `[c s; −s c]`
-    /// on the two other coordinates (as `Transform::from_axis_angle` gives), 1 on axis K.
+    /// `E_KC x`, the one nonzero of row K times `x`: `x` itself where `K == C` (a [`Turn`] with
+    /// `column == axis` has `E_KK = 1`, so the row is copied, as it was, and a chain of
+    /// placements does not wait on a product).
+    #[inline(always)]
+    fn scaled<S: Real>(e: &Matrix3<S>, x: S) -> S {
+        if K == C {
+            x
+        } else {
+            e[(K, C)] * x
+        }
+    }
+
+    /// The turn by the angle of sine `s` and cosine `c` as a joint's `E_J` (`K == C`): rows
+    /// `[c s; −s c]` on the two other coordinates (as `Transform::from_axis_angle` gives), 1 on
+    /// axis K.
     #[inline(always)]
     pub(crate) fn matrix<S: Real>(s: S, c: S) -> Matrix3<S> {
         let (f, second) = (Self::FIRST, Self::SECOND);
@@ -72,66 +103,139 @@ impl<const K: usize> TurnAbout<K> {
     }
 }
 
-impl<const K: usize> Rotation for TurnAbout<K> {
+impl<const K: usize, const C: usize> Rotation for TurnAbout<K, C> {
     #[inline(always)]
     fn rotate<S: Real>(e: &Matrix3<S>, v: &Vector3<S>) -> Vector3<S> {
-        let (f, s) = (Self::FIRST, Self::SECOND);
-        // (E v)_K = v_K
+        let (f, s, a, b) = (Self::FIRST, Self::SECOND, Self::A, Self::B);
         let mut out = *v;
-        out[f] = e[(f, f)] * v[f] + e[(f, s)] * v[s];
-        out[s] = e[(s, f)] * v[f] + e[(s, s)] * v[s];
+        out[K] = Self::scaled(e, v[C]);
+        out[f] = e[(f, a)] * v[a] + e[(f, b)] * v[b];
+        out[s] = e[(s, a)] * v[a] + e[(s, b)] * v[b];
         out
     }
 
     #[inline(always)]
     fn rotate_back<S: Real>(e: &Matrix3<S>, v: &Vector3<S>) -> Vector3<S> {
-        // Eᵀ turns about the same axis (the transpose is only other loads once inlined)
-        Self::rotate(&e.transpose(), v)
+        // Eᵀ has row C's one nonzero in column K (the transpose is only other loads once inlined)
+        TurnAbout::<C, K>::rotate(&e.transpose(), v)
     }
 
     #[inline(always)]
     fn rotated<S: Real>(e: &Matrix3<S>, m: &Matrix3<S>) -> Matrix3<S> {
-        let (f, s) = (Self::FIRST, Self::SECOND);
-        // M E: columns f and s turn, column K stays (entry by entry, not by a closure: a
-        // closure is not always inlined into a kernel compiled for wider lanes)
+        let (f, s, a, b) = (Self::FIRST, Self::SECOND, Self::A, Self::B);
+        // M E: column C is column K of M scaled, columns a and b mix columns f and s (entry by
+        // entry, not by a closure: a closure is not always inlined into a kernel compiled for
+        // wider lanes)
         let mut m_e = *m;
         for row in 0..3 {
-            m_e[(row, f)] = m[(row, f)] * e[(f, f)] + m[(row, s)] * e[(s, f)];
-            m_e[(row, s)] = m[(row, f)] * e[(f, s)] + m[(row, s)] * e[(s, s)];
+            m_e[(row, C)] = Self::scaled(e, m[(row, K)]);
+            m_e[(row, a)] = m[(row, f)] * e[(f, a)] + m[(row, s)] * e[(s, a)];
+            m_e[(row, b)] = m[(row, f)] * e[(f, b)] + m[(row, s)] * e[(s, b)];
         }
-        // then Eᵀ (M E): rows f and s turn
+        // then Eᵀ (M E): row C is row K scaled, rows a and b mix rows f and s
         let mut out = m_e;
         for col in 0..3 {
-            out[(f, col)] = e[(f, f)] * m_e[(f, col)] + e[(s, f)] * m_e[(s, col)];
-            out[(s, col)] = e[(f, s)] * m_e[(f, col)] + e[(s, s)] * m_e[(s, col)];
+            out[(C, col)] = Self::scaled(e, m_e[(K, col)]);
+            out[(a, col)] = e[(f, a)] * m_e[(f, col)] + e[(s, a)] * m_e[(s, col)];
+            out[(b, col)] = e[(f, b)] * m_e[(f, col)] + e[(s, b)] * m_e[(s, col)];
         }
         out
     }
 
     #[inline(always)]
     fn compose<S: Real>(e: &Matrix3<S>, m: &Matrix3<S>) -> Matrix3<S> {
-        let (f, s) = (Self::FIRST, Self::SECOND);
-        // row K of M stays, rows f and s turn (entry by entry, as in `rotated`)
+        let (f, s, a, b) = (Self::FIRST, Self::SECOND, Self::A, Self::B);
+        // row K is row C of M scaled, rows f and s mix rows a and b (entry by entry, as in
+        // `rotated`)
         let mut out = *m;
         for col in 0..3 {
-            out[(f, col)] = e[(f, f)] * m[(f, col)] + e[(f, s)] * m[(s, col)];
-            out[(s, col)] = e[(s, f)] * m[(f, col)] + e[(s, s)] * m[(s, col)];
+            out[(K, col)] = Self::scaled(e, m[(C, col)]);
+            out[(f, col)] = e[(f, a)] * m[(a, col)] + e[(f, b)] * m[(b, col)];
+            out[(s, col)] = e[(s, a)] * m[(a, col)] + e[(s, b)] * m[(b, col)];
         }
         out
     }
 }
 
-/// `$receiver.$method::<R>(arguments)` with `R` the [`Rotation`] of `turn` (`Some(k)`: about
-/// coordinate axis k only; `None`: any).
+/// The column of row `row`'s nonzero when `rotation` is exactly a signed permutation (every
+/// entry 0 or ±1, one nonzero in each row and in each column), else `None`.
+pub(crate) fn signed_permutation_column(rotation: &Matrix3<f64>, row: usize) -> Option<usize> {
+    let mut column_of_row = [0; 3];
+    let mut taken = [false; 3];
+    for (r, column) in column_of_row.iter_mut().enumerate() {
+        let mut nonzero = None;
+        for c in 0..3 {
+            let x = rotation[(r, c)];
+            if x == 0.0 {
+                continue;
+            }
+            if x.abs() != 1.0 || nonzero.is_some() {
+                return None;
+            }
+            nonzero = Some(c);
+        }
+        *column = nonzero?;
+        if std::mem::replace(&mut taken[*column], true) {
+            return None;
+        }
+    }
+    Some(column_of_row[row])
+}
+
+/// `rotation` with every entry rounded to 0 or ±1 when each is within
+/// [`SIGNED_PERMUTATION_TOLERANCE`] of one and the result is a signed permutation (a URDF
+/// `rpy` of quarter turns gives entries like cos(π/2) = 6e-17, the rounding of π/2, not 0).
+pub(crate) fn snapped_signed_permutation(rotation: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+    let snapped = rotation.map(|x| {
+        let rounded = x.round();
+        if (x - rounded).abs() <= SIGNED_PERMUTATION_TOLERANCE {
+            rounded
+        } else {
+            x
+        }
+    });
+    signed_permutation_column(&snapped, 0)?;
+    Some(snapped.map(|x| x + 0.0))
+}
+
+/// How far a rotation's entries may be from 0 and ±1 to be stored as a signed permutation: a few
+/// roundings of a product of quarter turns (cos(π/2) in `f64` is 6.1e-17).
+pub const SIGNED_PERMUTATION_TOLERANCE: f64 = 1e-14;
+
+/// `$receiver.$method::<R>(arguments)` with `R` the [`Rotation`] of `turn` (`Some`: a
+/// [`Turn`]; `None`: any).
 macro_rules! with_rotation {
     ($turn:expr, $receiver:ident . $method:ident ($($argument:expr),*)) => {{
         use $crate::spatial::turn::{AnyRotation, TurnAbout};
-        match $turn {
-            Some(0) => $receiver.$method::<TurnAbout<0>>($($argument),*),
-            Some(1) => $receiver.$method::<TurnAbout<1>>($($argument),*),
-            Some(2) => $receiver.$method::<TurnAbout<2>>($($argument),*),
+        // one number for the pair, so that the choice is one jump, not a pair compared in turn
+        match $turn.map_or(9, |turn| 3 * turn.axis + turn.column) {
+            0 => $receiver.$method::<TurnAbout<0, 0>>($($argument),*),
+            1 => $receiver.$method::<TurnAbout<0, 1>>($($argument),*),
+            2 => $receiver.$method::<TurnAbout<0, 2>>($($argument),*),
+            3 => $receiver.$method::<TurnAbout<1, 0>>($($argument),*),
+            4 => $receiver.$method::<TurnAbout<1, 1>>($($argument),*),
+            5 => $receiver.$method::<TurnAbout<1, 2>>($($argument),*),
+            6 => $receiver.$method::<TurnAbout<2, 0>>($($argument),*),
+            7 => $receiver.$method::<TurnAbout<2, 1>>($($argument),*),
+            8 => $receiver.$method::<TurnAbout<2, 2>>($($argument),*),
             _ => $receiver.$method::<AnyRotation>($($argument),*),
         }
     }};
 }
 pub(crate) use with_rotation;
+
+/// [`with_rotation!`] for the turns that keep their axis (`column == axis`) only, the others by
+/// the general products: for a short product in a chain (the placements'), where ten variants
+/// cost more in code than their products save.
+macro_rules! with_axis_rotation {
+    ($turn:expr, $receiver:ident . $method:ident ($($argument:expr),*)) => {{
+        use $crate::spatial::turn::{AnyRotation, TurnAbout};
+        match $turn.filter(|turn| turn.column == turn.axis).map(|turn| turn.axis) {
+            Some(0) => $receiver.$method::<TurnAbout<0, 0>>($($argument),*),
+            Some(1) => $receiver.$method::<TurnAbout<1, 1>>($($argument),*),
+            Some(2) => $receiver.$method::<TurnAbout<2, 2>>($($argument),*),
+            _ => $receiver.$method::<AnyRotation>($($argument),*),
+        }
+    }};
+}
+pub(crate) use with_axis_rotation;
