@@ -186,15 +186,51 @@ impl Joint {
     /// with the rotation's zeros (`Transform::apply_motion_turned` and the like).
     #[inline(always)]
     pub fn turn(&self, x_tree: &Transform) -> Option<Turn> {
-        let axis = match self {
-            Joint::Revolute { axis } => coordinate_axis(axis)?.index,
-            Joint::Prismatic { .. } => 2,
+        let (axis, axis_negative) = match self {
+            Joint::Revolute { axis } => {
+                let k = coordinate_axis(axis)?;
+                (k.index, k.negative)
+            }
+            Joint::Prismatic { .. } => (2, false),
             _ => return None,
         };
         let column = signed_permutation_column(&x_tree.rotation, axis)?;
         // row k of E = E_J E_T is E_T's: where it is −e_k, the general products
         let keeps_axis = column != axis || x_tree.rotation[(axis, axis)] == 1.0;
-        keeps_axis.then_some(Turn { axis, column })
+        keeps_axis.then_some(Turn {
+            axis,
+            column,
+            axis_negative,
+            tree_rotates: x_tree.rotation != Mat3::identity(),
+        })
+    }
+
+    /// [`Joint::transform_after_turn`] given the body's [`Turn`] (`Model::turn`, found once per
+    /// model): a revolute joint needs no test of its axis, and after a tree transform that does
+    /// not rotate its rotation is its own turn `E_J`, with no product by X_T's identity (the same
+    /// values: c·1 + s·0 = c).
+    #[inline(always)]
+    pub fn transform_after_turn_of<S: Real>(
+        &self,
+        q: &[S],
+        (s, c): (S, S),
+        x_tree: &Transform,
+        turn: Option<Turn>,
+    ) -> Transform<S> {
+        match (self, turn) {
+            (Joint::Revolute { .. }, Some(turn)) => {
+                // about −e_k by θ is about e_k by −θ
+                let s = if turn.axis_negative { -s } else { s };
+                match turn.tree_rotates {
+                    true => Transform::splat(x_tree).rotated_about_axis(turn.axis, s, c),
+                    false => Transform {
+                        rotation: Transform::rotation_about_axis(turn.axis, s, c),
+                        translation: splat_vector(&x_tree.translation),
+                    },
+                }
+            }
+            _ => self.transform_after_turn(q, (s, c), x_tree),
+        }
     }
 
     /// Column `k` of the motion subspace `S`, in the child frame.

@@ -279,22 +279,50 @@ fn turn_needs_a_coordinate_axis_and_a_tree_of_quarter_turns() {
     let revolute = |x: f64, y: f64, z: f64| Joint::Revolute {
         axis: Vec3::new(x, y, z),
     };
-    let turn = |axis, column| Some(Turn { axis, column });
-    assert_eq!(revolute(1.0, 0.0, 0.0).turn(&shifted), turn(0, 0));
-    assert_eq!(revolute(0.0, -1.0, 0.0).turn(&shifted), turn(1, 1));
-    assert_eq!(revolute(0.0, 0.0, 1.0).turn(&shifted), turn(2, 2));
-    assert_eq!(revolute(0.0, 0.0, 1.0).turn(&quarter_about_x), turn(2, 1));
-    assert_eq!(revolute(0.0, 1.0, 0.0).turn(&quarter_about_x), turn(1, 2));
-    assert_eq!(revolute(1.0, 0.0, 0.0).turn(&quarter_about_x), turn(0, 0));
-    assert_eq!(revolute(1.0, 0.0, 0.0).turn(&half_about_x), turn(0, 0));
+    let turn = |axis, column, axis_negative, tree_rotates| {
+        Some(Turn {
+            axis,
+            column,
+            axis_negative,
+            tree_rotates,
+        })
+    };
+    assert_eq!(
+        revolute(1.0, 0.0, 0.0).turn(&shifted),
+        turn(0, 0, false, false)
+    );
+    assert_eq!(
+        revolute(0.0, -1.0, 0.0).turn(&shifted),
+        turn(1, 1, true, false)
+    );
+    assert_eq!(
+        revolute(0.0, 0.0, 1.0).turn(&shifted),
+        turn(2, 2, false, false)
+    );
+    assert_eq!(
+        revolute(0.0, 0.0, 1.0).turn(&quarter_about_x),
+        turn(2, 1, false, true)
+    );
+    assert_eq!(
+        revolute(0.0, 1.0, 0.0).turn(&quarter_about_x),
+        turn(1, 2, false, true)
+    );
+    assert_eq!(
+        revolute(-1.0, 0.0, 0.0).turn(&quarter_about_x),
+        turn(0, 0, true, true)
+    );
+    assert_eq!(
+        revolute(1.0, 0.0, 0.0).turn(&half_about_x),
+        turn(0, 0, false, true)
+    );
     assert_eq!(revolute(0.0, 0.0, 1.0).turn(&half_about_x), None);
     assert_eq!(revolute(0.0, 0.0, 1.0).turn(&tilted), None);
     assert_eq!(revolute(0.6, 0.8, 0.0).turn(&shifted), None);
     let prismatic = Joint::Prismatic {
         axis: Vec3::new(0.6, 0.8, 0.0),
     };
-    assert_eq!(prismatic.turn(&shifted), turn(2, 2));
-    assert_eq!(prismatic.turn(&quarter_about_x), turn(2, 1));
+    assert_eq!(prismatic.turn(&shifted), turn(2, 2, false, false));
+    assert_eq!(prismatic.turn(&quarter_about_x), turn(2, 1, false, true));
     assert_eq!(prismatic.turn(&tilted), None);
     assert_eq!(Joint::Spherical.turn(&shifted), None);
     assert_eq!(Joint::Free.turn(&shifted), None);

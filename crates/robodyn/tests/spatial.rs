@@ -93,6 +93,13 @@ proptest! {
         // a tree that turns the axis into its opposite is the one case left to the general path
         let axis = if prismatic { 2 } else { k };
         prop_assert_eq!(turn.is_none(), tree.rotation[(axis, axis)] == -1.0);
+        // the joint's transform made knowing its turn (no axis test, no product by an identity)
+        prop_assert_eq!(joint.transform_after_turn_of(&[angle], angle.sin_cos(), &tree, turn), x);
+        let unrotated = Transform::from_translation(&r);
+        prop_assert_eq!(
+            joint.transform_after_turn_of(&[angle], angle.sin_cos(), &unrotated, joint.turn(&unrotated)),
+            joint.transform_after_turn(&[angle], angle.sin_cos(), &unrotated)
+        );
         prop_assume!(turn.is_some());
         let (m, f) = (Motion::new(w, v), Force::new(v, w));
         let u = nalgebra::Vector6::new(w.x, w.y, w.z, v.x, v.y, v.z);

@@ -1,7 +1,6 @@
 //! URDF loading: structure, conventions, and every kind of bad input giving a clear error.
 
 use robodyn::io::{bundled_model, bundled_names, load_urdf_file, load_urdf_str, LoadOptions};
-use robodyn::spatial::Turn;
 use robodyn::{Error, Joint};
 
 fn error_of(text: &str) -> String {
@@ -61,7 +60,10 @@ fn quarter_turns_in_rpy_are_stored_exactly() {
         assert!((rotation.determinant() - 1.0).abs() == 0.0);
     }
     // about x by −π/2: row z of the tree rotation is e_y
-    assert_eq!(model.turn(1), Some(Turn { axis: 2, column: 1 }));
+    let turn = model
+        .turn(1)
+        .expect("a z joint after a quarter turn about x");
+    assert_eq!((turn.axis, turn.column, turn.tree_rotates), (2, 1, true));
     assert!(model.turn(2).is_some());
     assert!(model.x_tree[3]
         .rotation

@@ -46,7 +46,8 @@ fn transforms_of_chunk<S: Real>(
     S::sin_cos_at(q, coordinates, turns);
     for (i, &turn) in bodies.zip(turns.iter()) {
         let joint = &model.joints[i];
-        x_up[i] = joint.transform_after_turn(&q[model.q_range(i)], turn, &model.x_tree[i]);
+        let (x_tree, pattern) = (&model.x_tree[i], model.turn(i));
+        x_up[i] = joint.transform_after_turn_of(&q[model.q_range(i)], turn, x_tree, pattern);
     }
 }
 

@@ -106,6 +106,17 @@ impl<S: Real> Transform<S> {
         }
     }
 
+    /// `E_J`, the rotation about coordinate axis `k` by the angle of sine `s` and cosine `c`, as
+    /// [`Transform::rotated_about_axis`] turns by.
+    #[inline(always)]
+    pub fn rotation_about_axis(k: usize, s: S, c: S) -> Matrix3<S> {
+        match k {
+            0 => TurnAbout::<0, 0>::matrix(s, c),
+            1 => TurnAbout::<1, 1>::matrix(s, c),
+            _ => TurnAbout::<2, 2>::matrix(s, c),
+        }
+    }
+
     /// [`Transform::rotated_about_axis`] for the axis `K`, given the angle's sine and cosine.
     #[inline(always)]
     fn rotated_about<const K: usize>(&self, s: S, c: S) -> Transform<S> {

@@ -60,6 +60,10 @@ pub struct Turn {
     pub axis: usize,
     /// The column of row k's nonzero.
     pub column: usize,
+    /// Whether a revolute joint's axis is −e_k (it then turns about e_k by −q).
+    pub axis_negative: bool,
+    /// Whether the tree transform rotates (else `E = E_J`, the joint's own turn).
+    pub tree_rotates: bool,
 }
 
 /// A rotation whose row `K` has its one nonzero in column `C` and whose other two rows have
