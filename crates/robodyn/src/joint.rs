@@ -8,7 +8,7 @@
 //! `difference(q, integrate(q, v)) = v`.
 
 use crate::spatial::trig::sin_cos;
-use crate::spatial::turn::signed_permutation_column;
+use crate::spatial::turn::lone_column;
 use crate::spatial::{
     cross, log_rotation, rotate_back, skew, splat_vector, zero_vector, Force, Mat3, Mat6, Motion,
     Real, Transform, Turn, Vec3,
@@ -180,9 +180,10 @@ impl Joint {
     }
 
     /// The pattern of `X_J(q) X_T`'s rotation when it turns about one coordinate axis after a
-    /// signed permutation, for this `X_T`: a revolute joint about ±e_k, or a prismatic joint
-    /// (whose X_J does not turn; k = 2), after an `X_T` whose rotation is exactly a signed
-    /// permutation (none, or quarter turns) that does not turn e_k into −e_k. Transforms by it can then leave out the products
+    /// rotation that keeps one axis, for this `X_T`: a revolute joint about ±e_k, or a prismatic
+    /// joint (whose X_J does not turn; k = 2), after an `X_T` whose rotation's row k is exactly
+    /// ±e_c with nothing else in column c (none, quarter turns, a rotation about e_k itself), and
+    /// does not turn e_k into −e_k. Transforms by it can then leave out the products
     /// with the rotation's zeros (`Transform::apply_motion_turned` and the like).
     #[inline(always)]
     pub fn turn(&self, x_tree: &Transform) -> Option<Turn> {
@@ -194,7 +195,7 @@ impl Joint {
             Joint::Prismatic { .. } => (2, false),
             _ => return None,
         };
-        let column = signed_permutation_column(&x_tree.rotation, axis)?;
+        let column = lone_column(&x_tree.rotation, axis)?;
         // row k of E = E_J E_T is E_T's: where it is −e_k, the general products
         let keeps_axis = column != axis || x_tree.rotation[(axis, axis)] == 1.0;
         keeps_axis.then_some(Turn {

@@ -264,10 +264,10 @@ fn subspace_components_are_the_projections() {
 }
 
 /// `Joint::turn`: a revolute joint about ±e_k or a prismatic joint after a tree transform whose
-/// rotation is exactly a signed permutation (none, or quarter turns), reporting the column of
-/// the rotation's row k; not after any other rotation, nor one that turns e_k into −e_k.
+/// rotation keeps one axis exactly (none, quarter turns, a turn about e_k), reporting the column
+/// of the rotation's row k; not after any other rotation, nor one that turns e_k into −e_k.
 #[test]
-fn turn_needs_a_coordinate_axis_and_a_tree_of_quarter_turns() {
+fn turn_needs_a_coordinate_axis_and_a_tree_that_keeps_an_axis() {
     let translation = Vec3::new(0.1, -0.2, 0.3);
     let tree = |rotation: Mat3| Transform::from_pose(&rotation, &translation);
     let shifted = Transform::from_translation(&translation);
@@ -317,6 +317,8 @@ fn turn_needs_a_coordinate_axis_and_a_tree_of_quarter_turns() {
     );
     assert_eq!(revolute(0.0, 0.0, 1.0).turn(&half_about_x), None);
     assert_eq!(revolute(0.0, 0.0, 1.0).turn(&tilted), None);
+    // a tree that turns about the joint's own axis keeps it
+    assert_eq!(revolute(0.0, 1.0, 0.0).turn(&tilted), turn(1, 1, false, true));
     assert_eq!(revolute(0.6, 0.8, 0.0).turn(&shifted), None);
     let prismatic = Joint::Prismatic {
         axis: Vec3::new(0.6, 0.8, 0.0),

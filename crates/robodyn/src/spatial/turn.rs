@@ -1,10 +1,11 @@
-//! Products with a rotation that turns about one coordinate axis, after a signed permutation.
+//! Products with a rotation that turns about one coordinate axis after one that keeps an axis.
 //!
-//! A revolute joint about ±e_k whose tree transform `X_T` rotates by a signed permutation `P` (no
-//! rotation, or quarter turns: what URDF `rpy` multiples of π/2 give, stored exactly by
-//! `ModelBuilder::add_body`) gives `X_up = X_J X_T` a rotation `E = E_J P` with row k equal to
-//! P's row k: one entry ±1, in some column c, and two exact zeros; the other two rows mix only
-//! the other two columns, and have exact zeros in column c ([`Turn`]). A product with such an
+//! A revolute joint about ±e_k whose tree transform `X_T` has a rotation `P` whose row k has one
+//! nonzero ±1, in some column c, and whose column c has no other (no rotation; quarter turns,
+//! what URDF `rpy` multiples of π/2 give, stored exactly by `ModelBuilder::add_body`; a rotation
+//! about e_k itself) gives `X_up = X_J X_T` a rotation `E = E_J P` with row k equal to P's row
+//! k: one entry ±1 in column c and two exact zeros; the other two rows mix only the other two
+//! columns, and have exact zeros in column c ([`Turn`]). A product with such an
 //! `E` needs only those entries: 5 products instead of 9 for a vector, 15 instead of 27 for a
 //! matrix. Leaving out products with an exact zero leaves the value as it was (x + 0·y = x; two
 //! terms add the same in either order, and ±1·x is exact), so a transform gives the same result
@@ -51,7 +52,7 @@ impl Rotation for AnyRotation {
 }
 
 /// Where a transform's rotation `E` has its nonzeros when it turns about coordinate axis `axis`
-/// after a signed permutation: row `axis` has its one nonzero (±1) in column `column`; the other
+/// after a rotation that keeps one axis (`spatial::turn`'s header): row `axis` has its one nonzero (±1) in column `column`; the other
 /// two rows have theirs in the other two columns. Where `column == axis` that nonzero is +1
 /// (no permutation, or one that keeps the axis: then row `axis` is the identity's).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -161,29 +162,33 @@ impl<const K: usize, const C: usize> Rotation for TurnAbout<K, C> {
     }
 }
 
-/// The column of row `row`'s nonzero when `rotation` is exactly a signed permutation (every
-/// entry 0 or ±1, one nonzero in each row and in each column), else `None`.
-pub(crate) fn signed_permutation_column(rotation: &Matrix3<f64>, row: usize) -> Option<usize> {
-    let mut column_of_row = [0; 3];
-    let mut taken = [false; 3];
-    for (r, column) in column_of_row.iter_mut().enumerate() {
-        let mut nonzero = None;
-        for c in 0..3 {
-            let x = rotation[(r, c)];
-            if x == 0.0 {
-                continue;
-            }
-            if x.abs() != 1.0 || nonzero.is_some() {
-                return None;
-            }
-            nonzero = Some(c);
-        }
-        *column = nonzero?;
-        if std::mem::replace(&mut taken[*column], true) {
-            return None;
-        }
-    }
-    Some(column_of_row[row])
+/// Whether `rotation` is exactly a signed permutation: every entry 0 or ±1, one nonzero in each
+/// row and in each column.
+fn is_signed_permutation(rotation: &Matrix3<f64>) -> bool {
+    // how many entries are ±1, or None where one is neither 0 nor ±1
+    let ones = |entries: [f64; 3]| {
+        entries.iter().try_fold(0, |count, &x| match x {
+            0.0 => Some(count),
+            1.0 | -1.0 => Some(count + 1),
+            _ => None,
+        })
+    };
+    (0..3).all(|k| {
+        let row = [rotation[(k, 0)], rotation[(k, 1)], rotation[(k, 2)]];
+        let column = [rotation[(0, k)], rotation[(1, k)], rotation[(2, k)]];
+        ones(row) == Some(1) && ones(column) == Some(1)
+    })
+}
+
+/// The column c of row `row`'s one nonzero (±1) when neither that row nor that column has another
+/// nonzero, else `None`: a tree rotation `R` of that shape gives `E_J R` (`E_J` about axis `row`)
+/// a [`Turn`]'s pattern. Every signed permutation has it, and so has any rotation about the
+/// axis itself (row and column `row` the identity's).
+pub(crate) fn lone_column(rotation: &Matrix3<f64>, row: usize) -> Option<usize> {
+    let column = (0..3).find(|&c| rotation[(row, c)].abs() == 1.0)?;
+    let row_alone = (0..3).all(|c| c == column || rotation[(row, c)] == 0.0);
+    let column_alone = (0..3).all(|r| r == row || rotation[(r, column)] == 0.0);
+    (row_alone && column_alone).then_some(column)
 }
 
 /// `rotation` with every entry rounded to 0 or ±1 when each is within
@@ -198,8 +203,7 @@ pub(crate) fn snapped_signed_permutation(rotation: &Matrix3<f64>) -> Option<Matr
             x
         }
     });
-    signed_permutation_column(&snapped, 0)?;
-    Some(snapped.map(|x| x + 0.0))
+    is_signed_permutation(&snapped).then(|| snapped.map(|x| x + 0.0))
 }
 
 /// How far a rotation's entries may be from 0 and ±1 to be stored as a signed permutation: a few
