@@ -318,7 +318,10 @@ fn turn_needs_a_coordinate_axis_and_a_tree_that_keeps_an_axis() {
     assert_eq!(revolute(0.0, 0.0, 1.0).turn(&half_about_x), None);
     assert_eq!(revolute(0.0, 0.0, 1.0).turn(&tilted), None);
     // a tree that turns about the joint's own axis keeps it
-    assert_eq!(revolute(0.0, 1.0, 0.0).turn(&tilted), turn(1, 1, false, true));
+    assert_eq!(
+        revolute(0.0, 1.0, 0.0).turn(&tilted),
+        turn(1, 1, false, true)
+    );
     assert_eq!(revolute(0.6, 0.8, 0.0).turn(&shifted), None);
     let prismatic = Joint::Prismatic {
         axis: Vec3::new(0.6, 0.8, 0.0),
