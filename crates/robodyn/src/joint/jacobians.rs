@@ -12,7 +12,7 @@
 //! Robotics*, 2017, §7.1.5 and §7.1.6, eqs. 7.77 and 7.86 for SO(3) and SE(3)); on SE(3) twists are
 //! [linear; angular] as in v, and Ad(R, p) = [R, p× R; 0, R].
 
-use super::left_jacobian_so3;
+use super::configuration::left_jacobian_so3;
 use crate::spatial::{skew, Mat3, Mat6, Vec3};
 use nalgebra::{SMatrix, SVector, UnitQuaternion};
 
