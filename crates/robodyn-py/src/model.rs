@@ -281,7 +281,6 @@ impl PyModel {
         let model = &self.model;
         match batch {
             None => {
-                let inputs = values;
                 let given = target.is_some();
                 let output = match target {
                     Some(target) => target,
@@ -292,8 +291,8 @@ impl PyModel {
                 let out = unsafe { output.as_slice_mut() }
                     .map_err(|e| PyValueError::new_err(e.to_string()))?;
                 match self.workspace.try_lock() {
-                    Ok(mut workspace) => run_kernel(kernel, model, &mut workspace, inputs, out),
-                    Err(_) => run_kernel(kernel, model, &mut Workspace::new(model), inputs, out),
+                    Ok(mut workspace) => run_kernel(kernel, model, &mut workspace, values, out),
+                    Err(_) => run_kernel(kernel, model, &mut Workspace::new(model), values, out),
                 }
                 .map_err(to_py_err)?;
                 if output_shape.is_empty() && !given {

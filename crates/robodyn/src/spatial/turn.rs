@@ -162,24 +162,6 @@ impl<const K: usize, const C: usize> Rotation for TurnAbout<K, C> {
     }
 }
 
-/// Whether `rotation` is exactly a signed permutation: every entry 0 or ±1, one nonzero in each
-/// row and in each column.
-fn is_signed_permutation(rotation: &Matrix3<f64>) -> bool {
-    // how many entries are ±1, or None where one is neither 0 nor ±1
-    let ones = |entries: [f64; 3]| {
-        entries.iter().try_fold(0, |count, &x| match x {
-            0.0 => Some(count),
-            1.0 | -1.0 => Some(count + 1),
-            _ => None,
-        })
-    };
-    (0..3).all(|k| {
-        let row = [rotation[(k, 0)], rotation[(k, 1)], rotation[(k, 2)]];
-        let column = [rotation[(0, k)], rotation[(1, k)], rotation[(2, k)]];
-        ones(row) == Some(1) && ones(column) == Some(1)
-    })
-}
-
 /// The column c of row `row`'s one nonzero (±1) when neither that row nor that column has another
 /// nonzero, else `None`: a tree rotation `R` of that shape gives `E_J R` (`E_J` about axis `row`)
 /// a [`Turn`]'s pattern. Every signed permutation has it, and so has any rotation about the
@@ -203,7 +185,9 @@ pub(crate) fn snapped_signed_permutation(rotation: &Matrix3<f64>) -> Option<Matr
             x
         }
     });
-    is_signed_permutation(&snapped).then(|| snapped.map(|x| x + 0.0))
+    // a signed permutation: every row's one ±1 alone in its row and column
+    let signed_permutation = (0..3).all(|row| lone_column(&snapped, row).is_some());
+    signed_permutation.then(|| snapped.map(|x| x + 0.0))
 }
 
 /// How far a rotation's entries may be from 0 and ±1 to be stored as a signed permutation: a few
