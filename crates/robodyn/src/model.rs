@@ -124,6 +124,11 @@ pub struct Model {
     /// snapshots.
     #[serde(skip)]
     pub turns: Vec<Option<Turn>>,
+    /// Derived from `joints` when the model is built, nv: [`Joint::subspace_component`] of
+    /// each velocity coordinate (asked for every coordinate of every mass matrix, so found
+    /// once). Not stored in snapshots.
+    #[serde(skip)]
+    pub subspace_components: Vec<Option<(usize, bool)>>,
     /// Position limits, length nq (±inf where none).
     pub lower_position_limit: DVector<f64>,
     pub upper_position_limit: DVector<f64>,
@@ -192,6 +197,16 @@ impl Model {
     pub fn turn(&self, i: usize) -> Option<Turn> {
         // none where the model was not built (any rotation: the same values, more products)
         self.turns.get(i).copied().flatten()
+    }
+
+    /// [`Joint::subspace_component`] of body i's joint's coordinate k.
+    #[inline(always)]
+    pub fn subspace_component(&self, i: usize, k: usize) -> Option<(usize, bool)> {
+        match self.subspace_components.get(self.idx_v[i] + k) {
+            Some(component) => *component,
+            // a model that was not built: asked of the joint
+            None => self.joints[i].subspace_component(k),
+        }
     }
 
     /// The range of body i's coordinates in q.
@@ -427,6 +442,21 @@ pub struct NewBody<'a> {
     pub inertia: Inertia,
 }
 
+impl Model {
+    /// The fields derived from the others, not stored in snapshots: found when a model is
+    /// built or read back.
+    pub(crate) fn derive(&mut self) {
+        self.dof_run_start = dof_run_starts(&self.dof_parent);
+        self.subtree_dof_end = subtree_dof_ends(&self.parent, &self.idx_v, self.nv);
+        self.turns = (self.joints.iter().zip(&self.x_tree))
+            .map(|(joint, x)| joint.turn(x))
+            .collect();
+        self.subspace_components = (self.joints.iter())
+            .flat_map(|joint| (0..joint.nv()).map(|k| joint.subspace_component(k)))
+            .collect();
+    }
+}
+
 /// Builds a [`Model`] body by body; every loader ends here.
 #[derive(Debug, Clone)]
 pub struct ModelBuilder {
@@ -434,15 +464,6 @@ pub struct ModelBuilder {
 }
 
 /// [`Model::dof_run_start`] from the coordinates' parents.
-/// [`Joint::turn`] of each body.
-pub(crate) fn turns(joints: &[Joint], x_tree: &[Transform]) -> Vec<Option<Turn>> {
-    joints
-        .iter()
-        .zip(x_tree)
-        .map(|(joint, x)| joint.turn(x))
-        .collect()
-}
-
 pub(crate) fn dof_run_starts(dof_parent: &[Option<usize>]) -> Vec<usize> {
     let mut starts = Vec::with_capacity(dof_parent.len());
     for (k, parent) in dof_parent.iter().enumerate() {
@@ -521,6 +542,7 @@ impl ModelBuilder {
                 dof_run_start: Vec::new(),
                 subtree_dof_end: None,
                 turns: Vec::new(),
+                subspace_components: Vec::new(),
                 lower_position_limit: DVector::zeros(0),
                 upper_position_limit: DVector::zeros(0),
                 velocity_limit: DVector::zeros(0),
@@ -676,9 +698,7 @@ impl ModelBuilder {
 
     /// The finished model.
     pub fn build(mut self) -> Model {
-        let m = &mut self.model;
-        m.subtree_dof_end = subtree_dof_ends(&m.parent, &m.idx_v, m.nv);
-        m.turns = turns(&m.joints, &m.x_tree);
+        self.model.derive();
         self.model
     }
 }

@@ -408,7 +408,9 @@ fn crba_into_writes_crba_s_matrix_which_is_exactly_symmetric() {
 
 /// CRBA's two forms (`algo::crba`), in body coordinates for bodies in depth-first order (every
 /// loader's) and in world coordinates otherwise, give the same M; `Model::subtree_dof_end`
-/// lists each subtree's coordinates, and a snapshot derives it (and `Model::turns`) again.
+/// lists each subtree's coordinates, and a snapshot derives it (and `Model::turns`,
+/// `Model::subspace_components`) again. A model whose derived components are missing (not
+/// built) asks its joints and gets the same M bit for bit.
 #[test]
 fn crba_in_body_and_world_coordinates_agree() {
     let mut rng = rng();
@@ -420,6 +422,11 @@ fn crba_in_body_and_world_coordinates_agree() {
         let reloaded = robodyn::io::model_from_bytes(&robodyn::io::model_to_bytes(&model)).unwrap();
         assert_eq!(reloaded.subtree_dof_end.as_ref(), Some(ends), "{name}");
         assert_eq!(reloaded.turns, model.turns, "{name}");
+        assert_eq!(
+            reloaded.subspace_components, model.subspace_components,
+            "{name}"
+        );
+        assert_eq!(model.subspace_components.len(), model.nv, "{name}");
         for (i, &end) in ends.iter().enumerate().skip(1) {
             for j in 1..model.nbodies() {
                 // body j is in body i's subtree when i is on j's path to the world
@@ -436,10 +443,15 @@ fn crba_in_body_and_world_coordinates_agree() {
             }
         }
         let world_form = not_depth_first(&model);
+        let mut unbuilt = model.clone();
+        unbuilt.subspace_components.clear();
         let (mut data, mut world_data) = (Data::new(&model), Data::new(&world_form));
+        let mut unbuilt_data = Data::new(&unbuilt);
         for _ in 0..3 {
             let q = model.random_configuration(&mut rng);
+            let m_unbuilt = crba(&unbuilt, &mut unbuilt_data, q.as_slice()).unwrap();
             let m = crba(&model, &mut data, q.as_slice()).unwrap();
+            assert_eq!(m, m_unbuilt, "{name}: M without the derived components");
             let m_world = crba(&world_form, &mut world_data, q.as_slice()).unwrap();
             let label = format!("{name}: M in body and world coordinates");
             assert_close(

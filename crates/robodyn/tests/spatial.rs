@@ -221,6 +221,23 @@ proptest! {
     }
 
     #[test]
+    fn an_inertia_times_a_unit_motion_is_its_column(i in inertia()) {
+        // ±e_c in Plücker order, against the general product
+        for c in 0..6 {
+            for negative in [false, true] {
+                let mut unit = [0.0; 6];
+                unit[c] = if negative { -1.0 } else { 1.0 };
+                let motion = Motion::new(
+                    Vec3::new(unit[0], unit[1], unit[2]),
+                    Vec3::new(unit[3], unit[4], unit[5]),
+                );
+                let column = i.mul_unit_motion(c, negative).plucker();
+                prop_assert_eq!(column, i.mul_motion(&motion).plucker(), "c = {}, negative = {}", c, negative);
+            }
+        }
+    }
+
+    #[test]
     fn factored_coriolis_is_twice_the_coriolis_factor(i in inertia(), w in vec3(), v in vec3(), w2 in vec3(), v2 in vec3(), j in inertia(), w3 in vec3(), v3 in vec3()) {
         let (velocity, s, other_velocity) = (Motion::new(w, v), Motion::new(w2, v2), Motion::new(w3, v3));
         // a subtree's H is the sum of its bodies'

@@ -250,27 +250,37 @@ pub(crate) fn body_frame_mass_matrix<S: Real, F: SubtreeForces<S>>(
     for i in (1..model.nbodies()).rev() {
         let joint = &model.joints[i];
         let subtree = model.idx_v[i]..subtree_dof_end[i];
-        // F_k = I^c_i S_k for the joint's own coordinates
+        // F_k = I^c_i S_k for the joint's own coordinates (a column of I^c_i where S_k is a
+        // coordinate axis)
+        let composite = &out.composites[i];
         for (k, dof) in model.v_range(i).enumerate() {
-            let column = Motion::splat(&joint.subspace_column(k));
-            forces.set(dof, &out.composites[i].mul_motion(&column));
+            let force = match model.subspace_component(i, k) {
+                Some((c, negative)) => composite.mul_unit_motion(c, negative),
+                None => composite.mul_motion(&Motion::splat(&joint.subspace_column(k))),
+            };
+            forces.set(dof, &force);
         }
         // H_dk = H_kd = S_kᵀ F_d for the subtree's coordinates d (a component of F_d where S_k
         // is a coordinate axis)
         for (k, col) in model.v_range(i).enumerate() {
-            let component = joint.subspace_component(k);
-            for d in subtree.clone() {
-                let h = match component {
-                    Some((c, false)) => forces.component(c, d),
-                    Some((c, true)) => -forces.component(c, d),
-                    None => joint.project_force(k, &forces.force(d)),
-                };
+            let mut store = |d: usize, h: S| {
                 out.mass_matrix[d + col * nv] = h;
                 out.mass_matrix[col + d * nv] = h;
+            };
+            match model.subspace_component(i, k) {
+                Some((c, negative)) => {
+                    // ±1 times the component (exact)
+                    let sign = S::splat(if negative { -1.0 } else { 1.0 });
+                    for d in subtree.clone() {
+                        store(d, forces.component(c, d) * sign);
+                    }
+                }
+                None => {
+                    for d in subtree.clone() {
+                        store(d, joint.project_force(k, &forces.force(d)));
+                    }
+                }
             }
-        }
-        for dof in model.v_range(i) {
-            out.mass_matrix[dof + dof * nv] += S::splat(model.armature[dof]);
         }
         // the subtree's inertia and forces into the parent's coordinates
         let parent = model.parent[i];
@@ -280,6 +290,9 @@ pub(crate) fn body_frame_mass_matrix<S: Real, F: SubtreeForces<S>>(
             out.composites[parent] += carried;
             forces.carry(x_up, turn, subtree);
         }
+    }
+    for (dof, armature) in model.armature.iter().enumerate() {
+        out.mass_matrix[dof + dof * nv] += S::splat(*armature);
     }
 }
 
@@ -359,9 +372,12 @@ impl<'r> ForceRows<'r> {
 impl SubtreeForces<f64> for ForceRows<'_> {
     #[inline(always)]
     fn set(&mut self, d: usize, force: &Force) {
+        // the six components, a row apart: one bounds check for all
+        let stride = self.nv + Self::PADDING;
+        let first = self.at(0, d);
+        let components = &mut self.rows[first..=first + 5 * stride];
         for (c, value) in force.plucker().into_iter().enumerate() {
-            let at = self.at(c, d);
-            self.rows[at] = value;
+            components[c * stride] = value;
         }
     }
 

@@ -8,7 +8,7 @@
 //! they become a model, so damaged bytes are an error, never a crash later.
 
 use crate::error::{Error, Result};
-use crate::model::{dof_run_starts, subtree_dof_ends, turns, Model};
+use crate::model::Model;
 
 /// What every snapshot starts with.
 const TAG: &[u8; 8] = b"robodyn\0";
@@ -59,9 +59,7 @@ pub fn model_from_bytes(bytes: &[u8]) -> Result<Model> {
     let mut model: Model = postcard::from_bytes(payload)
         .map_err(|e| refuse(format!("the snapshot (robodyn {version}) is damaged: {e}")))?;
     check_structure(&model)?;
-    model.dof_run_start = dof_run_starts(&model.dof_parent);
-    model.subtree_dof_end = subtree_dof_ends(&model.parent, &model.idx_v, model.nv);
-    model.turns = turns(&model.joints, &model.x_tree);
+    model.derive();
     Ok(model)
 }
 

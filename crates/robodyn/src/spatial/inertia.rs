@@ -42,6 +42,32 @@ impl<S: Real> Inertia<S> {
             linear: m.linear * self.mass - cross(&self.first_moment, &m.angular),
         }
     }
+
+    /// `f = I u` for `u` the unit motion ±e_c (c in [`Force::plucker`]'s order; `negative`: −):
+    /// column c of the 6x6 matrix, read off without products. About axis c < 3:
+    /// `n = Ī_O e_c`, `f = e_c × h`; along axis j = c − 3: `n = h × e_j`, `f = m e_j`.
+    #[inline(always)]
+    pub fn mul_unit_motion(&self, c: usize, negative: bool) -> Force<S> {
+        let (h, zero) = (&self.first_moment, S::zero());
+        // e_j × h
+        let unit_cross = |j: usize| match j {
+            0 => Vector3::new(zero, -h.z, h.y),
+            1 => Vector3::new(h.z, zero, -h.x),
+            _ => Vector3::new(-h.y, h.x, zero),
+        };
+        let force = if c < 3 {
+            Force::new(self.rotational.column(c).into_owned(), unit_cross(c))
+        } else {
+            let mut linear = Vector3::from_element(zero);
+            linear[c - 3] = self.mass;
+            Force::new(-unit_cross(c - 3), linear)
+        };
+        if negative {
+            -force
+        } else {
+            force
+        }
+    }
 }
 
 impl Default for Inertia {

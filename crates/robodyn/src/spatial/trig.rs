@@ -13,6 +13,8 @@
 
 use super::Real;
 use nalgebra::SimdBool;
+#[cfg(target_arch = "x86_64")]
+use simba::simd::{AutoF64x4, AutoF64x8};
 
 /// Largest |x| the three-part reduction handles (|n| < 2²⁰ with margin); beyond it, and for
 /// non-finite x, the standard library's functions answer.
@@ -92,11 +94,34 @@ pub fn sin_cos<S: Real>(x: S) -> (S, S) {
 #[inline(never)]
 pub fn sin_cos_at(q: &[f64], indices: &[usize], out: &mut [(f64, f64)]) {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the processor has AVX2, just checked.
-        return unsafe { sin_cos_at_avx2(q, indices, out) };
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the processor has AVX-512F, just checked.
+            return unsafe { sin_cos_at_avx512(q, indices, out) };
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the processor has AVX2, just checked.
+            return unsafe { sin_cos_at_avx2(q, indices, out) };
+        }
     }
     sin_cos_one_by_one(q, indices, out);
+}
+
+/// [`sin_cos_at`] in AVX-512 lanes, eight indices at a time while more than four are left,
+/// then four in AVX2 lanes: an evaluation in eight lanes costs about two in four, so a group of
+/// four or fewer takes four.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn sin_cos_at_avx512(q: &[f64], indices: &[usize], out: &mut [(f64, f64)]) {
+    let mut start = 0;
+    while indices.len() - start > 4 {
+        let end = indices.len().min(start + 8);
+        sin_cos_in_lanes::<AutoF64x8, 8>(q, &indices[start..end], &mut out[start..end]);
+        start = end;
+    }
+    if start < indices.len() {
+        sin_cos_in_lanes::<AutoF64x4, 4>(q, &indices[start..], &mut out[start..]);
+    }
 }
 
 /// [`sin_cos_at`] one value at a time, in `f64` or lanes.
@@ -107,17 +132,30 @@ pub(crate) fn sin_cos_one_by_one<S: Real>(q: &[S], indices: &[usize], out: &mut 
     }
 }
 
-/// [`sin_cos_at`] in AVX2 lanes, four indices at a time (the last group padded with zeros).
+/// [`sin_cos_at`] in AVX2 lanes, four indices at a time.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn sin_cos_at_avx2(q: &[f64], indices: &[usize], out: &mut [(f64, f64)]) {
     for (group, turns) in indices.chunks(4).zip(out.chunks_mut(4)) {
-        let value = |lane: usize| group.get(lane).map_or(0.0, |&index| q[index]);
-        let x = simba::simd::AutoF64x4::from([value(0), value(1), value(2), value(3)]);
-        let (sin, cos) = sin_cos(x);
-        for (lane, turn) in turns.iter_mut().enumerate() {
-            *turn = (sin.0[lane], cos.0[lane]);
-        }
+        sin_cos_in_lanes::<AutoF64x4, 4>(q, group, turns);
+    }
+}
+
+/// `turns[k] = (sin, cos)` of `q[group[k]]` for up to `N` indices, in one evaluation in `N`
+/// lanes (the lanes beyond the group's end hold zeros).
+#[inline(always)]
+fn sin_cos_in_lanes<V, const N: usize>(q: &[f64], group: &[usize], turns: &mut [(f64, f64)])
+where
+    V: Real + From<[f64; N]>,
+    [f64; N]: From<V>,
+{
+    let x = V::from(std::array::from_fn(|lane| {
+        group.get(lane).map_or(0.0, |&index| q[index])
+    }));
+    let (sin, cos) = sin_cos(x);
+    let (sin, cos) = (<[f64; N]>::from(sin), <[f64; N]>::from(cos));
+    for (lane, turn) in turns.iter_mut().enumerate() {
+        *turn = (sin[lane], cos[lane]);
     }
 }
 
@@ -176,19 +214,38 @@ mod tests {
             -4.0,
         ];
         let indices = [8, 0, 3, 3, 5, 1, 2, 7, 6, 4];
-        // the run-time choice (AVX2 lanes here), and the fallback
-        let (mut chosen, mut one_by_one) = ([(0.0, 0.0); 10], [(0.0, 0.0); 10]);
-        sin_cos_at(&q, &indices, &mut chosen);
-        sin_cos_one_by_one(&q, &indices, &mut one_by_one);
-        for out in [chosen, one_by_one] {
-            for (k, &index) in indices.iter().enumerate() {
-                let (s, c) = sin_cos(q[index]);
-                assert_eq!(
-                    (out[k].0.to_bits(), out[k].1.to_bits()),
-                    (s.to_bits(), c.to_bits()),
-                    "q[{index}] = {}",
-                    q[index]
-                );
+        // every count of indices (whole and partial groups of four and eight), by the run-time
+        // choice, each lane width the processor has, and the fallback
+        for count in 0..=indices.len() {
+            let indices = &indices[..count];
+            let mut outs = vec![[(0.0, 0.0); 10]; 2];
+            sin_cos_at(&q, indices, &mut outs[0][..count]);
+            sin_cos_one_by_one(&q, indices, &mut outs[1][..count]);
+            #[cfg(target_arch = "x86_64")]
+            {
+                if std::arch::is_x86_feature_detected!("avx2") {
+                    let mut out = [(0.0, 0.0); 10];
+                    // SAFETY: the processor has AVX2, just checked.
+                    unsafe { sin_cos_at_avx2(&q, indices, &mut out[..count]) };
+                    outs.push(out);
+                }
+                if std::arch::is_x86_feature_detected!("avx512f") {
+                    let mut out = [(0.0, 0.0); 10];
+                    // SAFETY: the processor has AVX-512F, just checked.
+                    unsafe { sin_cos_at_avx512(&q, indices, &mut out[..count]) };
+                    outs.push(out);
+                }
+            }
+            for out in outs {
+                for (k, &index) in indices.iter().enumerate() {
+                    let (s, c) = sin_cos(q[index]);
+                    assert_eq!(
+                        (out[k].0.to_bits(), out[k].1.to_bits()),
+                        (s.to_bits(), c.to_bits()),
+                        "q[{index}] = {} of {count}",
+                        q[index]
+                    );
+                }
             }
         }
     }
