@@ -1,9 +1,12 @@
 //! The model: topology and constants of a robot. Algorithms never mutate it; everything they
 //! write goes into [`crate::Data`].
 
+mod builder;
+
+pub use builder::{ModelBuilder, NewBody};
+
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::joint::Joint;
-use crate::spatial::turn::snapped_signed_permutation;
 use crate::spatial::{Inertia, Mat3, Transform, Turn, Vec3};
 use crate::visual::Visual;
 use nalgebra::DVector;
@@ -426,22 +429,6 @@ pub fn check_physical_parameters(p: &[f64; 10]) -> std::result::Result<(), Strin
     Ok(())
 }
 
-/// A moving body for [`ModelBuilder::add_body`].
-#[derive(Debug, Clone)]
-pub struct NewBody<'a> {
-    /// Index of the parent body (0 = world).
-    pub parent: usize,
-    pub joint: Joint,
-    pub joint_name: &'a str,
-    /// Featherstone's `X_T`: from the parent body's frame to the joint frame.
-    pub x_tree: Transform,
-    pub properties: JointProperties,
-    /// The body's (link's) name.
-    pub name: &'a str,
-    /// Spatial inertia in the body's own frame.
-    pub inertia: Inertia,
-}
-
 impl Model {
     /// The fields derived from the others, not stored in snapshots: found when a model is
     /// built or read back.
@@ -455,12 +442,6 @@ impl Model {
             .flat_map(|joint| (0..joint.nv()).map(|k| joint.subspace_component(k)))
             .collect();
     }
-}
-
-/// Builds a [`Model`] body by body; every loader ends here.
-#[derive(Debug, Clone)]
-pub struct ModelBuilder {
-    model: Model,
 }
 
 /// [`Model::dof_run_start`] from the coordinates' parents.
@@ -519,186 +500,5 @@ impl Iterator for AncestorRuns<'_> {
         let start = self.model.dof_run_start[end];
         self.top = self.model.dof_parent[start];
         Some(start..end + 1)
-    }
-}
-
-impl ModelBuilder {
-    /// A model holding only the world (body 0), named `world_name`.
-    pub fn new(name: &str, world_name: &str) -> Self {
-        ModelBuilder {
-            model: Model {
-                name: name.to_string(),
-                nq: 0,
-                nv: 0,
-                parent: vec![0],
-                joints: vec![Joint::Fixed],
-                joint_names: vec!["universe".into()],
-                body_names: vec![world_name.to_string()],
-                x_tree: vec![Transform::IDENTITY],
-                inertias: vec![Inertia::ZERO],
-                idx_q: vec![0],
-                idx_v: vec![0],
-                dof_parent: Vec::new(),
-                dof_run_start: Vec::new(),
-                subtree_dof_end: None,
-                turns: Vec::new(),
-                subspace_components: Vec::new(),
-                lower_position_limit: DVector::zeros(0),
-                upper_position_limit: DVector::zeros(0),
-                velocity_limit: DVector::zeros(0),
-                effort_limit: DVector::zeros(0),
-                armature: DVector::zeros(0),
-                damping: DVector::zeros(0),
-                friction: DVector::zeros(0),
-                stiffness: DVector::zeros(0),
-                spring_reference: DVector::zeros(0),
-                frames: Vec::new(),
-                gravity: Vec3::new(0.0, 0.0, -STANDARD_GRAVITY),
-                mimics: Vec::new(),
-                warnings: Vec::new(),
-                visuals: Vec::new(),
-            },
-        }
-    }
-
-    /// Adds a moving body (see [`NewBody`]) and a frame with its name. Returns the body index.
-    pub fn add_body(&mut self, body: NewBody) -> Result<usize> {
-        let NewBody {
-            parent,
-            joint,
-            joint_name,
-            x_tree,
-            properties,
-            name,
-            inertia,
-        } = body;
-        let m = &mut self.model;
-        if parent >= m.parent.len() {
-            return Err(Error::model(
-                format!("joint '{joint_name}'"),
-                format!("parent body {parent} does not exist"),
-            ));
-        }
-        if matches!(joint, Joint::Fixed) {
-            return Err(Error::model(
-                format!("joint '{joint_name}'"),
-                "a fixed joint is merged with add_fixed_link, not added as a body",
-            ));
-        }
-        let index = m.parent.len();
-        m.parent.push(parent);
-        m.joints.push(joint);
-        m.joint_names.push(joint_name.to_string());
-        m.body_names.push(name.to_string());
-        // quarter turns stored exactly, so that the joint's transforms leave out their zeros
-        let rotation = snapped_signed_permutation(&x_tree.rotation).unwrap_or(x_tree.rotation);
-        m.x_tree.push(Transform { rotation, ..x_tree });
-        m.inertias.push(inertia);
-        m.idx_q.push(m.nq);
-        m.idx_v.push(m.nv);
-        let (nq, nv) = (joint.nq(), joint.nv());
-        // the first coordinate hangs from the last of the nearest ancestor joint that moves
-        let mut ancestor = parent;
-        while ancestor != 0 && m.joints[ancestor].nv() == 0 {
-            ancestor = m.parent[ancestor];
-        }
-        let mut previous = (ancestor != 0).then(|| m.idx_v[ancestor] + m.joints[ancestor].nv() - 1);
-        for k in m.nv..m.nv + nv {
-            m.dof_parent.push(previous);
-            m.dof_run_start
-                .push(run_start(&m.dof_run_start, previous, k));
-            previous = Some(k);
-        }
-        m.nq += nq;
-        m.nv += nv;
-        // quaternion coordinates carry no limits
-        let limited = joint.quaternion_offset().is_none();
-        let extend = |v: &mut DVector<f64>, n: usize, value: f64| {
-            *v = DVector::from_iterator(
-                v.len() + n,
-                v.iter().copied().chain(std::iter::repeat_n(value, n)),
-            );
-        };
-        let (lower, upper) = if limited {
-            (properties.lower, properties.upper)
-        } else {
-            (f64::NEG_INFINITY, f64::INFINITY)
-        };
-        extend(&mut m.lower_position_limit, nq, lower);
-        extend(&mut m.upper_position_limit, nq, upper);
-        extend(&mut m.velocity_limit, nv, properties.velocity_limit);
-        extend(&mut m.effort_limit, nv, properties.effort_limit);
-        extend(&mut m.armature, nv, properties.armature);
-        extend(&mut m.damping, nv, properties.damping);
-        extend(&mut m.friction, nv, properties.friction);
-        extend(&mut m.stiffness, nv, properties.stiffness);
-        extend(&mut m.spring_reference, nq, properties.spring_reference);
-        if nq > 1 {
-            joint.neutral(&mut m.spring_reference.as_mut_slice()[m.nq - nq..]);
-        }
-        m.frames.push(Frame {
-            name: name.to_string(),
-            body: index,
-            placement: Transform::IDENTITY,
-        });
-        Ok(index)
-    }
-
-    /// Merges a link attached by a fixed joint into `body`: `placement` is `X_{link←body}`,
-    /// `inertia` the link's spatial inertia in its own frame. The link stays as a frame.
-    pub fn add_fixed_link(
-        &mut self,
-        body: usize,
-        placement: Transform,
-        inertia: Inertia,
-        name: &str,
-    ) {
-        let merged = placement.transpose_apply_inertia(&inertia);
-        self.model.inertias[body] += merged;
-        self.add_frame(name, body, placement);
-    }
-
-    /// Scales every body's mass and inertia by `factor` (MJCF's `settotalmass`).
-    pub fn scale_inertias(&mut self, factor: f64) {
-        for inertia in &mut self.model.inertias {
-            inertia.mass *= factor;
-            inertia.first_moment *= factor;
-            inertia.rotational *= factor;
-        }
-    }
-
-    /// Adds a piece of visual geometry.
-    pub fn add_visual(&mut self, visual: Visual) {
-        self.model.visuals.push(visual);
-    }
-
-    /// Adds a named frame on `body` at `placement` (`X_{frame←body}`).
-    pub fn add_frame(&mut self, name: &str, body: usize, placement: Transform) {
-        self.model.frames.push(Frame {
-            name: name.to_string(),
-            body,
-            placement,
-        });
-    }
-
-    /// Records a mimic relation between two joints (body indices).
-    pub fn add_mimic(&mut self, mimic: Mimic) {
-        self.model.mimics.push(mimic);
-    }
-
-    /// Records something the user should know about the model.
-    pub fn warn(&mut self, message: String) {
-        self.model.warnings.push(message);
-    }
-
-    /// Sets the gravity vector.
-    pub fn gravity(&mut self, gravity: Vec3) {
-        self.model.gravity = gravity;
-    }
-
-    /// The finished model.
-    pub fn build(mut self) -> Model {
-        self.model.derive();
-        self.model
     }
 }
