@@ -212,6 +212,18 @@ impl Model {
         }
     }
 
+    /// `Some((c, negative))` where body i's joint has one velocity coordinate whose motion
+    /// subspace is the unit motion ±e_c ([`Joint::subspace_component`]): `S q̇` is then one
+    /// component.
+    #[inline(always)]
+    pub fn unit_axis(&self, i: usize) -> Option<(usize, bool)> {
+        if self.joints[i].nv() == 1 {
+            self.subspace_component(i, 0)
+        } else {
+            None
+        }
+    }
+
     /// The range of body i's coordinates in q.
     pub fn q_range(&self, i: usize) -> std::ops::Range<usize> {
         self.idx_q[i]..self.idx_q[i] + self.joints[i].nq()

@@ -576,3 +576,73 @@ fn every_quaternion_is_checked() {
         assert!(error.contains(&format!("joint '{joint}'")), "{error}");
     }
 }
+
+/// Joints along negative and linear coordinate axes, after quarter turns and after none.
+const AXES_URDF: &str = r#"<robot name="axes">
+  <link name="base"/>
+  <joint name="turn" type="revolute"><parent link="base"/><child link="a"/>
+    <origin xyz="0 0 0.1"/><axis xyz="0 0 -1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <link name="a"><inertial><origin xyz="0.1 0 0"/><mass value="1"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.03"/></inertial></link>
+  <joint name="slide" type="prismatic"><parent link="a"/><child link="b"/>
+    <origin xyz="0.2 0 0" rpy="1.5707963267948966 0 0"/><axis xyz="-1 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <link name="b"><inertial><origin xyz="0 0.1 0"/><mass value="0.5"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <joint name="lift" type="prismatic"><parent link="b"/><child link="c"/>
+    <origin xyz="0 0 0.1"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <link name="c"><inertial><origin xyz="0 0 0.05"/><mass value="0.2"/>
+    <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial></link>
+</robot>"#;
+
+/// The specialised paths, a joint's transform that turns about a coordinate axis
+/// (`Model::turns`) and a motion subspace that is one unit motion (`Model::subspace_components`,
+/// `Model::unit_axis`), give the values of the general products: the same model without either
+/// gives the same τ (with and without external forces), bias forces, gravity, q̈ and M.
+#[test]
+fn the_specialised_joint_paths_give_the_general_products_values() {
+    let mut rng = rng();
+    let mut models = test_models();
+    let options = robodyn::io::LoadOptions::floating(false);
+    let axes = robodyn::io::load_urdf_str(AXES_URDF, "axes.urdf", options).unwrap();
+    models.push(("axes", axes));
+    for (name, model) in models {
+        let unit_axes = (1..model.nbodies()).filter(|&i| model.unit_axis(i).is_some());
+        assert!(unit_axes.count() > 0, "{name}: no joint along a unit axis");
+        let mut general = model.clone();
+        general.turns = vec![None; model.nbodies()];
+        general.subspace_components = vec![None; model.nv];
+        assert!((1..model.nbodies()).all(|i| general.unit_axis(i).is_none()));
+        let (mut data, mut general_data) = (Data::new(&model), Data::new(&general));
+        for _ in 0..3 {
+            let (q, v, a) = state(&model, &mut rng);
+            let (q, v, a) = (q.as_slice(), v.as_slice(), a.as_slice());
+            let f_ext: Vec<_> = (1..model.nbodies())
+                .map(|_| robodyn::spatial::Force::from_array(&[0.3, -0.2, 0.5, 0.1, 0.05, -0.1]))
+                .collect();
+            for forces in [None, Some(&f_ext[..])] {
+                let tau = rnea(&model, &mut data, q, v, a, forces).unwrap();
+                let general_tau = rnea(&general, &mut general_data, q, v, a, forces).unwrap();
+                assert_eq!(tau, general_tau, "{name}: τ");
+                let qdd = aba(&model, &mut data, q, v, a, forces).unwrap();
+                let general_qdd = aba(&general, &mut general_data, q, v, a, forces).unwrap();
+                assert_eq!(qdd, general_qdd, "{name}: q̈");
+            }
+            let bias = bias_forces(&model, &mut data, q, v).unwrap();
+            assert_eq!(
+                bias,
+                bias_forces(&general, &mut general_data, q, v).unwrap()
+            );
+            let g = generalized_gravity(&model, &mut data, q).unwrap();
+            assert_eq!(
+                g,
+                generalized_gravity(&general, &mut general_data, q).unwrap()
+            );
+            let m = crba(&model, &mut data, q).unwrap();
+            assert_eq!(
+                m,
+                crba(&general, &mut general_data, q).unwrap(),
+                "{name}: M"
+            );
+        }
+    }
+}

@@ -1,5 +1,6 @@
 //! Spatial algebra identities, as property tests over random transforms and vectors.
 
+use nalgebra::Vector6;
 use proptest::prelude::*;
 use robodyn::spatial::{
     rotation_from_rpy, CoriolisFactor, Force, Inertia, Mat3, Motion, Transform, Vec3,
@@ -234,6 +235,22 @@ proptest! {
                 let column = i.mul_unit_motion(c, negative).plucker();
                 prop_assert_eq!(column, i.mul_motion(&motion).plucker(), "c = {}, negative = {}", c, negative);
             }
+        }
+    }
+
+    #[test]
+    fn a_motion_across_a_unit_motion_is_the_general_cross_product(w in vec3(), v in vec3(), s in -10.0..10.0f64) {
+        // s e_c in Plücker order, against the general product and the general sum
+        let m = Motion::new(w, v);
+        for c in 0..6 {
+            let mut unit = Vector6::zeros();
+            unit[c] = s;
+            let scaled_unit = Motion::new(unit.fixed_rows::<3>(0).into(), unit.fixed_rows::<3>(3).into());
+            let across = m.cross_unit_motion(c, s).to_vector();
+            prop_assert_eq!(across, m.cross_motion(&scaled_unit).to_vector(), "c = {}", c);
+            let mut sum = m;
+            sum.add_to_component(c, s);
+            prop_assert_eq!(sum.to_vector(), (m + scaled_unit).to_vector(), "c = {}", c);
         }
     }
 

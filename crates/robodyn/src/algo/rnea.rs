@@ -9,6 +9,7 @@
 use crate::algo::kinematics::joint_transforms;
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::model::Model;
+use crate::spatial::turn::{with_rotation_fn, Rotation};
 use crate::spatial::{splat_vector, zero_vector, Force, Inertia, Motion, Real, Transform};
 use crate::Data;
 use nalgebra::DVector;
@@ -93,7 +94,7 @@ pub(crate) fn newton_euler_passes<S: Real>(
     v: Option<&[S]>,
     a: Option<&[S]>,
     f_ext: Option<&[Force<S>]>,
-    out: NewtonEulerBuffers<S>,
+    mut out: NewtonEulerBuffers<S>,
 ) {
     joint_transforms(model, q, out.x_up);
 
@@ -101,61 +102,109 @@ pub(crate) fn newton_euler_passes<S: Real>(
     out.v[0] = Motion::zeros();
     out.a[0] = Motion::new(zero_vector(), -splat_vector::<S>(&model.gravity));
     for i in 1..model.nbodies() {
-        let joint = &model.joints[i];
-        let parent = model.parent[i];
-        // I_i read into each product where it is used (kept whole, it would be copied)
-        let inertia = &model.inertias[i];
-        // a_i = X_i a_λ(i) + S q̈_i + v_i × v_J   (c_J = 0)
-        let mut a_i = out.x_up[i].apply_motion(&out.a[parent]);
-        if let Some(a) = a {
-            a_i += joint.motion(&a[model.v_range(i)]);
-        }
-        // f_i = I_i a_i + v_i ×* I_i v_i - f_ext_i
-        let mut f_i = match v {
-            Some(v) => {
-                // v_i = X_i v_λ(i) + v_J
-                let v_j = joint.motion(&v[model.v_range(i)]);
-                let v_i = out.x_up[i].apply_motion(&out.v[parent]) + v_j;
-                a_i += v_i.cross_motion(&v_j);
-                out.v[i] = v_i;
-                let momentum = Inertia::<S>::splat(inertia).mul_motion(&v_i);
-                Inertia::<S>::splat(inertia).mul_motion(&a_i) + v_i.cross_force(&momentum)
-            }
-            None => {
-                // at rest every velocity product vanishes
-                out.v[i] = Motion::zeros();
-                Inertia::<S>::splat(inertia).mul_motion(&a_i)
-            }
-        };
-        if let Some(forces) = f_ext {
-            f_i -= forces[i - 1];
-        }
-        out.a[i] = a_i;
-        out.f[i] = f_i;
+        with_rotation_fn!(model.turn(i), outward_body(model, i, v, a, f_ext, &mut out));
     }
 
     // inward pass: project onto the joint axes, pass the rest to the parent
     for i in (1..model.nbodies()).rev() {
         let joint = &model.joints[i];
         let dofs = model.v_range(i);
-        for (k, dof) in dofs.clone().enumerate() {
-            // τ_i = S_iᵀ f_i + armature (q̈_i + K(q̇_i) q̇_i)
-            let mut rate = a.map_or(S::zero(), |a| a[dof]);
-            if let Some(v) = v {
-                let v_i = &v[dofs.clone()];
-                for (c, v_c) in v_i.iter().enumerate() {
-                    rate += joint.rotor_velocity_term(k, c, v_i) * *v_c;
+        match model.unit_axis(i) {
+            Some((c, negative)) => {
+                // S = ±e_c: τ_i = ±f_i,c + armature q̈_i (no rotor term: only a free joint has one)
+                let (dof, f_c) = (dofs.start, out.f[i].component(c));
+                let rate = a.map_or(S::zero(), |a| a[dof]);
+                let projected = if negative { -f_c } else { f_c };
+                out.tau[dof] = projected + S::splat(model.armature[dof]) * rate;
+            }
+            None => {
+                for (k, dof) in dofs.clone().enumerate() {
+                    // τ_i = S_iᵀ f_i + armature (q̈_i + K(q̇_i) q̇_i)
+                    let mut rate = a.map_or(S::zero(), |a| a[dof]);
+                    if let Some(v) = v {
+                        let v_i = &v[dofs.clone()];
+                        for (c, v_c) in v_i.iter().enumerate() {
+                            rate += joint.rotor_velocity_term(k, c, v_i) * *v_c;
+                        }
+                    }
+                    let projected = joint.project_force(k, &out.f[i]);
+                    out.tau[dof] = projected + S::splat(model.armature[dof]) * rate;
                 }
             }
-            out.tau[dof] = joint.project_force(k, &out.f[i]) + S::splat(model.armature[dof]) * rate;
         }
         let parent = model.parent[i];
         if parent != 0 {
             // f_λ(i) += X_iᵀ f_i
-            let f_parent = out.x_up[i].transpose_apply_force(&out.f[i]);
+            let f_parent = out.x_up[i].transpose_apply_force_turned(model.turn(i), &out.f[i]);
             out.f[parent] += f_parent;
         }
     }
+}
+
+/// Body i of the outward pass, its transform's rotation applied as `R`.
+#[inline(always)]
+fn outward_body<R: Rotation, S: Real>(
+    model: &Model,
+    i: usize,
+    v: Option<&[S]>,
+    a: Option<&[S]>,
+    f_ext: Option<&[Force<S>]>,
+    out: &mut NewtonEulerBuffers<S>,
+) {
+    let joint = &model.joints[i];
+    let parent = model.parent[i];
+    // S = ±e_c for most joints: S x is then one component, ±x
+    let unit_axis = model.unit_axis(i);
+    let along_axis = |x: &[S], negative: bool| {
+        let x = x[model.idx_v[i]];
+        if negative {
+            -x
+        } else {
+            x
+        }
+    };
+    // I_i read into each product where it is used (kept whole, it would be copied)
+    let inertia = &model.inertias[i];
+    // a_i = X_i a_λ(i) + S q̈_i + v_i × v_J   (c_J = 0)
+    let mut a_i = out.x_up[i].apply_motion_by::<R>(&out.a[parent]);
+    if let Some(a) = a {
+        match unit_axis {
+            Some((c, negative)) => a_i.add_to_component(c, along_axis(a, negative)),
+            None => a_i += joint.motion(&a[model.v_range(i)]),
+        }
+    }
+    // f_i = I_i a_i + v_i ×* I_i v_i - f_ext_i
+    let mut f_i = match v {
+        Some(v) => {
+            // v_i = X_i v_λ(i) + v_J
+            let mut v_i = out.x_up[i].apply_motion_by::<R>(&out.v[parent]);
+            match unit_axis {
+                Some((c, negative)) => {
+                    let rate = along_axis(v, negative);
+                    v_i.add_to_component(c, rate);
+                    a_i += v_i.cross_unit_motion(c, rate);
+                }
+                None => {
+                    let v_j = joint.motion(&v[model.v_range(i)]);
+                    v_i += v_j;
+                    a_i += v_i.cross_motion(&v_j);
+                }
+            }
+            out.v[i] = v_i;
+            let momentum = Inertia::<S>::splat(inertia).mul_motion(&v_i);
+            Inertia::<S>::splat(inertia).mul_motion(&a_i) + v_i.cross_force(&momentum)
+        }
+        None => {
+            // at rest every velocity product vanishes
+            out.v[i] = Motion::zeros();
+            Inertia::<S>::splat(inertia).mul_motion(&a_i)
+        }
+    };
+    if let Some(forces) = f_ext {
+        f_i -= forces[i - 1];
+    }
+    out.a[i] = a_i;
+    out.f[i] = f_i;
 }
 
 /// Checks one finite force per moving body.

@@ -48,6 +48,39 @@ impl<S: Real> Motion<S> {
         )
     }
 
+    /// Adds `x` to component `index` of `[angular; linear]` (the order of
+    /// [`super::Force::plucker`]); one branch per component, so that the motion can stay in
+    /// registers.
+    #[inline(always)]
+    pub fn add_to_component(&mut self, index: usize, x: S) {
+        match index {
+            0 => self.angular.x += x,
+            1 => self.angular.y += x,
+            2 => self.angular.z += x,
+            3 => self.linear.x += x,
+            4 => self.linear.y += x,
+            _ => self.linear.z += x,
+        }
+    }
+
+    /// `m × (s u)` for `u` the unit motion e_c (c as in [`Motion::add_to_component`]): the value
+    /// of [`Motion::cross_motion`] without the products with u's zeros. About axis c < 3:
+    /// `[ω × s e_c; v × s e_c]`; along axis j = c − 3: `[0; ω × s e_j]`.
+    #[inline(always)]
+    pub fn cross_unit_motion(&self, c: usize, s: S) -> Motion<S> {
+        // x × s e_j: two products
+        let unit_cross = |x: &Vector3<S>, j: usize| match j {
+            0 => Vector3::new(S::zero(), x.z * s, -(x.y * s)),
+            1 => Vector3::new(-(x.z * s), S::zero(), x.x * s),
+            _ => Vector3::new(x.y * s, -(x.x * s), S::zero()),
+        };
+        if c < 3 {
+            Motion::new(unit_cross(&self.angular, c), unit_cross(&self.linear, c))
+        } else {
+            Motion::new(super::zero_vector(), unit_cross(&self.angular, c - 3))
+        }
+    }
+
     /// `m × n`: the motion cross product (Featherstone eq. 2.31).
     #[inline(always)]
     pub fn cross_motion(&self, other: &Motion<S>) -> Motion<S> {

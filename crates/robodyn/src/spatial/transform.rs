@@ -158,7 +158,7 @@ impl<S: Real> Transform<S> {
     }
 
     #[inline(always)]
-    fn apply_motion_by<R: Rotation>(&self, m: &Motion<S>) -> Motion<S> {
+    pub(crate) fn apply_motion_by<R: Rotation>(&self, m: &Motion<S>) -> Motion<S> {
         Motion {
             angular: R::rotate(&self.rotation, &m.angular),
             linear: R::rotate(
@@ -217,7 +217,7 @@ impl<S: Real> Transform<S> {
     }
 
     #[inline(always)]
-    fn transpose_apply_force_by<R: Rotation>(&self, f: &Force<S>) -> Force<S> {
+    pub(crate) fn transpose_apply_force_by<R: Rotation>(&self, f: &Force<S>) -> Force<S> {
         let linear = R::rotate_back(&self.rotation, &f.linear);
         Force {
             angular: R::rotate_back(&self.rotation, &f.angular) + cross(&self.translation, &linear),

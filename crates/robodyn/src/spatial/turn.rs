@@ -216,6 +216,27 @@ macro_rules! with_rotation {
 }
 pub(crate) use with_rotation;
 
+/// `$function::<R, _>(arguments)` with `R` the [`Rotation`] of `turn`, as [`with_rotation!`]:
+/// one choice for a function that applies the same rotation several times.
+macro_rules! with_rotation_fn {
+    ($turn:expr, $function:ident ($($argument:expr),*)) => {{
+        use $crate::spatial::turn::{AnyRotation, TurnAbout};
+        match $turn.map_or(9, |turn| 3 * turn.axis + turn.column) {
+            0 => $function::<TurnAbout<0, 0>, _>($($argument),*),
+            1 => $function::<TurnAbout<0, 1>, _>($($argument),*),
+            2 => $function::<TurnAbout<0, 2>, _>($($argument),*),
+            3 => $function::<TurnAbout<1, 0>, _>($($argument),*),
+            4 => $function::<TurnAbout<1, 1>, _>($($argument),*),
+            5 => $function::<TurnAbout<1, 2>, _>($($argument),*),
+            6 => $function::<TurnAbout<2, 0>, _>($($argument),*),
+            7 => $function::<TurnAbout<2, 1>, _>($($argument),*),
+            8 => $function::<TurnAbout<2, 2>, _>($($argument),*),
+            _ => $function::<AnyRotation, _>($($argument),*),
+        }
+    }};
+}
+pub(crate) use with_rotation_fn;
+
 /// [`with_rotation!`] for the turns that keep their axis (`column == axis`) only, the others by
 /// the general products: for a short product in a chain (the placements'), where ten variants
 /// cost more in code than their products save.
