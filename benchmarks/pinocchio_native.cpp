@@ -53,6 +53,8 @@ int main(int argc, char** argv) {
       pinocchio::computeFrameJacobian(model, data, q, frame, pinocchio::LOCAL_WORLD_ALIGNED, jacobian);
     }, calls));
     std::printf("%s rnea %.1f\n", name.c_str(), best_ns([&] { pinocchio::rnea(model, data, q, v, a); }, calls));
+    std::printf("%s gravity %.1f\n", name.c_str(),
+                best_ns([&] { pinocchio::computeGeneralizedGravity(model, data, q); }, calls));
     std::printf("%s crba %.1f\n", name.c_str(), best_ns([&] { pinocchio::crba(model, data, q); }, calls));
     std::printf("%s aba %.1f\n", name.c_str(), best_ns([&] { pinocchio::aba(model, data, q, v, a); }, calls));
     std::printf("%s rnea_derivatives %.1f\n", name.c_str(),

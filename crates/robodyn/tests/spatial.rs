@@ -239,6 +239,12 @@ proptest! {
     }
 
     #[test]
+    fn an_inertia_times_a_linear_motion_is_the_general_product(i in inertia(), v in vec3()) {
+        let general = i.mul_motion(&Motion::new(Vec3::zeros(), v));
+        prop_assert_eq!(i.mul_linear_motion(&v).plucker(), general.plucker());
+    }
+
+    #[test]
     fn a_motion_across_a_unit_motion_is_the_general_cross_product(w in vec3(), v in vec3(), s in -10.0..10.0f64) {
         // s e_c in Plücker order, against the general product and the general sum
         let m = Motion::new(w, v);

@@ -6,7 +6,7 @@
 use rand::{rngs::StdRng, SeedableRng};
 use robodyn::algo::{
     aba, aba_derivatives, centroidal_momentum_matrix, coriolis_matrix, crba, forward_kinematics,
-    frame_pose, jacobian, rnea, rnea_derivatives, Reference,
+    frame_pose, generalized_gravity, jacobian, rnea, rnea_derivatives, Reference,
 };
 use robodyn::io::{bundled_model, load_urdf_file, LoadOptions};
 use robodyn::{Data, Model};
@@ -54,11 +54,12 @@ pub fn models() -> Vec<(&'static str, Model, &'static str)> {
 }
 
 /// The algorithms timed, by name.
-pub const ALGORITHMS: [&str; 10] = [
+pub const ALGORITHMS: [&str; 11] = [
     "forward_kinematics",
     "frame_pose",
     "jacobian",
     "rnea",
+    "gravity",
     "crba",
     "coriolis_matrix",
     "centroidal_momentum_matrix",
@@ -99,6 +100,7 @@ impl<'m> Bench<'m> {
             "frame_pose" => frame_pose(model, data, q, frame).map(|x| x.translation.x),
             "jacobian" => jacobian(model, data, q, frame, Reference::World).map(|j| j[0]),
             "rnea" => rnea(model, data, q, v, a, None).map(|t| t[0]),
+            "gravity" => generalized_gravity(model, data, q).map(|g| g[0]),
             "crba" => crba(model, data, q).map(|m| m[0]),
             "coriolis_matrix" => coriolis_matrix(model, data, q, v).map(|m| m[0]),
             "centroidal_momentum_matrix" => {

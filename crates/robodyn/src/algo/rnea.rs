@@ -166,7 +166,14 @@ fn outward_body<R: Rotation, S: Real>(
     // I_i read into each product where it is used (kept whole, it would be copied)
     let inertia = &model.inertias[i];
     // a_i = X_i a_λ(i) + S q̈_i + v_i × v_J   (c_J = 0)
-    let mut a_i = out.x_up[i].apply_motion_by::<R>(&out.a[parent]);
+    let mut a_i = match (v, a) {
+        // at rest every a_i is gravity's, a linear motion [0; g_i]: g_i = E_i g_λ(i)
+        (None, None) => Motion::new(
+            zero_vector(),
+            R::rotate(&out.x_up[i].rotation, &out.a[parent].linear),
+        ),
+        _ => out.x_up[i].apply_motion_by::<R>(&out.a[parent]),
+    };
     if let Some(a) = a {
         match unit_axis {
             Some((c, negative)) => a_i.add_to_component(c, along_axis(a, negative)),
@@ -197,7 +204,10 @@ fn outward_body<R: Rotation, S: Real>(
         None => {
             // at rest every velocity product vanishes
             out.v[i] = Motion::zeros();
-            Inertia::<S>::splat(inertia).mul_motion(&a_i)
+            match a {
+                Some(_) => Inertia::<S>::splat(inertia).mul_motion(&a_i),
+                None => Inertia::<S>::splat(inertia).mul_linear_motion(&a_i.linear),
+            }
         }
     };
     if let Some(forces) = f_ext {

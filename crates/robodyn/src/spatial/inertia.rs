@@ -43,6 +43,16 @@ impl<S: Real> Inertia<S> {
         }
     }
 
+    /// `f = I [0; v]`, a motion with no angular part: `n = h × v`, `f = m v` (the value of
+    /// [`Inertia::mul_motion`] without the products with the zeros).
+    #[inline(always)]
+    pub fn mul_linear_motion(&self, v: &Vector3<S>) -> Force<S> {
+        Force {
+            angular: cross(&self.first_moment, v),
+            linear: v * self.mass,
+        }
+    }
+
     /// `f = I u` for `u` the unit motion ±e_c (c in [`Force::plucker`]'s order; `negative`: −):
     /// column c of the 6x6 matrix, read off without products. About axis c < 3:
     /// `n = Ī_O e_c`, `f = e_c × h`; along axis j = c − 3: `n = h × e_j`, `f = m e_j`.
