@@ -9,7 +9,7 @@
 use crate::algo::kinematics::joint_transforms;
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::model::Model;
-use crate::spatial::turn::{with_rotation_fn, Rotation};
+use crate::spatial::turn::{for_rotation_of, Rotation};
 use crate::spatial::{splat_vector, zero_vector, Force, Inertia, Motion, Real, Transform};
 use crate::Data;
 use nalgebra::DVector;
@@ -102,7 +102,7 @@ pub(crate) fn newton_euler_passes<S: Real>(
     out.v[0] = Motion::zeros();
     out.a[0] = Motion::new(zero_vector(), -splat_vector::<S>(&model.gravity));
     for i in 1..model.nbodies() {
-        with_rotation_fn!(model.turn(i), outward_body(model, i, v, a, f_ext, &mut out));
+        for_rotation_of!(model.turn(i), R => outward_body::<R, S>(model, i, v, a, f_ext, &mut out));
     }
 
     // inward pass: project onto the joint axes, pass the rest to the parent

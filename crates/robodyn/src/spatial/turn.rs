@@ -194,48 +194,65 @@ pub(crate) fn snapped_signed_permutation(rotation: &Matrix3<f64>) -> Option<Matr
 /// roundings of a product of quarter turns (cos(π/2) in `f64` is 6.1e-17).
 pub const SIGNED_PERMUTATION_TOLERANCE: f64 = 1e-14;
 
-/// `$receiver.$method::<R>(arguments)` with `R` the [`Rotation`] of `turn` (`Some`: a
-/// [`Turn`]; `None`: any).
-macro_rules! with_rotation {
-    ($turn:expr, $receiver:ident . $method:ident ($($argument:expr),*)) => {{
+/// `$body` with the type `$rotation` the [`Rotation`] of `turn` (`Some`: a [`Turn`]; `None`:
+/// any): one choice, then the body compiled for each of the ten.
+macro_rules! for_rotation_of {
+    ($turn:expr, $rotation:ident => $body:expr) => {{
         use $crate::spatial::turn::{AnyRotation, TurnAbout};
         // one number for the pair, so that the choice is one jump, not a pair compared in turn
         match $turn.map_or(9, |turn| 3 * turn.axis + turn.column) {
-            0 => $receiver.$method::<TurnAbout<0, 0>>($($argument),*),
-            1 => $receiver.$method::<TurnAbout<0, 1>>($($argument),*),
-            2 => $receiver.$method::<TurnAbout<0, 2>>($($argument),*),
-            3 => $receiver.$method::<TurnAbout<1, 0>>($($argument),*),
-            4 => $receiver.$method::<TurnAbout<1, 1>>($($argument),*),
-            5 => $receiver.$method::<TurnAbout<1, 2>>($($argument),*),
-            6 => $receiver.$method::<TurnAbout<2, 0>>($($argument),*),
-            7 => $receiver.$method::<TurnAbout<2, 1>>($($argument),*),
-            8 => $receiver.$method::<TurnAbout<2, 2>>($($argument),*),
-            _ => $receiver.$method::<AnyRotation>($($argument),*),
+            0 => {
+                type $rotation = TurnAbout<0, 0>;
+                $body
+            }
+            1 => {
+                type $rotation = TurnAbout<0, 1>;
+                $body
+            }
+            2 => {
+                type $rotation = TurnAbout<0, 2>;
+                $body
+            }
+            3 => {
+                type $rotation = TurnAbout<1, 0>;
+                $body
+            }
+            4 => {
+                type $rotation = TurnAbout<1, 1>;
+                $body
+            }
+            5 => {
+                type $rotation = TurnAbout<1, 2>;
+                $body
+            }
+            6 => {
+                type $rotation = TurnAbout<2, 0>;
+                $body
+            }
+            7 => {
+                type $rotation = TurnAbout<2, 1>;
+                $body
+            }
+            8 => {
+                type $rotation = TurnAbout<2, 2>;
+                $body
+            }
+            _ => {
+                type $rotation = AnyRotation;
+                $body
+            }
         }
     }};
+}
+pub(crate) use for_rotation_of;
+
+/// `$receiver.$method::<R>(arguments)` with `R` the [`Rotation`] of `turn` ([`for_rotation_of!`]).
+macro_rules! with_rotation {
+    ($turn:expr, $receiver:ident . $method:ident ($($argument:expr),*)) => {
+        $crate::spatial::turn::for_rotation_of!($turn, R => $receiver.$method::<R>($($argument),*))
+    };
 }
 pub(crate) use with_rotation;
-
-/// `$function::<R, _>(arguments)` with `R` the [`Rotation`] of `turn`, as [`with_rotation!`]:
-/// one choice for a function that applies the same rotation several times.
-macro_rules! with_rotation_fn {
-    ($turn:expr, $function:ident ($($argument:expr),*)) => {{
-        use $crate::spatial::turn::{AnyRotation, TurnAbout};
-        match $turn.map_or(9, |turn| 3 * turn.axis + turn.column) {
-            0 => $function::<TurnAbout<0, 0>, _>($($argument),*),
-            1 => $function::<TurnAbout<0, 1>, _>($($argument),*),
-            2 => $function::<TurnAbout<0, 2>, _>($($argument),*),
-            3 => $function::<TurnAbout<1, 0>, _>($($argument),*),
-            4 => $function::<TurnAbout<1, 1>, _>($($argument),*),
-            5 => $function::<TurnAbout<1, 2>, _>($($argument),*),
-            6 => $function::<TurnAbout<2, 0>, _>($($argument),*),
-            7 => $function::<TurnAbout<2, 1>, _>($($argument),*),
-            8 => $function::<TurnAbout<2, 2>, _>($($argument),*),
-            _ => $function::<AnyRotation, _>($($argument),*),
-        }
-    }};
-}
-pub(crate) use with_rotation_fn;
 
 /// [`with_rotation!`] for the turns that keep their axis (`column == axis`) only, the others by
 /// the general products: for a short product in a chain (the placements'), where ten variants
