@@ -127,9 +127,12 @@ pub(crate) fn support_placements<S: Real>(
             x_up,
         );
     }
+    // X_{i←0} = X_{i←λ(i)} X_{λ(i)←0} down the chain from the world, whose every body's parent
+    // is the one before it: that one's placement is carried on, not read back from memory
+    let mut placement = x_world[0];
     for &i in support.iter().rev() {
-        // X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}
-        x_world[i] = x_up[i].compose_turned(model.turn(i), &x_world[model.parent[i]]);
+        placement = x_up[i].compose_turned(model.turn(i), &placement);
+        x_world[i] = placement;
     }
 }
 
