@@ -138,12 +138,9 @@ def test_batches_equal_the_loop_bit_for_bit(floating):
     np.testing.assert_array_equal(batch, np.stack([m.inverse_dynamics(q[k], v[k], a[k], f_ext=f_ext[k]) for k in range(n)]))
 
 
-def test_results_can_be_written_into_a_given_array(floating):
-    """`out=`: the result written into the caller's array, which is returned; single and batch,
-    equal to the plain call bit for bit; a wrong array is refused, naming `out`."""
-    m, n = floating, 8
-    q, v, a, f_ext, frame = batch_of_states(m, n, seed=4)
-    calls = {
+def calls_taking_out(q, v, a, f_ext, frame):
+    """The methods that take `out=`, each with its arguments and options."""
+    return {
         "inverse_dynamics": ((q, v, a), {}),
         "forward_dynamics": ((q, v, a), {"f_ext": f_ext}),
         "bias_forces": ((q, v), {}),
@@ -152,7 +149,14 @@ def test_results_can_be_written_into_a_given_array(floating):
         "frame_pose": ((q, frame), {}),
         "jacobian": ((q, frame), {"reference": "local"}),
     }
-    for name, (args, options) in calls.items():
+
+
+def test_results_can_be_written_into_a_given_array(floating):
+    """`out=`: the result written into the caller's array, which is returned; single and batch,
+    equal to the plain call bit for bit; a wrong array is refused, naming `out`."""
+    m, n = floating, 8
+    q, v, a, f_ext, frame = batch_of_states(m, n, seed=4)
+    for name, (args, options) in calls_taking_out(q, v, a, f_ext, frame).items():
         method = getattr(m, name)
         for batch in (True, False):
             call_args = args if batch else tuple(x[0] if isinstance(x, np.ndarray) else x for x in args)
@@ -179,6 +183,34 @@ def test_results_can_be_written_into_a_given_array(floating):
     with pytest.raises(ValueError, match=r"argument 'out': expected shape \(8, %d\)" % m.nv):
         m.inverse_dynamics(q, v, a, out=np.zeros(m.nv))
     np.testing.assert_array_equal(m.inverse_dynamics(q[0], v[0], a[0]), tau)
+
+
+def test_new_results_hold_no_stale_memory(floating):
+    """A method that can write into a caller's `out` gets a new result array that is not zeroed
+    first (NumPy's `PyArray_Empty`): its kernel writes every value. NumPy makes a new array of
+    the memory of one just freed of the same size, so arrays of NaN are freed before each call:
+    a value the kernel left alone would come through as NaN (the Jacobian's columns of the other
+    legs are zeros, as are M's entries between legs)."""
+    m = floating
+    q, v, a, f_ext, frame = batch_of_states(m, 1, seed=5)
+    q, v, a, f_ext = q[0], v[0], a[0], f_ext[0]
+    calls = calls_taking_out(q, v, a, f_ext, frame) | {
+        "center_of_mass_jacobian": ((q,), {}),
+        "centroidal_momentum_matrix": ((q,), {}),
+        "inverse_mass_matrix": ((q,), {}),
+    }
+    options = [{}, {"method": "rnea"}, {"method": "jacobians"}]
+    for name, (args, keywords) in calls.items():
+        method = getattr(m, name)
+        for extra in options if name in ("mass_matrix", "generalized_gravity") else [{}]:
+            if extra.get("method") == "rnea" and name == "generalized_gravity":
+                continue
+            expected = method(*args, **keywords, **extra)
+            assert np.isfinite(expected).all(), name
+            for _ in range(8):
+                stale = [np.full(expected.shape, np.nan) for _ in range(4)]
+                del stale
+                np.testing.assert_array_equal(method(*args, **keywords, **extra), expected, err_msg=f"{name} {extra}")
 
 
 def test_crba_mass_matrix_is_exactly_symmetric(floating):

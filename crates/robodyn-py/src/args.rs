@@ -195,12 +195,16 @@ impl<'py> Argument<'py> {
     }
 }
 
-/// A new C-ordered float64 array of zeros of `shape`, by NumPy's `PyArray_Zeros` with the
-/// descriptor found once ([`PLAIN_FLOAT64`]): rust-numpy's `zeros` looks the descriptor up and
-/// copies the shape on every call, a tenth of a small call's fixed cost.
-pub(crate) fn zeros<'py>(
+/// A new C-ordered float64 array of `shape`, of zeros where `zeroed` (else its values are
+/// whatever its memory held: for a caller that writes every one), by NumPy's `PyArray_Zeros` or
+/// `PyArray_Empty` with the descriptor found once ([`PLAIN_FLOAT64`]): rust-numpy's `zeros` looks
+/// the descriptor up and copies the shape on every call, a tenth of a small call's fixed cost;
+/// and a zeroed array past NumPy's cache of small blocks (1 KiB) is a `calloc`, dearer than the
+/// `malloc` of an empty one (40 ns of a Talos Jacobian's 6 × 39).
+pub(crate) fn new_array<'py>(
     py: Python<'py>,
     shape: &[usize],
+    zeroed: bool,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     const MOST_DIMENSIONS: usize = 4;
     if shape.len() > MOST_DIMENSIONS {
@@ -211,17 +215,17 @@ pub(crate) fn zeros<'py>(
         *dim = n as npy_intp;
     }
     let (_, float64) = plain_float64(py);
-    // SAFETY: NumPy's API with the GIL held; PyArray_Zeros takes the reference to the descriptor
-    // given it, and returns a new array or null with the error set.
+    let rank = shape.len() as c_int;
+    // SAFETY: NumPy's API with the GIL held; PyArray_Zeros and PyArray_Empty take the reference
+    // to the descriptor given them, and return a new array or null with the error set.
     unsafe {
         ffi::Py_IncRef(float64 as *mut ffi::PyObject);
-        let array = PY_ARRAY_API.PyArray_Zeros(
-            py,
-            shape.len() as c_int,
-            dims.as_mut_ptr(),
-            float64 as *mut PyArray_Descr,
-            0,
-        );
+        let descriptor = float64 as *mut PyArray_Descr;
+        let array = if zeroed {
+            PY_ARRAY_API.PyArray_Zeros(py, rank, dims.as_mut_ptr(), descriptor, 0)
+        } else {
+            PY_ARRAY_API.PyArray_Empty(py, rank, dims.as_mut_ptr(), descriptor, 0)
+        };
         Bound::from_owned_ptr_or_err(py, array).map(|array| array.cast_into_unchecked())
     }
 }

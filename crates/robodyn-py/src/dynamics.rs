@@ -79,7 +79,7 @@ impl PyModel {
             derivatives(m, data, (i[0], i[1], i[2], forces), out)
         };
         let lanes = lanes.filter(|_| arguments.len() < 4);
-        let stack = self.evaluate_into(py, arguments, &[3, nv, nv], None, kernel, lanes)?;
+        let stack = self.evaluate_to(py, arguments, &[3, nv, nv], Target::Zeros, kernel, lanes)?;
         split_stack(py, &stack, &names)
     }
 }

@@ -243,13 +243,14 @@ impl PyModel {
         output_shape: &[usize],
         kernel: &Kernel,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.evaluate_into(py, arguments, output_shape, None, kernel, None)
+        self.evaluate_to(py, arguments, output_shape, Target::Zeros, kernel, None)
     }
 
-    /// [`Self::evaluate`], writing into the caller's array `out` when one is given (checked by
-    /// [`output_array`]) and returning it, so that a loop can reuse its result array; a batch runs
-    /// the kernel in `lanes` (when given) on each thread's run of samples instead of `kernel` on
-    /// one sample at a time.
+    /// [`Self::evaluate`] for a kernel that writes every value of its result: into the caller's
+    /// array `out` when one is given (checked by [`output_array`]), returned, so that a loop can
+    /// reuse its result array; else into a new array not zeroed first. A batch runs the kernel in
+    /// `lanes` (when given) on each thread's run of samples instead of `kernel` on one sample at
+    /// a time.
     pub(crate) fn evaluate_into<'py>(
         &self,
         py: Python<'py>,
@@ -259,6 +260,23 @@ impl PyModel {
         kernel: &Kernel,
         lanes: Option<LaneKernel>,
     ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate_to(py, arguments, output_shape, Target::Out(out), kernel, lanes)
+    }
+
+    /// [`Self::evaluate_into`] with the result's array chosen by `target`.
+    pub(crate) fn evaluate_to<'py>(
+        &self,
+        py: Python<'py>,
+        arguments: &[Argument<'py>],
+        output_shape: &[usize],
+        target: Target<'_, 'py>,
+        kernel: &Kernel,
+        lanes: Option<LaneKernel>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (out, zeroed) = match target {
+            Target::Zeros => (None, true),
+            Target::Out(out) => (out, false),
+        };
         let batch = common_batch(arguments)?;
         // the inputs in place, or copies of the strided ones (plain loops: through an array of
         // `Cow`s made by `array::from_fn`, each came back through memory and was copied again)
@@ -284,7 +302,7 @@ impl PyModel {
                 let given = target.is_some();
                 let output = match target {
                     Some(target) => target,
-                    None => zeros(py, output_shape)?,
+                    None => new_array(py, output_shape, zeroed)?,
                 };
                 // SAFETY: a new array nothing else refers to yet, or the caller's, checked to
                 // share no memory with an input
@@ -445,6 +463,15 @@ impl PyModel {
             ))),
         }
     }
+}
+
+/// Where a kernel's result goes.
+pub(crate) enum Target<'a, 'py> {
+    /// A new array of zeros: for a kernel that may leave values as they are.
+    Zeros,
+    /// The caller's `out` when given, else a new array not zeroed: for a kernel that writes
+    /// every value (as it must for a caller's array).
+    Out(Option<&'a Bound<'py, PyAny>>),
 }
 
 /// The inputs of a batch: each argument's values, flattened, and its size per sample.
