@@ -114,8 +114,7 @@ pub(crate) fn newton_euler_passes<S: Real>(
                 // S = ±e_c: τ_i = ±f_i,c + armature q̈_i (no rotor term: only a free joint has one)
                 let (dof, f_c) = (dofs.start, out.f[i].component(c));
                 let rate = a.map_or(S::zero(), |a| a[dof]);
-                let projected = if negative { -f_c } else { f_c };
-                out.tau[dof] = projected + S::splat(model.armature[dof]) * rate;
+                out.tau[dof] = signed(f_c, negative) + S::splat(model.armature[dof]) * rate;
             }
             None => {
                 for (k, dof) in dofs.clone().enumerate() {
@@ -155,14 +154,7 @@ fn outward_body<R: Rotation, S: Real>(
     let parent = model.parent[i];
     // S = ±e_c for most joints: S x is then one component, ±x
     let unit_axis = model.unit_axis(i);
-    let along_axis = |x: &[S], negative: bool| {
-        let x = x[model.idx_v[i]];
-        if negative {
-            -x
-        } else {
-            x
-        }
-    };
+    let along_axis = |x: &[S], negative: bool| signed(x[model.idx_v[i]], negative);
     // I_i read into each product where it is used (kept whole, it would be copied)
     let inertia = &model.inertias[i];
     // a_i = X_i a_λ(i) + S q̈_i + v_i × v_J   (c_J = 0)
@@ -215,6 +207,16 @@ fn outward_body<R: Rotation, S: Real>(
     }
     out.a[i] = a_i;
     out.f[i] = f_i;
+}
+
+/// `−x` where `negative`, else `x`: a component along the unit motion ±e_c.
+#[inline(always)]
+fn signed<S: Real>(x: S, negative: bool) -> S {
+    if negative {
+        -x
+    } else {
+        x
+    }
 }
 
 /// Checks one finite force per moving body.

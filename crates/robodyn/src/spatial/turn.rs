@@ -194,54 +194,38 @@ pub(crate) fn snapped_signed_permutation(rotation: &Matrix3<f64>) -> Option<Matr
 /// roundings of a product of quarter turns (cos(π/2) in `f64` is 6.1e-17).
 pub const SIGNED_PERMUTATION_TOLERANCE: f64 = 1e-14;
 
+/// `match $key` whose arm `$value` runs `$body` with the type `$rotation` the [`Rotation`]
+/// `$chosen`: the body compiled once per arm.
+macro_rules! match_rotation {
+    ($key:expr, $rotation:ident => $body:expr; $($value:pat => $chosen:ty),+ $(,)?) => {
+        match $key {
+            $($value => {
+                type $rotation = $chosen;
+                $body
+            })+
+        }
+    };
+}
+pub(crate) use match_rotation;
+
 /// `$body` with the type `$rotation` the [`Rotation`] of `turn` (`Some`: a [`Turn`]; `None`:
 /// any): one choice, then the body compiled for each of the ten.
 macro_rules! for_rotation_of {
     ($turn:expr, $rotation:ident => $body:expr) => {{
-        use $crate::spatial::turn::{AnyRotation, TurnAbout};
+        use $crate::spatial::turn::{match_rotation, AnyRotation, TurnAbout};
         // one number for the pair, so that the choice is one jump, not a pair compared in turn
-        match $turn.map_or(9, |turn| 3 * turn.axis + turn.column) {
-            0 => {
-                type $rotation = TurnAbout<0, 0>;
-                $body
-            }
-            1 => {
-                type $rotation = TurnAbout<0, 1>;
-                $body
-            }
-            2 => {
-                type $rotation = TurnAbout<0, 2>;
-                $body
-            }
-            3 => {
-                type $rotation = TurnAbout<1, 0>;
-                $body
-            }
-            4 => {
-                type $rotation = TurnAbout<1, 1>;
-                $body
-            }
-            5 => {
-                type $rotation = TurnAbout<1, 2>;
-                $body
-            }
-            6 => {
-                type $rotation = TurnAbout<2, 0>;
-                $body
-            }
-            7 => {
-                type $rotation = TurnAbout<2, 1>;
-                $body
-            }
-            8 => {
-                type $rotation = TurnAbout<2, 2>;
-                $body
-            }
-            _ => {
-                type $rotation = AnyRotation;
-                $body
-            }
-        }
+        match_rotation!($turn.map_or(9, |turn| 3 * turn.axis + turn.column), $rotation => $body;
+            0 => TurnAbout<0, 0>,
+            1 => TurnAbout<0, 1>,
+            2 => TurnAbout<0, 2>,
+            3 => TurnAbout<1, 0>,
+            4 => TurnAbout<1, 1>,
+            5 => TurnAbout<1, 2>,
+            6 => TurnAbout<2, 0>,
+            7 => TurnAbout<2, 1>,
+            8 => TurnAbout<2, 2>,
+            _ => AnyRotation,
+        )
     }};
 }
 pub(crate) use for_rotation_of;
@@ -259,13 +243,14 @@ pub(crate) use with_rotation;
 /// cost more in code than their products save.
 macro_rules! with_axis_rotation {
     ($turn:expr, $receiver:ident . $method:ident ($($argument:expr),*)) => {{
-        use $crate::spatial::turn::{AnyRotation, TurnAbout};
-        match $turn.filter(|turn| turn.column == turn.axis).map(|turn| turn.axis) {
-            Some(0) => $receiver.$method::<TurnAbout<0, 0>>($($argument),*),
-            Some(1) => $receiver.$method::<TurnAbout<1, 1>>($($argument),*),
-            Some(2) => $receiver.$method::<TurnAbout<2, 2>>($($argument),*),
-            _ => $receiver.$method::<AnyRotation>($($argument),*),
-        }
+        use $crate::spatial::turn::{match_rotation, AnyRotation, TurnAbout};
+        let axis = $turn.filter(|turn| turn.column == turn.axis).map(|turn| turn.axis);
+        match_rotation!(axis, R => $receiver.$method::<R>($($argument),*);
+            Some(0) => TurnAbout<0, 0>,
+            Some(1) => TurnAbout<1, 1>,
+            Some(2) => TurnAbout<2, 2>,
+            _ => AnyRotation,
+        )
     }};
 }
 pub(crate) use with_axis_rotation;
