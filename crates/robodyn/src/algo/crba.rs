@@ -260,25 +260,19 @@ pub(crate) fn body_frame_mass_matrix<S: Real, F: SubtreeForces<S>>(
             };
             forces.set(dof, &force);
         }
-        // H_dk = H_kd = S_kᵀ F_d for the subtree's coordinates d (a component of F_d where S_k
-        // is a coordinate axis)
+        // H_dk = H_kd = S_kᵀ F_d for the subtree's coordinates d ≥ k (a component of F_d where
+        // S_k is a coordinate axis), armature on the diagonal
         for (k, col) in model.v_range(i).enumerate() {
-            let mut store = |d: usize, h: S| {
-                out.mass_matrix[d + col * nv] = h;
-                out.mass_matrix[col + d * nv] = h;
-            };
+            let rows = col..subtree.end;
+            let armature = S::splat(model.armature[col]);
             match model.subspace_component(i, k) {
                 Some((c, negative)) => {
-                    // ±1 times the component (exact)
-                    let sign = S::splat(if negative { -1.0 } else { 1.0 });
-                    for d in subtree.clone() {
-                        store(d, forces.component(c, d) * sign);
-                    }
+                    let values = forces.unit_projections(c, negative, rows);
+                    store_column(out.mass_matrix, nv, col, armature, values);
                 }
                 None => {
-                    for d in subtree.clone() {
-                        store(d, joint.project_force(k, &forces.force(d)));
-                    }
+                    let values = rows.map(|d| joint.project_force(k, &forces.force(d)));
+                    store_column(out.mass_matrix, nv, col, armature, values);
                 }
             }
         }
@@ -291,9 +285,26 @@ pub(crate) fn body_frame_mass_matrix<S: Real, F: SubtreeForces<S>>(
             forces.carry(x_up, turn, subtree);
         }
     }
-    for (dof, armature) in model.armature.iter().enumerate() {
-        out.mass_matrix[dof + dof * nv] += S::splat(*armature);
+}
+
+/// `H[d, col] = H[col, d] = h_d` for the values `h_col, h_col+1, …` (column col of the
+/// column-major nv × nv `mass_matrix` from its diagonal down, and row col from its diagonal
+/// right), `armature` added to the diagonal.
+#[inline(always)]
+fn store_column<S: Real>(
+    mass_matrix: &mut [S],
+    nv: usize,
+    col: usize,
+    armature: S,
+    values: impl Iterator<Item = S>,
+) {
+    // H[col + j, col] down the column, H[col, col + j] a column apart along the row
+    let diagonal = col * nv + col;
+    for (j, h) in values.enumerate() {
+        mass_matrix[diagonal + j] = h;
+        mass_matrix[diagonal + j * nv] = h;
     }
+    mass_matrix[diagonal] += armature;
 }
 
 /// Where the body-coordinate CRBA keeps the forces `F_d = I^c S_d` of the coordinates d: one
@@ -303,8 +314,14 @@ pub(crate) trait SubtreeForces<S: Real> {
     /// `F_d = force`.
     fn set(&mut self, d: usize, force: &Force<S>);
 
-    /// Component c of `F_d` (in [`Force::plucker`]'s order).
-    fn component(&self, c: usize, d: usize) -> S;
+    /// `S_kᵀ F_d` for `S_k = ±e_c` (c in [`Force::plucker`]'s order; `negative`: −): ±
+    /// component c of `F_d`, for the coordinates d of `rows` in turn.
+    fn unit_projections(
+        &self,
+        c: usize,
+        negative: bool,
+        rows: Range<usize>,
+    ) -> impl Iterator<Item = S>;
 
     /// `F_d`.
     fn force(&self, d: usize) -> Force<S>;
@@ -321,8 +338,17 @@ impl<S: Real> SubtreeForces<S> for &mut [Force<S>] {
     }
 
     #[inline(always)]
-    fn component(&self, c: usize, d: usize) -> S {
-        self[d].component(c)
+    fn unit_projections(
+        &self,
+        c: usize,
+        negative: bool,
+        rows: Range<usize>,
+    ) -> impl Iterator<Item = S> {
+        // ±1 times the component (exact)
+        let sign = S::splat(if negative { -1.0 } else { 1.0 });
+        self[rows]
+            .iter()
+            .map(move |force| force.component(c) * sign)
     }
 
     #[inline(always)]
@@ -382,13 +408,21 @@ impl SubtreeForces<f64> for ForceRows<'_> {
     }
 
     #[inline(always)]
-    fn component(&self, c: usize, d: usize) -> f64 {
-        self.rows[self.at(c, d)]
+    fn unit_projections(
+        &self,
+        c: usize,
+        negative: bool,
+        rows: Range<usize>,
+    ) -> impl Iterator<Item = f64> {
+        // ±1 times the component (exact): component c of consecutive forces is consecutive
+        let sign = if negative { -1.0 } else { 1.0 };
+        let components = &self.rows[self.at(c, rows.start)..self.at(c, rows.end)];
+        components.iter().map(move |component| component * sign)
     }
 
     #[inline(always)]
     fn force(&self, d: usize) -> Force {
-        let c = |c: usize| self.component(c, d);
+        let c = |c: usize| self.rows[self.at(c, d)];
         Force::from_plucker([c(0), c(1), c(2), c(3), c(4), c(5)])
     }
 

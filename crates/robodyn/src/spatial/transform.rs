@@ -396,19 +396,30 @@ impl Transform {
             rotation: self.rotation.map(splat),
             translation: self.translation.map(splat),
         };
-        for group in 1..=groups {
-            let d = end - 4 * group;
-            // four values at once (an array taken whole is one load; built value by value, it
-            // was four)
-            let four = |c: usize| {
-                let values: [f64; 4] = rows[c * stride + d..][..4].try_into().expect("four");
-                AutoF64x4::from(values)
-            };
-            let f = Force::from_plucker([four(0), four(1), four(2), four(3), four(4), four(5)]);
-            let carried = fours.transpose_apply_force_by::<R>(&f).plucker();
-            for (c, value) in carried.into_iter().enumerate() {
-                rows[c * stride + d..][..4].copy_from_slice(&<[f64; 4]>::from(value));
-            }
+        // each component's row from the first group on, in groups of four: the groups' reads
+        // and writes then need no bounds checks
+        let start = end - 4 * groups;
+        let mut component_rows = rows.chunks_exact_mut(stride);
+        let mut next_row = || {
+            let row = component_rows.next().expect("six component rows");
+            &mut row[start..end].as_chunks_mut::<4>().0[..groups]
+        };
+        let (n0, n1, n2) = (next_row(), next_row(), next_row());
+        let (f0, f1, f2) = (next_row(), next_row(), next_row());
+        for g in 0..groups {
+            // four values at once (an array taken whole is one load)
+            let four = AutoF64x4::from;
+            let f = Force::from_plucker([
+                four(n0[g]),
+                four(n1[g]),
+                four(n2[g]),
+                four(f0[g]),
+                four(f1[g]),
+                four(f2[g]),
+            ]);
+            let [a0, a1, a2, l0, l1, l2] = fours.transpose_apply_force_by::<R>(&f).plucker();
+            (n0[g], n1[g], n2[g]) = (a0.into(), a1.into(), a2.into());
+            (f0[g], f1[g], f2[g]) = (l0.into(), l1.into(), l2.into());
         }
     }
 }
