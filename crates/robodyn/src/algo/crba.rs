@@ -248,32 +248,20 @@ pub(crate) fn body_frame_mass_matrix<S: Real, F: SubtreeForces<S>>(
     out.mass_matrix.fill(S::splat(0.0));
     let mut forces = out.forces;
     for i in (1..model.nbodies()).rev() {
-        let joint = &model.joints[i];
         let subtree = model.idx_v[i]..subtree_dof_end[i];
-        // F_k = I^c_i S_k for the joint's own coordinates (a column of I^c_i where S_k is a
-        // coordinate axis)
         let composite = &out.composites[i];
-        for (k, dof) in model.v_range(i).enumerate() {
-            let force = match model.subspace_component(i, k) {
-                Some((c, negative)) => composite.mul_unit_motion(c, negative),
-                None => composite.mul_motion(&Motion::splat(&joint.subspace_column(k))),
-            };
-            forces.set(dof, &force);
-        }
-        // H_dk = H_kd = S_kᵀ F_d for the subtree's coordinates d ≥ k (a component of F_d where
-        // S_k is a coordinate axis), armature on the diagonal
-        for (k, col) in model.v_range(i).enumerate() {
-            let rows = col..subtree.end;
-            let armature = S::splat(model.armature[col]);
-            match model.subspace_component(i, k) {
-                Some((c, negative)) => {
-                    let values = forces.unit_projections(c, negative, rows);
-                    store_column(out.mass_matrix, nv, col, armature, values);
-                }
-                None => {
-                    let values = rows.map(|d| joint.project_force(k, &forces.force(d)));
-                    store_column(out.mass_matrix, nv, col, armature, values);
-                }
+        match model.unit_axis(i) {
+            // one coordinate, S = ±e_c: F = ±column c of I^c_i, and H_d = ±component c of F_d
+            Some((c, negative)) => {
+                let dof = subtree.start;
+                forces.set(dof, &composite.mul_unit_motion(c, negative));
+                let armature = S::splat(model.armature[dof]);
+                let values = forces.unit_projections(c, negative, subtree.clone());
+                store_column(out.mass_matrix, nv, dof, armature, values);
+            }
+            None => {
+                let columns = (&mut forces, &mut *out.mass_matrix);
+                joint_columns(model, i, composite, subtree.clone(), columns);
             }
         }
         // the subtree's inertia and forces into the parent's coordinates
@@ -283,6 +271,42 @@ pub(crate) fn body_frame_mass_matrix<S: Real, F: SubtreeForces<S>>(
             let carried = x_up.transpose_apply_inertia_turned(turn, &out.composites[i]);
             out.composites[parent] += carried;
             forces.carry(x_up, turn, subtree);
+        }
+    }
+}
+
+/// The forces `F_k = I^c_i S_k` of body i's joint's coordinates k and the columns
+/// `H_dk = S_kᵀ F_d` of M for the coordinates d ≥ k of its `subtree`, for any joint (a column
+/// of I^c_i and a component of F_d where S_k is a coordinate axis).
+#[inline(always)]
+fn joint_columns<S: Real, F: SubtreeForces<S>>(
+    model: &Model,
+    i: usize,
+    composite: &Inertia<S>,
+    subtree: Range<usize>,
+    (forces, mass_matrix): (&mut F, &mut [S]),
+) {
+    let joint = &model.joints[i];
+    // all the joint's forces first: column k takes those of its later coordinates
+    for (k, dof) in model.v_range(i).enumerate() {
+        let force = match model.subspace_component(i, k) {
+            Some((c, negative)) => composite.mul_unit_motion(c, negative),
+            None => composite.mul_motion(&Motion::splat(&joint.subspace_column(k))),
+        };
+        forces.set(dof, &force);
+    }
+    for (k, col) in model.v_range(i).enumerate() {
+        let rows = col..subtree.end;
+        let armature = S::splat(model.armature[col]);
+        match model.subspace_component(i, k) {
+            Some((c, negative)) => {
+                let values = forces.unit_projections(c, negative, rows);
+                store_column(mass_matrix, model.nv, col, armature, values);
+            }
+            None => {
+                let values = rows.map(|d| joint.project_force(k, &forces.force(d)));
+                store_column(mass_matrix, model.nv, col, armature, values);
+            }
         }
     }
 }
