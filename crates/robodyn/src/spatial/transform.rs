@@ -399,7 +399,7 @@ impl Transform {
         // each component's row from the first group on, in groups of four: the groups' reads
         // and writes then need no bounds checks
         let start = end - 4 * groups;
-        let mut component_rows = rows.chunks_exact_mut(stride);
+        let mut component_rows = rows.chunks_mut(stride);
         let mut next_row = || {
             let row = component_rows.next().expect("six component rows");
             &mut row[start..end].as_chunks_mut::<4>().0[..groups]
