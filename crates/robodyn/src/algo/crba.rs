@@ -22,7 +22,7 @@
 use crate::algo::kinematics::{body_placements, joint_transforms};
 use crate::error::{check_length, Result};
 use crate::model::Model;
-use crate::spatial::{Force, Inertia, Motion, Real, Transform, Turn};
+use crate::spatial::{signed, Force, Inertia, Motion, Real, Transform, Turn};
 use crate::Data;
 use nalgebra::DMatrix;
 use std::ops::Range;
@@ -368,11 +368,9 @@ impl<S: Real> SubtreeForces<S> for &mut [Force<S>] {
         negative: bool,
         rows: Range<usize>,
     ) -> impl Iterator<Item = S> {
-        // ±1 times the component (exact)
-        let sign = S::splat(if negative { -1.0 } else { 1.0 });
         self[rows]
             .iter()
-            .map(move |force| force.component(c) * sign)
+            .map(move |force| signed(force.component(c), negative))
     }
 
     #[inline(always)]
@@ -438,10 +436,11 @@ impl SubtreeForces<f64> for ForceRows<'_> {
         negative: bool,
         rows: Range<usize>,
     ) -> impl Iterator<Item = f64> {
-        // ±1 times the component (exact): component c of consecutive forces is consecutive
-        let sign = if negative { -1.0 } else { 1.0 };
+        // component c of consecutive forces is consecutive
         let components = &self.rows[self.at(c, rows.start)..self.at(c, rows.end)];
-        components.iter().map(move |component| component * sign)
+        components
+            .iter()
+            .map(move |&component| signed(component, negative))
     }
 
     #[inline(always)]

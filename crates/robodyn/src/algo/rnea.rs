@@ -10,7 +10,7 @@ use crate::algo::kinematics::joint_transforms;
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::model::Model;
 use crate::spatial::turn::{for_rotation_of, Rotation};
-use crate::spatial::{splat_vector, zero_vector, Force, Inertia, Motion, Real, Transform};
+use crate::spatial::{signed, splat_vector, zero_vector, Force, Inertia, Motion, Real, Transform};
 use crate::Data;
 use nalgebra::DVector;
 
@@ -207,16 +207,6 @@ fn outward_body<R: Rotation, S: Real>(
     }
     out.a[i] = a_i;
     out.f[i] = f_i;
-}
-
-/// `−x` where `negative`, else `x`: a component along the unit motion ±e_c.
-#[inline(always)]
-fn signed<S: Real>(x: S, negative: bool) -> S {
-    if negative {
-        -x
-    } else {
-        x
-    }
 }
 
 /// Checks one finite force per moving body.

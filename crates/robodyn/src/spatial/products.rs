@@ -47,6 +47,16 @@ where
     }
 }
 
+/// `−x` where `negative`, else `x`: a component along the unit motion ±e_c (exact).
+#[inline(always)]
+pub(crate) fn signed<S: Real>(x: S, negative: bool) -> S {
+    if negative {
+        -x
+    } else {
+        x
+    }
+}
+
 /// The skew-symmetric matrix `v×` with `(v×) w = v × w`.
 #[inline(always)]
 pub fn skew<S: Real>(v: &Vector3<S>) -> Matrix3<S> {
