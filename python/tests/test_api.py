@@ -242,7 +242,8 @@ class _Subclass(np.ndarray):
 def test_every_kind_of_float64_array_reads_the_same(ur5):
     """A plain float64 ndarray is recognised by its type and NumPy's own descriptor; a subclass,
     the other byte order, a descriptor with metadata or a 0-stride array take the general path,
-    and a read-only array the plain one: all must give the same numbers bit for bit."""
+    a read-only array the plain one, an unaligned one a copy: all must give the same numbers bit
+    for bit."""
     q = ur5.random_configuration(seed=12)
     v = np.linspace(-1, 1, ur5.nv)
     expected = ur5.inverse_dynamics(q, v, v)
@@ -260,6 +261,12 @@ def test_every_kind_of_float64_array_reads_the_same(ur5):
         np.testing.assert_array_equal(ur5.generalized_gravity(variant), ur5.generalized_gravity(q), err_msg=name)
     constant = np.broadcast_to(np.float64(0.3), (ur5.nv,))  # stride 0: not contiguous, copied
     np.testing.assert_array_equal(ur5.generalized_gravity(constant), ur5.generalized_gravity(np.full(ur5.nv, 0.3)))
+    # contiguous but one byte off an 8-byte boundary: read through a copy, never in place
+    unaligned = np.zeros(8 * ur5.nq + 1, dtype=np.uint8)[1:].view(np.float64)
+    unaligned[:] = q
+    assert unaligned.flags.c_contiguous and not unaligned.flags.aligned
+    np.testing.assert_array_equal(ur5.inverse_dynamics(unaligned, v, v), expected)
+    np.testing.assert_array_equal(ur5.generalized_gravity(unaligned), ur5.generalized_gravity(q))
 
 
 def test_random_configuration_respects_limits_and_seed(ur5, floating):

@@ -5,7 +5,8 @@ use crate::to_py_err;
 use nalgebra::DVector;
 use numpy::ndarray::IxDyn;
 use numpy::npyffi::{
-    get_type_object, npy_intp, NpyTypes, PyArrayObject, PyArray_Descr, PY_ARRAY_API,
+    get_type_object, npy_intp, NpyTypes, PyArrayObject, PyArray_Descr, NPY_ARRAY_ALIGNED,
+    NPY_ARRAY_C_CONTIGUOUS, PY_ARRAY_API,
 };
 use numpy::{
     dtype, AllowTypeChange, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods,
@@ -19,30 +20,32 @@ use std::borrow::Cow;
 use std::ffi::c_int;
 use std::sync::OnceLock;
 
-/// The shape of one sample of an argument: one or two dimensions, stored without allocating.
+/// The shape of one sample of an argument: one or two dimensions, in two words (a vector's
+/// second is [`SampleShape::NONE`]), so that it travels in registers, not through memory.
 #[derive(Clone, Copy)]
 pub(crate) struct SampleShape {
-    pub(crate) dims: [usize; 2],
-    pub(crate) ndim: usize,
+    dims: [usize; 2],
 }
 
 impl SampleShape {
+    /// The second dimension of a vector's shape: none.
+    const NONE: usize = usize::MAX;
+
     pub(crate) fn vector(n: usize) -> Self {
         SampleShape {
-            dims: [n, 0],
-            ndim: 1,
+            dims: [n, Self::NONE],
         }
     }
 
     pub(crate) fn matrix(rows: usize, columns: usize) -> Self {
         SampleShape {
             dims: [rows, columns],
-            ndim: 2,
         }
     }
 
     pub(crate) fn as_slice(&self) -> &[usize] {
-        &self.dims[..self.ndim]
+        let ndim = if self.dims[1] == Self::NONE { 1 } else { 2 };
+        &self.dims[..ndim]
     }
 }
 
@@ -86,36 +89,33 @@ fn plain_float64_array<'a, 'py>(
 }
 
 impl<'py> Argument<'py> {
-    #[inline]
+    #[inline(always)]
     pub(crate) fn new(
         name: &'static str,
         value: &Bound<'py, PyAny>,
         sample_shape: SampleShape,
     ) -> PyResult<Self> {
         // a float64 ndarray is used as it is; anything else goes through numpy.asarray
-        match plain_float64_array(value) {
-            Some(array) => Ok(Argument {
-                name,
-                array: array.clone(),
-                sample_shape,
-            }),
-            None => Self::converted(name, value, sample_shape),
-        }
+        let array = match plain_float64_array(value) {
+            Some(array) => array.clone(),
+            None => Self::converted(name, value, sample_shape)?,
+        };
+        Ok(Argument {
+            name,
+            array,
+            sample_shape,
+        })
     }
 
-    /// [`Self::new`] for a value that is not a plain float64 array.
+    /// [`Self::new`]'s array for a value that is not a plain float64 array.
     #[inline(never)]
     fn converted(
         name: &'static str,
         value: &Bound<'py, PyAny>,
         sample_shape: SampleShape,
-    ) -> PyResult<Self> {
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         if let Ok(array) = value.cast::<PyArrayDyn<f64>>() {
-            return Ok(Argument {
-                name,
-                array: array.clone(),
-                sample_shape,
-            });
+            return Ok(array.clone());
         }
         let converted = value.extract::<PyArrayLikeDyn<'py, f64, AllowTypeChange>>().map_err(|_| {
             PyValueError::new_err(format!(
@@ -124,11 +124,7 @@ impl<'py> Argument<'py> {
                 value.repr().map(|r| r.to_string()).unwrap_or_else(|_| "an unreadable object".into())
             ))
         })?;
-        Ok(Argument {
-            name,
-            array: (**converted).clone(),
-            sample_shape,
-        })
+        Ok((**converted).clone())
     }
 
     /// The batch size, `None` for a single sample; errors if the shape fits neither.
@@ -176,15 +172,24 @@ impl<'py> Argument<'py> {
         }
     }
 
-    /// The values in place when the array is C-contiguous.
+    /// The values in place when the array is C-contiguous and aligned (read from the array's
+    /// flags: rust-numpy's `as_slice` tests contiguity and alignment again on its own).
     #[inline]
     pub(crate) fn contiguous_values(&self) -> Option<&[f64]> {
-        if !self.array.is_c_contiguous() {
+        const IN_PLACE: c_int = NPY_ARRAY_C_CONTIGUOUS | NPY_ARRAY_ALIGNED;
+        // SAFETY: the fields of a live ndarray, read with the GIL held
+        let fields = unsafe { &(*self.array.as_array_ptr()).fields };
+        if fields.flags & IN_PLACE != IN_PLACE {
             return None;
         }
-        // SAFETY: no Rust code holds a mutable view of an input: the only array robodyn writes is
-        // the output, which a call creates itself or checks to share no memory with an input.
-        unsafe { self.array.as_slice() }.ok()
+        let length: usize = self.array.shape().iter().product();
+        if length == 0 {
+            return Some(&[]);
+        }
+        // SAFETY: `length` float64 values, C-contiguous and aligned. No Rust code holds a mutable
+        // view of an input: the only array robodyn writes is the output, which a call creates
+        // itself or checks to share no memory with an input.
+        Some(unsafe { std::slice::from_raw_parts(fields.data.cast::<f64>(), length) })
     }
 
     /// A copy of the values in C order (of a strided array).

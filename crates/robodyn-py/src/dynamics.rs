@@ -3,7 +3,6 @@
 
 use crate::args::*;
 use crate::model::*;
-use arrayvec::ArrayVec;
 use nalgebra::DVector;
 use pyo3::prelude::*;
 use pyo3::types::PyString;
@@ -12,32 +11,38 @@ use robodyn::spatial::Force;
 use robodyn::{Data, Model};
 
 impl PyModel {
-    /// The arguments (q, v, x[, f_ext]) of a dynamics algorithm with optional external forces.
-    #[inline]
-    pub(crate) fn dynamics_arguments<'py>(
+    /// `then` on the arguments (q, v, x[, f_ext]) of a dynamics algorithm with optional external
+    /// forces. Each argument is made in its place in an array of three or four on this frame:
+    /// moved after it was made (into a vector returned to the caller), a freshly written
+    /// argument was read back in wider pieces than it was stored in, and each such read waited
+    /// for the stores (a tenth of a small call's fixed cost).
+    #[inline(always)]
+    pub(crate) fn with_dynamics_arguments<'py, R>(
         &self,
-        q: &Bound<'py, PyAny>,
-        v: &Bound<'py, PyAny>,
-        x: (&'static str, &Bound<'py, PyAny>),
+        (q, v, x): (
+            &Bound<'py, PyAny>,
+            &Bound<'py, PyAny>,
+            (&'static str, &Bound<'py, PyAny>),
+        ),
         f_ext: Option<&Bound<'py, PyAny>>,
-    ) -> PyResult<ArrayVec<Argument<'py>, MAX_ARGUMENTS>> {
-        // on the stack: a call's fixed cost counts against the algorithm's
-        let mut arguments = ArrayVec::new();
-        arguments.push(self.q_arg("q", q)?);
-        arguments.push(self.v_arg("v", v)?);
-        arguments.push(self.v_arg(x.0, x.1)?);
-        if let Some(f) = f_ext {
-            arguments.push(Argument::new(
-                "f_ext",
-                f,
-                SampleShape::matrix(self.model.nbodies() - 1, 6),
-            )?);
+        then: impl FnOnce(&[Argument<'py>]) -> PyResult<R>,
+    ) -> PyResult<R> {
+        let (q, v, x) = (
+            self.q_arg("q", q)?,
+            self.v_arg("v", v)?,
+            self.v_arg(x.0, x.1)?,
+        );
+        match f_ext {
+            None => then(&[q, v, x]),
+            Some(f) => {
+                let shape = SampleShape::matrix(self.model.nbodies() - 1, 6);
+                then(&[q, v, x, Argument::new("f_ext", f, shape)?])
+            }
         }
-        Ok(arguments)
     }
 
     /// Dynamics with optional external forces: `algorithm(q, v, x, f_ext)` on the arguments of
-    /// [`Self::dynamics_arguments`], into `out` when given; a batch without external forces runs
+    /// [`Self::with_dynamics_arguments`], into `out` when given; a batch without external forces runs
     /// `lanes` (the algorithm in lanes) when given.
     pub(crate) fn with_external_forces<'py>(
         &self,
@@ -122,14 +127,10 @@ impl PyModel {
         f_ext: Option<&Bound<'py, PyAny>>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let arguments = self.dynamics_arguments(q, v, ("a", a), f_ext)?;
-        self.with_external_forces(
-            py,
-            &arguments,
-            out,
-            algo::rnea,
-            Some(LaneKernel::NewtonEuler),
-        )
+        self.with_dynamics_arguments((q, v, ("a", a)), f_ext, |arguments| {
+            let lanes = Some(LaneKernel::NewtonEuler);
+            self.with_external_forces(py, arguments, out, algo::rnea, lanes)
+        })
     }
 
     /// The joint-torque regressor Y(q, v, a), shape (nv, 10 nbodies): τ = Y π with π =
@@ -143,17 +144,13 @@ impl PyModel {
         a: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let columns = 10 * (self.model.nbodies() - 1);
-        let arguments = self.dynamics_arguments(q, v, ("a", a), None)?;
-        self.evaluate(
-            py,
-            &arguments,
-            &[self.model.nv, columns],
-            &|m, w, i, out| {
+        self.with_dynamics_arguments((q, v, ("a", a)), None, |arguments| {
+            self.evaluate(py, arguments, &[self.model.nv, columns], &|m, w, i, out| {
                 let y = algo::torque_regressor(m, &mut w.data, i[0], i[1], i[2])?;
                 write_row_major(y, m.nv, out);
                 Ok(())
-            },
-        )
+            })
+        })
     }
 
     /// Forward dynamics by ABA: a = M(q)⁻¹ (τ - C(q, v) v - g(q) + Σ J_iᵀ f_ext_i).
@@ -168,14 +165,10 @@ impl PyModel {
         f_ext: Option<&Bound<'py, PyAny>>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let arguments = self.dynamics_arguments(q, v, ("tau", tau), f_ext)?;
-        self.with_external_forces(
-            py,
-            &arguments,
-            out,
-            algo::aba,
-            Some(LaneKernel::ArticulatedBody),
-        )
+        self.with_dynamics_arguments((q, v, ("tau", tau)), f_ext, |arguments| {
+            let lanes = Some(LaneKernel::ArticulatedBody);
+            self.with_external_forces(py, arguments, out, algo::aba, lanes)
+        })
     }
 
     /// Derivatives of inverse dynamics τ = ID(q, v, a, f_ext): dict of `dtau_dq`, `dtau_dv` and
@@ -192,15 +185,11 @@ impl PyModel {
         a: &Bound<'py, PyAny>,
         f_ext: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let arguments = self.dynamics_arguments(q, v, ("a", a), f_ext)?;
         let names = keys!(py, "dtau_dq", "dtau_dv", "dtau_da");
-        self.dynamics_derivatives(
-            py,
-            &arguments,
-            names,
-            algo::rnea_derivatives_stacked,
-            Some(LaneKernel::RneaDerivatives),
-        )
+        self.with_dynamics_arguments((q, v, ("a", a)), f_ext, |arguments| {
+            let lanes = Some(LaneKernel::RneaDerivatives);
+            self.dynamics_derivatives(py, arguments, names, algo::rnea_derivatives_stacked, lanes)
+        })
     }
 
     /// Derivatives of forward dynamics a = FD(q, v, tau, f_ext): dict of `dqdd_dq`, `dqdd_dv`
@@ -215,15 +204,11 @@ impl PyModel {
         tau: &Bound<'py, PyAny>,
         f_ext: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let arguments = self.dynamics_arguments(q, v, ("tau", tau), f_ext)?;
         let names = keys!(py, "dqdd_dq", "dqdd_dv", "dqdd_dtau");
-        self.dynamics_derivatives(
-            py,
-            &arguments,
-            names,
-            algo::aba_derivatives_stacked,
-            Some(LaneKernel::AbaDerivatives),
-        )
+        self.with_dynamics_arguments((q, v, ("tau", tau)), f_ext, |arguments| {
+            let lanes = Some(LaneKernel::AbaDerivatives);
+            self.dynamics_derivatives(py, arguments, names, algo::aba_derivatives_stacked, lanes)
+        })
     }
 
     /// Joint-space inertia matrix M(q), full and symmetric, armature included. (nv, nv).

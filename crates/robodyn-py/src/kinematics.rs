@@ -168,7 +168,11 @@ impl PyModel {
         #[pyo3(from_py_with = named::reference)] reference: algo::Reference,
     ) -> PyResult<Bound<'py, PyAny>> {
         let frame = self.frame_index(frame)?;
-        let arguments = self.dynamics_arguments(q, v, ("a", a), None)?;
+        let arguments = [
+            self.q_arg("q", q)?,
+            self.v_arg("v", v)?,
+            self.v_arg("a", a)?,
+        ];
         let stack = self.evaluate(py, &arguments, &[5, 6, self.model.nv], &|m, w, i, out| {
             let data = &mut w.data;
             algo::frame_motion_derivatives(m, data, i[0], i[1], i[2], frame, reference)?;
@@ -253,7 +257,11 @@ impl PyModel {
         #[pyo3(from_py_with = named::reference)] reference: algo::Reference,
     ) -> PyResult<Bound<'py, PyAny>> {
         let frame = self.frame_index(frame)?;
-        let arguments = self.dynamics_arguments(q, v, ("a", a), None)?;
+        let arguments = [
+            self.q_arg("q", q)?,
+            self.v_arg("v", v)?,
+            self.v_arg("a", a)?,
+        ];
         self.evaluate(py, &arguments, &[6], &|m, w, i, out| {
             out.copy_from_slice(&algo::frame_acceleration(
                 m,

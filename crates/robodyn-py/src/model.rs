@@ -278,17 +278,20 @@ impl PyModel {
             Target::Out(out) => (out, false),
         };
         let batch = common_batch(arguments)?;
-        // the inputs in place, or copies of the strided ones (plain loops: through an array of
-        // `Cow`s made by `array::from_fn`, each came back through memory and was copied again)
+        // the inputs in place, or copies of the strided ones, each argument looked at once (plain
+        // loops: through an array of `Cow`s made by `array::from_fn`, each came back through
+        // memory and was copied again)
+        let mut in_place: [Option<&[f64]>; MAX_ARGUMENTS] = [None; MAX_ARGUMENTS];
         let mut copies: [Vec<f64>; MAX_ARGUMENTS] = Default::default();
-        for (copy, argument) in copies.iter_mut().zip(arguments) {
-            if argument.contiguous_values().is_none() {
+        for ((place, copy), argument) in in_place.iter_mut().zip(&mut copies).zip(arguments) {
+            *place = argument.contiguous_values();
+            if place.is_none() {
                 *copy = argument.copied_values();
             }
         }
         let mut values: [&[f64]; MAX_ARGUMENTS] = [&[]; MAX_ARGUMENTS];
-        for ((value, argument), copy) in values.iter_mut().zip(arguments).zip(&copies) {
-            *value = argument.contiguous_values().unwrap_or(copy);
+        for ((value, place), copy) in values.iter_mut().zip(in_place).zip(&copies) {
+            *value = place.unwrap_or(copy);
         }
         let values = &values[..arguments.len()];
         let target = match out {
@@ -427,7 +430,7 @@ impl PyModel {
         })
     }
 
-    #[inline]
+    #[inline(always)]
     pub(crate) fn q_arg<'py>(
         &self,
         name: &'static str,
@@ -436,7 +439,7 @@ impl PyModel {
         Argument::new(name, value, SampleShape::vector(self.model.nq))
     }
 
-    #[inline]
+    #[inline(always)]
     pub(crate) fn v_arg<'py>(
         &self,
         name: &'static str,

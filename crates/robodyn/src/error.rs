@@ -91,19 +91,29 @@ impl Error {
     }
 }
 
-/// Checks that an argument has `expected` entries.
+/// Checks that an argument has `expected` entries. The checks are inlined into every call that
+/// makes them (a few instructions each), their errors built out of line.
+#[inline]
 pub fn check_length(argument: &str, length: usize, expected: usize) -> Result<()> {
     if length == expected {
         return Ok(());
     }
-    Err(Error::Shape {
+    Err(length_error(argument, length, expected))
+}
+
+/// The error of [`check_length`].
+#[cold]
+#[inline(never)]
+fn length_error(argument: &str, length: usize, expected: usize) -> Error {
+    Error::Shape {
         argument: argument.to_string(),
         expected: format!("length {expected}"),
         received: format!("length {length}"),
-    })
+    }
 }
 
 /// Checks that `values` has `expected` entries, all finite.
+#[inline]
 pub fn check_vector(argument: &str, values: &[f64], expected: usize) -> Result<()> {
     check_length(argument, values.len(), expected)?;
     check_finite(argument, values)
@@ -112,8 +122,19 @@ pub fn check_vector(argument: &str, values: &[f64], expected: usize) -> Result<(
 /// Whether every entry of `values` is finite, in one pass without an early exit: a value is not
 /// finite exactly when its exponent bits are all set, tested on every value and or-ed (vectorised,
 /// with AVX-512 or AVX2 where the processor has it: results are checked this way after every call,
-/// a batch's megabytes at a time).
+/// a batch's megabytes at a time). A few values (a state of a small robot, its result) take the
+/// plain loop inlined where it is called: the choice of instruction set costs more than they do.
+#[inline]
 pub fn all_finite(values: &[f64]) -> bool {
+    const FEW: usize = 16;
+    if values.len() <= FEW {
+        return all_finite_generic(values);
+    }
+    all_finite_wide(values)
+}
+
+/// [`all_finite`] of many values, in the widest vectors the processor has.
+fn all_finite_wide(values: &[f64]) -> bool {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx512f") {
         // SAFETY: the processor has AVX-512F, just checked.
@@ -151,10 +172,18 @@ fn all_finite_generic(values: &[f64]) -> bool {
 }
 
 /// Checks that every entry of `values` is finite.
+#[inline]
 pub fn check_finite(argument: &str, values: &[f64]) -> Result<()> {
     if all_finite(values) {
         return Ok(());
     }
+    first_not_finite(argument, values)
+}
+
+/// The error of [`check_finite`] for values that are not all finite.
+#[cold]
+#[inline(never)]
+fn first_not_finite(argument: &str, values: &[f64]) -> Result<()> {
     match values.iter().position(|x| !x.is_finite()) {
         None => Ok(()),
         Some(index) => Err(Error::NotFinite {
