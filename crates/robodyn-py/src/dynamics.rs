@@ -42,8 +42,8 @@ impl PyModel {
     }
 
     /// Dynamics with optional external forces: `algorithm(q, v, x, f_ext)` on the arguments of
-    /// [`Self::with_dynamics_arguments`], into `out` when given; a batch without external forces runs
-    /// `lanes` (the algorithm in lanes) when given.
+    /// [`Self::with_dynamics_arguments`], into `out` when given; a batch without external forces
+    /// runs `lanes` (the algorithm in lanes) when given.
     pub(crate) fn with_external_forces<'py>(
         &self,
         py: Python<'py>,

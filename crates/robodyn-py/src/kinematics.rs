@@ -168,23 +168,20 @@ impl PyModel {
         #[pyo3(from_py_with = named::reference)] reference: algo::Reference,
     ) -> PyResult<Bound<'py, PyAny>> {
         let frame = self.frame_index(frame)?;
-        let arguments = [
-            self.q_arg("q", q)?,
-            self.v_arg("v", v)?,
-            self.v_arg("a", a)?,
-        ];
-        let stack = self.evaluate(py, &arguments, &[5, 6, self.model.nv], &|m, w, i, out| {
-            let data = &mut w.data;
-            algo::frame_motion_derivatives(m, data, i[0], i[1], i[2], frame, reference)?;
-            let matrices = [
-                &data.frame_velocity_dq,
-                &data.jacobian,
-                &data.frame_acceleration_dq,
-                &data.frame_acceleration_dv,
-                &data.jacobian,
-            ];
-            write_stack(&matrices, 6, out);
-            Ok(())
+        let stack = self.with_dynamics_arguments((q, v, ("a", a)), None, |arguments| {
+            self.evaluate(py, arguments, &[5, 6, self.model.nv], &|m, w, i, out| {
+                let data = &mut w.data;
+                algo::frame_motion_derivatives(m, data, i[0], i[1], i[2], frame, reference)?;
+                let matrices = [
+                    &data.frame_velocity_dq,
+                    &data.jacobian,
+                    &data.frame_acceleration_dq,
+                    &data.frame_acceleration_dv,
+                    &data.jacobian,
+                ];
+                write_stack(&matrices, 6, out);
+                Ok(())
+            })
         })?;
         split_stack(
             py,
@@ -257,22 +254,14 @@ impl PyModel {
         #[pyo3(from_py_with = named::reference)] reference: algo::Reference,
     ) -> PyResult<Bound<'py, PyAny>> {
         let frame = self.frame_index(frame)?;
-        let arguments = [
-            self.q_arg("q", q)?,
-            self.v_arg("v", v)?,
-            self.v_arg("a", a)?,
-        ];
-        self.evaluate(py, &arguments, &[6], &|m, w, i, out| {
-            out.copy_from_slice(&algo::frame_acceleration(
-                m,
-                &mut w.data,
-                i[0],
-                i[1],
-                i[2],
-                frame,
-                reference,
-            )?);
-            Ok(())
+        self.with_dynamics_arguments((q, v, ("a", a)), None, |arguments| {
+            self.evaluate(py, arguments, &[6], &|m, w, i, out| {
+                let data = &mut w.data;
+                let acceleration =
+                    algo::frame_acceleration(m, data, i[0], i[1], i[2], frame, reference)?;
+                out.copy_from_slice(&acceleration);
+                Ok(())
+            })
         })
     }
 
