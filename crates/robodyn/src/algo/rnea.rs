@@ -99,7 +99,7 @@ pub(crate) fn newton_euler_passes<S: Real>(
     joint_transforms(model, q, out.x_up);
 
     // outward pass: velocities, accelerations and the force each body needs
-    out.v[0] = Motion::zeros();
+    out.v[0].set_zero();
     out.a[0] = Motion::new(zero_vector(), -splat_vector::<S>(&model.gravity));
     for i in 1..model.nbodies() {
         for_rotation_of!(model.turn(i), R => outward_body::<R, S>(model, i, v, a, f_ext, &mut out));
@@ -195,7 +195,7 @@ fn outward_body<R: Rotation, S: Real>(
         }
         None => {
             // at rest every velocity product vanishes
-            out.v[i] = Motion::zeros();
+            out.v[i].set_zero();
             match a {
                 Some(_) => Inertia::<S>::splat(inertia).mul_motion(&a_i),
                 None => Inertia::<S>::splat(inertia).mul_linear_motion(&a_i.linear),

@@ -39,6 +39,14 @@ impl<S: Real> Motion<S> {
         Motion::new(super::zero_vector(), super::zero_vector())
     }
 
+    /// Sets the motion to zero where it lies: `*m = Motion::zeros()` builds the zeros beside it
+    /// and copies them, and at eight lanes the copy's loads wait on the stores just made.
+    #[inline(always)]
+    pub fn set_zero(&mut self) {
+        self.angular.fill(S::zero());
+        self.linear.fill(S::zero());
+    }
+
     /// A constant motion (of the model) in every lane.
     #[inline(always)]
     pub fn splat(m: &Motion) -> Self {
@@ -68,16 +76,13 @@ impl<S: Real> Motion<S> {
     /// `[ω × s e_c; v × s e_c]`; along axis j = c − 3: `[0; ω × s e_j]`.
     #[inline(always)]
     pub fn cross_unit_motion(&self, c: usize, s: S) -> Motion<S> {
-        // x × s e_j: two products
-        let unit_cross = |x: &Vector3<S>, j: usize| match j {
-            0 => Vector3::new(S::zero(), x.z * s, -(x.y * s)),
-            1 => Vector3::new(-(x.z * s), S::zero(), x.x * s),
-            _ => Vector3::new(x.y * s, -(x.x * s), S::zero()),
-        };
         if c < 3 {
-            Motion::new(unit_cross(&self.angular, c), unit_cross(&self.linear, c))
+            Motion::new(
+                cross_unit(&self.angular, c, s),
+                cross_unit(&self.linear, c, s),
+            )
         } else {
-            Motion::new(super::zero_vector(), unit_cross(&self.angular, c - 3))
+            Motion::new(super::zero_vector(), cross_unit(&self.angular, c - 3, s))
         }
     }
 
@@ -103,6 +108,17 @@ impl<S: Real> Motion<S> {
     #[inline(always)]
     pub fn dot(&self, f: &Force<S>) -> S {
         self.angular.dot(&f.angular) + self.linear.dot(&f.linear)
+    }
+}
+
+/// `x × s e_j`: two products (a function, not a closure, so that it is inlined into the lane
+/// kernels too).
+#[inline(always)]
+fn cross_unit<S: Real>(x: &Vector3<S>, j: usize, s: S) -> Vector3<S> {
+    match j {
+        0 => Vector3::new(S::zero(), x.z * s, -(x.y * s)),
+        1 => Vector3::new(-(x.z * s), S::zero(), x.x * s),
+        _ => Vector3::new(x.y * s, -(x.x * s), S::zero()),
     }
 }
 

@@ -306,9 +306,6 @@ pub(super) fn groups<S: Scatter>(
 
 /// Lane l of `lanes[j]` = entry j of row `first + l` of the row-major `rows` (width `size`).
 #[inline(always)]
-fn gather<S: Real>(lanes: &mut [S], rows: &[f64], first: usize, size: usize) {
-    let rows = &rows[first * size..(first + S::LANES) * size];
-    for (j, lane) in lanes.iter_mut().enumerate() {
-        *lane = S::from_lanes(|l| rows[l * size + j]);
-    }
+fn gather<S: Scatter>(lanes: &mut [S], rows: &[f64], first: usize, size: usize) {
+    S::gather(&rows[first * size..(first + S::LANES) * size], lanes);
 }

@@ -1,19 +1,25 @@
-//! Lanes back into rows. A group's result is held lane-interleaved (vector j holds entry j of
-//! each state); the output is row-major, one row per state, so putting it back is a transpose.
-//! Taken one lane at a time, the compiler renders it as one gather per row piece; a square tile
-//! of lane vectors transposed in registers by shuffles (log₂ LANES stages, each exchanging one
-//! bit of the row index with the same bit of the column index) and stored whole row by row is
-//! several times cheaper, which matters where results are large (a Talos derivative batch
-//! writes 4 332 numbers per state; `benchmarks/README.md`).
+//! Rows into lanes and back. A group is held lane-interleaved (vector j holds entry j of each
+//! state); the batch is row-major, one row per state, so taking a group's inputs from it and
+//! putting its result back are transposes. Taken one lane at a time, the compiler renders them
+//! as one gather or scatter per row piece (a load or store per value); a square tile of vectors
+//! transposed in registers by shuffles (log₂ LANES stages, each exchanging one bit of the row
+//! index with the same bit of the column index) and loaded or stored whole is several times
+//! cheaper, which matters where results are large (a Talos derivative batch writes 4 332
+//! numbers per state; `benchmarks/README.md`) and where the kernel is short (a Talos RNEA
+//! gathers 115 numbers per state).
 
 use crate::spatial::Real;
 use simba::simd::{AutoF64x4, AutoF64x8};
 
-/// How a lane type is put back into rows.
+/// How a lane type is taken from rows and put back into them.
 pub(super) trait Scatter: Real {
     /// Entry j of row l of the row-major `rows` (width `size`), from `offset` on, = lane l of
     /// `lanes[j]` (`offset` places one block of a stacked result).
     fn scatter(lanes: &[Self], rows: &mut [f64], size: usize, offset: usize);
+
+    /// Lane l of `lanes[j]` = entry j of row l of the row-major `rows` (`Self::LANES` rows of
+    /// width `lanes.len()`).
+    fn gather(rows: &[f64], lanes: &mut [Self]);
 }
 
 impl Scatter for AutoF64x4 {
@@ -26,6 +32,17 @@ impl Scatter for AutoF64x4 {
             return scatter_by_lane(&lanes[tiled..], rows, size, offset + tiled);
         }
         scatter_by_lane(lanes, rows, size, offset)
+    }
+
+    #[inline(always)]
+    fn gather(rows: &[f64], lanes: &mut [Self]) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the CPU has AVX
+            let tiled = unsafe { x86::gather_four(rows, lanes) };
+            return gather_by_lane(rows, lanes, tiled);
+        }
+        gather_by_lane(rows, lanes, 0)
     }
 }
 
@@ -40,6 +57,17 @@ impl Scatter for AutoF64x8 {
         }
         scatter_by_lane(lanes, rows, size, offset)
     }
+
+    #[inline(always)]
+    fn gather(rows: &[f64], lanes: &mut [Self]) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU has AVX-512F
+            let tiled = unsafe { x86::gather_eight(rows, lanes) };
+            return gather_by_lane(rows, lanes, tiled);
+        }
+        gather_by_lane(rows, lanes, 0)
+    }
 }
 
 /// [`Scatter::scatter`] one value at a time: any lane type, and the columns left after the
@@ -53,24 +81,44 @@ fn scatter_by_lane<S: Real>(lanes: &[S], rows: &mut [f64], size: usize, offset: 
     }
 }
 
+/// [`Scatter::gather`] one value at a time, from column `first` on: any lane type, and the
+/// columns left after the whole tiles.
+#[inline(always)]
+fn gather_by_lane<S: Real>(rows: &[f64], lanes: &mut [S], first: usize) {
+    let size = lanes.len();
+    for (j, lane) in lanes.iter_mut().enumerate().skip(first) {
+        *lane = S::from_lanes(|l| rows[l * size + j]);
+    }
+}
+
 #[cfg(target_arch = "x86_64")]
 mod x86 {
-    use simba::simd::{AutoF64x4, AutoF64x8};
+    use simba::simd::{AutoF64x4, AutoF64x8, AutoSimd};
     use std::arch::x86_64::*;
 
-    /// The whole 4 × 4 tiles of [`super::Scatter::scatter`]; returns how many columns they cover.
-    #[target_feature(enable = "avx")]
-    pub(super) unsafe fn scatter_four(
-        lanes: &[AutoF64x4],
-        rows: &mut [f64],
-        size: usize,
-        offset: usize,
-    ) -> usize {
-        let rows = &mut rows[..4 * size];
-        let tiles = lanes.chunks_exact(4);
-        let tiled = 4 * tiles.len();
-        for (t, tile) in tiles.enumerate() {
-            let [r0, r1, r2, r3] = std::array::from_fn(|j| _mm256_loadu_pd(tile[j].0.as_ptr()));
+    /// A vector register of N lanes, loaded and stored whole, and an N × N tile of them
+    /// transposed in registers. Safety (every method): only on a CPU with the register's
+    /// instructions (inlined into callers compiled for them).
+    trait Tile<const N: usize>: Copy {
+        unsafe fn load(from: &[f64]) -> Self;
+        unsafe fn store(self, to: &mut [f64]);
+        /// Vector l of the result holds entry l of each vector given.
+        unsafe fn transpose(tile: [Self; N]) -> [Self; N];
+    }
+
+    impl Tile<4> for __m256d {
+        #[inline(always)]
+        unsafe fn load(from: &[f64]) -> Self {
+            _mm256_loadu_pd(from[..4].as_ptr())
+        }
+
+        #[inline(always)]
+        unsafe fn store(self, to: &mut [f64]) {
+            _mm256_storeu_pd(to[..4].as_mut_ptr(), self)
+        }
+
+        #[inline(always)]
+        unsafe fn transpose([r0, r1, r2, r3]: [Self; 4]) -> [Self; 4] {
             // exchange row bit 1 with column bit 1: 2 × 2 blocks of 2 × 2
             let (s0, s2) = (
                 _mm256_permute2f128_pd::<0x20>(r0, r2),
@@ -81,18 +129,13 @@ mod x86 {
                 _mm256_permute2f128_pd::<0x31>(r1, r3),
             );
             // exchange row bit 0 with column bit 0
-            let transposed = [
+            [
                 _mm256_unpacklo_pd(s0, s1),
                 _mm256_unpackhi_pd(s0, s1),
                 _mm256_unpacklo_pd(s2, s3),
                 _mm256_unpackhi_pd(s2, s3),
-            ];
-            for (l, row) in transposed.into_iter().enumerate() {
-                let start = l * size + offset + 4 * t;
-                _mm256_storeu_pd(rows[start..start + 4].as_mut_ptr(), row);
-            }
+            ]
         }
-        tiled
     }
 
     /// The stages of an 8 × 8 transpose: b, and the pairs of rows (i, i + b) it exchanges.
@@ -102,7 +145,112 @@ mod x86 {
         (1, [(0, 1), (2, 3), (4, 5), (6, 7)]),
     ];
 
-    /// The whole 8 × 8 tiles of [`super::Scatter::scatter`]; returns how many columns they cover.
+    /// For each stage of [`STAGES`], where row i (bit b clear) and row i + b take their entries
+    /// from, as indices into the pair (row i, row i + b): `[low, high]`.
+    const STAGE_INDICES: [[[i64; 8]; 2]; 3] = {
+        let mut indices = [[[0; 8]; 2]; 3];
+        let mut stage = 0;
+        while stage < 3 {
+            let b = STAGES[stage].0;
+            let mut c = 0;
+            while c < 8 {
+                let (low, high) = match c & b == 0 {
+                    true => (c, c + b),
+                    false => (c - b + 8, c + 8),
+                };
+                indices[stage][0][c] = low as i64;
+                indices[stage][1][c] = high as i64;
+                c += 1;
+            }
+            stage += 1;
+        }
+        indices
+    };
+
+    impl Tile<8> for __m512d {
+        #[inline(always)]
+        unsafe fn load(from: &[f64]) -> Self {
+            _mm512_loadu_pd(from[..8].as_ptr())
+        }
+
+        #[inline(always)]
+        unsafe fn store(self, to: &mut [f64]) {
+            _mm512_storeu_pd(to[..8].as_mut_ptr(), self)
+        }
+
+        #[inline(always)]
+        unsafe fn transpose(mut r: [Self; 8]) -> [Self; 8] {
+            // exchange row bit b with column bit b, b = 4, 2, 1
+            for ((_, pairs), [low, high]) in STAGES.iter().zip(&STAGE_INDICES) {
+                let low = _mm512_loadu_si512(low.as_ptr().cast());
+                let high = _mm512_loadu_si512(high.as_ptr().cast());
+                for &(i, j) in pairs {
+                    let (x, y) = (r[i], r[j]);
+                    r[i] = _mm512_permutex2var_pd(x, low, y);
+                    r[j] = _mm512_permutex2var_pd(x, high, y);
+                }
+            }
+            r
+        }
+    }
+
+    /// The whole N × N tiles of [`super::Scatter::scatter`]; returns how many columns they cover.
+    #[inline(always)]
+    unsafe fn scatter_tiles<V: Tile<N>, const N: usize>(
+        lanes: &[AutoSimd<[f64; N]>],
+        rows: &mut [f64],
+        size: usize,
+        offset: usize,
+    ) -> usize {
+        let rows = &mut rows[..N * size];
+        let tiles = lanes.chunks_exact(N);
+        let tiled = N * tiles.len();
+        for (t, tile) in tiles.enumerate() {
+            let tile = std::array::from_fn(|j| V::load(&tile[j].0));
+            for (l, row) in V::transpose(tile).into_iter().enumerate() {
+                row.store(&mut rows[l * size + offset + N * t..]);
+            }
+        }
+        tiled
+    }
+
+    /// The whole N × N tiles of [`super::Scatter::gather`]; returns how many columns they cover.
+    #[inline(always)]
+    unsafe fn gather_tiles<V: Tile<N>, const N: usize>(
+        rows: &[f64],
+        lanes: &mut [AutoSimd<[f64; N]>],
+    ) -> usize {
+        let size = lanes.len();
+        let rows = &rows[..N * size];
+        let tiles = lanes.chunks_exact_mut(N);
+        let tiled = N * tiles.len();
+        for (t, tile) in tiles.enumerate() {
+            let pieces = std::array::from_fn(|l| V::load(&rows[l * size + N * t..]));
+            for (lane, vector) in tile.iter_mut().zip(V::transpose(pieces)) {
+                vector.store(&mut lane.0);
+            }
+        }
+        tiled
+    }
+
+    /// [`scatter_tiles`] of 4 × 4. Safety: only on a CPU with AVX.
+    #[target_feature(enable = "avx")]
+    pub(super) unsafe fn scatter_four(
+        lanes: &[AutoF64x4],
+        rows: &mut [f64],
+        size: usize,
+        offset: usize,
+    ) -> usize {
+        scatter_tiles::<__m256d, 4>(lanes, rows, size, offset)
+    }
+
+    /// [`gather_tiles`] of 4 × 4. Safety: only on a CPU with AVX.
+    #[target_feature(enable = "avx")]
+    pub(super) unsafe fn gather_four(rows: &[f64], lanes: &mut [AutoF64x4]) -> usize {
+        gather_tiles::<__m256d, 4>(rows, lanes)
+    }
+
+    /// [`scatter_tiles`] of 8 × 8. Safety: only on a CPU with AVX-512F.
     #[target_feature(enable = "avx512f")]
     pub(super) unsafe fn scatter_eight(
         lanes: &[AutoF64x8],
@@ -110,42 +258,13 @@ mod x86 {
         size: usize,
         offset: usize,
     ) -> usize {
-        let rows = &mut rows[..8 * size];
-        let tiles = lanes.chunks_exact(8);
-        let tiled = 8 * tiles.len();
-        // for each stage b: where row i (bit b clear) and row i + b take their entries from, as
-        // indices into the pair (row i, row i + b), and the pairs
-        let stages = STAGES.map(|(b, pairs)| {
-            let from = |c: usize, high: bool| match (c & b == 0, high) {
-                (true, false) => c,
-                (false, false) => c - b + 8,
-                (true, true) => c + b,
-                (false, true) => c + 8,
-            };
-            let indices = |high| std::array::from_fn::<i64, 8, _>(|c| from(c, high) as i64);
-            let (low, high) = (indices(false), indices(true));
-            (
-                pairs,
-                _mm512_loadu_si512(low.as_ptr().cast()),
-                _mm512_loadu_si512(high.as_ptr().cast()),
-            )
-        });
-        for (t, tile) in tiles.enumerate() {
-            let mut r: [__m512d; 8] = std::array::from_fn(|j| _mm512_loadu_pd(tile[j].0.as_ptr()));
-            // exchange row bit b with column bit b, b = 4, 2, 1
-            for (pairs, low, high) in stages {
-                for (i, j) in pairs {
-                    let (x, y) = (r[i], r[j]);
-                    r[i] = _mm512_permutex2var_pd(x, low, y);
-                    r[j] = _mm512_permutex2var_pd(x, high, y);
-                }
-            }
-            for (l, row) in r.into_iter().enumerate() {
-                let start = l * size + offset + 8 * t;
-                _mm512_storeu_pd(rows[start..start + 8].as_mut_ptr(), row);
-            }
-        }
-        tiled
+        scatter_tiles::<__m512d, 8>(lanes, rows, size, offset)
+    }
+
+    /// [`gather_tiles`] of 8 × 8. Safety: only on a CPU with AVX-512F.
+    #[target_feature(enable = "avx512f")]
+    pub(super) unsafe fn gather_eight(rows: &[f64], lanes: &mut [AutoF64x8]) -> usize {
+        gather_tiles::<__m512d, 8>(rows, lanes)
     }
 }
 
@@ -172,5 +291,28 @@ mod tests {
     fn scatter_equals_the_value_by_value_scatter() {
         equals_by_lane::<AutoF64x4>();
         equals_by_lane::<AutoF64x8>();
+    }
+
+    /// Each lane type's gather (the register transposes where the CPU has them) equals the value
+    /// by value one, for widths with and without whole tiles.
+    fn gather_equals_by_lane<S: Scatter>() {
+        for size in [1, 3, 4, 8, 17, 39, 40] {
+            let rows: Vec<f64> = (0..S::LANES * size).map(|k| k as f64 + 0.5).collect();
+            let mut tiled = vec![S::splat(-1.0); size];
+            S::gather(&rows, &mut tiled);
+            let mut by_lane = vec![S::splat(-1.0); size];
+            gather_by_lane(&rows, &mut by_lane, 0);
+            assert_eq!(tiled, by_lane, "{} lanes, {size} values", S::LANES);
+            // and the scatter puts the rows back
+            let mut back = vec![0.0; rows.len()];
+            S::scatter(&tiled, &mut back, size, 0);
+            assert_eq!(back, rows, "{} lanes, {size} values", S::LANES);
+        }
+    }
+
+    #[test]
+    fn gather_equals_the_value_by_value_gather() {
+        gather_equals_by_lane::<AutoF64x4>();
+        gather_equals_by_lane::<AutoF64x8>();
     }
 }
