@@ -477,7 +477,7 @@ mod tests {
 
     /// The lane kernels themselves, compiled without the wide instruction sets, so that they are
     /// checked on a CPU that lacks them too: each lane equals the one-state call bit for bit.
-    fn lanes_equal_one_state<S: scatter::Scatter>(algorithm: Algorithm) {
+    fn lanes_equal_one_state<S: scatter::LaneRows>(algorithm: Algorithm) {
         let mut model = bundled_model("ur5", true).unwrap();
         // a floating UR5 needs a base inertia for forward dynamics
         let base = Mat3::from_diagonal_element(0.01);

@@ -1,7 +1,7 @@
 //! The lane kernels: a group of `S::LANES` states gathered into lanes, run through an algorithm's
 //! generic passes, scattered back; compiled once per instruction set.
 
-use super::scatter::Scatter;
+use super::scatter::LaneRows;
 use super::{write_jacobian_column, Algorithm, States};
 use crate::algo::aba::{articulated_body_passes, AbaBuffers};
 use crate::algo::crba::{mass_matrix_of, MassMatrixBuffers};
@@ -176,24 +176,24 @@ pub(super) unsafe fn groups_eight(
 /// `algorithm` on the groups of states that fill `out`, `S::LANES` at a time. An error gives the
 /// first state of a group where a lane failed (a singular articulated inertia or mass matrix).
 #[inline(always)]
-pub(super) fn groups<S: Scatter>(
+pub(super) fn groups<S: LaneRows>(
     algorithm: Algorithm,
     model: &Model,
     lanes: &mut Lanes<S>,
     states: States,
     out: &mut [f64],
 ) -> std::result::Result<(), usize> {
-    let (nq, nv, size) = (model.nq, model.nv, algorithm.output_size(model));
+    let (nv, size) = (model.nv, algorithm.output_size(model));
     for (g, out) in out.chunks_exact_mut(S::LANES * size).enumerate() {
         let first = g * S::LANES;
-        gather(&mut lanes.q, states.q, first, nq);
+        gather(&mut lanes.q, states.q, first);
         for (input, lanes) in [
             (states.v, &mut lanes.v),
             (states.a, &mut lanes.a),
             (states.tau, &mut lanes.tau),
         ] {
             if let Some(input) = input {
-                gather(lanes, input, first, nv);
+                gather(lanes, input, first);
             }
         }
         match algorithm {
@@ -304,8 +304,10 @@ pub(super) fn groups<S: Scatter>(
     Ok(())
 }
 
-/// Lane l of `lanes[j]` = entry j of row `first + l` of the row-major `rows` (width `size`).
+/// Lane l of `lanes[j]` = entry j of row `first + l` of the row-major `rows` (width
+/// `lanes.len()`).
 #[inline(always)]
-fn gather<S: Scatter>(lanes: &mut [S], rows: &[f64], first: usize, size: usize) {
+fn gather<S: LaneRows>(lanes: &mut [S], rows: &[f64], first: usize) {
+    let size = lanes.len();
     S::gather(&rows[first * size..(first + S::LANES) * size], lanes);
 }

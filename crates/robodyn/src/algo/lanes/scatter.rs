@@ -12,7 +12,7 @@ use crate::spatial::Real;
 use simba::simd::{AutoF64x4, AutoF64x8};
 
 /// How a lane type is taken from rows and put back into them.
-pub(super) trait Scatter: Real {
+pub(super) trait LaneRows: Real {
     /// Entry j of row l of the row-major `rows` (width `size`), from `offset` on, = lane l of
     /// `lanes[j]` (`offset` places one block of a stacked result).
     fn scatter(lanes: &[Self], rows: &mut [f64], size: usize, offset: usize);
@@ -22,7 +22,7 @@ pub(super) trait Scatter: Real {
     fn gather(rows: &[f64], lanes: &mut [Self]);
 }
 
-impl Scatter for AutoF64x4 {
+impl LaneRows for AutoF64x4 {
     #[inline(always)]
     fn scatter(lanes: &[Self], rows: &mut [f64], size: usize, offset: usize) {
         #[cfg(target_arch = "x86_64")]
@@ -46,7 +46,7 @@ impl Scatter for AutoF64x4 {
     }
 }
 
-impl Scatter for AutoF64x8 {
+impl LaneRows for AutoF64x8 {
     #[inline(always)]
     fn scatter(lanes: &[Self], rows: &mut [f64], size: usize, offset: usize) {
         #[cfg(target_arch = "x86_64")]
@@ -70,7 +70,7 @@ impl Scatter for AutoF64x8 {
     }
 }
 
-/// [`Scatter::scatter`] one value at a time: any lane type, and the columns left after the
+/// [`LaneRows::scatter`] one value at a time: any lane type, and the columns left after the
 /// whole tiles.
 #[inline(always)]
 fn scatter_by_lane<S: Real>(lanes: &[S], rows: &mut [f64], size: usize, offset: usize) {
@@ -81,7 +81,7 @@ fn scatter_by_lane<S: Real>(lanes: &[S], rows: &mut [f64], size: usize, offset: 
     }
 }
 
-/// [`Scatter::gather`] one value at a time, from column `first` on: any lane type, and the
+/// [`LaneRows::gather`] one value at a time, from column `first` on: any lane type, and the
 /// columns left after the whole tiles.
 #[inline(always)]
 fn gather_by_lane<S: Real>(rows: &[f64], lanes: &mut [S], first: usize) {
@@ -194,7 +194,7 @@ mod x86 {
         }
     }
 
-    /// The whole N × N tiles of [`super::Scatter::scatter`]; returns how many columns they cover.
+    /// The whole N × N tiles of [`super::LaneRows::scatter`]; returns how many columns they cover.
     #[inline(always)]
     unsafe fn scatter_tiles<V: Tile<N>, const N: usize>(
         lanes: &[AutoSimd<[f64; N]>],
@@ -214,7 +214,7 @@ mod x86 {
         tiled
     }
 
-    /// The whole N × N tiles of [`super::Scatter::gather`]; returns how many columns they cover.
+    /// The whole N × N tiles of [`super::LaneRows::gather`]; returns how many columns they cover.
     #[inline(always)]
     unsafe fn gather_tiles<V: Tile<N>, const N: usize>(
         rows: &[f64],
@@ -274,7 +274,7 @@ mod tests {
 
     /// Each lane type's scatter (the register transposes where the CPU has them) equals the value
     /// by value one, for widths with and without whole tiles and at an offset into the rows.
-    fn equals_by_lane<S: Scatter>() {
+    fn equals_by_lane<S: LaneRows>() {
         for (count, size, offset) in [(3, 3, 0), (8, 8, 0), (17, 40, 5), (36, 108, 72)] {
             let lanes: Vec<S> = (0..count)
                 .map(|j| S::from_lanes(|l| (100 * j + l) as f64 + 0.25))
@@ -295,7 +295,7 @@ mod tests {
 
     /// Each lane type's gather (the register transposes where the CPU has them) equals the value
     /// by value one, for widths with and without whole tiles.
-    fn gather_equals_by_lane<S: Scatter>() {
+    fn gather_equals_by_lane<S: LaneRows>() {
         for size in [1, 3, 4, 8, 17, 39, 40] {
             let rows: Vec<f64> = (0..S::LANES * size).map(|k| k as f64 + 0.5).collect();
             let mut tiled = vec![S::splat(-1.0); size];
