@@ -6,6 +6,7 @@ use robodyn::spatial::{
     rotation_from_rpy, CoriolisFactor, Force, Inertia, Mat3, Motion, Transform, Vec3,
 };
 use robodyn::Joint;
+use simba::simd::{AutoF64x4, SimdValue};
 
 const TOLERANCE: f64 = 1e-12;
 
@@ -111,10 +112,10 @@ proptest! {
         prop_assert_eq!(x.compose_turned(turn, &y), x * y);
         prop_assert_eq!(x.apply_motion_turned(turn, &m), x.apply_motion(&m));
         prop_assert_eq!(x.transpose_apply_force_turned(turn, &f), x.transpose_apply_force(&f));
-        prop_assert_eq!(
-            x.transpose_apply_matrix_turned(turn, &articulated),
-            x.transpose_apply_matrix(&articulated)
-        );
+        // added in place to a sum: the same sum, bit for bit, as the product added after
+        let mut sum = articulated;
+        x.add_transpose_apply_matrix_turned(turn, &articulated, &mut sum);
+        prop_assert_eq!(sum, articulated + x.transpose_apply_matrix(&articulated));
         prop_assert_eq!(x.transpose_apply_inertia_turned(turn, &i), x.transpose_apply_inertia(&i));
         let mut forces = [f, Force::new(w, v)];
         x.transpose_apply_forces_turned(turn, &mut forces);
@@ -190,6 +191,15 @@ proptest! {
     #[test]
     fn composition_matches_matrix_product(a in transform(), b in transform()) {
         prop_assert!(((a * b).to_matrix() - a.to_matrix() * b.to_matrix()).norm() < 1e-10);
+    }
+
+    #[test]
+    fn an_inertia_splat_into_lanes_is_its_matrix_in_every_lane(i in inertia()) {
+        let mut lanes = nalgebra::Matrix6::from_element(AutoF64x4::splat(f64::NAN));
+        i.splat_matrix_into(&mut lanes);
+        for lane in 0..4 {
+            prop_assert_eq!(lanes.map(|x| x.extract(lane)), i.to_matrix());
+        }
     }
 
     #[test]

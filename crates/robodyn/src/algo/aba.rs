@@ -13,8 +13,7 @@ use crate::algo::SINGULARITY_TOLERANCE;
 use crate::error::{check_vector, Error, Result};
 use crate::model::Model;
 use crate::spatial::{
-    mat6_mul_motion, splat_matrix6, splat_vector, zero_vector, Force, Inertia, Motion, Real,
-    Transform,
+    mat6_mul_motion, splat_vector, zero_vector, Force, Inertia, Motion, Real, Transform,
 };
 use crate::Data;
 use nalgebra::{DVector, Matrix6, SimdBool};
@@ -133,7 +132,7 @@ pub(crate) fn articulated_body_passes<S: Real>(
         let v_i = out.x_up[i].apply_motion_turned(turn, &out.v[model.parent[i]]) + v_j;
         out.c[i] = v_i.cross_motion(&v_j);
         let inertia = Inertia::<S>::splat(&model.inertias[i]);
-        out.i_a[i] = splat_matrix6(&model.inertias[i].to_matrix());
+        model.inertias[i].splat_matrix_into(&mut out.i_a[i]);
         // p^A_i = v_i ×* I_i v_i - f_ext_i
         out.p_a[i] = v_i.cross_force(&inertia.mul_motion(&v_i));
         if let Some(forces) = f_ext {
@@ -194,14 +193,7 @@ pub(crate) fn articulated_body_passes<S: Real>(
             p_a += mat6_mul_motion(&i_a, &out.c[i]);
             // I^A_λ(i) += X_iᵀ I^a X_i;  p^A_λ(i) += X_iᵀ p^a
             let turn = model.turn(i);
-            let carried = out.x_up[i].transpose_apply_matrix_turned(turn, &i_a);
-            for (sum, x) in out.i_a[parent]
-                .as_mut_slice()
-                .iter_mut()
-                .zip(carried.as_slice())
-            {
-                *sum += *x;
-            }
+            out.x_up[i].add_transpose_apply_matrix_turned(turn, &i_a, &mut out.i_a[parent]);
             let p_parent = out.x_up[i].transpose_apply_force_turned(turn, &p_a);
             out.p_a[parent] += p_parent;
         }

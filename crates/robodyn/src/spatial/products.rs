@@ -147,19 +147,16 @@ pub fn block<S: Real>(m: &Matrix6<S>, row: usize, col: usize) -> Matrix3<S> {
     matrix3(|r, c| m[(row + r, col + c)])
 }
 
-/// The 6x6 matrix of four 3x3 blocks `[a b; c d]`.
+/// `sum += [a b; c d]`, entry by entry in place (no 6x6 matrix built beside `sum` and copied).
 #[inline(always)]
-pub fn from_blocks<S: Real>(
-    a: &Matrix3<S>,
-    b: &Matrix3<S>,
-    c: &Matrix3<S>,
-    d: &Matrix3<S>,
-) -> Matrix6<S> {
-    matrix6(|row, col| match (row < 3, col < 3) {
-        (true, true) => a[(row, col)],
-        (true, false) => b[(row, col - 3)],
-        (false, true) => c[(row - 3, col)],
-        (false, false) => d[(row - 3, col - 3)],
+pub fn add_blocks<S: Real>(sum: &mut Matrix6<S>, [a, b, c, d]: [&Matrix3<S>; 4]) {
+    update_matrix6(sum, |row, col, old| {
+        old + match (row < 3, col < 3) {
+            (true, true) => a[(row, col)],
+            (true, false) => b[(row, col - 3)],
+            (false, true) => c[(row - 3, col)],
+            (false, false) => d[(row - 3, col - 3)],
+        }
     })
 }
 
@@ -167,6 +164,16 @@ pub fn from_blocks<S: Real>(
 #[inline(always)]
 pub fn splat_matrix6<S: Real>(m: &Mat6) -> Matrix6<S> {
     matrix6(|r, c| S::splat(m[(r, c)]))
+}
+
+/// Each entry of `m` replaced by `entry(row, column, its value)`, column by column in place.
+#[inline(always)]
+pub fn update_matrix6<S: Real>(m: &mut Matrix6<S>, entry: impl Fn(usize, usize, S) -> S) {
+    for col in 0..6 {
+        for row in 0..6 {
+            m[(row, col)] = entry(row, col, m[(row, col)]);
+        }
+    }
 }
 
 /// The 6x6 matrix of `entry(row, column)`, built column by column in place.

@@ -2,8 +2,8 @@
 
 use super::turn::{with_axis_rotation, with_rotation, AnyRotation, Rotation, Turn, TurnAbout};
 use super::{
-    block, cross, from_blocks, matrix3, rotate, rotate_back, skew, transposed, Force, Inertia,
-    Mat3, Mat6, Motion, Real, Vec3,
+    add_blocks, block, cross, matrix3, matrix6, rotate, rotate_back, skew, transposed, Force,
+    Inertia, Mat3, Mat6, Motion, Real, Vec3,
 };
 use nalgebra::{Matrix3, Matrix6, Vector3};
 use simba::simd::AutoF64x4;
@@ -234,22 +234,30 @@ impl<S: Real> Transform<S> {
     /// theirs and mirrored, so the result is exactly symmetric.
     #[inline(always)]
     pub fn transpose_apply_matrix(&self, inertia: &Matrix6<S>) -> Matrix6<S> {
-        self.transpose_apply_matrix_by::<AnyRotation>(inertia)
+        let mut moved = matrix6(|_, _| S::zero());
+        self.add_transpose_apply_matrix_by::<AnyRotation>(inertia, &mut moved);
+        moved
     }
 
-    /// [`Transform::transpose_apply_matrix`] for a rotation of the pattern `turn`, as
-    /// [`Transform::apply_motion_turned`].
+    /// `sum += Xᵀ I X` ([`Transform::transpose_apply_matrix`]) in place, for a rotation of the
+    /// pattern `turn` as [`Transform::apply_motion_turned`]: the articulated inertia a body adds
+    /// to its parent's, without a 6x6 matrix built beside the sum and copied.
     #[inline(always)]
-    pub fn transpose_apply_matrix_turned(
+    pub fn add_transpose_apply_matrix_turned(
         &self,
         turn: Option<Turn>,
         inertia: &Matrix6<S>,
-    ) -> Matrix6<S> {
-        with_rotation!(turn, self.transpose_apply_matrix_by(inertia))
+        sum: &mut Matrix6<S>,
+    ) {
+        with_rotation!(turn, self.add_transpose_apply_matrix_by(inertia, sum))
     }
 
     #[inline(always)]
-    fn transpose_apply_matrix_by<R: Rotation>(&self, inertia: &Matrix6<S>) -> Matrix6<S> {
+    fn add_transpose_apply_matrix_by<R: Rotation>(
+        &self,
+        inertia: &Matrix6<S>,
+        sum: &mut Matrix6<S>,
+    ) {
         let (e, r) = (&self.rotation, &self.translation);
         // Â, Ĉ from the upper triangles of A, C, kept on theirs
         let rotated_symmetric = |m: &Matrix3<S>| upper_mirrored(&R::rotated(e, &upper_mirrored(m)));
@@ -262,7 +270,7 @@ impl<S: Real> Transform<S> {
         let q = cross_columns(r, &transposed(&r_c));
         let angular =
             symmetric3(|row, col| a[(row, col)] + p[(row, col)] + p[(col, row)] + q[(row, col)]);
-        from_blocks(&angular, &coupling, &transposed(&coupling), &c)
+        add_blocks(sum, [&angular, &coupling, &transposed(&coupling), &c]);
     }
 
     /// `Xᵀ I X`: a rigid-body inertia given in B coordinates, expressed in A coordinates.
