@@ -24,9 +24,8 @@ fn benchmarks(c: &mut Criterion) {
 const BATCH: usize = 256;
 
 /// Batches of `BATCH` states through the lane kernels (`algo::lanes`: RNEA, gravity, ABA, CRBA,
-/// RNEA derivatives) at every width this CPU runs, each kernel at exactly that width (also those a
-/// batch runs at a narrower one, so that the widths can be compared), in states per second: the
-/// one-state width is the plain loop of single calls.
+/// RNEA derivatives) at every width this CPU runs, in states per second: the one-state width is
+/// the plain loop of single calls.
 fn lanes(c: &mut Criterion) {
     use rand::{rngs::StdRng, SeedableRng};
     use robodyn::algo::States;
@@ -46,7 +45,7 @@ fn lanes(c: &mut Criterion) {
             .collect();
         let (mut out, mut matrices) = (vec![0.0; v.len()], vec![0.0; 3 * v.len() * model.nv]);
         for width in LaneWidth::ALL.into_iter().filter(|w| w.available()) {
-            let mut workspace = BatchWorkspace::with_kernel_width(&model, width).unwrap();
+            let mut workspace = BatchWorkspace::with_width(&model, width).unwrap();
             let id = |algorithm: &str| format!("{name}/{algorithm}/{width:?}");
             let dynamics = States {
                 q: &q,

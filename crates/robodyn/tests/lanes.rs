@@ -45,12 +45,9 @@ fn one_state(model: &Model, data: &mut Data, states: &States, k: usize) -> Vec<f
     .to_vec()
 }
 
-/// A workspace at `width` (as chosen for the CPU), or with every kernel at exactly `width`.
-fn workspace_at(model: &Model, width: LaneWidth, exact: bool) -> Option<BatchWorkspace> {
-    let workspace = match exact {
-        false => BatchWorkspace::with_width(model, width),
-        true => BatchWorkspace::with_kernel_width(model, width),
-    };
+/// A workspace at `width`, or `None` where this CPU lacks it.
+fn workspace_at(model: &Model, width: LaneWidth) -> Option<BatchWorkspace> {
+    let workspace = BatchWorkspace::with_width(model, width);
     assert!(
         workspace.is_ok() || !width.available(),
         "{width:?} is available but refused"
@@ -58,35 +55,17 @@ fn workspace_at(model: &Model, width: LaneWidth, exact: bool) -> Option<BatchWor
     workspace.ok()
 }
 
-/// The states that run in lanes at `width`: forward dynamics and the mass matrix run at four
-/// lanes where eight are available, unless the workspace is `exact`.
-fn group_of(width: LaneWidth, narrower_at_eight: bool, exact: bool) -> usize {
-    match width {
-        LaneWidth::Eight if narrower_at_eight && !exact => 4,
-        width => width.states(),
-    }
-}
-
-/// The batch of `states` at `width` (every kernel at exactly `width` if `exact`), or `None`
-/// where this CPU lacks the width.
-fn batch_at(model: &Model, width: LaneWidth, exact: bool, states: States) -> Option<Vec<f64>> {
-    let mut workspace = workspace_at(model, width, exact)?;
+/// The batch of `states` at `width`, or `None` where this CPU lacks the width.
+fn batch_at(model: &Model, width: LaneWidth, states: States) -> Option<Vec<f64>> {
+    let mut workspace = workspace_at(model, width)?;
     let mut out = vec![f64::NAN; STATES * model.nv];
     match states.tau {
         Some(_) => aba_batch(model, &mut workspace, states, &mut out),
         None => newton_euler_batch(model, &mut workspace, states, &mut out),
     }
     .unwrap();
-    let group = group_of(width, states.tau.is_some(), exact);
-    assert_groups_ran_in_lanes(&workspace, group, &format!("{width:?}"));
+    assert_groups_ran_in_lanes(&workspace, width.states(), &format!("{width:?}"));
     Some(out)
-}
-
-/// Every width, each as chosen for the CPU and with every kernel at exactly that width.
-fn widths_and_kernels() -> impl Iterator<Item = (LaneWidth, bool)> {
-    LaneWidth::ALL
-        .into_iter()
-        .flat_map(|width| [(width, false), (width, true)])
 }
 
 /// The same numbers, bit for bit (signed zeros and NaN payloads included).
@@ -137,8 +116,8 @@ fn every_lane_width_equals_the_one_state_call_bit_for_bit() {
                 tau: Some(&a),
             },
         ] {
-            for (width, exact) in widths_and_kernels() {
-                let Some(out) = batch_at(&model, width, exact, states) else {
+            for width in LaneWidth::ALL {
+                let Some(out) = batch_at(&model, width, states) else {
                     continue;
                 };
                 exercised += 1;
@@ -147,14 +126,14 @@ fn every_lane_width_equals_the_one_state_call_bit_for_bit() {
                     let same = bit_equal(row, &expected);
                     assert!(
                         same,
-                        "{name}, {width:?}, exact {exact}, state {k}: {row:?} != {expected:?}"
+                        "{name}, {width:?}, state {k}: {row:?} != {expected:?}"
                     );
                 }
             }
         }
     }
-    // the one-state width runs everywhere, as chosen and exactly
-    assert!(exercised >= 8 * test_models().len());
+    // the one-state width runs everywhere, on each of the four kinds of state
+    assert!(exercised >= 4 * test_models().len());
 }
 
 #[test]
@@ -262,17 +241,17 @@ fn mass_matrices_in_lanes_equal_crba_bit_for_bit() {
         let (q, _, _) = batch(&model);
         let mut data = Data::new(&model);
         let size = model.nv * model.nv;
-        for (width, exact) in widths_and_kernels() {
-            let Some(mut workspace) = workspace_at(&model, width, exact) else {
+        for width in LaneWidth::ALL {
+            let Some(mut workspace) = workspace_at(&model, width) else {
                 continue;
             };
             let mut out = vec![f64::NAN; STATES * size];
             crba_batch(&model, &mut workspace, &q, &mut out).unwrap();
-            assert_groups_ran_in_lanes(&workspace, group_of(width, true, exact), name);
+            assert_groups_ran_in_lanes(&workspace, width.states(), name);
             for (k, m) in out.chunks(size).enumerate() {
                 let expected = crba(&model, &mut data, &q[k * model.nq..(k + 1) * model.nq]);
                 let same = bit_equal(m, expected.unwrap().as_slice());
-                assert!(same, "{name}, {width:?}, exact {exact}, state {k}");
+                assert!(same, "{name}, {width:?}, state {k}");
             }
         }
     }

@@ -79,9 +79,6 @@ impl LaneWidth {
 #[derive(Debug, Clone)]
 pub struct BatchWorkspace {
     width: LaneWidth,
-    /// Whether every algorithm runs at `width` exactly, none at a narrower width where it runs
-    /// faster ([`BatchWorkspace::with_kernel_width`]).
-    exact: bool,
     /// How many states of the last batch ran in lanes.
     in_lanes: usize,
     data: Data,
@@ -94,7 +91,6 @@ impl BatchWorkspace {
     pub fn new(model: &Model) -> Self {
         BatchWorkspace {
             width: LaneWidth::detect(),
-            exact: false,
             in_lanes: 0,
             data: Data::new(model),
             four: Lanes::new(model),
@@ -113,16 +109,6 @@ impl BatchWorkspace {
         Ok(BatchWorkspace {
             width,
             ..BatchWorkspace::new(model)
-        })
-    }
-
-    /// A workspace that runs every algorithm at exactly `width`, also those that run faster at a
-    /// narrower one (ABA and CRBA at four lanes where eight are available): for tests of each
-    /// kernel at each width. An error if this CPU lacks it.
-    pub fn with_kernel_width(model: &Model, width: LaneWidth) -> Result<Self> {
-        Ok(BatchWorkspace {
-            exact: true,
-            ..BatchWorkspace::with_width(model, width)?
         })
     }
 
@@ -179,25 +165,6 @@ impl Algorithm {
             Algorithm::FramePose { .. } => 16,
             Algorithm::Jacobian { .. } => 6 * model.nv,
             _ => model.nv,
-        }
-    }
-
-    /// The width to run at on a CPU that runs `widest`. The articulated-body algorithm's 6x6
-    /// inertias (36 values per body) no longer fit in the vector registers at eight lanes, and
-    /// the spills cost more than the wider instructions gain (on this project's AMD EPYC, whose
-    /// AVX-512 executes as two 256-bit halves, it ran 1.6x slower than at four lanes): it runs
-    /// at four. So does CRBA, whose body-coordinate form carries every force of a subtree through
-    /// memory at each joint (at eight lanes 1.1–1.3x slower than at four). Their eight-lane
-    /// kernels run where a workspace asks for every kernel at its width
-    /// ([`BatchWorkspace::with_kernel_width`], as the tests do).
-    fn width(self, widest: LaneWidth) -> LaneWidth {
-        match (self, widest) {
-            (Algorithm::ArticulatedBody | Algorithm::CompositeRigidBody, LaneWidth::Eight)
-                if LaneWidth::Four.available() =>
-            {
-                LaneWidth::Four
-            }
-            (_, width) => width,
         }
     }
 }
@@ -350,10 +317,7 @@ fn run_batch(
     }
     let n = out.len() / size;
     check_states(model, &states, n)?;
-    let width = match workspace.exact {
-        true => workspace.width,
-        false => algorithm.width(workspace.width),
-    };
+    let width = workspace.width;
     let grouped = match width {
         LaneWidth::One => 0,
         width => n - n % width.states(),
