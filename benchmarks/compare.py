@@ -36,9 +36,11 @@ ROBOTS = {
 }
 
 
-def best_times(ours, theirs, number: int, repeat: int = 7) -> tuple[float, float]:
+def best_times(ours, theirs, number: int, repeat: int = 21) -> tuple[float, float]:
     """Best per-call times in seconds of two functions over `repeat` rounds of `number` calls,
-    the rounds interleaved so that a drift in the machine's speed affects both alike."""
+    the rounds interleaved so that a drift in the machine's speed affects both alike (with 7
+    rounds of a few milliseconds, a UR5 call's ratio moved by 0.1 between runs on a shared host;
+    with 21, by 0.01-0.04)."""
     best_ours = best_theirs = float("inf")
     for _ in range(repeat):
         best_ours = min(best_ours, timeit.timeit(ours, number=number))
@@ -51,7 +53,7 @@ def best_times(ours, theirs, number: int, repeat: int = 7) -> tuple[float, float
 BATCH_ROUND_S = 0.02
 
 
-def batch_times(ours, theirs, repeat: int = 5) -> tuple[float, float]:
+def batch_times(ours, theirs, repeat: int = 9) -> tuple[float, float]:
     """Best per-call times in seconds of a batch and of the loop it replaces: each side calls
     itself enough times per round for `BATCH_ROUND_S` (the loops take that long once), the rounds
     interleaved as in `best_times`."""
