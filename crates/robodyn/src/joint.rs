@@ -254,6 +254,33 @@ impl Joint {
     /// no rotation product. Spherical and free joints' columns are all such axes.
     #[inline(always)]
     pub fn subspace_column_from<S: Real>(&self, k: usize, x: &Transform<S>) -> Motion<S> {
+        // turning about ω through r: v = r × ω
+        self.subspace_column_with(k, x, |angular| cross(&x.translation, angular))
+    }
+
+    /// [`Joint::subspace_column_from`] with its linear part the velocity of the body point at
+    /// `point` (in the same coordinates) instead of the one at the origin: turning about ω
+    /// through r, that point moves at `ω × (point − r)`; sliding, every point moves alike.
+    #[inline(always)]
+    pub fn subspace_column_at<S: Real>(
+        &self,
+        k: usize,
+        x: &Transform<S>,
+        point: &Vector3<S>,
+    ) -> Motion<S> {
+        let arm = point - x.translation;
+        self.subspace_column_with(k, x, |angular| cross(angular, &arm))
+    }
+
+    /// Column `k` of `S` in the coordinates `x` maps from, its axis `Eᵀ a` and, where the joint
+    /// turns about it, its linear part `turning_velocity(Eᵀ a)`.
+    #[inline(always)]
+    fn subspace_column_with<S: Real>(
+        &self,
+        k: usize,
+        x: &Transform<S>,
+        turning_velocity: impl Fn(&Vector3<S>) -> Vector3<S>,
+    ) -> Motion<S> {
         let e = &x.rotation;
         let row = |c: usize| Vector3::new(e[(c, 0)], e[(c, 1)], e[(c, 2)]);
         // Eᵀ a, a row of E (or its opposite) when a is a coordinate axis (or its opposite)
@@ -262,7 +289,7 @@ impl Joint {
             None => rotate_back(e, &splat_vector(a)),
         };
         let turning = |angular: Vector3<S>| Motion {
-            linear: cross(&x.translation, &angular),
+            linear: turning_velocity(&angular),
             angular,
         };
         let sliding = |linear: Vector3<S>| Motion {

@@ -172,10 +172,7 @@ fn transform_after_is_the_joint_transform_times_the_tree_transform() {
 fn subspace_column_from_a_frame_is_the_inverse_transform_of_the_column() {
     let mut rng = rng();
     for joint in joints_and_shortcuts() {
-        let x = Transform::from_pose(
-            &random_rotation(&mut rng),
-            &Vec3::new(rng.random(), rng.random(), rng.random()),
-        );
+        let x = random_transform(&mut rng);
         for k in 0..joint.nv() {
             let expected = x.inverse_apply_motion(&joint.subspace_column(k));
             let column = joint.subspace_column_from(k, &x);
@@ -189,6 +186,35 @@ fn subspace_column_from_a_frame_is_the_inverse_transform_of_the_column() {
             );
         }
     }
+}
+
+/// `subspace_column_at` moves the column's linear part from the origin to a point:
+/// `v_p = v_O + ω × p`, the same angular part.
+#[test]
+fn subspace_column_at_a_point_is_the_velocity_of_that_point() {
+    let mut rng = rng();
+    for joint in joints_and_shortcuts() {
+        let x = random_transform(&mut rng);
+        let point = Vec3::new(rng.random(), rng.random(), rng.random());
+        for k in 0..joint.nv() {
+            let at_origin = joint.subspace_column_from(k, &x);
+            let at_point = joint.subspace_column_at(k, &x, &point);
+            let expected = at_origin.linear + at_origin.angular.cross(&point);
+            assert_eq!(at_point.angular, at_origin.angular, "{joint:?} column {k}");
+            assert!(
+                (at_point.linear - expected).amax() < COMPOSITION_TOLERANCE,
+                "{joint:?} column {k}: {at_point:?} vs {expected:?}"
+            );
+        }
+    }
+}
+
+/// A transform of random rotation and translation (each coordinate in [0, 1)).
+fn random_transform(rng: &mut impl Rng) -> Transform {
+    Transform::from_pose(
+        &random_rotation(rng),
+        &Vec3::new(rng.random(), rng.random(), rng.random()),
+    )
 }
 
 fn random_rotation(rng: &mut impl Rng) -> nalgebra::Matrix3<f64> {

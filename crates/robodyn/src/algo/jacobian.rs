@@ -3,7 +3,8 @@
 //! Reference: the ECE 470 and TU Berlin notes' geometric Jacobian (column i of a revolute joint: `[z_i × (p - p_i); z_i]`,
 //! prismatic: `[z_i; 0]`), computed generally as in Featherstone (2008) §8.1: column k of joint j
 //! is the joint's subspace column `S_k` mapped to world coordinates, `X_{j←0}⁻¹ S_k = (ω, v_O)`;
-//! the linear velocity of the frame's origin p is then `v_O + ω × p`.
+//! the linear velocity of the frame's origin p is then `v_O + ω × p`, for a joint turning about ω
+//! through r the notes' `ω × (p − r)`, which is how it is computed.
 //! Input: q (nq), a frame index and a [`Reference`]. Writes `data.support`, and `data.x_up`,
 //! `data.x_world` along it, and `data.jacobian`. Cost: O(depth) plus one column per ancestor
 //! degree of freedom.
@@ -11,7 +12,7 @@
 use crate::algo::kinematics::{check_frame, placement_of_frame, update_support_placements};
 use crate::error::Result;
 use crate::model::Model;
-use crate::spatial::{cross, rotate, Real, Transform, Vec3};
+use crate::spatial::{rotate, Real, Transform, Vec3};
 use crate::Data;
 use nalgebra::{DMatrix, Vector3};
 
@@ -90,16 +91,23 @@ pub(crate) fn columns_of<S: Real>(
     for &j in support {
         let joint = &model.joints[j];
         for (k, index) in model.v_range(j).enumerate() {
-            // (ω, v_O) = X_{j←0}⁻¹ S_k
-            let s = joint.subspace_column_from(k, &x_world[j]);
+            // (ω, v_O) = X_{j←0}⁻¹ S_k, or (ω, v_p) with v_p = v_O + ω × p
             let (linear, angular) = match reference {
-                Reference::Spatial => (s.linear, s.angular),
-                // v_p = v_O + ω × p
-                Reference::World => (s.linear + cross(&s.angular, &origin), s.angular),
-                Reference::Local => (
-                    rotate(&pose.rotation, &(s.linear + cross(&s.angular, &origin))),
-                    rotate(&pose.rotation, &s.angular),
-                ),
+                Reference::Spatial => {
+                    let s = joint.subspace_column_from(k, &x_world[j]);
+                    (s.linear, s.angular)
+                }
+                Reference::World => {
+                    let s = joint.subspace_column_at(k, &x_world[j], &origin);
+                    (s.linear, s.angular)
+                }
+                Reference::Local => {
+                    let s = joint.subspace_column_at(k, &x_world[j], &origin);
+                    (
+                        rotate(&pose.rotation, &s.linear),
+                        rotate(&pose.rotation, &s.angular),
+                    )
+                }
             };
             column(index, &linear, &angular);
         }
