@@ -19,7 +19,6 @@ import re
 import subprocess
 import sys
 import tempfile
-from collections import Counter
 from pathlib import Path
 
 #: Arithmetic on doubles, scalar (sd) or packed (pd); a fused multiply-add is two operations.
@@ -60,8 +59,9 @@ def operations_by_address(binary: str) -> dict[int, int]:
     return operations
 
 
-def executed(binary: str, robot: str, algorithm: str, calls: int) -> Counter:
-    """How often each address of `binary` ran in `calls` calls (callgrind), and the total."""
+def executed(binary: str, operations: dict[int, int], robot: str, algorithm: str, calls: int) -> tuple[int, int]:
+    """Instructions and floating-point operations (`operations` by address) executed by `calls`
+    calls, loading and set-up included (callgrind)."""
     with tempfile.TemporaryDirectory() as folder:
         out = Path(folder) / "callgrind.out"
         subprocess.run(
@@ -70,7 +70,7 @@ def executed(binary: str, robot: str, algorithm: str, calls: int) -> Counter:
              str(calls)],
             capture_output=True, check=True,
         )
-        counts: Counter = Counter()
+        instructions = flops = 0
         ours = after_call = False
         for line in out.read_text().splitlines():
             if line.startswith("ob="):
@@ -83,23 +83,18 @@ def executed(binary: str, robot: str, algorithm: str, calls: int) -> Counter:
                     after_call = False
                     continue
                 address, _line, count = line.split()
-                counts["instructions"] += int(count)
+                instructions += int(count)
                 if ours:
-                    counts[int(address, 16)] += int(count)
-        return counts
+                    flops += int(count) * operations.get(int(address, 16), 0)
+        return instructions, flops
 
 
 def main() -> None:
     binary, robot, algorithm = sys.argv[1:4]
     calls = int(sys.argv[4]) if len(sys.argv) > 4 else 50
     operations = operations_by_address(binary)
-    once, twice = (executed(binary, robot, algorithm, n) for n in (calls, 2 * calls))
-
-    def flops(counts: Counter) -> int:
-        return sum(n * operations.get(address, 0) for address, n in counts.items() if address != "instructions")
-
-    instructions = (twice["instructions"] - once["instructions"]) // calls
-    print(instructions, (flops(twice) - flops(once)) // calls)
+    once, twice = (executed(binary, operations, robot, algorithm, n) for n in (calls, 2 * calls))
+    print(*((b - a) // calls for a, b in zip(once, twice)))
 
 
 if __name__ == "__main__":
