@@ -187,10 +187,11 @@ def test_results_can_be_written_into_a_given_array(floating):
 
 def test_new_results_hold_no_stale_memory(floating):
     """A method that can write into a caller's `out` gets a new result array that is not zeroed
-    first (NumPy's `PyArray_Empty`): its kernel writes every value. NumPy makes a new array of
-    the memory of one just freed of the same size, so arrays of NaN are freed before each call:
-    a value the kernel left alone would come through as NaN (the Jacobian's columns of the other
-    legs are zeros, as are M's entries between legs)."""
+    first: its kernel writes every value. A new array takes the memory of one just freed of the
+    same size (NumPy's for a result up to 1 KiB, the extension's own past that), so arrays of NaN
+    of both kinds are freed before each call — NumPy's, and robodyn's own results filled with
+    NaN: a value the kernel left alone would come through as NaN (the Jacobian's columns of the
+    other legs are zeros, as are M's entries between legs)."""
     m = floating
     q, v, a, f_ext, frame = batch_of_states(m, 1, seed=5)
     q, v, a, f_ext = q[0], v[0], a[0], f_ext[0]
@@ -209,8 +210,56 @@ def test_new_results_hold_no_stale_memory(floating):
             assert np.isfinite(expected).all(), name
             for _ in range(8):
                 stale = [np.full(expected.shape, np.nan) for _ in range(4)]
-                del stale
+                stale += [method(*args, **keywords, **extra) for _ in range(4)]
+                for array in stale:
+                    array.fill(np.nan)
+                del stale, array
                 np.testing.assert_array_equal(method(*args, **keywords, **extra), expected, err_msg=f"{name} {extra}")
+
+
+def test_large_results_are_ordinary_arrays_that_outlive_the_model(robots_dir):
+    """A result past NumPy's cache of small blocks (1 KiB: Talos's 6 x 50 Jacobian, its 50 x 50
+    mass matrix, its 3 x 50 x 50 derivatives, of which each is a view) lives in a buffer of the extension's: still a
+    writeable, C-ordered float64 array with the values a NumPy array given as `out` receives; it
+    outlives the model, and its memory goes back when it is freed (a leak of the 20 000 mass
+    matrices below would hold 400 MB)."""
+    import gc
+    import resource
+
+    talos = robodyn.load(robots_dir / "talos_data/robots/talos_full_v2.urdf", floating_base=True)
+    q = talos.random_configuration(seed=2)
+    rng = np.random.default_rng(2)
+    v, a = rng.uniform(-1, 1, talos.nv), rng.uniform(-1, 1, talos.nv)
+    frame = "gripper_left_fingertip_1_link"
+    results = {
+        "jacobian": talos.jacobian(q, frame),
+        "mass_matrix": talos.mass_matrix(q),
+        "dtau_dq": talos.inverse_dynamics_derivatives(q, v, a)["dtau_dq"],
+    }
+    assert results["jacobian"].nbytes > 1024
+    for name, result in results.items():
+        assert result.dtype == np.float64 and result.flags.c_contiguous and result.flags.writeable, name
+        assert result.shape == {"jacobian": (6, 50)}.get(name, (50, 50)), name
+        assert np.isfinite(result).all(), name
+    for name in ("jacobian", "mass_matrix"):
+        given = np.full_like(results[name], np.nan)
+        arguments = (q, frame) if name == "jacobian" else (q,)
+        np.testing.assert_array_equal(getattr(talos, name)(*arguments, out=given), results[name])
+    copies = {name: result.copy() for name, result in results.items()}
+    results["jacobian"][0, 0] += 1.0
+    copies["jacobian"][0, 0] += 1.0
+    del talos
+    gc.collect()
+    for name, result in results.items():
+        np.testing.assert_array_equal(result, copies[name], err_msg=name)
+    talos = robodyn.load(robots_dir / "talos_data/robots/talos_full_v2.urdf", floating_base=True)
+    for _ in range(1000):
+        talos.mass_matrix(q)
+    peak_kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    for _ in range(20_000):
+        talos.mass_matrix(q)
+    grown_mib = (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - peak_kib) / 1024
+    assert grown_mib < 100, f"20 000 mass matrices of 20 KB grew the peak memory by {grown_mib:.0f} MiB"
 
 
 def test_crba_mass_matrix_is_exactly_symmetric(floating):

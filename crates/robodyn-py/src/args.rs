@@ -3,10 +3,8 @@
 
 use crate::to_py_err;
 use nalgebra::DVector;
-use numpy::ndarray::IxDyn;
 use numpy::npyffi::{
-    get_type_object, npy_intp, NpyTypes, PyArrayObject, PyArray_Descr, NPY_ARRAY_ALIGNED,
-    NPY_ARRAY_C_CONTIGUOUS, PY_ARRAY_API,
+    get_type_object, NpyTypes, PyArrayObject, NPY_ARRAY_ALIGNED, NPY_ARRAY_C_CONTIGUOUS,
 };
 use numpy::{
     dtype, AllowTypeChange, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods,
@@ -63,7 +61,7 @@ static PLAIN_FLOAT64: OnceLock<(usize, usize)> = OnceLock::new();
 
 /// The pair of [`PLAIN_FLOAT64`].
 #[inline]
-fn plain_float64(py: Python) -> (usize, usize) {
+pub(crate) fn plain_float64(py: Python) -> (usize, usize) {
     *PLAIN_FLOAT64.get_or_init(|| {
         // SAFETY: NumPy's API table, read with the GIL held
         let array_type = unsafe { get_type_object(py, NpyTypes::PyArray_Type) };
@@ -197,41 +195,6 @@ impl<'py> Argument<'py> {
     #[inline(never)]
     pub(crate) fn copied_values(&self) -> Vec<f64> {
         self.array.to_owned_array().iter().copied().collect()
-    }
-}
-
-/// A new C-ordered float64 array of `shape`, of zeros where `zeroed` (else its values are
-/// whatever its memory held: for a caller that writes every one), by NumPy's `PyArray_Zeros` or
-/// `PyArray_Empty` with the descriptor found once ([`PLAIN_FLOAT64`]): rust-numpy's `zeros` looks
-/// the descriptor up and copies the shape on every call, a tenth of a small call's fixed cost;
-/// and a zeroed array past NumPy's cache of small blocks (1 KiB) is a `calloc`, dearer than the
-/// `malloc` of an empty one (40 ns of a Talos Jacobian's 6 × 39).
-pub(crate) fn new_array<'py>(
-    py: Python<'py>,
-    shape: &[usize],
-    zeroed: bool,
-) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-    const MOST_DIMENSIONS: usize = 4;
-    if shape.len() > MOST_DIMENSIONS {
-        return Ok(PyArrayDyn::zeros(py, IxDyn(shape), false));
-    }
-    let mut dims: [npy_intp; MOST_DIMENSIONS] = [0; MOST_DIMENSIONS];
-    for (dim, &n) in dims.iter_mut().zip(shape) {
-        *dim = n as npy_intp;
-    }
-    let (_, float64) = plain_float64(py);
-    let rank = shape.len() as c_int;
-    // SAFETY: NumPy's API with the GIL held; PyArray_Zeros and PyArray_Empty take the reference
-    // to the descriptor given them, and return a new array or null with the error set.
-    unsafe {
-        ffi::Py_IncRef(float64 as *mut ffi::PyObject);
-        let descriptor = float64 as *mut PyArray_Descr;
-        let array = if zeroed {
-            PY_ARRAY_API.PyArray_Zeros(py, rank, dims.as_mut_ptr(), descriptor, 0)
-        } else {
-            PY_ARRAY_API.PyArray_Empty(py, rank, dims.as_mut_ptr(), descriptor, 0)
-        };
-        Bound::from_owned_ptr_or_err(py, array).map(|array| array.cast_into_unchecked())
     }
 }
 

@@ -5,12 +5,19 @@ use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
 use pyo3::prelude::*;
 use robodyn::Error;
 
+/// The extension's allocator: mimalloc, whose blocks of a few KiB to a few hundred KiB (a large
+/// robot's Jacobian, mass matrix or derivatives) come from per-thread free lists, where the C
+/// library's `malloc` searches sorted bins (`results.rs`).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 mod args;
 mod dynamics;
 mod kinematics;
 mod loaders;
 mod model;
 mod properties;
+mod results;
 mod simulation;
 mod visuals;
 

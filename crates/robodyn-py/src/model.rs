@@ -3,6 +3,7 @@
 //! released).
 
 use crate::args::*;
+use crate::results::new_array;
 use crate::to_py_err;
 use nalgebra::DMatrix;
 use numpy::ndarray::Axis;
