@@ -10,9 +10,7 @@
 
 use crate::args::plain_float64;
 use numpy::ndarray::IxDyn;
-use numpy::npyffi::{
-    get_type_object, npy_intp, NpyTypes, PyArray_Descr, NPY_ARRAY_CARRAY, PY_ARRAY_API,
-};
+use numpy::npyffi::{npy_intp, PyArray_Descr, NPY_ARRAY_CARRAY, PY_ARRAY_API};
 use numpy::PyArrayDyn;
 use pyo3::ffi;
 use pyo3::prelude::*;
@@ -99,12 +97,12 @@ fn array_on_buffer<'py>(
             return Err(PyErr::fetch(py));
         }
         let capsule = Bound::from_owned_ptr(py, capsule);
-        let (_, float64) = plain_float64(py);
+        let (array_type, float64) = plain_float64(py);
         // NumPy takes this reference to its descriptor, even where it fails
         ffi::Py_IncRef(float64 as *mut ffi::PyObject);
         let array = PY_ARRAY_API.PyArray_NewFromDescr(
             py,
-            get_type_object(py, NpyTypes::PyArray_Type),
+            array_type as *mut ffi::PyTypeObject,
             float64 as *mut PyArray_Descr,
             dims.len() as c_int,
             dims.as_mut_ptr(),
