@@ -115,7 +115,7 @@ pub(crate) fn read_mesh_file<'py>(
     let extension = path
         .extension()
         .map_or_else(String::new, |e| e.to_string_lossy().to_lowercase());
-    let mesh = read_mesh(&bytes, &extension)
+    let file = read_mesh(&bytes, &extension)
         .map_err(|m| PyValueError::new_err(format!("{}: {m}", path.display())))?;
-    mesh_arrays(py, &mesh)
+    mesh_arrays(py, &file.mesh)
 }

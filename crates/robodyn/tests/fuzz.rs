@@ -330,7 +330,8 @@ fn mutated_mesh_files_end_in_ok_or_err() {
         }
         let extension = extension.clone();
         let outcome = std::panic::catch_unwind(move || {
-            if let Ok(mesh) = read_mesh(&mutated, &extension) {
+            if let Ok(file) = read_mesh(&mutated, &extension) {
+                let mesh = file.mesh;
                 if mesh.check().is_ok() {
                     for mode in [
                         MeshInertia::Legacy,

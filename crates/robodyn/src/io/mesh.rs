@@ -36,6 +36,36 @@ pub struct TriangleMesh {
     pub faces: Vec<[usize; 3]>,
 }
 
+/// The most corners of an OBJ polygon that MuJoCo (4.0) cuts into triangles: a larger polygon
+/// gives no triangles, silently, in its compiler and its renderer alike.
+pub const MAX_POLYGON_CORNERS: usize = 100;
+
+/// A mesh file as read: its triangles, and the polygons left out as MuJoCo leaves them out.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshFile {
+    pub mesh: TriangleMesh,
+    pub dropped_polygons: Vec<DroppedPolygon>,
+}
+
+/// An OBJ polygon of more than [`MAX_POLYGON_CORNERS`] corners, which gives no triangles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DroppedPolygon {
+    /// Its line in the file (1-based), when the face lines could be matched to the polygons.
+    pub line: Option<usize>,
+    pub corners: usize,
+}
+
+impl DroppedPolygon {
+    /// What a model's warning says of it, after the file's name.
+    pub fn describe(&self) -> String {
+        let line = self.line.map_or_else(String::new, |l| format!("line {l}: "));
+        format!(
+            "{line}a face of {} corners gives no triangles, as in MuJoCo, which cuts faces of at most {MAX_POLYGON_CORNERS} corners (the mesh's mass properties and its drawing leave it out)",
+            self.corners
+        )
+    }
+}
+
 /// How a mesh's inertia is computed (`<mesh inertia>`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MeshInertia {
@@ -93,11 +123,15 @@ pub fn reference_map(refpos: Vec3, refquat: [f64; 4], scale: Vec3) -> Matrix4<f6
 }
 
 /// Reads a mesh file by its extension: `.stl`, `.obj` or `.msh`.
-pub fn read_mesh(bytes: &[u8], extension: &str) -> Result<TriangleMesh, String> {
+pub fn read_mesh(bytes: &[u8], extension: &str) -> Result<MeshFile, String> {
+    let whole = |mesh| MeshFile {
+        mesh,
+        dropped_polygons: Vec::new(),
+    };
     match extension.to_ascii_lowercase().as_str() {
-        "stl" => read_stl(bytes),
+        "stl" => read_stl(bytes).map(whole),
         "obj" => read_obj(bytes),
-        "msh" => read_msh(bytes),
+        "msh" => read_msh(bytes).map(whole),
         other => Err(format!(
             "expected a mesh file ending in .stl, .obj or .msh, got '.{other}'"
         )),
@@ -146,8 +180,8 @@ fn read_stl(bytes: &[u8]) -> Result<TriangleMesh, String> {
 
 /// OBJ as MuJoCo reads it: every vertex of the file, and the faces of its first object (`o`/`g`
 /// group; MuJoCo ignores the rest), polygons cut into triangles as its reader cuts them
-/// ([`polygon::triangulate`]).
-fn read_obj(bytes: &[u8]) -> Result<TriangleMesh, String> {
+/// ([`polygon::triangulate`]), those of more than [`MAX_POLYGON_CORNERS`] corners left out.
+fn read_obj(bytes: &[u8]) -> Result<MeshFile, String> {
     let options = tobj::LoadOptions {
         triangulate: false,
         single_index: false,
@@ -164,6 +198,7 @@ fn read_obj(bytes: &[u8]) -> Result<TriangleMesh, String> {
         .map(|p| Vec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])))
         .collect();
     let mut triangles = Vec::new();
+    let mut dropped_polygons = Vec::new();
     if let Some(first) = models.first() {
         let (indices, arities) = (&first.mesh.indices, &first.mesh.face_arities);
         // polygon sizes; none listed means triangles only
@@ -173,14 +208,36 @@ fn read_obj(bytes: &[u8]) -> Result<TriangleMesh, String> {
             arities.iter().map(|&n| n as usize).collect()
         };
         let mut start = 0;
-        for n in sizes {
-            let corners = &indices[start..start + n];
-            polygon::triangulate(&first.mesh.positions, corners, &mut triangles);
+        for (k, &n) in sizes.iter().enumerate() {
+            if n > MAX_POLYGON_CORNERS {
+                dropped_polygons.push(DroppedPolygon {
+                    line: face_line(bytes, k, n),
+                    corners: n,
+                });
+            } else {
+                let corners = &indices[start..start + n];
+                polygon::triangulate(&first.mesh.positions, corners, &mut triangles);
+            }
             start += n;
         }
     }
     let faces = triangles.iter().map(|t| t.map(|v| v as usize)).collect();
-    Ok(TriangleMesh { vertices, faces })
+    Ok(MeshFile {
+        mesh: TriangleMesh { vertices, faces },
+        dropped_polygons,
+    })
+}
+
+/// The line (1-based) of the file's `k`-th face (`f …`), if it has `corners` corners: the first
+/// object's polygons are the file's first face lines, in order.
+fn face_line(bytes: &[u8], k: usize, corners: usize) -> Option<usize> {
+    let (number, line) = bytes
+        .split(|&b| b == b'\n')
+        .enumerate()
+        .filter(|(_, line)| line.trim_ascii_start().starts_with(b"f "))
+        .nth(k)?;
+    let found = line.split(|b| b.is_ascii_whitespace()).filter(|w| !w.is_empty()).count() - 1;
+    (found == corners).then_some(number + 1)
 }
 
 /// MuJoCo's `.msh`: four int32 counts (vertices, normals, texture coordinates, faces), then the
@@ -523,17 +580,57 @@ mod tests {
         assert!((mirrored.mass_properties(MeshInertia::Exact).unwrap().volume - 1.0).abs() < 1e-15);
     }
 
+    /// An OBJ pyramid: a regular `n`-gon base as one face (after a comment line) and `n` sides.
+    fn pyramid_obj(n: usize) -> String {
+        let mut text = String::from("# pyramid\n");
+        for k in 0..n {
+            let angle = std::f64::consts::TAU * k as f64 / n as f64;
+            text += &format!("v {} {} 0\n", angle.cos(), angle.sin());
+        }
+        text += "v 0 0 1\nf";
+        for k in (1..=n).rev() {
+            text += &format!(" {k}");
+        }
+        text += "\n";
+        for k in 1..=n {
+            text += &format!("f {k} {} {}\n", k % n + 1, n + 1);
+        }
+        text
+    }
+
+    #[test]
+    fn obj_faces_past_the_corner_limit_give_no_triangles() {
+        let at_limit = read_mesh(pyramid_obj(MAX_POLYGON_CORNERS).as_bytes(), "obj").unwrap();
+        assert!(at_limit.dropped_polygons.is_empty());
+        // n − 2 triangles for the base, n for the sides
+        assert_eq!(at_limit.mesh.faces.len(), 2 * MAX_POLYGON_CORNERS - 2);
+        let n = MAX_POLYGON_CORNERS + 1;
+        let past = read_mesh(pyramid_obj(n).as_bytes(), "obj").unwrap();
+        assert_eq!(past.mesh.faces.len(), n);
+        // the base is the first face, after the comment, the n + 1 vertices
+        assert_eq!(
+            past.dropped_polygons,
+            vec![DroppedPolygon {
+                line: Some(n + 3),
+                corners: n
+            }]
+        );
+        assert!(past.dropped_polygons[0]
+            .describe()
+            .starts_with(&format!("line {}: a face of {n} corners", n + 3)));
+    }
+
     #[test]
     fn malformed_files_are_errors() {
         assert!(
             read_mesh(b"solid nothing", "stl").is_err()
-                || read_mesh(b"solid nothing", "stl").unwrap().check().is_err()
+                || read_mesh(b"solid nothing", "stl").unwrap().mesh.check().is_err()
         );
         assert!(read_mesh(&[0u8; 10], "msh").unwrap_err().contains("header"));
         assert!(read_mesh(b"", "ply")
             .unwrap_err()
             .contains(".stl, .obj or .msh"));
         let obj = read_mesh(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "obj").unwrap();
-        assert!(obj.check().unwrap_err().contains("at least 4 vertices"));
+        assert!(obj.mesh.check().unwrap_err().contains("at least 4 vertices"));
     }
 }

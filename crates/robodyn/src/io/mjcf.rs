@@ -158,6 +158,7 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         mesh_directory: None,
         fit_aabb: false,
         mesh_cache: RefCell::new(HashMap::new()),
+        warnings: RefCell::new(Vec::new()),
     };
     if !root.has_tag_name("mujoco") {
         return Err(reader.error(root, "expected the root element <mujoco>"));
@@ -210,6 +211,9 @@ fn load_sources(sources: &Sources) -> Result<Model> {
     if let Some(factor) = reader.mass_rules.total_mass_scale(reader.total_mass.get()) {
         builder.scale_inertias(factor);
     }
+    for message in reader.warnings.take() {
+        builder.warn(message);
+    }
     Ok(builder.build())
 }
 
@@ -236,6 +240,8 @@ struct Reader<'a> {
     /// `<compiler fitaabb>`: primitives fitted to a mesh's bounding box rather than its inertia
     fit_aabb: bool,
     mesh_cache: RefCell<HashMap<String, meshes::CompiledMesh>>,
+    /// what the model's warnings will say of the files read on the way (meshes' dropped faces)
+    warnings: RefCell<Vec<String>>,
 }
 
 impl<'a> Reader<'a> {

@@ -53,8 +53,17 @@ impl<'a> Reader<'a> {
                 let extension = path
                     .extension()
                     .map_or_else(String::new, |e| e.to_string_lossy().into_owned());
-                read_mesh(&bytes, &extension)
-                    .map_err(|m| error(format!("{}: {m}", path.display())))?
+                let file = read_mesh(&bytes, &extension)
+                    .map_err(|m| error(format!("{}: {m}", path.display())))?;
+                for dropped in &file.dropped_polygons {
+                    self.warnings.borrow_mut().push(format!(
+                        "{}: '{}': {}",
+                        self.location(mesh),
+                        path.display(),
+                        dropped.describe()
+                    ));
+                }
+                file.mesh
             }
             None => self.inline_mesh(mesh)?,
         };
