@@ -4,7 +4,7 @@ numbers is accepted; results are float64."""
 
 from os import PathLike
 from pathlib import Path
-from typing import Any, Callable, overload
+from typing import Any, Callable, Sequence, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -18,6 +18,7 @@ Matrix = np.ndarray[tuple[int, int], np.dtype[np.float64]]
 class SimulationError(ValueError): ...
 
 def read_mesh_file(path: str | PathLike[str]) -> tuple[FloatArray, NDArray[np.int64]]: ...
+def check_physical_parameters(parameters: Sequence[float]) -> None: ...
 
 class Model:
     def __reduce__(self) -> tuple[Callable[[bytes], Model], tuple[bytes]]: ...

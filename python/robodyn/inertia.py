@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from robodyn import _core
+
 __all__ = [
     "solid_box",
     "solid_sphere",
@@ -34,7 +36,7 @@ __all__ = [
     "from_spatial_inertia",
 ]
 
-#: Relative slack for the validity checks (symmetry, positive definiteness, triangle inequality).
+#: Relative slack for the symmetry check (the rest of the rule is the core's, with its tolerance).
 VALIDITY_TOLERANCE = 1e-12
 
 _AXES = {"x": 0, "y": 1, "z": 2}
@@ -185,22 +187,28 @@ def principal_axes(inertia) -> tuple[np.ndarray, np.ndarray]:
 
 
 def check_physical(inertia, mass: float | None = None) -> None:
-    """Raises ValueError unless the tensor could belong to a rigid body: symmetric, positive
-    definite, and its principal moments obey the triangle inequality I₁ + I₂ ≥ I₃ (the notes' "facts
-    about inertia tensors"); ``mass``, when given, must be positive."""
+    """Raises ValueError unless the tensor (about the centre of mass) could belong to a rigid body:
+    symmetric, positive semi-definite, and its principal moments obey the triangle inequality
+    I₁ + I₂ ≥ I₃ (the notes' "facts about inertia tensors"); ``mass``, when given, must be positive.
+
+    This is robodyn's one rule for physical inertias, the same code the loaders and the
+    ``Model.inertial_parameters`` setter apply. They differ only in what follows a tensor that
+    breaks the triangle inequality alone (every algorithm still computes with it): a loaded file
+    and the setter report it as a ``ModelWarning`` (``load(..., strict=True)`` refuses it), while
+    this check raises."""
     inertia = _matrix("inertia", inertia)
     scale = max(1e-300, float(np.abs(inertia).max()))
     if mass is not None and not (np.isfinite(mass) and mass > 0):
         raise ValueError(f"argument 'mass': expected a positive finite number, got {mass!r}")
     if np.abs(inertia - inertia.T).max() > VALIDITY_TOLERANCE * scale:
         raise ValueError(f"argument 'inertia': expected a symmetric matrix, got {inertia.tolist()}")
-    moments, _ = principal_axes(inertia)
-    if moments[0] <= VALIDITY_TOLERANCE * scale:
-        raise ValueError(f"argument 'inertia': expected positive definite, got principal moments {moments.tolist()}")
-    if moments[0] + moments[1] < moments[2] * (1.0 - VALIDITY_TOLERANCE):
-        raise ValueError(
-            f"argument 'inertia': principal moments {moments.tolist()} violate the triangle inequality I1 + I2 >= I3"
-        )
+    # the ten parameters [m, m c, I] of a body whose centre of mass is its origin
+    i = inertia
+    parameters = [1.0 if mass is None else float(mass), 0.0, 0.0, 0.0, i[0, 0], i[0, 1], i[1, 1], i[0, 2], i[1, 2], i[2, 2]]
+    try:
+        _core.check_physical_parameters(parameters)
+    except ValueError as error:
+        raise ValueError(f"argument 'inertia': {error}") from None
 
 
 def spatial_inertia(mass: float, com, inertia_com) -> np.ndarray:

@@ -73,7 +73,7 @@ def test_physical_validity():
     inertia.check_physical(inertia.solid_box(1.0, (0.1, 0.2, 0.3)), mass=1.0)
     for bad, message in [
         (np.diag([1.0, 1.0, 3.0]), "triangle inequality"),
-        (np.diag([1.0, -1.0, 1.0]), "positive definite"),
+        (np.diag([1.0, -1.0, 1.0]), "positive semi-definite"),
         ([[1.0, 0.1, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], "symmetric"),
         (np.eye(2), "3x3"),
     ]:

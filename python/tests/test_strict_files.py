@@ -7,9 +7,11 @@ from __future__ import annotations
 
 import warnings
 
+import numpy as np
 import pytest
 
 import robodyn
+from robodyn import inertia
 
 LINK = """<link name="{name}"><inertial><origin xyz="0 0 0.1"/><mass value="1"/>
   <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>"""
@@ -57,9 +59,37 @@ def test_a_typo_is_a_warning_naming_the_file_line_and_nearest_name(tmp_path, tex
 
 
 def test_a_typo_inside_an_attribute_name_is_not_read_as_a_default(tmp_path):
-    """`ixxx="0.1"` used to load as ixx = 0; now the missing ixx is an error."""
+    """`ixxx="0.1"` used to load as ixx = 0; now the missing ixx is an error naming the typo."""
     text = robot(JOINT).replace('ixx="0.01"', 'ixxx="0.01"', 1)
-    with pytest.raises(ValueError, match=r"<link name='base'>/<inertia> \(line 3\): missing attribute 'ixx'"):
+    with pytest.raises(
+        ValueError,
+        match=r"<link name='base'>/<inertia> \(line 3\): missing attribute 'ixx' \(the element has 'ixxx': a misspelling of 'ixx'\?\)",
+    ):
+        load(tmp_path, text)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (robot(JOINT).replace("<mass ", "<maas ", 1), r"missing <mass> \(it has <maas>: a misspelling of <mass>\?\)"),
+        (robot(JOINT.replace('<parent link="base"/>', '<parnet link="base"/>')), r"missing <parent> \(it has <parnet>"),
+        (robot(JOINT.replace('<parent link="base"/>', '<parent lnk="base"/>')), r"missing attribute 'link' \(the element has 'lnk'"),
+        (robot(JOINT.replace(' type="revolute"', ' tpye="revolute"')), r"missing attribute 'type' \(the element has 'tpye'"),
+    ],
+)
+def test_a_missing_name_error_names_the_unknown_name_beside_it(tmp_path, text, message):
+    with pytest.raises(ValueError, match=message):
+        load(tmp_path, text)
+
+
+def test_a_missing_name_error_names_no_known_or_distant_name(tmp_path):
+    """Only unknown names close to the missing one are suggested: `ixy` is a known attribute
+    one edit from `ixx`, and `weight` is unknown but far from `value`."""
+    text = robot(JOINT).replace('ixx="0.01" ', "", 1)
+    with pytest.raises(ValueError, match=r"missing attribute 'ixx'$"):
+        load(tmp_path, text)
+    text = robot(JOINT).replace('<mass value="1"/>', '<mass weight="1"/>', 1)
+    with pytest.raises(ValueError, match=r"missing attribute 'value'$"):
         load(tmp_path, text)
 
 
@@ -122,3 +152,29 @@ def test_published_urdfs(robots_dir):
         panda = robodyn.load(robots_dir / "panda_description/urdf/panda.urdf")
     assert sorted(w.split("unknown attribute ")[1].split(" of")[0] for w in panda.warnings) == ["'D'", "'K'", "'mu_coulomb'", "'mu_viscous'"]
     assert all("times; the first is here" in w for w in panda.warnings)
+
+
+def test_an_inertia_that_breaks_the_triangle_inequality_follows_the_one_rule(tmp_path):
+    """One rule for physical inertias: a file's tensor whose principal moments break the triangle
+    inequality is a ModelWarning naming the link and the three moments (strict=True refuses it),
+    the setter takes it back with the same warning, and check_physical refuses it."""
+    text = robot(JOINT)
+    at = text.rindex('ixx="0.01"')
+    text = text[:at] + 'ixx="0.03"' + text[at + len('ixx="0.01"'):]
+    expected = (
+        r"<link name='arm'>/<inertial> \(line 4\): the principal moments about the centre of mass "
+        r"\[1\.000000e-2, 1\.000000e-2, 3\.000000e-2\] break the triangle inequality"
+    )
+    with pytest.warns(robodyn.ModelWarning, match=expected):
+        model = load(tmp_path, text)
+    with pytest.raises(ValueError, match="strict=True: .*break the triangle inequality"):
+        load(tmp_path, text, strict=True)
+    parameters = model.inertial_parameters
+    with pytest.warns(robodyn.ModelWarning, match=r"row 0 \(body 'arm'\): the principal moments .* break the triangle inequality"):
+        model.inertial_parameters = parameters
+    assert (model.inertial_parameters == parameters).all()
+    with pytest.raises(ValueError, match="argument 'inertia': the principal moments .* break the triangle inequality"):
+        inertia.check_physical(np.diag([0.01, 0.01, 0.03]), mass=1.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        load(tmp_path, robot(JOINT)).inertial_parameters = load(tmp_path, robot(JOINT)).inertial_parameters

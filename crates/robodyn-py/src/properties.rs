@@ -234,9 +234,11 @@ impl PyModel {
     /// body_names: [m, m c_x, m c_y, m c_z, I_xx, I_xy, I_yy, I_xz, I_yz, I_zz], c the centre of
     /// mass and I the rotational inertia about the body's origin, in the body's axes (the
     /// regressor's order, as Pinocchio's dynamic parameters). Settable: every algorithm then
-    /// uses the new values; each row must be a physical body (m >= 0, the inertia about the
-    /// centre of mass positive semi-definite with principal moments obeying the triangle
-    /// inequalities), else ValueError naming the row and body, and nothing changes.
+    /// uses the new values. Each row follows the rule for physical inertias, as a loaded file's
+    /// do: m >= 0 and the inertia about the centre of mass positive semi-definite, else
+    /// ValueError naming the row and body, and nothing changes; principal moments that break
+    /// the triangle inequality are set with a ModelWarning naming them, so that
+    /// `m.inertial_parameters = m.inertial_parameters` always holds.
     #[getter]
     fn get_inertial_parameters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let rows = self.model.nbodies() - 1;
@@ -257,9 +259,11 @@ impl PyModel {
             .chunks_exact(10)
             .map(|row| <[f64; 10]>::try_from(row).expect("rows of ten"))
             .collect();
-        self.model
+        let warnings = self
+            .model
             .set_inertial_parameters(&parameters)
-            .map_err(to_py_err)
+            .map_err(to_py_err)?;
+        warn_model(value.py(), &warnings)
     }
 
     /// Total mass (kg).
@@ -406,4 +410,25 @@ impl PyModel {
             Ok(())
         })
     }
+}
+
+/// Reports each message as a `robodyn.ModelWarning` (an error if warnings are turned into errors).
+fn warn_model(py: Python<'_>, messages: &[String]) -> PyResult<()> {
+    if messages.is_empty() {
+        return Ok(());
+    }
+    let category = py.import("robodyn")?.getattr("ModelWarning")?;
+    for message in messages {
+        let text = std::ffi::CString::new(message.replace('\0', " "))?;
+        PyErr::warn(py, &category, &text, 1)?;
+    }
+    Ok(())
+}
+
+/// Checks ten inertial parameters [m, m c, Ī_O] against the rule for physical inertias, the one
+/// the loaders and the `inertial_parameters` setter apply; raises ValueError naming what breaks it.
+#[pyfunction]
+pub(crate) fn check_physical_parameters(parameters: [f64; 10]) -> PyResult<()> {
+    robodyn::model::check_physical_parameters(&parameters)
+        .map_err(|defect| PyValueError::new_err(defect.to_string()))
 }

@@ -346,20 +346,32 @@ impl Model {
             .collect()
     }
 
-    /// Replaces the inertia of every moving body by its ten parameters, after checking that each
-    /// body is physical (see [`check_physical_parameters`]); on an error nothing changes.
-    pub fn set_inertial_parameters(&mut self, parameters: &[[f64; 10]]) -> Result<()> {
+    /// Replaces the inertia of every moving body by its ten parameters, after checking each
+    /// against the rule for physical inertias ([`check_physical_parameters`]): a body no
+    /// algorithm can compute with is an error and nothing changes; a body that breaks only the
+    /// triangle inequality is set, and its message returned as a warning (as a file's is).
+    pub fn set_inertial_parameters(&mut self, parameters: &[[f64; 10]]) -> Result<Vec<String>> {
         check_length("inertial_parameters", parameters.len(), self.nbodies() - 1)?;
+        let mut warnings = Vec::new();
         for (k, p) in parameters.iter().enumerate() {
-            check_physical_parameters(p).map_err(|message| Error::InvalidValue {
-                argument: "inertial_parameters".into(),
-                message: format!("row {k} (body '{}'): {message}", self.body_names[k + 1]),
-            })?;
+            let row = format!("row {k} (body '{}')", self.body_names[k + 1]);
+            match check_physical_parameters(p) {
+                Ok(()) => {}
+                Err(Unphysical::Invalid(message)) => {
+                    return Err(Error::InvalidValue {
+                        argument: "inertial_parameters".into(),
+                        message: format!("{row}: {message}"),
+                    })
+                }
+                Err(Unphysical::TriangleInequality(message)) => {
+                    warnings.push(format!("argument 'inertial_parameters': {row}: {message}"));
+                }
+            }
         }
         for (inertia, p) in self.inertias[1..].iter_mut().zip(parameters) {
             *inertia = Inertia::from_parameters(p);
         }
-        Ok(())
+        Ok(warnings)
     }
 
     /// Total mass.
@@ -399,44 +411,69 @@ pub fn check_positive_semidefinite(inertia_com: &Mat3) -> std::result::Result<()
     Ok(())
 }
 
-/// Checks that ten inertial parameters [m, h, Ī_O] describe a rigid body: finite, m ≥ 0, and the
-/// rotational inertia about the centre of mass I_C = Ī_O − (h·h 1 − h hᵀ)/m positive
-/// semi-definite with principal moments obeying the triangle inequalities λ_a + λ_b ≥ λ_c (a
-/// massless body has h = 0 and I_C = Ī_O).
-pub fn check_physical_parameters(p: &[f64; 10]) -> std::result::Result<(), String> {
+/// Why ten inertial parameters are not those of a rigid body.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Unphysical {
+    /// No algorithm can compute with them: a value not finite, a negative mass, a first moment
+    /// without mass, or an inertia about the centre of mass that is not positive semi-definite.
+    Invalid(String),
+    /// Positive semi-definite, but the principal moments break a triangle inequality: no body of
+    /// matter has them (its density would be negative somewhere), though every algorithm still
+    /// computes with them, as Pinocchio's do; MuJoCo refuses such a body.
+    TriangleInequality(String),
+}
+
+impl std::fmt::Display for Unphysical {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Unphysical::Invalid(message) | Unphysical::TriangleInequality(message) => {
+                f.write_str(message)
+            }
+        }
+    }
+}
+
+/// The one rule for physical inertias, applied by the loaders, the `inertial_parameters`
+/// setter and Python's `robodyn.inertia.check_physical`: ten inertial parameters [m, h, Ī_O]
+/// describe a rigid body when they are finite, m ≥ 0, and the rotational inertia about the
+/// centre of mass I_C = Ī_O − (h·h 1 − h hᵀ)/m is positive semi-definite with principal moments
+/// obeying the triangle inequalities λ_a + λ_b ≥ λ_c (a massless body has h = 0 and I_C = Ī_O),
+/// all within [`INERTIA_EIGENVALUE_TOLERANCE`] of the tensor's largest entry.
+pub fn check_physical_parameters(p: &[f64; 10]) -> std::result::Result<(), Unphysical> {
     if let Some(k) = p.iter().position(|x| !x.is_finite()) {
-        return Err(format!(
+        return Err(Unphysical::Invalid(format!(
             "expected finite parameters, got {} at index {k}",
             p[k]
-        ));
+        )));
     }
     let inertia = Inertia::from_parameters(p);
     let (mass, h) = (inertia.mass, inertia.first_moment);
     if mass < 0.0 {
-        return Err(format!("expected a mass >= 0, got {mass}"));
+        return Err(Unphysical::Invalid(format!(
+            "expected a mass >= 0, got {mass}"
+        )));
     }
     let scale = inertia.rotational.abs().max();
     let tolerance = (INERTIA_EIGENVALUE_TOLERANCE * scale).max(INERTIA_ABSOLUTE_TOLERANCE);
     let inertia_com = if mass > 0.0 {
         inertia.rotational - (Mat3::identity() * h.norm_squared() - h * h.transpose()) / mass
     } else if h.norm() > INERTIA_ABSOLUTE_TOLERANCE {
-        return Err(format!(
+        return Err(Unphysical::Invalid(format!(
             "a massless body has no first moment, got m c = [{}, {}, {}]",
             h.x, h.y, h.z
-        ));
+        )));
     } else {
         inertia.rotational
     };
-    check_positive_semidefinite(&inertia_com)?;
-    let moments = inertia_com.symmetric_eigenvalues();
-    for c in 0..3 {
-        let (a, b) = (moments[(c + 1) % 3], moments[(c + 2) % 3]);
-        if a + b < moments[c] - tolerance {
-            return Err(format!(
-                "the principal moments about the centre of mass [{:.6e}, {:.6e}, {:.6e}] break the triangle inequality ({a:.6e} + {b:.6e} < {:.6e})",
-                moments[0], moments[1], moments[2], moments[c]
-            ));
-        }
+    check_positive_semidefinite(&inertia_com).map_err(Unphysical::Invalid)?;
+    // sorted, λ₁ ≤ λ₂ ≤ λ₃, only λ₁ + λ₂ ≥ λ₃ can fail
+    let mut moments: [f64; 3] = inertia_com.symmetric_eigenvalues().into();
+    moments.sort_by(f64::total_cmp);
+    let [a, b, c] = moments;
+    if a + b < c - tolerance {
+        return Err(Unphysical::TriangleInequality(format!(
+            "the principal moments about the centre of mass [{a:.6e}, {b:.6e}, {c:.6e}] break the triangle inequality ({a:.6e} + {b:.6e} < {c:.6e}): no rigid body has them"
+        )));
     }
     Ok(())
 }

@@ -7,7 +7,7 @@ use common::*;
 use nalgebra::DVector;
 use rand::Rng;
 use robodyn::algo::*;
-use robodyn::model::check_physical_parameters;
+use robodyn::model::{check_physical_parameters, Unphysical};
 use robodyn::Data;
 
 /// τ = Y π against RNEA: the same sums in another order.
@@ -92,36 +92,19 @@ fn new_parameters_change_every_algorithm_consistently() {
 }
 
 #[test]
-fn unphysical_parameters_are_refused_by_name() {
+fn unphysical_parameters_are_refused_or_reported_by_name() {
     let (_, mut model) = test_models().remove(0);
     let good = model.inertial_parameters();
     let mut rng = rng();
     let row = rng.random_range(0..good.len());
     type Spoil = fn(&mut [f64; 10]);
-    let cases: [(&str, Spoil); 4] = [
+    let cases: [(&str, Spoil); 3] = [
         ("expected a mass >= 0", |p| p[0] = -1.0),
         ("expected finite parameters", |p| p[4] = f64::NAN),
         ("positive semi-definite", |p| {
             p[4] = -1.0;
             p[6] = -1.0;
             p[9] = -1.0;
-        }),
-        ("triangle inequality", |p| {
-            // about the centre of mass: moments 1, 1, 3 (1 + 1 < 3)
-            let m = p[0].max(1.0);
-            let c = [p[1] / m, p[2] / m, p[3] / m];
-            let shift = |i: usize, j: usize| {
-                let cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
-                m * (if i == j { cc } else { 0.0 } - c[i] * c[j])
-            };
-            p[0] = m;
-            let moments = [1.0, 1.0, 3.0];
-            for (k, (i, j)) in [(0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)]
-                .into_iter()
-                .enumerate()
-            {
-                p[4 + k] = if i == j { moments[i] } else { 0.0 } + shift(i, j);
-            }
         }),
     ];
     for (message, spoil) in cases {
@@ -140,6 +123,18 @@ fn unphysical_parameters_are_refused_by_name() {
         );
     }
     assert!(model.set_inertial_parameters(&good[1..]).is_err());
+    // principal moments that break only the triangle inequality are set, with a warning
+    let mut unusual = good.clone();
+    break_the_triangle_inequality(&mut unusual[row]);
+    let warnings = model.set_inertial_parameters(&unusual).unwrap();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(warnings[0].contains("triangle inequality"), "{warnings:?}");
+    assert!(warnings[0].contains(&format!("row {row} (body '{}')", model.body_names[row + 1])));
+    assert_eq!(model.inertial_parameters(), unusual);
+    assert!(matches!(
+        check_physical_parameters(&unusual[row]),
+        Err(Unphysical::TriangleInequality(_))
+    ));
     // a point mass and a massless body are physical
     assert!(
         check_physical_parameters(&[1.0, 0.1, 0.0, 0.0, 0.0, 0.0, 0.01, 0.0, 0.0, 0.01]).is_ok()
@@ -148,4 +143,22 @@ fn unphysical_parameters_are_refused_by_name() {
     assert!(
         check_physical_parameters(&[0.0, 0.1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]).is_err()
     );
+}
+
+/// Principal moments 1, 1, 3 about the centre of mass (1 + 1 < 3), the centre of mass kept.
+fn break_the_triangle_inequality(p: &mut [f64; 10]) {
+    let m = p[0].max(1.0);
+    let c = [p[1] / m, p[2] / m, p[3] / m];
+    let shift = |i: usize, j: usize| {
+        let cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+        m * (if i == j { cc } else { 0.0 } - c[i] * c[j])
+    };
+    p[0] = m;
+    let moments = [1.0, 1.0, 3.0];
+    for (k, (i, j)) in [(0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)]
+        .into_iter()
+        .enumerate()
+    {
+        p[4 + k] = if i == j { moments[i] } else { 0.0 } + shift(i, j);
+    }
 }

@@ -16,8 +16,8 @@ use crate::error::{Error, Result};
 use crate::io::read_model_file;
 use crate::joint::Joint;
 use crate::model::{
-    check_mass_and_inertia, check_positive_semidefinite, JointProperties, Model, ModelBuilder,
-    NewBody,
+    check_mass_and_inertia, check_physical_parameters, JointProperties, Model, ModelBuilder,
+    NewBody, Unphysical,
 };
 use crate::spatial::{Inertia, Mat3, Transform, Vec3};
 
@@ -151,15 +151,22 @@ pub fn build_dh(table: &DhTable) -> Result<Model> {
             ));
         }
         check_mass_and_inertia(row.mass, &row.inertia)
-            .and_then(|_| check_positive_semidefinite(&row.inertia))
             .map_err(|message| Error::model(location.clone(), message))?;
+        // the rule for physical inertias: invalid is an error, the triangle inequality a warning
+        let link = Inertia::from_com(row.mass, &row.com, &row.inertia);
+        match check_physical_parameters(&link.to_parameters()) {
+            Ok(()) => {}
+            Err(Unphysical::Invalid(message)) => return Err(Error::model(location, message)),
+            Err(Unphysical::TriangleInequality(message)) => builder.warn(format!(
+                "{location}: {message} (loaded as given; strict=True refuses it)"
+            )),
+        }
         let (before, after) = split_row(table.convention, row);
         let joint = match row.joint {
             DhJoint::Revolute => Joint::Revolute { axis: Vec3::z() },
             DhJoint::Prismatic => Joint::Prismatic { axis: Vec3::z() },
         };
-        // the link's inertia, given in DH frame i, moved into the body frame
-        let link = Inertia::from_com(row.mass, &row.com, &row.inertia);
+        // the link's inertia (above), given in DH frame i, is moved into the body frame
         // the body frame is DH frame i when nothing follows the joint (modified convention)
         let dh_frame_is_body = after == Transform::IDENTITY;
         let body_name = if dh_frame_is_body {

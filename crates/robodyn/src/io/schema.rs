@@ -35,6 +35,43 @@ fn suggestion(name: &str, known: &[&str], brackets: bool) -> String {
     }
 }
 
+/// What an error about `node`'s missing attribute `name` adds when the element has an attribute
+/// the schema does not know that is close to it (the likely typo), else nothing.
+pub(crate) fn misspelt_attribute(schema: &[SchemaElement], node: Node, name: &str) -> String {
+    let known = schema
+        .iter()
+        .find(|e| node.has_tag_name(e.name))
+        .and_then(|e| e.attributes)
+        .unwrap_or(&[]);
+    let unknown = node
+        .attributes()
+        .map(|a| a.name())
+        .filter(|a| !known.contains(a));
+    match nearest(name, unknown) {
+        Some(typo) => format!(" (the element has '{typo}': a misspelling of '{name}'?)"),
+        None => String::new(),
+    }
+}
+
+/// What an error about `node`'s missing child element `<tag>` adds when the element has a child
+/// the schema does not know that is close to it, else nothing.
+pub(crate) fn misspelt_child(schema: &[SchemaElement], node: Node, tag: &str) -> String {
+    let known: Vec<&str> = schema
+        .iter()
+        .find(|e| node.has_tag_name(e.name))
+        .map(|e| e.children.iter().map(|&k| schema[k].name).collect())
+        .unwrap_or_default();
+    let unknown = node
+        .children()
+        .filter(|c| c.is_element())
+        .map(|c| c.tag_name().name())
+        .filter(|c| !known.contains(c));
+    match nearest(tag, unknown) {
+        Some(typo) => format!(" (it has <{typo}>: a misspelling of <{tag}>?)"),
+        None => String::new(),
+    }
+}
+
 /// The child elements of a node as a format sees them (MJCF replaces each `<include>` by the
 /// included file's elements).
 pub(crate) type Children<'c, 'a> = dyn Fn(Node<'a, 'a>) -> Result<Vec<Node<'a, 'a>>> + 'c;

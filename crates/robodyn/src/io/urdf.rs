@@ -5,8 +5,9 @@
 //! tags. Fixed joints are merged into the parent body and the child link is kept as a frame.
 //! Bodies are numbered depth-first, children in file order. The root link is the world unless
 //! `floating_base` puts a free joint named `root_joint` between the world and the root.
-//! An inertia that is not positive semi-definite is an error unless `check_inertia` is off, when
-//! it becomes a warning on the model. A mimic tag on a fixed joint, or naming a joint that does not
+//! Inertias follow the rule for physical inertias ([`check_physical_parameters`]): one that is not
+//! positive semi-definite is an error unless `check_inertia` is off, when it becomes a warning on
+//! the model; one whose principal moments break the triangle inequality is a warning. A mimic tag on a fixed joint, or naming a joint that does not
 //! move, is ignored with a warning.
 //! Visuals are read for the viewer (`urdf/visuals.rs`); collision, transmission and gazebo
 //! elements are ignored.
@@ -18,8 +19,8 @@ use crate::io::xml::{check_nesting, location, parse_numbers};
 use crate::io::{read_model_file, LoadOptions};
 use crate::joint::Joint;
 use crate::model::{
-    check_mass_and_inertia, check_positive_semidefinite, JointProperties, Mimic, Model,
-    ModelBuilder, NewBody,
+    check_mass_and_inertia, check_physical_parameters, JointProperties, Mimic, Model,
+    ModelBuilder, NewBody, Unphysical,
 };
 use crate::spatial::{rotation_from_rpy, Inertia, Mat3, Transform, Vec3};
 use roxmltree::{Document, Node};
@@ -159,7 +160,19 @@ impl<'a> Parser<'a> {
     /// A required attribute.
     fn attribute(&self, node: Node<'a, 'a>, name: &str) -> Result<&'a str> {
         node.attribute(name)
-            .ok_or_else(|| self.error(node, format!("missing attribute '{name}'")))
+            .ok_or_else(|| self.missing_attribute(node, name))
+    }
+
+    /// The error for a required attribute that is absent, naming a close unknown one beside it.
+    fn missing_attribute(&self, node: Node, name: &str) -> Error {
+        let typo = schema::misspelt_attribute(URDF_SCHEMA, node, name);
+        self.error(node, format!("missing attribute '{name}'{typo}"))
+    }
+
+    /// The error for a required child element that is absent, naming a close unknown one.
+    fn missing_child(&self, node: Node, tag: &str) -> Error {
+        let typo = schema::misspelt_child(URDF_SCHEMA, node, tag);
+        self.error(node, format!("missing <{tag}>{typo}"))
     }
 
     /// An attribute of `n` numbers, or `default` when absent.
@@ -219,10 +232,10 @@ impl<'a> Parser<'a> {
     /// `<inertial>`: mass, centre of mass and rotational inertia, with their own origin.
     fn inertial(&mut self, inertial: Node<'a, 'a>) -> Result<Inertia> {
         let mass_node =
-            Self::child(inertial, "mass").ok_or_else(|| self.error(inertial, "missing <mass>"))?;
+            Self::child(inertial, "mass").ok_or_else(|| self.missing_child(inertial, "mass"))?;
         let [mass] = self.numbers(mass_node, "value", [f64::NAN])?;
         if mass.is_nan() {
-            return Err(self.error(mass_node, "missing attribute 'value'"));
+            return Err(self.missing_attribute(mass_node, "value"));
         }
         let inertia_com = match Self::child(inertial, "inertia") {
             None => Mat3::zeros(),
@@ -230,7 +243,7 @@ impl<'a> Parser<'a> {
                 let get = |name: &str| -> Result<f64> {
                     let [value] = self.numbers(node, name, [f64::NAN])?;
                     if value.is_nan() {
-                        return Err(self.error(node, format!("missing attribute '{name}'")));
+                        return Err(self.missing_attribute(node, name));
                     }
                     Ok(value)
                 };
@@ -245,15 +258,26 @@ impl<'a> Parser<'a> {
         let inertia_com = rotation * inertia_com * rotation.transpose();
         check_mass_and_inertia(mass, &inertia_com)
             .map_err(|message| self.error(inertial, message))?;
-        if let Err(message) = check_positive_semidefinite(&inertia_com) {
-            let error = self.error(inertial, message);
-            if self.options.check_inertia {
-                return Err(error);
+        let inertia = Inertia::from_com(mass, &frame.translation, &inertia_com);
+        // the rule for physical inertias: an invalid tensor is an error (a warning with
+        // check_inertia off), one that breaks only the triangle inequality a warning
+        match check_physical_parameters(&inertia.to_parameters()) {
+            Ok(()) => {}
+            Err(Unphysical::Invalid(message)) => {
+                let error = self.error(inertial, message);
+                if self.options.check_inertia {
+                    return Err(error);
+                }
+                self.warnings
+                    .push(format!("{error} (loaded anyway: check_inertia is off)"));
             }
-            self.warnings
-                .push(format!("{error} (loaded anyway: check_inertia is off)"));
+            Err(Unphysical::TriangleInequality(message)) => {
+                let error = self.error(inertial, message);
+                self.warnings
+                    .push(format!("{error} (loaded as given; strict=True refuses it)"));
+            }
         }
-        Ok(Inertia::from_com(mass, &frame.translation, &inertia_com))
+        Ok(inertia)
     }
 
     /// Every `<joint>`, with its links resolved to indices into `links`.
@@ -268,7 +292,7 @@ impl<'a> Parser<'a> {
             }
             let link_of = |tag: &str| -> Result<usize> {
                 let element = Self::child(node, tag)
-                    .ok_or_else(|| self.error(node, format!("missing <{tag}>")))?;
+                    .ok_or_else(|| self.missing_child(node, tag))?;
                 let link = self.attribute(element, "link")?;
                 index.get(link).copied().ok_or_else(|| {
                     self.error(node, format!("<{tag} link='{link}'>: no link of that name"))

@@ -76,7 +76,7 @@ impl<'a> Parser<'a> {
             None => Ok(None),
             Some(color) => {
                 if !color.has_attribute("rgba") {
-                    return Err(self.error(color, "missing attribute 'rgba'"));
+                    return Err(self.missing_attribute(color, "rgba"));
                 }
                 Ok(Some(self.numbers(color, "rgba", DEFAULT_RGBA)?))
             }
@@ -117,7 +117,7 @@ impl<'a> Parser<'a> {
     /// The shape in a visual's `<geometry>`.
     fn visual_shape(&self, visual: Node<'a, 'a>) -> Result<Shape> {
         let geometry = Self::child(visual, "geometry")
-            .ok_or_else(|| self.error(visual, "missing <geometry>"))?;
+            .ok_or_else(|| self.missing_child(visual, "geometry"))?;
         let shape = geometry
             .children()
             .find(|c| c.is_element())
