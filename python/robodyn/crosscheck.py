@@ -75,17 +75,18 @@ __all__ = [
 
 #: A body's compiled inertia, robodyn's against MuJoCo's, where both compilers do the same
 #: arithmetic: mass (relative to the mass), centre of mass (relative to the larger of its distance
-#: from the body's origin and the body's radius of gyration), tensor (relative to its trace).
+#: from the body's origin and the body's size √(tr I / m)), tensor (relative to its trace).
 COMPILED_TOLERANCE = 1e-12
 #: MuJoCo's compile noise on the inertia of a body whose mass comes from a mesh, relative to the
 #: tensor's trace (its nuclear norm, so the bound also holds for bodies merged into one).
 #: Measured by ``measure_mujoco_inertia_noise`` (MuJoCo 4.0.0): over 3 000 tetrahedra whose exact
 #: inertia is known, MuJoCo's tensor is off by up to 4.8e-8 of its trace (99th percentile 3.9e-8,
-#: median 8e-10; mass and centre of mass exact to 1e-14): the single-precision size of a rotation
-#: (2^-24 = 6e-8) in the mesh's principal axes. The bound is that figure, rounded up to 1e-7. A
-#: ``fullinertia`` is compiled exactly (7e-15 over 2 000 tensors of random axes, any magnitude).
-#: A primitive fitted to a mesh (``fitaabb``) is sized along those noisy axes, so its mass and
-#: centre of mass carry the noise too (2e-9 and 3e-9 in testdata/mjcf/mesh_fitaabb.xml).
+#: median 8e-10; mass and centre of mass exact to 1e-14), about single precision (2^-24 = 6e-8).
+#: The bound is that figure rounded up to 1e-7. MuJoCo's eigensolver is not the cause: a
+#: ``fullinertia`` of any axes and magnitude is compiled to 1e-14, and ``mju_eig3`` reproduces
+#: its input to 7e-15, nearly diagonal ones included. A primitive fitted to a mesh (``fitaabb``)
+#: is sized along the mesh's noisy axes, so its mass and centre of mass carry the noise too (2e-9
+#: and 3e-9 in testdata/mjcf/mesh_fitaabb.xml).
 MUJOCO_INERTIA_NOISE = 1e-7
 #: The dynamics, kinematics and Jacobians against MuJoCo, relative to each quantity's size (or 1).
 DYNAMICS_TOLERANCE = 1e-9
@@ -189,7 +190,7 @@ def mujoco_discrepancies(model, mj_model, seed: int = 0, states: int = 3) -> dic
 class BodyComparison:
     """One body's compiled inertia, robodyn's against MuJoCo's (a weld group's, merged): the
     mass error relative to the mass, the centre of mass's relative to the larger of its distance
-    from the body's origin and the body's radius of gyration, the tensor's (about the centre of
+    from the body's origin and the body's size √(tr I / m), the tensor's (about the centre of
     mass, spectral norm of the difference) relative to its trace. Zero where both are massless."""
 
     body: str
@@ -288,6 +289,7 @@ def _merged(parts: list[_Inertia]) -> _Inertia:
 
 
 def _rotation_of(quaternion_wxyz: np.ndarray) -> np.ndarray:
+    """The rotation matrix of a MuJoCo quaternion (w first)."""
     import mujoco
 
     matrix = np.zeros(9)
@@ -365,9 +367,10 @@ def _paired_inertias(model: Any, mj_model: Any) -> list[tuple[str, int, _Inertia
     parameters = np.asarray(model.inertial_parameters)
     # robodyn's moving body k is moved by its joint k and has row k of the parameters
     robodyn_of_joint = {j: k for k, j in enumerate(layout.mujoco_joints)}
-    frame_of_body = {}
+    # each body's own frame: the first on it with its name (a site may share the name)
+    frame_of_body: dict[int, int] = {}
     for index, (name, body) in enumerate(zip(model.frame_names, model.frame_bodies)):
-        if name == model.body_names[body]:
+        if body >= 0 and name == model.body_names[body]:
             frame_of_body.setdefault(body, index)
     pairs = []
     claimed = set()
