@@ -314,11 +314,13 @@ def _in_root_frame(mj_model: Any, root: int, body: int) -> tuple[np.ndarray, np.
 
 
 def _weld_groups(mj_model: Any) -> dict[int, list[int]]:
-    """MuJoCo's bodies with joints, each with the joint-less bodies welded to it (itself first)."""
+    """MuJoCo's bodies with joints, each with the joint-less bodies welded to it (itself first).
+    A mocap body is its own weld root without a joint: robodyn welds it, and what is welded to
+    it, to the world, so it is left out like the world's group."""
     groups: dict[int, list[int]] = {}
     for body in range(1, mj_model.nbody):
         root = int(mj_model.body_weldid[body])
-        if root != 0:
+        if root != 0 and mj_model.body_jntnum[root] > 0:
             groups.setdefault(root, []).append(body)
     return groups
 

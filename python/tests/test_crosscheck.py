@@ -187,3 +187,43 @@ def test_the_menagerie_table_reports_the_verdict_and_the_worst_body():
     assert outcome == WITHIN_NOISE and line.startswith("| `mesh_inertia.xml` | yes | within MuJoCo's compile noise: worst body '")
     line, outcome = table.row(TEST_MJCF / "ur5e_nomesh.xml", TEST_MJCF)
     assert outcome == EXACT and "| yes | exact (dynamics" in line
+
+
+def test_a_mocap_body_is_left_out_like_the_world():
+    """A mocap body is its own weld root in MuJoCo but has no joint (as in Menagerie's
+    franka_emika_panda/mjx_single_cube.xml): robodyn welds it, and its children, to the world."""
+    text = """
+<mujoco model="mocap">
+  <worldbody>
+    <body name="target" mocap="true" pos="0.3 0 0.5">
+      <geom type="box" size="0.02 0.02 0.02"/>
+      <body name="on_target" pos="0 0 0.1"><geom type="sphere" size="0.03"/></body>
+    </body>
+    <body name="arm" pos="0 0 1">
+      <joint name="hinge" axis="0 1 0"/>
+      <geom type="capsule" fromto="0 0 0 0.4 0 0" size="0.03"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+    agreement = agreement_of(text)
+    assert agreement.verdict == EXACT, agreement
+    assert [body.body for body in agreement.bodies] == ["arm"]
+
+
+def test_the_menagerie_table_counts_a_file_absent_from_the_copy_apart(tmp_path):
+    """A model naming a file the copy lacks (Menagerie's mirror leaves out blobs over 4 MiB) is
+    "not compared", naming the file; one MuJoCo refuses for another reason is "not loaded"."""
+    spec = importlib.util.spec_from_file_location("menagerie_table", REPOSITORY / "scripts" / "menagerie_table.py")
+    assert spec is not None and spec.loader is not None
+    table = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(table)
+    robot = tmp_path / "robot"
+    robot.mkdir()
+    (robot / "robot.xml").write_text("""<mujoco><compiler meshdir="assets"/><asset><mesh file="big.obj"/></asset>
+      <worldbody><body><joint/><geom type="mesh" mesh="big"/></body></worldbody></mujoco>""")
+    line, outcome = table.row(robot / "robot.xml", tmp_path, {"robot/assets/big.obj"})
+    assert outcome == "not compared: a file absent from the snapshot"
+    assert "not compared: file `robot/assets/big.obj` absent from the snapshot" in line
+    line, outcome = table.row(robot / "robot.xml", tmp_path, set())
+    assert outcome == "not loaded by MuJoCo" and "Error opening file" in line
