@@ -480,7 +480,7 @@ def _parser() -> _Parser:
                                 help="what to evaluate at each state (default tau)")
     dataset_parser.add_argument("--seed", type=int, default=0, help="the seed (default 0)")
     dataset_parser.add_argument("--chunk", type=_positive_int, default=65_536,
-                                help="states per task and Zarr chunk, a multiple of 256 (default 65536)")
+                                help="states per task and Zarr chunk (default 65536)")
     dataset_parser.add_argument("--sampler", choices=["uniform", "gaussian"], default="uniform",
                                 help="q uniform within the limits, or Gaussian around the neutral pose")
     dataset_parser.add_argument("--scheduler", help="a Dask scheduler's address (default: this machine, no Dask)")

@@ -129,11 +129,14 @@ class MujocoLayout:
             index_in_body = j - int(mj_model.body_jntadr[body])
             names.append(mj_model.joint(j).name or f"{mj_model.body(body).name}_joint{index_in_body}")
         self.v_index = np.zeros(model.nv, dtype=int)
+        # mujoco_joints[k]: MuJoCo's index of robodyn's joint k (the one that moves body_names[k])
+        self.mujoco_joints: list[int] = []
         self._joints = []
         for name, kind, iq, iv in zip(model.joint_names, model.joint_types, model.joint_idx_q, model.joint_idx_v):
             if name not in names:
                 raise ValueError(f"argument 'mj_model': expected a joint named '{name}', found none")
             j = names.index(name)
+            self.mujoco_joints.append(j)
             mj_iq, mj_iv = int(mj_model.jnt_qposadr[j]), int(mj_model.jnt_dofadr[j])
             self._joints.append((kind, iq, iv, mj_iq))
             nv = {"free": 6, "spherical": 3}.get(kind, 1)

@@ -5,8 +5,9 @@ quantities), rollouts gathered or written to Zarr.
 `dataset(model, n, quantities, sampler, seed, chunk, out, client)` samples n states (q, v, a),
 evaluates the requested quantities with the batched core calls (all cores, lanes) chunk by
 chunk, and writes every array of the store chunk by chunk (one Parquet file per chunk). Samples are drawn in blocks of
-`SEED_BLOCK` states, block b from the seed sequence (seed, b), so the store is the same for any
-chunk size (a multiple of the block) and any number of workers. Each chunk is marked done when
+`SEED_BLOCK` states, block b from the seed sequence (seed, b); a chunk draws the blocks it
+overlaps and keeps its own states, so the store is the same for any chunk size and any number of
+workers. Each chunk is marked done when
 written, so an interrupted run resumes (`resume=True`) without recomputing finished chunks, and
 a chunk whose worker died is simply computed again (Dask reruns its task).
 
@@ -31,7 +32,8 @@ from numpy.typing import NDArray
 
 from robodyn import _core
 
-#: States per independently seeded block: chunks are whole blocks, so chunking changes nothing.
+#: States per independently seeded block: a chunk draws the blocks it overlaps and keeps its
+#: states, so the chunking changes nothing.
 SEED_BLOCK = 256
 #: Half-ranges of the uniform v, a and applied τ where the model gives no limit.
 DEFAULT_VELOCITY = 1.0
@@ -61,7 +63,8 @@ def _limits(model: _core.Model) -> tuple[FloatArray, FloatArray]:
 
 
 def _block(model: _core.Model, sampler: Any, limits: tuple[FloatArray, FloatArray], seed: int, block: int, start: int, stop: int) -> dict[str, FloatArray]:
-    """q, v, a and the applied τ of states [start, stop) of block `block` (whole blocks only)."""
+    """q, v, a and the applied τ of block `block`, states [start, stop) of the dataset: the whole
+    block (its last states only if the dataset ends inside it)."""
     rng = np.random.default_rng(np.random.SeedSequence([seed, block]))
     count = stop - start
     kind = sampler["kind"]
@@ -85,11 +88,11 @@ def _fill_chunk(model: _core.Model, out: str, form: str, index: int, chunk: int,
     """Samples chunk `index`, evaluates the quantities, writes them and marks the chunk done."""
     start, stop = index * chunk, min((index + 1) * chunk, n)
     limits = _limits(model)
-    parts = [
-        _block(model, sampler, limits, seed, b, b * SEED_BLOCK, min((b + 1) * SEED_BLOCK, n))
-        for b in range(start // SEED_BLOCK, (stop + SEED_BLOCK - 1) // SEED_BLOCK)
-    ]
-    arrays = {key: np.concatenate([p[key] for p in parts]) for key in parts[0]}
+    first, last = start // SEED_BLOCK, (stop + SEED_BLOCK - 1) // SEED_BLOCK
+    parts = [_block(model, sampler, limits, seed, b, b * SEED_BLOCK, min((b + 1) * SEED_BLOCK, n)) for b in range(first, last)]
+    # the blocks overlapped draw whole, so a state's values do not depend on where chunks end
+    offset = first * SEED_BLOCK
+    arrays = {key: np.concatenate([p[key] for p in parts])[start - offset : stop - offset] for key in parts[0]}
     q, v, a, tau = arrays["q"], arrays["v"], arrays["a"], arrays["tau_applied"]
     for name in quantities:
         arrays[name] = QUANTITIES[name][0](model, q, v, a, tau)
@@ -215,8 +218,9 @@ def dataset(
       `tau_applied`.
     - `quantities`: any of "tau" (inverse dynamics at q, v, a), "M" (mass matrix), "g" (gravity),
       "qdd" (forward dynamics at q, v, tau_applied).
-    - `chunk`: states per task and per Zarr chunk, a multiple of `SEED_BLOCK`; `seed` and the
-      sampler decide the store, whatever the chunk size and the number of workers.
+    - `chunk`: states per task and per Zarr chunk, any positive number; `seed` and the sampler
+      decide the store, whatever the chunk size and the number of workers (states are drawn in
+      blocks of `SEED_BLOCK`, each chunk drawing the blocks it overlaps).
     - `client`: a `dask.distributed.Client` (a local cluster or a scheduler's address); without
       one the chunks run here, one after the other, by the same code.
     - `resume=True` continues a store left incomplete by an interrupted run (same arguments),
@@ -229,8 +233,9 @@ def dataset(
     n = int(n)
     if n < 1:
         raise ValueError(f"argument 'n': expected a positive number of states, got {n}")
-    if chunk < SEED_BLOCK or chunk % SEED_BLOCK:
-        raise ValueError(f"argument 'chunk': expected a multiple of {SEED_BLOCK}, got {chunk}")
+    if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
+        raise ValueError(f"argument 'chunk': expected a positive whole number of states, got {chunk!r}")
+    chunk = int(chunk)
     unknown = [q for q in quantities if q not in QUANTITIES]
     if unknown:
         raise ValueError(f"argument 'quantities': expected names among {sorted(QUANTITIES)}, got {unknown}")

@@ -61,6 +61,57 @@ def test_the_store_does_not_depend_on_the_chunking(tmp_path):
     assert not np.array_equal(other_seed["q"][:], make(tmp_path, "d.zarr")["q"][:])
 
 
+#: States for the chunkings below: not a multiple of 256, 1000 or 5000, so each last chunk is short.
+UNEVEN_N = 5300
+
+
+def test_chunks_of_any_size_give_the_same_store(tmp_path):
+    # chunk edges inside seed blocks (5000, 1000, 77), on them (256), and one chunk of all states
+    options = dict(n=UNEVEN_N, quantities=["tau", "qdd"])
+    reference = make(tmp_path, "256.zarr", chunk=256, **options)
+    for chunk in (5000, 1000, 77, UNEVEN_N):
+        store = make(tmp_path, f"{chunk}.zarr", chunk=chunk, **options)
+        assert store["q"].chunks == (chunk, 6) and store["done"].shape == (-(-UNEVEN_N // chunk),)
+        assert_same_store(store, reference)
+    expected = robodyn.read_dataset(tmp_path / "256.zarr")
+    for chunk in (5000, 1000):
+        make(tmp_path, f"{chunk}.parquet", chunk=chunk, **options)
+        written = robodyn.read_dataset(tmp_path / f"{chunk}.parquet")
+        for name, values in expected.items():
+            np.testing.assert_array_equal(written[name], values, err_msg=f"{name}, Parquet chunks of {chunk}")
+
+
+def test_the_gaussian_and_given_samplers_do_not_depend_on_the_chunking(tmp_path):
+    q = robodyn.load("ur5").random_configuration(n=UNEVEN_N, seed=2)
+    for label, sampler in (("gaussian", "gaussian"), ("given", q)):
+        options = dict(n=UNEVEN_N, quantities=["tau"], sampler=sampler)
+        assert_same_store(make(tmp_path, f"{label}-1000.zarr", chunk=1000, **options),
+                          make(tmp_path, f"{label}-256.zarr", chunk=256, **options))
+
+
+def test_a_store_in_uneven_chunks_resumes_to_the_same_values(tmp_path, monkeypatch):
+    options = dict(n=UNEVEN_N, quantities=["tau"], chunk=1000)
+    complete = make(tmp_path, "full.zarr", **options)
+    make(tmp_path, "partial.zarr", **options)
+    make(tmp_path, "partial.parquet", **options)
+    # chunk 1, states 1000-1999, starts and ends inside seed blocks 3 and 7
+    writable = zarr.open_group(str(tmp_path / "partial.zarr"), mode="r+")
+    writable["done"][1] = False
+    for name in ("q", "v", "a", "tau_applied", "tau"):
+        writable[name][1000:2000] = 0.0
+    # chunk 5, the short last one (states 5000-5299)
+    (tmp_path / "partial.parquet" / "part-000005.parquet").unlink()
+    computed = []
+    fill = robodyn.datasets._fill_chunk
+    monkeypatch.setattr(robodyn.datasets, "_fill_chunk", lambda *a: computed.append(a[3]) or fill(*a))
+    assert_same_store(make(tmp_path, "partial.zarr", resume=True, **options), complete)
+    make(tmp_path, "partial.parquet", resume=True, **options)
+    assert computed == [1, 5]
+    resumed = robodyn.read_dataset(tmp_path / "partial.parquet")
+    for name in resumed:
+        np.testing.assert_array_equal(resumed[name], complete[name][:], err_msg=name)
+
+
 def test_gaussian_and_given_samplers(tmp_path):
     m = robodyn.load("ur5")
     center = m.neutral() + 0.3
@@ -75,8 +126,9 @@ def test_gaussian_and_given_samplers(tmp_path):
 
 def test_bad_arguments_are_named(tmp_path):
     m = robodyn.load("ur5")
-    with pytest.raises(ValueError, match="argument 'chunk': expected a multiple of 256"):
-        make(tmp_path, "x.zarr", chunk=1000)
+    for chunk in (0, -256, 2.5, "512"):
+        with pytest.raises(ValueError, match=f"argument 'chunk': expected a positive whole number of states, got {chunk!r}"):
+            make(tmp_path, "x.zarr", chunk=chunk)
     with pytest.raises(ValueError, match="argument 'quantities'"):
         make(tmp_path, "x.zarr", quantities=["torque"])
     with pytest.raises(ValueError, match="argument 'sampler'"):

@@ -12,7 +12,7 @@ from conftest import CROSS_CHECK_TOLERANCE, REPOSITORY, ROBOTS, assert_close
 
 import robodyn
 from robodyn.convert import MujocoLayout
-from robodyn.crosscheck import mujoco_discrepancies, rigid_body_only
+from robodyn.crosscheck import EXACT, compare_bodies, mujoco_discrepancies, rigid_body_only
 
 
 def mujoco_model(urdf):
@@ -25,8 +25,11 @@ QUANTITIES = {"M", "bias", "forward_dynamics", "inverse_dynamics", "body_pose", 
 
 
 def check_against_mujoco(model, mj, seed, label, states=3):
-    """Dynamics, body and site poses, Jacobians and J̇v at a few random states, through
-    robodyn.convert's MuJoCo layout (robodyn.crosscheck)."""
+    """Every body's compiled inertia exactly MuJoCo's (none comes from a mesh), then dynamics, body
+    and site poses, Jacobians and J̇v at a few random states, through robodyn.convert's MuJoCo
+    layout (robodyn.crosscheck)."""
+    inexact = [str(body) for body in compare_bodies(model, mj) if body.verdict != EXACT]
+    assert not inexact, f"{label}: compiled inertias differ from MuJoCo's: {inexact}"
     errors = mujoco_discrepancies(model, mj, seed=seed, states=states)
     assert QUANTITIES <= set(errors), f"{label}: compared only {sorted(errors)}"
     assert ("site_pose" in errors) == (mj.nsite > 0)
