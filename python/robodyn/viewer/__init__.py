@@ -102,8 +102,8 @@ class Viewer:
     drawn (MuJoCo's default 0, 1, 2; None for all). ``host`` is the loopback address unless you
     want other machines to connect; ``port`` is tried first, then the next free one.
     ``open_browser``: open the page (default: when a desktop session is there). ``camera``:
-    (position, point looked at) of the first view, in world coordinates (default: the whole robot
-    from the front right and above).
+    (position, point looked at) of the first view, in world coordinates (default: the whole robot,
+    planes left out, from the front right and above).
     Use :meth:`show` to pose the robot, :meth:`close` (or a ``with`` block) to stop the server.
     """
 

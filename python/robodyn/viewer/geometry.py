@@ -49,6 +49,8 @@ class Piece:
     vertices: np.ndarray
     faces: np.ndarray
     rgba: tuple[float, float, float, float]
+    #: Left out of the first view's framing: planes (often unbounded floors).
+    backdrop: bool = False
 
 
 def _primitive(kind: str, size: list[float]):
@@ -143,7 +145,7 @@ def visual_pieces(model, groups: tuple[int, ...] | None = MUJOCO_VISIBLE_GROUPS)
         else:
             mesh = _primitive(visual["kind"], visual["size"])
             pieces.append(Piece(visual["name"], visual["body"], _affine(placement, np.asarray(mesh.vertices)),
-                                np.asarray(mesh.faces, dtype=np.int64), rgba))
+                                np.asarray(mesh.faces, dtype=np.int64), rgba, backdrop=visual["kind"] == "plane"))
     return pieces
 
 

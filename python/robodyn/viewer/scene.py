@@ -35,9 +35,12 @@ def poses_to_wxyz_position(poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _bounds(pieces: list[Piece], poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The world bounding box of the pieces (and body origins) at body poses ``poses``."""
-    points = [poses[:, :3, 3]]
-    for piece in pieces:
+    """The world bounding box of the pieces and the moving bodies' origins at body poses
+    ``poses``, planes left out (a floor is unbounded, or drawn far larger than the robot) unless
+    there is nothing else."""
+    framed = [piece for piece in pieces if not piece.backdrop] or pieces
+    points = [poses[1:, :3, 3] if len(poses) > 1 else poses[:, :3, 3]]
+    for piece in framed:
         low, high = piece.vertices.min(axis=0), piece.vertices.max(axis=0)
         corners = np.array([[x, y, z] for x in (low[0], high[0]) for y in (low[1], high[1]) for z in (low[2], high[2])])
         pose = poses[piece.body]
@@ -63,8 +66,9 @@ def _node_name(text: str) -> str:
 class RobotScene:
     """The robot's nodes in ``server``'s scene, set up for body poses ``poses`` (nbodies, 4, 4)
     and centre of mass ``com``; ``frames``, ``com_marker`` and ``ground`` switch the overlays.
-    The initial camera shows the robot whole (at every pose of ``extent_poses`` when given), from
-    the front right and above, unless ``camera`` gives its (position, point looked at)."""
+    The initial camera shows the robot whole (at every pose of ``extent_poses`` when given; planes
+    left out), from the front right and above, unless ``camera`` gives its (position, point
+    looked at)."""
 
     def __init__(self, server, pieces: list[Piece], poses: np.ndarray, com: np.ndarray, *,
                  frames: bool = False, com_marker: bool = False, ground: bool = True,
