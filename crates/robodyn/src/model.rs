@@ -8,7 +8,7 @@ pub use builder::{ModelBuilder, NewBody};
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::joint::Joint;
 use crate::spatial::{Inertia, Mat3, Transform, Turn, Vec3};
-use crate::visual::Visual;
+use crate::visual::{Texture, Visual};
 use nalgebra::DVector;
 use rand::Rng;
 
@@ -164,6 +164,8 @@ pub struct Model {
     pub warnings: Vec<String>,
     /// What the links look like (URDF `<visual>`, MJCF geoms); only the viewer reads it.
     pub visuals: Vec<Visual>,
+    /// The scene's background (MJCF's first `<texture type="skybox">`); only the viewer reads it.
+    pub skybox: Option<Texture>,
 }
 
 impl Model {

@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 use crate::joint::Joint;
 use crate::spatial::turn::snapped_signed_permutation;
 use crate::spatial::{Inertia, Transform, Vec3};
-use crate::visual::Visual;
+use crate::visual::{Texture, Visual};
 use nalgebra::DVector;
 
 /// A moving body for [`ModelBuilder::add_body`].
@@ -68,6 +68,7 @@ impl ModelBuilder {
                 mimics: Vec::new(),
                 warnings: Vec::new(),
                 visuals: Vec::new(),
+                skybox: None,
             },
         }
     }
@@ -183,6 +184,11 @@ impl ModelBuilder {
     /// Adds a piece of visual geometry.
     pub fn add_visual(&mut self, visual: Visual) {
         self.model.visuals.push(visual);
+    }
+
+    /// Sets the scene's background texture.
+    pub fn set_skybox(&mut self, texture: Texture) {
+        self.model.skybox = Some(texture);
     }
 
     /// Adds a named frame on `body` at `placement` (`X_{frame←body}`).
