@@ -1,6 +1,7 @@
 """MJCF features MuJoCo applies to the model, each on a test model in testdata/mjcf/, compared field
 by field with MuJoCo (robodyn.crosscheck): nested includes, the compiler's mass options, an
-<inertial> without a tensor, armature on a free joint, sites placed by fromto."""
+<inertial> without a tensor, armature on a free joint, sites placed by fromto, and the neutral
+configuration (MuJoCo's qpos0)."""
 
 from __future__ import annotations
 
@@ -10,15 +11,22 @@ import pytest
 from conftest import CROSS_CHECK_TOLERANCE, REPOSITORY
 
 import robodyn
+from robodyn.convert import MujocoLayout
 from robodyn.crosscheck import EXACT, WITHIN_NOISE, mujoco_agreement, mujoco_discrepancies, rigid_body_only
 
 TEST_MJCF = REPOSITORY / "testdata" / "mjcf"
-FEATURE_MODELS = ["nested/scene.xml", "compiler_mass.xml", "free_armature.xml", "framed_joints.xml", "mesh_inertia.xml", "mesh_fitaabb.xml"]
+FEATURE_MODELS = ["nested/scene.xml", "compiler_mass.xml", "free_armature.xml", "framed_joints.xml", "mesh_inertia.xml", "mesh_fitaabb.xml",
+                  "reference_pose.xml"]
 
 
 def mujoco_and_robodyn(name):
     path = TEST_MJCF / name
     return rigid_body_only(mujoco.MjModel.from_xml_path(str(path))), robodyn.load(path)
+
+
+#: robodyn finds a free joint's neutral quaternion from the body's rotation matrix, MuJoCo keeps the
+#: file's orientation as a quaternion: the two agree to a few rounding errors of unit quantities.
+QPOS0_TOLERANCE = 1e-14
 
 
 @pytest.mark.parametrize("name", FEATURE_MODELS)
@@ -111,3 +119,34 @@ def test_mesh_errors_name_the_mesh(mesh, message, tmp_path):
     with pytest.raises(ValueError, match=message) as error:
         robodyn.load(path)
     assert "<mesh name='m'>" in str(error.value) and "model.xml" in str(error.value)
+
+
+def test_neutral_is_mujocos_qpos0():
+    """A free joint at its body's pose in the file, hinges and slides at their ref, a ball joint at
+    the identity: robodyn's neutral() is MuJoCo's qpos0, and every body is where MuJoCo puts it."""
+    mj, model = mujoco_and_robodyn("reference_pose.xml")
+    layout = MujocoLayout(model, mj)
+    q = np.asarray(model.neutral())
+    qpos0 = layout.q_from_mujoco(mj.qpos0)
+    # q and -q are one rotation: each quaternion compared with the sign of MuJoCo's
+    for kind, start in zip(model.joint_types, model.joint_idx_q):
+        offset = {"free": 3, "spherical": 0}.get(kind)
+        if offset is not None:
+            quaternion = slice(start + offset, start + offset + 4)
+            q[quaternion] *= np.sign(q[quaternion] @ qpos0[quaternion])
+    np.testing.assert_allclose(q, qpos0, rtol=0, atol=QPOS0_TOLERANCE)
+    assert q[model.joint_idx_q[model.joint_names.index("arm_hinge")]] == pytest.approx(np.radians(-45), abs=1e-16)
+    data = mujoco.MjData(mj)
+    data.qpos[:] = mj.qpos0
+    mujoco.mj_kinematics(mj, data)
+    for body in range(1, mj.nbody):
+        pose = np.asarray(model.frame_pose(model.neutral(), mj.body(body).name))
+        np.testing.assert_allclose(pose[:3, 3], data.xpos[body], rtol=0, atol=QPOS0_TOLERANCE)
+        np.testing.assert_allclose(pose[:3, :3], data.xmat[body].reshape(3, 3), rtol=0, atol=QPOS0_TOLERANCE)
+
+
+def test_urdf_neutral_is_zero_angles_and_identity_quaternions():
+    model = robodyn.load("ur5", floating_base=True)
+    expected = np.zeros(model.nq)
+    expected[6] = 1.0
+    assert np.asarray(model.neutral()).tolist() == expected.tolist()

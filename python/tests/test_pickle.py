@@ -20,7 +20,7 @@ def every_model(robots_dir):
     models += [robodyn.load("ur5", floating_base=True)]
     for path, floating in ROBOTS.values():
         models.append(robodyn.load(robots_dir / path, floating_base=floating))
-    for name in ("iiwa14.xml", "free_armature.xml", "mesh_inertia.xml", "ur5e_nomesh.xml"):
+    for name in ("iiwa14.xml", "free_armature.xml", "mesh_inertia.xml", "ur5e_nomesh.xml", "reference_pose.xml"):
         models.append(robodyn.load(TESTDATA / "mjcf" / name))
     models.append(robodyn.load(TESTDATA / "dh" / "rpp_arm.toml"))
     return models
@@ -52,6 +52,7 @@ def outputs(m):
         "gravity": np.asarray(m.gravity),
         "passive": np.concatenate([m.armature, m.damping, m.friction, m.stiffness]),
         "parameters": m.inertial_parameters,
+        "neutral": m.neutral(),
     }
 
 

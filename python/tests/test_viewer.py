@@ -15,7 +15,7 @@ import pytest
 
 import robodyn
 from browser import colour_fraction, project, screenshot
-from robodyn.viewer import TrajectoryViewer
+from robodyn.viewer import TrajectoryViewer, Viewer
 from robodyn.viewer.geometry import stick_pieces, visual_pieces
 from robodyn.viewer.scene import CAMERA_FOV
 
@@ -295,6 +295,17 @@ def test_readme_picture(tmp_path: Path) -> None:
         from PIL import Image
 
         Image.fromarray(picture.astype(np.uint8)).save(ROOT / "docs" / "viewer.png", optimize=True)
+
+
+def test_the_first_view_frames_the_bodies_not_the_floor() -> None:
+    """The arm stands on a 1.2 m plane: the first view frames the arm alone (within its own reach),
+    and the camera comes as close as the arm's size asks."""
+    model = robodyn.load(ARM)
+    with Viewer(model, open_browser=False, port=0) as viewer:
+        low, high = viewer.scene.bounds
+        position, target = viewer.scene.camera
+    assert np.all(low[:2] > -0.2) and np.all(high[:2] < 0.2), (low, high)
+    assert np.linalg.norm(position - target) < 2.0
 
 
 def test_player_rejects_an_unknown_speed() -> None:

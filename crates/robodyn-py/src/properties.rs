@@ -283,7 +283,9 @@ impl PyModel {
         )
     }
 
-    /// The neutral configuration: zero angles, identity quaternions. Shape (nq,).
+    /// The neutral configuration, shape (nq,): zero angles and identity quaternions for URDF and
+    /// DH models; MuJoCo's `qpos0` for an MJCF model (free joints at their bodies' poses in the
+    /// file, hinges and slides at their `ref`).
     fn neutral<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         vector_array(py, self.model.neutral().as_slice())
     }

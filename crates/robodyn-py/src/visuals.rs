@@ -9,7 +9,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use robodyn::io::mesh::{read_mesh, TriangleMesh};
-use robodyn::visual::{MeshSource, Shape};
+use robodyn::visual::{MeshSource, Shape, Texture, TextureImage};
 
 /// A triangle mesh as NumPy arrays: vertices (n, 3) and faces (m, 3).
 type MeshArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>);
@@ -30,15 +30,64 @@ fn mesh_arrays<'py>(py: Python<'py>, mesh: &TriangleMesh) -> PyResult<MeshArrays
     ))
 }
 
+/// A texture as a dict: `name`, `kind` ("2d", "cube", "skybox"), `element`, and its image: `file`
+/// (with `hflip`, `vflip`), or `builtin` (a dict: `pattern`, `rgb1`, `rgb2`, `mark`, `markrgb`,
+/// `random`, `width`, `height`), or `undrawable` (why robodyn cannot draw it); the others None.
+fn texture_dict<'py>(py: Python<'py>, texture: &Texture) -> PyResult<Bound<'py, PyDict>> {
+    let item = PyDict::new(py);
+    item.set_item("name", &texture.name)?;
+    item.set_item("kind", texture.kind.as_str())?;
+    item.set_item("element", &texture.element)?;
+    item.set_item("file", py.None())?;
+    item.set_item("builtin", py.None())?;
+    item.set_item("undrawable", py.None())?;
+    match &texture.image {
+        TextureImage::File { path, hflip, vflip } => {
+            item.set_item("file", path.display().to_string())?;
+            item.set_item("hflip", *hflip)?;
+            item.set_item("vflip", *vflip)?;
+        }
+        TextureImage::Builtin(builtin) => {
+            let pattern = PyDict::new(py);
+            pattern.set_item("pattern", &builtin.pattern)?;
+            pattern.set_item("rgb1", builtin.rgb1.to_vec())?;
+            pattern.set_item("rgb2", builtin.rgb2.to_vec())?;
+            pattern.set_item("mark", &builtin.mark)?;
+            pattern.set_item("markrgb", builtin.mark_rgb.to_vec())?;
+            pattern.set_item("random", builtin.random)?;
+            pattern.set_item("width", builtin.width)?;
+            pattern.set_item("height", builtin.height)?;
+            item.set_item("builtin", pattern)?;
+        }
+        TextureImage::Undrawable(why) => item.set_item("undrawable", why)?,
+    }
+    Ok(item)
+}
+
 #[pymethods]
 impl PyModel {
+    /// The scene's background texture (MJCF's first `<texture type="skybox">`) as a dict (see
+    /// `visuals`' `texture`), or None.
+    #[getter]
+    fn skybox<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        self.model
+            .skybox
+            .as_ref()
+            .map(|texture| texture_dict(py, texture))
+            .transpose()
+    }
+
     /// The robot's visual geometry (URDF `<visual>`s, MJCF geoms), one dict each: `name`,
     /// `body` (index into `["world"] + body_names`), `placement` (4x4 pose in the body),
     /// `kind` ("box", "sphere", "cylinder", "capsule", "ellipsoid", "plane", "mesh"), `size`
     /// (MJCF's convention: half-extents, radius, [radius, half-length]), `rgba`, `group` (MJCF;
     /// MuJoCo shows 0–2), `element` (where it is written), and for meshes `mesh_file` (or
     /// `mesh_vertices` and `mesh_faces` when written inline), `mesh_missing` (why the file was
-    /// not found, else None) and `file_to_visual` (4x4, may scale).
+    /// not found, else None) and `file_to_visual` (4x4, may scale); `texture`: None, or the
+    /// texture its MJCF material lays on it, a dict with `name`, `kind` ("2d", "cube",
+    /// "skybox"), `element`, `repeat` (`texrepeat`), `uniform` (`texuniform`) and its image:
+    /// `file` (a PNG, with `hflip` and `vflip`), `builtin` (a dict: `pattern`, `rgb1`, `rgb2`,
+    /// `mark`, `markrgb`, `random`, `width`, `height`) or `undrawable` (why it is not drawn).
     #[getter]
     fn visuals<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         let mut visuals = Vec::with_capacity(self.model.visuals.len());
@@ -67,6 +116,15 @@ impl PyModel {
             item.set_item("rgba", visual.rgba.to_vec())?;
             item.set_item("group", visual.group)?;
             item.set_item("element", &visual.element)?;
+            match &visual.texture {
+                None => item.set_item("texture", py.None())?,
+                Some(mapping) => {
+                    let texture = texture_dict(py, &mapping.texture)?;
+                    texture.set_item("repeat", mapping.repeat.to_vec())?;
+                    texture.set_item("uniform", mapping.uniform)?;
+                    item.set_item("texture", texture)?;
+                }
+            }
             if let Shape::Mesh {
                 source,
                 file_to_visual,

@@ -8,7 +8,7 @@ pub use builder::{ModelBuilder, NewBody};
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::joint::Joint;
 use crate::spatial::{Inertia, Mat3, Transform, Turn, Vec3};
-use crate::visual::Visual;
+use crate::visual::{Texture, Visual};
 use nalgebra::DVector;
 use rand::Rng;
 
@@ -149,6 +149,11 @@ pub struct Model {
     /// simulation, like damping and friction.
     pub stiffness: DVector<f64>,
     pub spring_reference: DVector<f64>,
+    /// The configuration [`Model::neutral`] returns, length nq: zero angles and displacements and
+    /// identity quaternions, except where the loader knows the pose the file draws (an MJCF
+    /// model's MuJoCo `qpos0`: a free joint at its body's pose in the file, a hinge or slide at
+    /// its `ref`).
+    pub neutral_configuration: DVector<f64>,
     /// Named frames: one per link, moving or merged.
     pub frames: Vec<Frame>,
     /// Gravitational acceleration in world axes.
@@ -159,6 +164,8 @@ pub struct Model {
     pub warnings: Vec<String>,
     /// What the links look like (URDF `<visual>`, MJCF geoms); only the viewer reads it.
     pub visuals: Vec<Visual>,
+    /// The scene's background (MJCF's first `<texture type="skybox">`); only the viewer reads it.
+    pub skybox: Option<Texture>,
 }
 
 impl Model {
@@ -234,13 +241,11 @@ impl Model {
         self.idx_v[i]..self.idx_v[i] + self.joints[i].nv()
     }
 
-    /// The neutral configuration: zero angles and displacements, identity quaternions.
+    /// The neutral configuration ([`Model::neutral_configuration`]): zero angles and
+    /// displacements and identity quaternions for URDF and DH models; an MJCF model's MuJoCo
+    /// `qpos0`, the pose its file draws.
     pub fn neutral(&self) -> DVector<f64> {
-        let mut q = DVector::zeros(self.nq);
-        for i in 1..self.nbodies() {
-            self.joints[i].neutral(&mut q.as_mut_slice()[self.q_range(i)]);
-        }
-        q
+        self.neutral_configuration.clone()
     }
 
     /// A random configuration within the position limits (see [`Joint::random`]).

@@ -84,4 +84,79 @@ pub struct Visual {
     pub group: i64,
     /// The element it comes from (file, element, line), for messages about it.
     pub element: String,
+    /// The texture its material lays on it (MJCF), drawn times `rgba`.
+    pub texture: Option<TextureMapping>,
+}
+
+/// What an MJCF `<texture>` is for (`type`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum TextureKind {
+    /// An image laid on a surface by texture coordinates (`2d`).
+    Planar,
+    /// Six square faces around the object (`cube`).
+    Cube,
+    /// Six square faces around the whole scene, its background (`skybox`).
+    Skybox,
+}
+
+impl TextureKind {
+    /// The kind as MJCF names it.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            TextureKind::Planar => "2d",
+            TextureKind::Cube => "cube",
+            TextureKind::Skybox => "skybox",
+        }
+    }
+}
+
+/// The image of a texture MuJoCo draws itself (`builtin`): `pattern` in `rgb1` and `rgb2`, then
+/// the `mark` in `markrgb`, on `width` x `height` pixels (each face of a cube `width` square).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct BuiltinTexture {
+    /// "gradient", "checker" or "flat".
+    pub pattern: String,
+    pub rgb1: [f64; 3],
+    pub rgb2: [f64; 3],
+    /// "none", "edge", "cross" or "random" (dots, each pixel with probability `random`).
+    pub mark: String,
+    pub mark_rgb: [f64; 3],
+    pub random: f64,
+    pub width: usize,
+    pub height: usize,
+}
+
+/// Where a texture's image comes from.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum TextureImage {
+    /// A PNG file, mirrored left to right (`hflip`) or top to bottom (`vflip`) when drawn.
+    File {
+        path: PathBuf,
+        hflip: bool,
+        vflip: bool,
+    },
+    Builtin(BuiltinTexture),
+    /// A texture robodyn cannot draw, and why (a file not found, not a PNG, a cube's faces from
+    /// files): the viewer draws the material's colour and warns.
+    Undrawable(String),
+}
+
+/// An MJCF `<texture>`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Texture {
+    /// Its name in the file (or one made from its position there).
+    pub name: String,
+    pub kind: TextureKind,
+    pub image: TextureImage,
+    /// The element it comes from (file, element, line), for messages about it.
+    pub element: String,
+}
+
+/// A texture as a material lays it on a geom: `repeat` times over the geom (`texrepeat`), or
+/// per two spatial units where `uniform` (`texuniform`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TextureMapping {
+    pub texture: Texture,
+    pub repeat: [f64; 2],
+    pub uniform: bool,
 }

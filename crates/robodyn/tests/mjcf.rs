@@ -84,6 +84,59 @@ fn tree_classes_and_degrees() {
 }
 
 #[test]
+fn neutral_is_mujocos_qpos0() {
+    // a free joint at its body's pose in the file, hinges and slides at their ref
+    let model = load_mjcf_str(
+        r#"<mujoco><worldbody>
+          <body name="base" pos="0.5 -1 2" axisangle="0 0 1 90"><freejoint/>
+            <inertial mass="1" diaginertia="1 1 1"/>
+            <body name="link" pos="1 0 0"><joint name="hinge" axis="0 0 1" ref="30"/>
+              <inertial mass="1" diaginertia="1 1 1"/>
+              <body name="tip" pos="1 0 0"><joint name="slide" type="slide" ref="0.25"/>
+                <inertial mass="1" diaginertia="1 1 1"/>
+                <body name="ball"><joint type="ball"/><inertial mass="1" diaginertia="1 1 1"/>
+                </body>
+              </body>
+            </body>
+          </body>
+        </worldbody></mujoco>"#,
+        "reference.xml",
+    )
+    .unwrap();
+    let half = std::f64::consts::FRAC_1_SQRT_2;
+    let expected = [
+        0.5,
+        -1.0,
+        2.0,
+        0.0,
+        0.0,
+        half,
+        half,               // free: the body's pose
+        30f64.to_radians(), // hinge: its ref
+        0.25,               // slide: its ref
+        0.0,
+        0.0,
+        0.0,
+        1.0, // ball: the identity
+    ];
+    let q = model.neutral();
+    for (k, (a, b)) in q.iter().zip(expected).enumerate() {
+        assert!((a - b).abs() < 1e-15, "q[{k}] = {a}, expected {b}");
+    }
+    // at q = ref every body is where the file puts it
+    let mut data = Data::new(&model);
+    let tip = frame_pose(
+        &model,
+        &mut data,
+        q.as_slice(),
+        model.frame_index("tip").unwrap(),
+    )
+    .unwrap();
+    let expected_tip = nalgebra::Vector3::new(0.5, 1.0, 2.0);
+    assert!((tip.translation - expected_tip).norm() < 1e-12, "{tip:?}");
+}
+
+#[test]
 fn errors_name_element_and_line() {
     let cases = [
         ("<mujoco><worldbody>\n<body name='x'><geom type='mesh' mesh='m'/></body></worldbody></mujoco>", "<body name='x'>/<geom> (line 2): attribute 'mesh': no <mesh name='m'> in the <asset>s"),

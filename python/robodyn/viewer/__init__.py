@@ -102,8 +102,9 @@ class Viewer:
     drawn (MuJoCo's default 0, 1, 2; None for all). ``host`` is the loopback address unless you
     want other machines to connect; ``port`` is tried first, then the next free one.
     ``open_browser``: open the page (default: when a desktop session is there). ``camera``:
-    (position, point looked at) of the first view, in world coordinates (default: the whole robot
-    from the front right and above).
+    (position, point looked at) of the first view, in world coordinates (default: the whole robot,
+    planes left out, from the front right and above). MJCF textures and the skybox are drawn (see
+    ``robodyn.viewer.textures``).
     Use :meth:`show` to pose the robot, :meth:`close` (or a ``with`` block) to stop the server.
     """
 
@@ -122,7 +123,7 @@ class Viewer:
         self.model = model
         pieces = _pieces(model, groups)
         self.server = _server(host, port)
-        self.scene = RobotScene(self.server, pieces, poses, com, extent_poses=extent_poses, **options)
+        self.scene = RobotScene(self.server, pieces, poses, com, extent_poses=extent_poses, skybox=model.skybox, **options)
         self.url = f"http://{host}:{self.server.get_port()}"
 
     def _open(self, open_browser: bool | None) -> None:
@@ -254,7 +255,7 @@ def model_html(model, path: str | os.PathLike[str], q=None, *, frames: bool = Fa
     pieces = _pieces(model, groups)
     server = _server(LOOPBACK, 0)
     RobotScene(server, pieces, np.asarray(model.body_poses(q)), np.asarray(model.center_of_mass(q)),
-               frames=frames, com_marker=com, ground=ground, camera=camera)
+               frames=frames, com_marker=com, ground=ground, camera=camera, skybox=model.skybox)
     return _write_html(server, lambda serializer: None, target)
 
 
@@ -269,7 +270,7 @@ def trajectory_html(trajectory, path: str | os.PathLike[str], *, frames: bool = 
     pieces = _pieces(trajectory.model, groups)
     server = _server(LOOPBACK, 0)
     scene = RobotScene(server, pieces, poses[0], coms[0], frames=frames, com_marker=com, ground=ground,
-                       extent_poses=_spread(poses), camera=camera)
+                       extent_poses=_spread(poses), camera=camera, skybox=trajectory.model.skybox)
     frame_times = np.arange(times[0], times[-1] + 0.5 / PLAYBACK_RATE, 1.0 / PLAYBACK_RATE)
 
     def record(serializer) -> None:

@@ -4,18 +4,22 @@ Each visual of ``Model.visuals`` becomes one or more :class:`Piece`: primitives 
 trimesh, MuJoCo's mesh formats (STL, OBJ, .msh) are read by robodyn's own readers (the ones the
 mesh inertias use), and the formats ROS robots ship (Collada ``.dae``, glTF, PLY, ...) by trimesh,
 keeping the colours of their materials unless the model gives the visual a colour of its own.
+MJCF textures (``robodyn.viewer.textures``) are laid on planes by MuJoCo's texture coordinates and
+on meshes by their files'; the skybox is a panorama on a sphere around the scene.
 """
 
 from __future__ import annotations
 
 import os
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from robodyn import _core
+from robodyn.viewer.textures import plane_uv, skybox_panorama, texture_image, undrawn
 
-__all__ = ["DEFAULT_RGBA", "MUJOCO_VISIBLE_GROUPS", "Piece", "stick_pieces", "visual_pieces"]
+__all__ = ["DEFAULT_RGBA", "MUJOCO_VISIBLE_GROUPS", "Piece", "skybox_piece", "stick_pieces", "visual_pieces"]
 
 #: MuJoCo's geom colour when nothing gives one; a visual of this colour keeps its mesh's own.
 DEFAULT_RGBA = (0.5, 0.5, 0.5, 1.0)
@@ -37,6 +41,11 @@ STICK_RGBA = (0.35, 0.45, 0.6, 1.0)
 JOINT_RGBA = (0.9, 0.5, 0.1, 1.0)
 #: The formats robodyn reads itself, triangulated as MuJoCo triangulates them.
 OWN_FORMATS = {".stl", ".obj", ".msh"}
+#: The skybox sphere: its radius as a multiple of the scene's size (at least
+#: :data:`SKYBOX_MIN_RADIUS` metres), inside the camera's far plane, and its tessellation.
+SKYBOX_RADIUS_FACTOR = 20.0
+SKYBOX_MIN_RADIUS = 50.0
+SKYBOX_SEGMENTS = (64, 32)
 
 
 @dataclass
@@ -49,6 +58,14 @@ class Piece:
     vertices: np.ndarray
     faces: np.ndarray
     rgba: tuple[float, float, float, float]
+    #: When textured: texture coordinates (n, 2) in trimesh's convention (v from the image's
+    #: bottom) and the image (PIL), drawn times ``rgba``.
+    uv: np.ndarray | None = None
+    image: Any = None
+    #: Left out of the first view's framing: planes (often unbounded floors) and the skybox.
+    backdrop: bool = False
+    #: Drawn in its own colours whatever the light (the skybox).
+    unlit: bool = False
 
 
 def _primitive(kind: str, size: list[float]):
@@ -111,6 +128,42 @@ def _mesh_file_parts(visual: dict) -> list[tuple[np.ndarray, np.ndarray, tuple[f
     return parts
 
 
+def _textured_mesh(visual: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """(vertices, faces, uv) of a mesh file that has texture coordinates, else None."""
+    import trimesh
+
+    path = visual.get("mesh_file")
+    if path is None:
+        return None
+    try:
+        mesh = trimesh.load(path, process=False, force="mesh")
+    except Exception as error:  # trimesh raises many kinds; name the file and element
+        raise ValueError(f"{visual['element']}: cannot read the mesh file '{path}' ({type(error).__name__}: {error})") from None
+    uv = getattr(mesh.visual, "uv", None)
+    if uv is None or len(uv) != len(mesh.vertices):
+        return None
+    return np.asarray(mesh.vertices), np.asarray(mesh.faces, dtype=np.int64), np.asarray(uv, dtype=float)
+
+
+class _TextureImages:
+    """Each 2-D texture's image, made once; a texture that cannot be drawn warns once."""
+
+    def __init__(self) -> None:
+        self.images: dict[str, Any] = {}
+        self.warned: set[str] = set()
+
+    def image(self, texture: dict[str, Any]):
+        key = texture["element"]
+        if key not in self.images:
+            self.images[key] = texture_image(texture)
+        return self.images[key]
+
+    def undrawn(self, texture: dict[str, Any], why: str) -> None:
+        if texture["element"] not in self.warned:
+            self.warned.add(texture["element"])
+            undrawn(texture, why)
+
+
 def _affine(matrix: np.ndarray, points: np.ndarray) -> np.ndarray:
     """Points mapped by a 4x4 homogeneous matrix."""
     return points @ matrix[:3, :3].T + matrix[:3, 3]
@@ -123,15 +176,30 @@ def visual_pieces(model, groups: tuple[int, ...] | None = MUJOCO_VISIBLE_GROUPS)
     pieces = []
     # a file named by several visuals (a hand's fingers) is read once
     files: dict[str, list[tuple[np.ndarray, np.ndarray, tuple[float, ...] | None]]] = {}
+    textures = _TextureImages()
     for visual in model.visuals:
         if groups is not None and visual["group"] not in groups:
             continue
         placement = np.asarray(visual["placement"])
         rgba = tuple(float(np.clip(c, 0.0, 1.0)) for c in visual["rgba"])
+        texture = visual.get("texture")
+        image = None
+        if texture is not None and texture["kind"] != "2d":
+            textures.undrawn(texture, f"a {texture['kind']} texture on a {visual['kind']} geom is not drawn")
+        elif texture is not None:
+            image = textures.image(texture)
         if visual["kind"] == "mesh":
             to_body = placement @ np.asarray(visual["file_to_visual"])
             # a mirroring scale turns the faces inside out: turn them back
             flip = np.linalg.det(to_body[:3, :3]) < 0
+            textured = _textured_mesh(visual) if image is not None else None
+            if image is not None and textured is None:
+                textures.undrawn(texture, "the mesh has no texture coordinates")
+            if textured is not None:
+                vertices, faces, uv = textured
+                pieces.append(Piece(visual["name"], visual["body"], _affine(to_body, vertices), faces[:, ::-1] if flip else faces,
+                                    rgba, uv=uv, image=image))
+                continue
             key = visual.get("mesh_file") or f"inline:{visual['element']}"
             if key not in files:
                 files[key] = _mesh_file_parts(visual)
@@ -140,11 +208,44 @@ def visual_pieces(model, groups: tuple[int, ...] | None = MUJOCO_VISIBLE_GROUPS)
                 color = own if (own is not None and rgba == DEFAULT_RGBA) else rgba
                 pieces.append(Piece(f"{visual['name']}/{k}", visual["body"], _affine(to_body, np.asarray(vertices, dtype=float)),
                                     faces[:, ::-1] if flip else faces, color))
-        else:
-            mesh = _primitive(visual["kind"], visual["size"])
-            pieces.append(Piece(visual["name"], visual["body"], _affine(placement, np.asarray(mesh.vertices)),
-                                np.asarray(mesh.faces, dtype=np.int64), rgba))
+            continue
+        mesh = _primitive(visual["kind"], visual["size"])
+        vertices = np.asarray(mesh.vertices)
+        piece = Piece(visual["name"], visual["body"], _affine(placement, vertices), np.asarray(mesh.faces, dtype=np.int64), rgba,
+                      backdrop=visual["kind"] == "plane")
+        if image is not None and visual["kind"] == "plane":
+            # trimesh's v runs from the image's bottom, MuJoCo's t from its top row
+            st = plane_uv(vertices, visual["size"], texture)
+            piece.uv, piece.image = np.stack([st[:, 0], 1 - st[:, 1]], axis=1), image
+        elif image is not None:
+            textures.undrawn(texture, f"robodyn lays 2-D textures on planes and meshes, not on a {visual['kind']}")
+        pieces.append(piece)
     return pieces
+
+
+def skybox_piece(texture: dict[str, Any] | None, centre: np.ndarray, size: float) -> Piece | None:
+    """A skybox texture (``Model.skybox``) as an unlit sphere around ``centre``, larger than the
+    scene's ``size``, painted with its panorama; None when there is none, or with a warning when
+    it cannot be drawn."""
+    from PIL import Image
+
+    if texture is None:
+        return None
+    if texture["builtin"] is None:
+        undrawn(texture, texture["undrawable"] or "a skybox from image files is not drawn")
+        return None
+    columns, rows = SKYBOX_SEGMENTS
+    longitude = np.linspace(-np.pi, np.pi, columns + 1)
+    latitude = np.linspace(np.pi / 2, -np.pi / 2, rows + 1)
+    lon, lat = np.meshgrid(longitude, latitude)
+    radius = max(SKYBOX_RADIUS_FACTOR * size, SKYBOX_MIN_RADIUS)
+    vertices = radius * np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], axis=-1).reshape(-1, 3)
+    uv = np.stack([(lon + np.pi) / (2 * np.pi), (lat + np.pi / 2) / np.pi], axis=-1).reshape(-1, 2)
+    index = np.arange((rows + 1) * (columns + 1)).reshape(rows + 1, columns + 1)
+    a, b, c, d = index[:-1, :-1], index[:-1, 1:], index[1:, :-1], index[1:, 1:]
+    faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([b, d, c], -1).reshape(-1, 3)])
+    return Piece("skybox", 0, vertices + centre, faces, (1.0, 1.0, 1.0, 1.0), uv=uv,
+                 image=Image.fromarray(skybox_panorama(texture["builtin"])), backdrop=True, unlit=True)
 
 
 def _rod(start: np.ndarray, end: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarray] | None:

@@ -8,7 +8,8 @@ from typing import Any
 
 import numpy as np
 
-from robodyn.viewer.geometry import Piece
+from robodyn.viewer.geometry import Piece, skybox_piece
+from robodyn.viewer.textures import unlit_glb
 
 __all__ = ["RobotScene", "camera_for", "poses_to_wxyz_position"]
 
@@ -35,9 +36,12 @@ def poses_to_wxyz_position(poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _bounds(pieces: list[Piece], poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The world bounding box of the pieces (and body origins) at body poses ``poses``."""
-    points = [poses[:, :3, 3]]
-    for piece in pieces:
+    """The world bounding box of the pieces and the moving bodies' origins at body poses
+    ``poses``, planes left out (a floor is unbounded, or drawn far larger than the robot) unless
+    there is nothing else."""
+    framed = [piece for piece in pieces if not piece.backdrop] or pieces
+    points = [poses[1:, :3, 3] if len(poses) > 1 else poses[:, :3, 3]]
+    for piece in framed:
         low, high = piece.vertices.min(axis=0), piece.vertices.max(axis=0)
         corners = np.array([[x, y, z] for x in (low[0], high[0]) for y in (low[1], high[1]) for z in (low[2], high[2])])
         pose = poses[piece.body]
@@ -55,6 +59,20 @@ def camera_for(low: np.ndarray, high: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return centre + distance * direction, centre
 
 
+def _textured_glb(piece: Piece) -> bytes:
+    """A textured piece as a binary glTF: its image times its colour, seen from both sides."""
+    import trimesh
+
+    colour = np.round(255 * np.asarray(piece.rgba)).astype(np.uint8)
+    material = trimesh.visual.material.PBRMaterial(baseColorTexture=piece.image, baseColorFactor=colour, doubleSided=True,
+                                                   metallicFactor=0.0, roughnessFactor=1.0,
+                                                   alphaMode="BLEND" if piece.rgba[3] < 1 else None)
+    mesh = trimesh.Trimesh(piece.vertices, piece.faces, process=False,
+                           visual=trimesh.visual.TextureVisuals(uv=piece.uv, material=material))
+    glb = mesh.export(file_type="glb")
+    return unlit_glb(glb) if piece.unlit else glb
+
+
 def _node_name(text: str) -> str:
     """A scene-node name part: letters, digits, '_' and '-' only."""
     return re.sub(r"[^A-Za-z0-9_-]", "_", text)
@@ -63,12 +81,14 @@ def _node_name(text: str) -> str:
 class RobotScene:
     """The robot's nodes in ``server``'s scene, set up for body poses ``poses`` (nbodies, 4, 4)
     and centre of mass ``com``; ``frames``, ``com_marker`` and ``ground`` switch the overlays.
-    The initial camera shows the robot whole (at every pose of ``extent_poses`` when given), from
-    the front right and above, unless ``camera`` gives its (position, point looked at)."""
+    The initial camera shows the robot whole (at every pose of ``extent_poses`` when given; planes
+    left out), from the front right and above, unless ``camera`` gives its (position, point
+    looked at). ``skybox``: the model's skybox texture (``Model.skybox``), drawn around the scene."""
 
     def __init__(self, server, pieces: list[Piece], poses: np.ndarray, com: np.ndarray, *,
                  frames: bool = False, com_marker: bool = False, ground: bool = True,
-                 extent_poses: np.ndarray | None = None, camera: tuple[Any, Any] | None = None) -> None:
+                 extent_poses: np.ndarray | None = None, camera: tuple[Any, Any] | None = None,
+                 skybox: dict[str, Any] | None = None) -> None:
         self.server = server
         scene = server.scene
         scene.set_up_direction("+z")
@@ -92,10 +112,14 @@ class RobotScene:
         for body in range(len(poses)):
             self.bodies.append(scene.add_frame(f"/robot/body{body}", show_axes=frames, axes_length=AXES_FRACTION * size,
                                                axes_radius=AXES_FRACTION * size / 20))
-        for index, piece in enumerate(pieces):
+        sky = skybox_piece(skybox, (low + high) / 2, size)
+        for index, piece in enumerate(pieces + ([sky] if sky is not None else [])):
+            name = f"/robot/body{piece.body}/{index}_{_node_name(piece.name)}"
+            if piece.image is not None:
+                scene.add_glb(name, _textured_glb(piece), cast_shadow=False, receive_shadow=False)
+                continue
             rgb = tuple(int(round(255 * c)) for c in piece.rgba[:3])
-            scene.add_mesh_simple(f"/robot/body{piece.body}/{index}_{_node_name(piece.name)}",
-                                  vertices=piece.vertices.astype(np.float32), faces=piece.faces.astype(np.uint32),
+            scene.add_mesh_simple(name, vertices=piece.vertices.astype(np.float32), faces=piece.faces.astype(np.uint32),
                                   color=rgb, opacity=piece.rgba[3] if piece.rgba[3] < 1 else None, side="double")
         self.com = scene.add_icosphere("/com", radius=COM_FRACTION * size, color=COM_RGB, visible=com_marker)
         self.show(poses, com)

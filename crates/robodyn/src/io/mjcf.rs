@@ -33,6 +33,7 @@ mod inertia;
 mod mass;
 mod meshes;
 mod schema_table;
+mod textures;
 mod visuals;
 
 use inertia::InertiaFromGeoms;
@@ -158,6 +159,9 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         mesh_directory: None,
         fit_aabb: false,
         mesh_cache: RefCell::new(HashMap::new()),
+        textures: HashMap::new(),
+        skybox: None,
+        texture_directory: None,
         warnings: RefCell::new(Vec::new()),
     };
     if !root.has_tag_name("mujoco") {
@@ -180,6 +184,7 @@ fn load_sources(sources: &Sources) -> Result<Model> {
     }
     for asset in sections.iter().filter(|c| c.has_tag_name("asset")) {
         reader.read_assets(*asset)?;
+        reader.read_textures(*asset)?;
     }
     let mut builder = ModelBuilder::new(root.attribute("model").unwrap_or("mjcf"), "world");
     builder.add_frame("world", 0, Transform::IDENTITY);
@@ -207,6 +212,9 @@ fn load_sources(sources: &Sources) -> Result<Model> {
             Transform::IDENTITY,
         )?;
         reader.read_children(&mut builder, *world, 0, Transform::IDENTITY, "main")?;
+    }
+    if let Some(skybox) = reader.skybox_texture()? {
+        builder.set_skybox(skybox);
     }
     if let Some(factor) = reader.mass_rules.total_mass_scale(reader.total_mass.get()) {
         builder.scale_inertias(factor);
@@ -240,6 +248,11 @@ struct Reader<'a> {
     /// `<compiler fitaabb>`: primitives fitted to a mesh's bounding box rather than its inertia
     fit_aabb: bool,
     mesh_cache: RefCell<HashMap<String, meshes::CompiledMesh>>,
+    /// `<asset><texture>` elements by name, the first skybox, and `<compiler texturedir>` (or
+    /// `assetdir`)
+    textures: HashMap<String, Node<'a, 'a>>,
+    skybox: Option<Node<'a, 'a>>,
+    texture_directory: Option<String>,
     /// what the model's warnings will say of the files read on the way (meshes' dropped faces)
     warnings: RefCell<Vec<String>>,
 }
@@ -329,6 +342,12 @@ impl<'a> Reader<'a> {
             .or(compiler.attribute("assetdir"))
         {
             self.mesh_directory = Some(folder.to_string());
+        }
+        if let Some(folder) = compiler
+            .attribute("texturedir")
+            .or(compiler.attribute("assetdir"))
+        {
+            self.texture_directory = Some(folder.to_string());
         }
         if let Some(value) = compiler.attribute("fitaabb") {
             self.fit_aabb = value == "true";

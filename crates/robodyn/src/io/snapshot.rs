@@ -14,7 +14,7 @@ use crate::model::Model;
 const TAG: &[u8; 8] = b"robodyn\0";
 
 /// The snapshot format: bumped whenever `Model` (or a type inside it) changes its fields.
-pub const MODEL_FORMAT: u32 = 1;
+pub const MODEL_FORMAT: u32 = 2;
 
 /// The model as bytes.
 pub fn model_to_bytes(model: &Model) -> Vec<u8> {
@@ -114,6 +114,11 @@ fn check_structure(model: &Model) -> Result<()> {
         ("lower_position_limit", model.lower_position_limit.len(), nq),
         ("upper_position_limit", model.upper_position_limit.len(), nq),
         ("spring_reference", model.spring_reference.len(), nq),
+        (
+            "neutral_configuration",
+            model.neutral_configuration.len(),
+            nq,
+        ),
         ("velocity_limit", model.velocity_limit.len(), nv),
         ("effort_limit", model.effort_limit.len(), nv),
         ("armature", model.armature.len(), nv),

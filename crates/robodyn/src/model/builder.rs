@@ -1,11 +1,13 @@
 //! [`ModelBuilder`]: a model built body by body, as every loader builds one.
 
-use super::{run_start, Frame, JointProperties, Mimic, Model, STANDARD_GRAVITY};
+use super::{
+    run_start, Frame, JointProperties, Mimic, Model, QUATERNION_NORM_TOLERANCE, STANDARD_GRAVITY,
+};
 use crate::error::{Error, Result};
 use crate::joint::Joint;
 use crate::spatial::turn::snapped_signed_permutation;
 use crate::spatial::{Inertia, Transform, Vec3};
-use crate::visual::Visual;
+use crate::visual::{Texture, Visual};
 use nalgebra::DVector;
 
 /// A moving body for [`ModelBuilder::add_body`].
@@ -60,11 +62,13 @@ impl ModelBuilder {
                 friction: DVector::zeros(0),
                 stiffness: DVector::zeros(0),
                 spring_reference: DVector::zeros(0),
+                neutral_configuration: DVector::zeros(0),
                 frames: Vec::new(),
                 gravity: Vec3::new(0.0, 0.0, -STANDARD_GRAVITY),
                 mimics: Vec::new(),
                 warnings: Vec::new(),
                 visuals: Vec::new(),
+                skybox: None,
             },
         }
     }
@@ -141,6 +145,8 @@ impl ModelBuilder {
         extend(&mut m.friction, nv, properties.friction);
         extend(&mut m.stiffness, nv, properties.stiffness);
         extend(&mut m.spring_reference, nq, properties.spring_reference);
+        extend(&mut m.neutral_configuration, nq, 0.0);
+        joint.neutral(&mut m.neutral_configuration.as_mut_slice()[m.nq - nq..]);
         if nq > 1 {
             joint.neutral(&mut m.spring_reference.as_mut_slice()[m.nq - nq..]);
         }
@@ -180,6 +186,11 @@ impl ModelBuilder {
         self.model.visuals.push(visual);
     }
 
+    /// Sets the scene's background texture.
+    pub fn set_skybox(&mut self, texture: Texture) {
+        self.model.skybox = Some(texture);
+    }
+
     /// Adds a named frame on `body` at `placement` (`X_{frame←body}`).
     pub fn add_frame(&mut self, name: &str, body: usize, placement: Transform) {
         self.model.frames.push(Frame {
@@ -197,6 +208,40 @@ impl ModelBuilder {
     /// Records something the user should know about the model.
     pub fn warn(&mut self, message: String) {
         self.model.warnings.push(message);
+    }
+
+    /// Sets body `body`'s joint coordinates in the neutral configuration (the pose the file
+    /// draws, [`Model::neutral`]); a quaternion among them must have unit norm.
+    pub fn set_neutral(&mut self, body: usize, q: &[f64]) -> Result<()> {
+        let m = &mut self.model;
+        let joint_name = m.joint_names.get(body).cloned().unwrap_or_default();
+        let refuse = |message: String| Err(Error::model(format!("joint '{joint_name}'"), message));
+        if body == 0 || body >= m.parent.len() {
+            return refuse(format!("body {body} does not exist or has no joint"));
+        }
+        let joint = m.joints[body];
+        if q.len() != joint.nq() {
+            return refuse(format!(
+                "expected {} neutral coordinates, got {}",
+                joint.nq(),
+                q.len()
+            ));
+        }
+        if let Some(offset) = joint.quaternion_offset() {
+            let norm = q[offset..offset + 4]
+                .iter()
+                .map(|x| x * x)
+                .sum::<f64>()
+                .sqrt();
+            if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
+                return refuse(format!(
+                    "the neutral quaternion has norm {norm}, expected 1"
+                ));
+            }
+        }
+        let start = m.idx_q[body];
+        m.neutral_configuration.as_mut_slice()[start..start + q.len()].copy_from_slice(q);
+        Ok(())
     }
 
     /// Sets the gravity vector.

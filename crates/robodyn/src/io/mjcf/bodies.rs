@@ -6,7 +6,7 @@ use crate::error::Result;
 use crate::joint::Joint;
 use crate::model::{JointProperties, ModelBuilder, NewBody};
 use crate::spatial::{Inertia, Transform, Vec3};
-use nalgebra::Unit;
+use nalgebra::{Rotation3, Unit, UnitQuaternion};
 use roxmltree::Node;
 
 /// Whether `element` is a `<frame>` of the worldbody itself (not of one of its bodies).
@@ -17,6 +17,23 @@ fn in_world_frame(element: Node) -> bool {
             .skip(1)
             .find(|a| a.has_tag_name("body") || a.has_tag_name("worldbody"))
             .is_some_and(|a| a.has_tag_name("worldbody"))
+}
+
+/// A free joint's `[x, y, z, qx, qy, qz, qw]` that places its body at `to_body`
+/// (`X_{B←world}`).
+fn free_joint_coordinates(to_body: &Transform) -> [f64; 7] {
+    let rotation = Rotation3::from_matrix_unchecked(to_body.rotation.transpose());
+    let quaternion = UnitQuaternion::from_rotation_matrix(&rotation);
+    let p = to_body.translation;
+    [
+        p.x,
+        p.y,
+        p.z,
+        quaternion.i,
+        quaternion.j,
+        quaternion.k,
+        quaternion.w,
+    ]
 }
 
 impl<'a> Reader<'a> {
@@ -273,6 +290,12 @@ impl<'a> Reader<'a> {
                     Inertia::ZERO
                 },
             })?;
+            // MuJoCo's qpos0: a hinge or slide at its ref, a free joint at the body's XML pose
+            if joint == Joint::Free {
+                builder.set_neutral(body, &free_joint_coordinates(&to_body))?;
+            } else if joint.nq() == 1 {
+                builder.set_neutral(body, &[reference])?;
+            }
             previous_position = position;
             to_body = to_own_frame;
         }

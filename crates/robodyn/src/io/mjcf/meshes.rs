@@ -184,30 +184,9 @@ impl<'a> Reader<'a> {
         Ok(TriangleMesh { vertices, faces })
     }
 
-    /// Where a mesh file is: relative to `<compiler meshdir>` (or `assetdir`), itself relative to
-    /// the main file's folder, else to the folder of the file holding the `<mesh>`.
+    /// Where a mesh file is: see [`Reader::find_asset_file`], under `<compiler meshdir>`.
     fn find_mesh_file(&self, mesh: Node<'a, 'a>, file: &str) -> Result<PathBuf> {
-        let directory = self.mesh_directory.as_deref().unwrap_or("");
-        let main = self.sources.files[0].folder.clone();
-        let own = self.sources.files[self.file_index(mesh)].folder.clone();
-        let mut tried = Vec::new();
-        for folder in [main, own].into_iter().flatten() {
-            let path = folder.join(directory).join(file);
-            if path.is_file() {
-                return Ok(path);
-            }
-            if !tried.contains(&path) {
-                tried.push(path);
-            }
-        }
-        if tried.is_empty() {
-            return Err(self.error(mesh, format!("the mesh file '{file}' is resolved against the model's folder: load the model from its file")));
-        }
-        let places: Vec<String> = tried.iter().map(|p| p.display().to_string()).collect();
-        Err(self.error(
-            mesh,
-            format!("mesh file '{file}' not found; tried {}", places.join(", ")),
-        ))
+        self.find_asset_file(mesh, file, self.mesh_directory.as_deref(), "mesh")
     }
 
     /// A primitive fitted to the mesh `mesh` (MuJoCo's `FitGeom`): its size and

@@ -45,6 +45,10 @@ impl<'a> Reader<'a> {
                 rgba: self.geom_rgba(geom, class)?,
                 group: self.geom_group(geom, class)?,
                 element: self.location(geom),
+                texture: match self.geom_material(geom, class)? {
+                    Some(material) => self.material_texture(material)?,
+                    None => None,
+                },
             });
         }
         Ok(())
@@ -109,15 +113,7 @@ impl<'a> Reader<'a> {
     /// A geom's colour: its `rgba` unless that is MuJoCo's default and it names a material.
     fn geom_rgba(&self, geom: Node<'a, 'a>, class: &str) -> Result<[f64; 4]> {
         let own = self.numbers::<4>(geom, class, "rgba")?;
-        let material = match self.attribute(geom, class, "material") {
-            None => None,
-            Some(name) => Some(*self.materials.get(&name).ok_or_else(|| {
-                self.error(
-                    geom,
-                    format!("attribute 'material': no <material name='{name}'> in the <asset>s"),
-                )
-            })?),
-        };
+        let material = self.geom_material(geom, class)?;
         let rgba = match (own, material) {
             (Some(rgba), Some(_)) if rgba != DEFAULT_RGBA => rgba,
             (_, Some(material)) => {
@@ -128,5 +124,18 @@ impl<'a> Reader<'a> {
             (own, None) => own.unwrap_or(DEFAULT_RGBA),
         };
         Ok(rgba)
+    }
+
+    /// The `<material>` a geom names, if any.
+    fn geom_material(&self, geom: Node<'a, 'a>, class: &str) -> Result<Option<Node<'a, 'a>>> {
+        match self.attribute(geom, class, "material") {
+            None => Ok(None),
+            Some(name) => Ok(Some(*self.materials.get(&name).ok_or_else(|| {
+                self.error(
+                    geom,
+                    format!("attribute 'material': no <material name='{name}'> in the <asset>s"),
+                )
+            })?)),
+        }
     }
 }

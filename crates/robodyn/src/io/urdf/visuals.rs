@@ -57,6 +57,7 @@ impl<'a> Parser<'a> {
                     rgba: self.visual_color(visual, &materials, &mut undefined)?,
                     group: 0,
                     element: self.location(visual),
+                    texture: None,
                 });
             }
         }
