@@ -58,7 +58,9 @@ pub struct DroppedPolygon {
 impl DroppedPolygon {
     /// What a model's warning says of it, after the file's name.
     pub fn describe(&self) -> String {
-        let line = self.line.map_or_else(String::new, |l| format!("line {l}: "));
+        let line = self
+            .line
+            .map_or_else(String::new, |l| format!("line {l}: "));
         format!(
             "{line}a face of {} corners gives no triangles, as in MuJoCo, which cuts faces of at most {MAX_POLYGON_CORNERS} corners (the mesh's mass properties and its drawing leave it out)",
             self.corners
@@ -236,7 +238,11 @@ fn face_line(bytes: &[u8], k: usize, corners: usize) -> Option<usize> {
         .enumerate()
         .filter(|(_, line)| line.trim_ascii_start().starts_with(b"f "))
         .nth(k)?;
-    let found = line.split(|b| b.is_ascii_whitespace()).filter(|w| !w.is_empty()).count() - 1;
+    let found = line
+        .split(|b| b.is_ascii_whitespace())
+        .filter(|w| !w.is_empty())
+        .count()
+        - 1;
     (found == corners).then_some(number + 1)
 }
 
@@ -624,13 +630,21 @@ mod tests {
     fn malformed_files_are_errors() {
         assert!(
             read_mesh(b"solid nothing", "stl").is_err()
-                || read_mesh(b"solid nothing", "stl").unwrap().mesh.check().is_err()
+                || read_mesh(b"solid nothing", "stl")
+                    .unwrap()
+                    .mesh
+                    .check()
+                    .is_err()
         );
         assert!(read_mesh(&[0u8; 10], "msh").unwrap_err().contains("header"));
         assert!(read_mesh(b"", "ply")
             .unwrap_err()
             .contains(".stl, .obj or .msh"));
         let obj = read_mesh(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "obj").unwrap();
-        assert!(obj.mesh.check().unwrap_err().contains("at least 4 vertices"));
+        assert!(obj
+            .mesh
+            .check()
+            .unwrap_err()
+            .contains("at least 4 vertices"));
     }
 }

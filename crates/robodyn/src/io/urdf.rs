@@ -19,8 +19,8 @@ use crate::io::xml::{check_nesting, location, parse_numbers};
 use crate::io::{read_model_file, LoadOptions};
 use crate::joint::Joint;
 use crate::model::{
-    check_mass_and_inertia, check_physical_parameters, JointProperties, Mimic, Model,
-    ModelBuilder, NewBody, Unphysical,
+    check_mass_and_inertia, check_physical_parameters, JointProperties, Mimic, Model, ModelBuilder,
+    NewBody, Unphysical,
 };
 use crate::spatial::{rotation_from_rpy, Inertia, Mat3, Transform, Vec3};
 use roxmltree::{Document, Node};
@@ -291,8 +291,8 @@ impl<'a> Parser<'a> {
                 return Err(self.error(node, "duplicate joint name"));
             }
             let link_of = |tag: &str| -> Result<usize> {
-                let element = Self::child(node, tag)
-                    .ok_or_else(|| self.missing_child(node, tag))?;
+                let element =
+                    Self::child(node, tag).ok_or_else(|| self.missing_child(node, tag))?;
                 let link = self.attribute(element, "link")?;
                 index.get(link).copied().ok_or_else(|| {
                     self.error(node, format!("<{tag} link='{link}'>: no link of that name"))
