@@ -34,7 +34,16 @@ from robodyn._core import (
     load_urdf_string,
 )
 from robodyn.operational_space import operational_space as _operational_space
-from robodyn.simulation import PD, ComputedTorque, GravityCompensation, Trajectory, simulate, step
+from robodyn.simulation import (
+    PD,
+    AccuracyError,
+    AccuracyWarning,
+    ComputedTorque,
+    GravityCompensation,
+    Trajectory,
+    simulate,
+    step,
+)
 from robodyn.datasets import dataset, read_dataset, simulate_many
 
 # methods composed in NumPy from the core's batched calls
@@ -63,6 +72,8 @@ Model.view = _view
 Model.to_html = _to_html
 
 __all__ = [
+    "AccuracyError",
+    "AccuracyWarning",
     "ComputedTorque",
     "dataset",
     "read_dataset",
@@ -89,6 +100,10 @@ __version__ = "0.1.0"
 
 class ModelWarning(UserWarning):
     """A model loaded, but with something you should know (see ``Model.warnings``)."""
+
+
+# the warning (a UserWarning, like ModelWarning) and error of simulate's accuracy check live
+# beside simulate, in robodyn.simulation
 
 
 def models() -> list[str]:

@@ -191,7 +191,8 @@ def simulate(
     limit_stiffness: float = 1e4,
     limit_damping: float = 1e2,
     progress: Callable[[float], object] | None = None,
-) -> dict[str, FloatArray | list[int]]: ...
+    accuracy_rtol: float = 1e-3,
+) -> dict[str, Any]: ...
 def step(
     model: Model,
     q: ArrayLike,

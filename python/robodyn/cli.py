@@ -353,7 +353,7 @@ def simulate(model: str, t_end: float, dt: float, integrator: str, q0: Sequence[
         show_progress = t_end / dt > PROGRESS_BAR_SAMPLES and terminal
     begin = time.perf_counter()
     trajectory = robodyn.simulate(m, start_q, t_end=t_end, dt=dt, integrator=integrator,
-                                  controller=controllers[controller],
+                                  controller=controllers[controller], accuracy="ignore",
                                   progress=_progress_bar("simulating") if show_progress else None)
     elapsed = time.perf_counter() - begin
     drift = float(np.max(np.abs(trajectory.energy - trajectory.energy[0])))
@@ -361,6 +361,8 @@ def simulate(model: str, t_end: float, dt: float, integrator: str, q0: Sequence[
           f"{trajectory.rejected_steps} rejected, {trajectory.evaluations} evaluations of the dynamics)")
     print(f"energy: {trajectory.energy[0]:.6g} J at the start, {trajectory.energy[-1]:.6g} J at the end, "
           f"largest change {drift:.3g} J")
+    if trajectory.accuracy_issue is not None:
+        print(f"accuracy: {trajectory.accuracy_issue['message']}")
     kinds = dict(zip(m.joint_names, m.joint_types))
     for violation in trajectory.limit_violations:
         unit = _unit(kinds[violation["joint"]])

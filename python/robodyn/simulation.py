@@ -14,6 +14,15 @@ The loop runs in Rust (``robodyn._core.simulate``). Integrators: ``"euler"`` (ex
 dense output at every ``dt``). Spherical and free joints are integrated on their Lie group
 (Runge–Kutta–Munthe-Kaas), so quaternions stay unit without renormalisation.
 
+Accuracy: fixed-step runs check themselves. Every 50th step (and the first) is compared with two
+half steps, which estimates its local error; while nothing puts energy in or takes it out (no
+damping, friction, limit penalty, controller torque or wrench), the energy drift is tracked too.
+Past ``rtol`` (1e-3 of the state by default) :func:`simulate` warns once per run with an
+:class:`AccuracyWarning` naming the time, the error and the largest step that meets the tolerance
+(``accuracy="raise"`` raises :class:`AccuracyError` instead, ``"ignore"`` says nothing); the
+estimates stay in :class:`Trajectory` (``error_times``, ``error_estimate``, ``energy_drift``,
+``accuracy_issue``). RK45 controls its own error and is not checked.
+
 Controllers: the native :class:`PD`, :class:`ComputedTorque`, :class:`GravityCompensation`, a
 constant torque (an array of nv), or any Python callable ``controller(t, q, v) -> tau``. A callable is
 the slow path: it is called from Rust at every stage of every step (four times per RK4 step) with the
@@ -24,6 +33,7 @@ from __future__ import annotations
 
 import csv
 import os
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Sequence, Union, overload
@@ -37,6 +47,9 @@ from numpy.typing import ArrayLike
 from robodyn import _core
 
 __all__ = [
+    "AccuracyError",
+    "AccuracyWarning",
+    "ACCURACY_MODES",
     "ComputedTorque",
     "GravityCompensation",
     "INTEGRATORS",
@@ -50,6 +63,21 @@ __all__ = [
 INTEGRATORS = ("euler", "semi_implicit_euler", "rk4", "rk45")
 #: What :func:`simulate` does at a joint limit: report it, or also push back with a penalty.
 LIMIT_MODELS = ("report", "penalty")
+#: What :func:`simulate` does with a fixed-step run less accurate than ``rtol``.
+ACCURACY_MODES = ("warn", "raise", "ignore")
+#: The default ``rtol``: RK45's tolerance per step, and the fixed-step schemes' accuracy check.
+RK45_RTOL = 1e-6
+ACCURACY_RTOL = 1e-3
+
+
+class AccuracyWarning(UserWarning):
+    """A fixed-step simulation less accurate than its ``rtol``: the message says from when, how
+    large the error is and the largest step that meets the tolerance (see :func:`simulate`)."""
+
+
+class AccuracyError(_core.SimulationError):
+    """``simulate(..., accuracy="raise")`` on a fixed-step run less accurate than its ``rtol``
+    (a :class:`robodyn.SimulationError`, so a ``ValueError``); the message is the warning's."""
 
 
 def _reference_spec(q_ref, reference) -> dict[str, Any]:
@@ -171,6 +199,13 @@ class Trajectory:
     penalty). Energies (J), per sample: ``kinetic_energy``, ``potential_energy`` (gravity),
     ``spring_energy`` and their sum ``energy``. ``limit_violations`` lists the joints that left their
     position range. ``steps``, ``rejected_steps`` and ``evaluations`` tell the work done.
+
+    Accuracy (fixed-step schemes; empty or None for RK45): ``error_estimate`` holds the local error
+    of the steps checked by step doubling, relative to the state's size, at the steps' start times
+    ``error_times``; ``energy_drift`` the largest |E − E₀| relative to the largest kinetic energy while
+    the system was conservative (None if it never was); ``accuracy_issue``, when a measure exceeded
+    ``rtol``, a dict ``{"message", "measure"}`` (``"local_error"`` or ``"energy_drift"``), ``"time"``
+    (first exceeded, s), ``"error"`` (largest, relative) and ``"largest_step"`` (s).
     """
 
     model: Any = field(repr=False)
@@ -184,6 +219,10 @@ class Trajectory:
     steps: int
     rejected_steps: int
     evaluations: int
+    error_times: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False)
+    error_estimate: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False)
+    energy_drift: float | None = None
+    accuracy_issue: dict[str, Any] | None = None
     kinetic_energy: np.ndarray = field(init=False, repr=False)
     potential_energy: np.ndarray = field(init=False, repr=False)
     spring_energy: np.ndarray = field(init=False, repr=False)
@@ -306,25 +345,28 @@ Configurations = Union["np.ndarray[tuple[int, int], np.dtype[Any]]", Sequence[Se
 @overload
 def simulate(model: _core.Model, q0: Configuration, v0: ArrayLike | None = None, t_end: float = 1.0,
              dt: float = 1e-3, integrator: str = "rk4", controller: Any = None, wrenches: Any = None, *,
-             rtol: float = 1e-6, atol: float = 1e-9, max_step: float | None = None, friction_velocity: float = 1e-2,
-             limits: str = "report", limit_stiffness: float = 1e4, limit_damping: float = 1e2,
-             progress: Callable[[float], Any] | None = None) -> Trajectory: ...
+             rtol: float | None = None, atol: float = 1e-9, max_step: float | None = None,
+             friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
+             limit_damping: float = 1e2, progress: Callable[[float], Any] | None = None,
+             accuracy: str = "warn") -> Trajectory: ...
 
 
 @overload
 def simulate(model: _core.Model, q0: Configurations, v0: ArrayLike | None = None, t_end: float = 1.0,
              dt: float = 1e-3, integrator: str = "rk4", controller: Any = None, wrenches: Any = None, *,
-             rtol: float = 1e-6, atol: float = 1e-9, max_step: float | None = None, friction_velocity: float = 1e-2,
-             limits: str = "report", limit_stiffness: float = 1e4, limit_damping: float = 1e2,
-             progress: Callable[[float], Any] | None = None) -> list[Trajectory]: ...
+             rtol: float | None = None, atol: float = 1e-9, max_step: float | None = None,
+             friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
+             limit_damping: float = 1e2, progress: Callable[[float], Any] | None = None,
+             accuracy: str = "warn") -> list[Trajectory]: ...
 
 
 @overload
 def simulate(model: _core.Model, q0: ArrayLike, v0: ArrayLike | None = None, t_end: float = 1.0,
              dt: float = 1e-3, integrator: str = "rk4", controller: Any = None, wrenches: Any = None, *,
-             rtol: float = 1e-6, atol: float = 1e-9, max_step: float | None = None, friction_velocity: float = 1e-2,
-             limits: str = "report", limit_stiffness: float = 1e4, limit_damping: float = 1e2,
-             progress: Callable[[float], Any] | None = None) -> Trajectory | list[Trajectory]: ...
+             rtol: float | None = None, atol: float = 1e-9, max_step: float | None = None,
+             friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
+             limit_damping: float = 1e2, progress: Callable[[float], Any] | None = None,
+             accuracy: str = "warn") -> Trajectory | list[Trajectory]: ...
 
 
 def simulate(
@@ -337,7 +379,7 @@ def simulate(
     controller: Any = None,
     wrenches: Any = None,
     *,
-    rtol: float = 1e-6,
+    rtol: float | None = None,
     atol: float = 1e-9,
     max_step: float | None = None,
     friction_velocity: float = 1e-2,
@@ -345,6 +387,7 @@ def simulate(
     limit_stiffness: float = 1e4,
     limit_damping: float = 1e2,
     progress: Callable[[float], Any] | None = None,
+    accuracy: str = "warn",
 ) -> Trajectory | list[Trajectory]:
     """Simulate ``model`` from (``q0``, ``v0``) at t = 0 to ``t_end``, recording every ``dt``.
 
@@ -358,7 +401,17 @@ def simulate(
 
     ``integrator``: ``"euler"``, ``"semi_implicit_euler"`` or ``"rk4"`` step by ``dt``; ``"rk45"``
     chooses its steps to keep each one's error below ``atol + rtol·|x|`` (per component; ``max_step``
-    bounds them) and records every ``dt`` by dense output.
+    bounds them; ``rtol`` defaults to 1e-6 there) and records every ``dt`` by dense output.
+
+    Accuracy of the fixed-step schemes: the first step and every 50th are compared with two half
+    steps (step doubling), which estimates their local error relative to the state's size (max(1,
+    largest speed)); while the system is conservative (no damping, friction, limit penalty,
+    controller torque or wrench) the energy drift, relative to the largest kinetic energy, is
+    tracked too. When either exceeds ``rtol`` (default 1e-3), ``accuracy="warn"`` (the default)
+    issues one :class:`AccuracyWarning` per run with the time, the error and the largest step that
+    meets the tolerance; ``"raise"`` raises :class:`AccuracyError` (after the run) instead and
+    ``"ignore"`` says nothing. The estimates are kept in the :class:`Trajectory`. RK45 keeps its own
+    error below ``rtol`` and is not checked.
 
     ``controller``: ``None`` (no torque), a constant torque (nv values), :class:`PD`,
     :class:`ComputedTorque`, :class:`GravityCompensation`, or a callable ``(t, q, v) -> tau`` (slow
@@ -374,7 +427,8 @@ def simulate(
     held; Ctrl-C stops it).
 
     Raises ``ValueError`` naming the argument for bad input, and when the simulation diverges (with
-    the time it happened); an exception raised by a callback propagates unchanged.
+    the time it happened; :class:`robodyn.SimulationError`); an exception raised by a callback
+    propagates unchanged.
     """
     q0 = _numbers("q0", q0)
     v0 = np.zeros(q0.shape[:-1] + (model.nv,)) if v0 is None else _numbers("v0", v0)
@@ -382,21 +436,46 @@ def simulate(
         raise ValueError(f"argument 'integrator': expected one of {list(INTEGRATORS)}, got {integrator!r}")
     if limits not in LIMIT_MODELS:
         raise ValueError(f"argument 'limits': expected one of {list(LIMIT_MODELS)}, got {limits!r}")
+    if not isinstance(accuracy, str) or accuracy not in ACCURACY_MODES:
+        raise ValueError(f"argument 'accuracy': expected one of {list(ACCURACY_MODES)}, got {accuracy!r}")
+    # one rtol: RK45's step control, or the fixed-step schemes' accuracy check
+    adaptive = integrator == "rk45"
+    rk45_rtol = _real("rtol", rtol) if rtol is not None and adaptive else RK45_RTOL
+    accuracy_rtol = _real("rtol", rtol) if rtol is not None and not adaptive else ACCURACY_RTOL
     result = _core.simulate(
-        model, q0, v0, _real("t_end", t_end), _real("dt", dt), integrator, _real("rtol", rtol), _real("atol", atol),
+        model, q0, v0, _real("t_end", t_end), _real("dt", dt), integrator, rk45_rtol, _real("atol", atol),
         float("inf") if max_step is None else _real("max_step", max_step), _controller_argument(model, controller),
         wrenches, _real("friction_velocity", friction_velocity), limits, _real("limit_stiffness", limit_stiffness),
-        _real("limit_damping", limit_damping), progress,
+        _real("limit_damping", limit_damping), progress, accuracy_rtol,
     )
     series = ("q", "v", "a", "tau", "tau_passive")
     statistics = ("steps", "rejected_steps", "evaluations")
+    records = ("error_times", "error_estimate", "energy_drift", "accuracy_issue")
     batch = result["q"].ndim == 3
     runs = [
-        Trajectory(model, result["t"], *(result[key][k] if batch else result[key] for key in series), integrator,
-                   *(result[key][k] for key in statistics))
+        Trajectory(model, result["t"], integrator=integrator,
+                   **{key: result[key][k] if batch else result[key] for key in series},
+                   **{key: result[key][k] for key in statistics + records})
         for k in range(len(result["steps"]))
     ]
+    _report_accuracy(runs, accuracy, batch)
     return runs if batch else runs[0]
+
+
+def _report_accuracy(runs: list[Trajectory], accuracy: str, batch: bool) -> None:
+    """One :class:`AccuracyWarning` per run that missed its tolerance, or :class:`AccuracyError`
+    for the first of them (``accuracy="raise"``)."""
+    if accuracy == "ignore":
+        return
+    for k, run in enumerate(runs):
+        if run.accuracy_issue is None:
+            continue
+        message = f"{run.integrator}: {run.accuracy_issue['message']}"
+        if batch:
+            message = f"rollout {k}: {message}"
+        if accuracy == "raise":
+            raise AccuracyError(message)
+        warnings.warn(message, AccuracyWarning, stacklevel=3)
 
 
 def step(

@@ -10,10 +10,11 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
+use robodyn::integrate::simulator::DEFAULT_ACCURACY_RTOL;
 use robodyn::integrate::{
-    simulate as run, simulate_lockstep, ControlLaw, Controller, DesiredMotion, ExternalWrenches,
-    Integrator, LimitModel, NativeController, PassiveForces, SimulationOptions, StepWorkspace,
-    Trajectory,
+    simulate as run, simulate_lockstep, AccuracyIssue, AccuracyMeasure, ControlLaw, Controller,
+    DesiredMotion, ExternalWrenches, Integrator, LimitModel, NativeController, PassiveForces,
+    SimulationOptions, StepWorkspace, Trajectory,
 };
 use robodyn::spatial::Force;
 use robodyn::{Error, Model};
@@ -216,6 +217,41 @@ fn stack<'py>(
     out.set_item("steps", each(|r| r.statistics.steps))?;
     out.set_item("rejected_steps", each(|r| r.statistics.rejected_steps))?;
     out.set_item("evaluations", each(|r| r.statistics.evaluations))?;
+    // the accuracy record per rollout
+    let accuracy = |f: fn(&Trajectory) -> &Vec<f64>| -> Vec<Bound<'py, PyArray1<f64>>> {
+        runs.iter()
+            .map(|r| PyArray1::from_slice(py, f(r)))
+            .collect()
+    };
+    out.set_item("error_times", accuracy(|r| &r.accuracy.check_times))?;
+    out.set_item("error_estimate", accuracy(|r| &r.accuracy.local_errors))?;
+    let drifts: Vec<Option<f64>> = runs.iter().map(|r| r.accuracy.energy_drift).collect();
+    out.set_item("energy_drift", drifts)?;
+    let issues = runs
+        .iter()
+        .map(|r| {
+            r.accuracy
+                .issue
+                .map(|issue| accuracy_issue(py, &issue))
+                .transpose()
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    out.set_item("accuracy_issue", issues)?;
+    Ok(out)
+}
+
+/// An accuracy issue as `{"message", "measure", "time", "error", "largest_step"}`.
+fn accuracy_issue<'py>(py: Python<'py>, issue: &AccuracyIssue) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    out.set_item("message", issue.to_string())?;
+    let measure = match issue.measure {
+        AccuracyMeasure::LocalError => "local_error",
+        AccuracyMeasure::EnergyDrift => "energy_drift",
+    };
+    out.set_item("measure", measure)?;
+    out.set_item("time", issue.time)?;
+    out.set_item("error", issue.error)?;
+    out.set_item("largest_step", issue.largest_step)?;
     Ok(out)
 }
 
@@ -225,7 +261,7 @@ fn stack<'py>(
 #[pyfunction]
 #[pyo3(signature = (model, q0, v0, t_end, dt, integrator="rk4", rtol=1e-6, atol=1e-9, max_step=f64::INFINITY,
                     controller=None, wrenches=None, friction_velocity=1e-2, limits="report",
-                    limit_stiffness=1e4, limit_damping=1e2, progress=None))]
+                    limit_stiffness=1e4, limit_damping=1e2, progress=None, accuracy_rtol=DEFAULT_ACCURACY_RTOL))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
@@ -245,6 +281,7 @@ pub fn simulate<'py>(
     limit_stiffness: f64,
     limit_damping: f64,
     progress: Option<&Bound<'py, PyAny>>,
+    accuracy_rtol: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &model.model;
     let passive = passive_forces(friction_velocity, limits, limit_stiffness, limit_damping)?;
@@ -255,6 +292,7 @@ pub fn simulate<'py>(
     );
     options.max_step = max_step;
     options.passive = passive;
+    options.accuracy_rtol = accuracy_rtol;
     options.check().map_err(to_py_err)?;
 
     let q0 = model.q_arg("q0", q0)?;

@@ -29,5 +29,8 @@ pub mod step;
 pub use control::{ControlLaw, Controller, DesiredMotion, ExternalWrenches, NativeController};
 pub use forces::{LimitModel, PassiveForces};
 pub use schemes::Integrator;
-pub use simulator::{simulate, simulate_lockstep, SimulationOptions, Statistics, Trajectory};
+pub use simulator::{
+    simulate, simulate_lockstep, Accuracy, AccuracyIssue, AccuracyMeasure, SimulationOptions,
+    Statistics, Trajectory,
+};
 pub use step::StepWorkspace;

@@ -54,6 +54,16 @@ impl Integrator {
         }
     }
 
+    /// The order p of the scheme: its local error per step grows as h^(p+1), its global error
+    /// over a fixed time as h^p.
+    pub fn order(&self) -> i32 {
+        match self {
+            Integrator::ExplicitEuler | Integrator::SemiImplicitEuler => 1,
+            Integrator::Rk4 => 4,
+            Integrator::Rk45 { .. } => 5,
+        }
+    }
+
     /// The Butcher tableau of the Runge–Kutta schemes (semi-implicit Euler has none).
     pub(crate) fn tableau(&self) -> Option<&'static Tableau> {
         match self {

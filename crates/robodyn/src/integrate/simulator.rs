@@ -17,9 +17,11 @@ use crate::spatial::Force;
 use crate::Data;
 use guard::{EnergyAccount, STEP_CHECK_INTERVAL};
 
+mod accuracy;
 mod guard;
 mod lockstep;
 
+pub use accuracy::{Accuracy, AccuracyIssue, AccuracyMeasure, DEFAULT_ACCURACY_RTOL};
 pub use guard::{ENERGY_GROWTH_BOUND, SPEED_BOUND};
 pub use lockstep::{simulate_lockstep, RolloutError};
 
@@ -41,6 +43,9 @@ pub struct SimulationOptions {
     /// Largest step RK45 may take (s); infinity for no bound.
     pub max_step: f64,
     pub passive: PassiveForces,
+    /// Tolerance of the fixed-step schemes' accuracy check (local error per step and energy
+    /// drift, relative to the state), > 0; see [`Trajectory::accuracy`].
+    pub accuracy_rtol: f64,
 }
 
 impl SimulationOptions {
@@ -53,6 +58,7 @@ impl SimulationOptions {
             t_end,
             max_step: f64::INFINITY,
             passive: PassiveForces::default(),
+            accuracy_rtol: DEFAULT_ACCURACY_RTOL,
         }
     }
 
@@ -66,6 +72,7 @@ impl SimulationOptions {
             ));
         }
         positive("max_step", self.max_step, true)?;
+        positive("rtol", self.accuracy_rtol, false)?;
         if let Integrator::Rk45 { rtol, atol } = self.integrator {
             positive("rtol", rtol, false)?;
             positive("atol", atol, false)?;
@@ -117,11 +124,17 @@ pub struct Trajectory {
     pub tau: Vec<f64>,
     pub tau_passive: Vec<f64>,
     pub statistics: Statistics,
+    /// The fixed-step schemes' error estimates and energy drift, and whether they met
+    /// `SimulationOptions::accuracy_rtol`.
+    pub accuracy: Accuracy,
 }
 
 impl Trajectory {
-    fn with_capacity(samples: usize, model: &Model) -> Result<Self> {
-        let mut trajectory = Trajectory::default();
+    fn with_capacity(samples: usize, model: &Model, options: &SimulationOptions) -> Result<Self> {
+        let mut trajectory = Trajectory {
+            accuracy: Accuracy::new(model, options, samples)?,
+            ..Trajectory::default()
+        };
         let buffers = [
             (&mut trajectory.t, 1),
             (&mut trajectory.q, model.nq),
@@ -226,7 +239,7 @@ impl Dynamics<'_> {
         v: &[f64],
         a: &[f64],
     ) -> Result<()> {
-        self.check_sample(t, q, v, a)?;
+        self.check_sample(t, q, v, a, &mut trajectory.accuracy)?;
         trajectory.t.push(t);
         trajectory.q.extend_from_slice(q);
         trajectory.v.extend_from_slice(v);
@@ -317,7 +330,7 @@ impl<'a> Simulation<'a> {
             sample: State::new(model),
             middle: State::new(model),
             delta: vec![0.0; model.nv],
-            trajectory: Trajectory::with_capacity(samples, model)?,
+            trajectory: Trajectory::with_capacity(samples, model, options)?,
             progress: None,
             statistics: Statistics::default(),
         };

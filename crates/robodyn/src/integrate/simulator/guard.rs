@@ -10,8 +10,11 @@
 //! - fixed-step schemes, every `STEP_CHECK_INTERVAL` steps: the step compared with two half
 //!   steps (step doubling, Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.4): when they disagree
 //!   by more than the state's own size, the step is far too large.
+//!
+//! The same step-doubling checks and energy checks feed the accuracy record
+//! ([`super::accuracy`]), which holds a run to a much tighter tolerance but only reports.
 
-use super::{Dynamics, Simulation};
+use super::{Accuracy, Dynamics, Simulation};
 use crate::algo::{kinetic_energy, potential_energy};
 use crate::error::{Error, Result};
 use crate::integrate::forces::spring_energy;
@@ -74,8 +77,15 @@ fn diverged(t: f64, message: String) -> Error {
 
 impl Dynamics<'_> {
     /// The bounds at a recorded sample whose q̈ (and torques, and the body velocities in
-    /// `data.v`) were just evaluated.
-    pub(super) fn check_sample(&mut self, t: f64, q: &[f64], v: &[f64], a: &[f64]) -> Result<()> {
+    /// `data.v`) were just evaluated; the energy checks go into `accuracy` too.
+    pub(super) fn check_sample(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        accuracy: &mut Accuracy,
+    ) -> Result<()> {
         for (name, values) in [("q", q), ("v", v), ("q̈", a)] {
             if let Some(k) = values.iter().position(|x| !x.is_finite()) {
                 let joint = if name == "q" {
@@ -118,12 +128,22 @@ impl Dynamics<'_> {
         if account.samples != 1 && !account.samples.is_multiple_of(ENERGY_CHECK_INTERVAL) {
             return Ok(());
         }
-        let energy = kinetic_energy(self.model, &mut self.data, q, v)?
-            + potential_energy(self.model, &mut self.data, q)?
+        let kinetic = kinetic_energy(self.model, &mut self.data, q, v)?;
+        let stored = potential_energy(self.model, &mut self.data, q)?
             + spring_energy(self.model, q, &mut self.energy.displacement);
+        let energy = kinetic + stored;
         let account = &mut self.energy;
         if account.samples == 1 {
             account.initial_energy = energy;
+        }
+        accuracy.record_energy(
+            (account.samples, t),
+            kinetic,
+            stored,
+            account.initial_energy,
+            account.work,
+        );
+        if account.samples == 1 {
             return Ok(());
         }
         let allowed = ENERGY_GROWTH_BOUND * (account.initial_energy.abs() + account.work + 1.0);
@@ -213,7 +233,8 @@ impl Simulation<'_> {
         })
     }
 
-    /// Refuses a fixed step far too large for the dynamics.
+    /// Refuses a fixed step far too large for the dynamics, and records the step's estimated
+    /// local error.
     pub(super) fn check_step(&mut self, h: f64) -> Result<()> {
         let disagreement = self.step_disagreement(h)?;
         if disagreement > STEP_DISAGREEMENT_BOUND {
@@ -225,6 +246,9 @@ impl Simulation<'_> {
                 ),
             ));
         }
+        self.trajectory
+            .accuracy
+            .record_step(self.state.t, h, disagreement);
         Ok(())
     }
 

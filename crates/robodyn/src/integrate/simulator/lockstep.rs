@@ -283,6 +283,7 @@ mod tests {
                 assert_eq!(run.tau, alone.tau, "{integrator:?}");
                 assert_eq!(run.tau_passive, alone.tau_passive, "{integrator:?}");
                 assert_eq!(run.statistics, alone.statistics, "{integrator:?}");
+                assert_eq!(run.accuracy, alone.accuracy, "{integrator:?}");
             }
         }
         // far too large a step for a stiff PD: the rollout diverges, named as alone
