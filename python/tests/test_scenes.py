@@ -6,9 +6,6 @@ offscreen render of the same scene from the same camera."""
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 import warnings
 from pathlib import Path
 
@@ -21,12 +18,12 @@ import robodyn
 from browser import HEIGHT, WIDTH, colour_fraction, project, screenshot
 from robodyn.viewer import Viewer
 from robodyn.viewer.geometry import visual_pieces
+from robodyn.viewer.offscreen import mujoco_render
 from robodyn.viewer.scene import CAMERA_FOV
 from robodyn.viewer.textures import builtin_image, cube_faces, skybox_panorama
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENE = ROOT / "testdata" / "mjcf" / "textured" / "scene.xml"
-RENDERER = Path(__file__).resolve().parent / "mujoco_render.py"
 
 BUILTIN_TEXTURES = """<mujoco><asset>
   <texture name="checker" type="2d" builtin="checker" rgb1=".2 .3 .4" rgb2=".1 .2 .3" mark="edge" markrgb=".8 .8 .8" width="30" height="20"/>
@@ -204,14 +201,9 @@ def test_the_page_shows_what_mujoco_renders(tmp_path: Path):
     scene at its neutral configuration, from the same camera: the post's silhouette box, the
     panel's texture quadrants where its texture coordinates put them, a bluish checker floor and
     a bluish sky above the horizon, in both."""
-    out = tmp_path / "mujoco.npy"
-    environment = dict(os.environ, MUJOCO_GL="osmesa", PYOPENGL_PLATFORM="osmesa")
-    run = subprocess.run([sys.executable, str(RENDERER), str(SCENE), str(out), str(WIDTH), str(HEIGHT), *map(str, LOOKAT),
-                          str(DISTANCE), str(AZIMUTH), str(ELEVATION)], capture_output=True, text=True, env=environment, timeout=300)
-    assert run.returncode == 0, f"MuJoCo's offscreen render failed (is Debian's libosmesa6 installed?): {run.stderr[-2000:]}"
-    theirs = np.load(out).astype(np.int16)
-    model = robodyn.load(SCENE)
     camera = (camera_position(), LOOKAT)
+    theirs = mujoco_render(SCENE, tmp_path / "mujoco.npy", WIDTH, HEIGHT, camera)[0].astype(np.int16)
+    model = robodyn.load(SCENE)
     with pytest.warns(robodyn.ModelWarning, match="texture 'marble'"):
         page = model.to_html(tmp_path / "scene.html", camera=camera)
     ours, _ = screenshot(page.resolve().as_uri(), tmp_path, "scene")
