@@ -8,8 +8,9 @@ package ``chromium``; everything it opens is a file or a server on the loopback 
 
     MUJOCO_GL=osmesa python -m robodyn.viewer.offscreen MODEL OUT.npy WIDTH HEIGHT LOOKAT_X LOOKAT_Y LOOKAT_Z DISTANCE AZIMUTH ELEVATION [FOVY [Q ...]]
 
-writes MuJoCo's picture as an (H, W, 3) array and, beside it (``OUT`` with ``-robot.npy``), the
-mask of the pixels that show the robot: every geom but planes (MuJoCo's segmentation render).
+writes MuJoCo's picture (FOVY degrees, ``nan`` for the model's; at Q, default qpos0) as an
+(H, W, 3) array and, beside it (``OUT`` with ``-robot.npy``), the mask of the pixels that show the
+robot: every geom but planes (MuJoCo's segmentation render).
 """
 
 from __future__ import annotations
@@ -111,7 +112,7 @@ def mujoco_render(path: str | os.PathLike[str], out: Path, width: int, height: i
     planes, as robodyn's first view frames it). ``out``: the .npy file the subprocess writes."""
     look_at, distance, azimuth, elevation = mujoco_camera(*camera)
     environment = dict(os.environ, MUJOCO_GL="osmesa", PYOPENGL_PLATFORM="osmesa")
-    extra = [] if fovy is None else [str(fovy)] + ([] if q is None else [repr(float(x)) for x in np.asarray(q, dtype=float)])
+    extra = ["nan" if fovy is None else repr(float(fovy))] + ([] if q is None else [repr(float(x)) for x in np.asarray(q, dtype=float)])
     run = subprocess.run([sys.executable, "-m", "robodyn.viewer.offscreen", str(path), str(out), str(width), str(height),
                           *(repr(float(x)) for x in look_at), repr(distance), repr(azimuth), repr(elevation), *extra],
                          capture_output=True, text=True, env=environment, timeout=MUJOCO_TIMEOUT_S)
@@ -192,7 +193,7 @@ def without_notifications(page: Path, out: Path) -> Path:
 if __name__ == "__main__":
     model_path, out_path, w, h = sys.argv[1], Path(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
     numbers = [float(x) for x in sys.argv[5:]]
-    fov = numbers[6] if len(numbers) > 6 else None
+    fov = numbers[6] if len(numbers) > 6 and not np.isnan(numbers[6]) else None
     picture, robot = _render(model_path, w, h, numbers[:3], numbers[3], numbers[4], numbers[5], fov, numbers[7:])
     np.save(out_path, picture)
     np.save(out_path.with_name(out_path.stem + "-robot.npy"), robot)
