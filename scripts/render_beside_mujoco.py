@@ -6,9 +6,10 @@ For each MJCF scene PATH, both renderers show the model at its neutral configura
 qpos0: free bodies at their pose in the file) from the camera of robodyn's first view (the robot
 framed, planes left out) with robodyn's field of view: MuJoCo's ``mujoco.Renderer`` with
 ``MUJOCO_GL=osmesa`` (Debian's ``libosmesa6``) and robodyn's offline page (``Model.to_html``)
-screenshotted in headless Chromium (``robodyn.viewer.offscreen``; its pop-up notes hidden). DIR/NAME.png holds MuJoCo's
-picture on the left and robodyn's on the right (NAME: the scene's folder, or its file name), each
-W x H (default 640 x 480), the whole downscaled to P pixels wide when given.
+screenshotted in headless Chromium (``robodyn.viewer.offscreen``; its pop-up notes hidden).
+DIR/NAME.png holds MuJoCo's picture on the left and robodyn's on the right (NAME: the scene's
+folder, or its file name), each W x H (default 640 x 480), the whole downscaled to P pixels wide
+when given. docs/scenes.md shows four Menagerie scenes made so.
 
 One line per scene gives two measures of agreement over the robot's pixels, those showing any
 geom but a plane (the floor), as robodyn's first view frames it:
