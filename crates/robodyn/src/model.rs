@@ -276,12 +276,7 @@ impl Model {
             if let Some(offset) = self.joints[i].quaternion_offset() {
                 quaternions -= 1;
                 let start = self.idx_q[i] + offset;
-                let norm = q[start..start + 4]
-                    .iter()
-                    .map(|x| x * x)
-                    .sum::<f64>()
-                    .sqrt();
-                if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
+                if let Err(norm) = check_unit_quaternion(&q[start..start + 4]) {
                     return Err(Error::InvalidValue {
                         argument: "q".into(),
                         message: format!(
@@ -383,6 +378,16 @@ impl Model {
     pub fn total_mass(&self) -> f64 {
         self.inertias.iter().skip(1).map(|i| i.mass).sum()
     }
+}
+
+/// Checks that four coordinates are a unit quaternion within [`QUATERNION_NORM_TOLERANCE`];
+/// the error is their norm.
+pub(crate) fn check_unit_quaternion(q: &[f64]) -> std::result::Result<(), f64> {
+    let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
+        return Err(norm);
+    }
+    Ok(())
 }
 
 /// Checks that (mass, rotational inertia about the COM) can be computed with: finite, mass ≥ 0,

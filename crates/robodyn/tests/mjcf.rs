@@ -2,7 +2,21 @@
 
 use robodyn::algo::frame_pose;
 use robodyn::io::load_mjcf_str;
-use robodyn::{Data, Joint};
+use robodyn::spatial::Transform;
+use robodyn::{Data, Joint, Model};
+
+/// The placement of the frame `name` at the model's neutral configuration.
+fn neutral_pose(model: &Model, name: &str) -> Transform {
+    let mut data = Data::new(model);
+    let q = model.neutral();
+    frame_pose(
+        model,
+        &mut data,
+        q.as_slice(),
+        model.frame_index(name).unwrap(),
+    )
+    .unwrap()
+}
 
 const ARM: &str = r#"<mujoco model="arm">
   <default>
@@ -50,27 +64,13 @@ fn tree_classes_and_degrees() {
         (-0.1, 0.1)
     );
     // "90" is degrees by default: the upper arm's x axis points along world y
-    let mut data = Data::new(&model);
-    let q = model.neutral();
-    let upper = frame_pose(
-        &model,
-        &mut data,
-        q.as_slice(),
-        model.frame_index("upper").unwrap(),
-    )
-    .unwrap();
+    let upper = neutral_pose(&model, "upper");
     let pose = upper.to_homogeneous();
     assert!(
         (pose[(1, 0)] - 1.0).abs() < 1e-12 && (pose[(2, 3)] - 1.0).abs() < 1e-12,
         "{pose}"
     );
-    let tip = frame_pose(
-        &model,
-        &mut data,
-        q.as_slice(),
-        model.frame_index("tip").unwrap(),
-    )
-    .unwrap();
+    let tip = neutral_pose(&model, "tip");
     assert!((tip.translation - nalgebra::Vector3::new(0.0, 0.0, 0.3)).norm() < 1e-12);
     // the actuator section is reported, not read
     assert!(
@@ -124,14 +124,7 @@ fn neutral_is_mujocos_qpos0() {
         assert!((a - b).abs() < 1e-15, "q[{k}] = {a}, expected {b}");
     }
     // at q = ref every body is where the file puts it
-    let mut data = Data::new(&model);
-    let tip = frame_pose(
-        &model,
-        &mut data,
-        q.as_slice(),
-        model.frame_index("tip").unwrap(),
-    )
-    .unwrap();
+    let tip = neutral_pose(&model, "tip");
     let expected_tip = nalgebra::Vector3::new(0.5, 1.0, 2.0);
     assert!((tip.translation - expected_tip).norm() < 1e-12, "{tip:?}");
 }
@@ -181,16 +174,7 @@ fn each_compiler_element_changes_only_what_it_sets() {
     let text = "<mujoco><compiler angle='radian'/><compiler eulerseq='zyx'/><worldbody>
         <body name='turned' axisangle='0 0 1 1.5707963267948966'/></worldbody></mujoco>";
     let model = load_mjcf_str(text, "compilers.xml").unwrap();
-    let mut data = Data::new(&model);
-    let q = model.neutral();
-    let pose = frame_pose(
-        &model,
-        &mut data,
-        q.as_slice(),
-        model.frame_index("turned").unwrap(),
-    )
-    .unwrap()
-    .to_homogeneous();
+    let pose = neutral_pose(&model, "turned").to_homogeneous();
     // a quarter turn about z: the body's x axis along world y
     assert!((pose[(1, 0)] - 1.0).abs() < 1e-12, "{pose}");
 }

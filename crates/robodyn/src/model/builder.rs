@@ -1,7 +1,7 @@
 //! [`ModelBuilder`]: a model built body by body, as every loader builds one.
 
 use super::{
-    run_start, Frame, JointProperties, Mimic, Model, QUATERNION_NORM_TOLERANCE, STANDARD_GRAVITY,
+    check_unit_quaternion, run_start, Frame, JointProperties, Mimic, Model, STANDARD_GRAVITY,
 };
 use crate::error::{Error, Result};
 use crate::joint::Joint;
@@ -228,12 +228,7 @@ impl ModelBuilder {
             ));
         }
         if let Some(offset) = joint.quaternion_offset() {
-            let norm = q[offset..offset + 4]
-                .iter()
-                .map(|x| x * x)
-                .sum::<f64>()
-                .sqrt();
-            if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
+            if let Err(norm) = check_unit_quaternion(&q[offset..offset + 4]) {
                 return refuse(format!(
                     "the neutral quaternion has norm {norm}, expected 1"
                 ));
