@@ -1,9 +1,7 @@
 //! PyO3 glue for robodyn: argument conversion, batching over all cores with the GIL released, and
 //! errors turned into `ValueError` / `FileNotFoundError`. No physics lives here.
 
-use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
 use pyo3::prelude::*;
-use robodyn::Error;
 
 /// The extension's allocator: mimalloc, whose blocks of a few KiB to a few hundred KiB (a large
 /// robot's Jacobian, mass matrix or derivatives) come from per-thread free lists, where the C
@@ -13,6 +11,7 @@ static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 mod args;
 mod dynamics;
+mod errors;
 mod kinematics;
 mod loaders;
 mod model;
@@ -24,24 +23,8 @@ mod visuals;
 use loaders::*;
 use model::PyModel;
 
-pyo3::create_exception!(
-    robodyn,
-    SimulationError,
-    PyValueError,
-    "A simulation stopped: it diverged (the message says when, which quantity and joint, and \
-     a step that keeps it stable), or its controller or wrenches gave something unusable."
-);
-
-/// A core error as the Python exception the API promises.
-pub(crate) fn to_py_err(error: Error) -> PyErr {
-    match error {
-        Error::FileNotFound { .. } => PyFileNotFoundError::new_err(error.to_string()),
-        Error::Simulation { .. } | Error::Diverged { .. } => {
-            SimulationError::new_err(error.to_string())
-        }
-        _ => PyValueError::new_err(error.to_string()),
-    }
-}
+pub(crate) use errors::to_py_err;
+use errors::SimulationError;
 
 #[pymodule]
 fn _core(module: &Bound<'_, PyModule>) -> PyResult<()> {
