@@ -240,7 +240,7 @@ def test_large_results_are_ordinary_arrays_that_outlive_the_model(robots_dir):
     for name, result in results.items():
         assert result.dtype == np.float64 and result.flags.c_contiguous and result.flags.writeable, name
         assert result.shape == {"jacobian": (6, 50)}.get(name, (50, 50)), name
-        # the README's word: robodyn's memory, not the array's own
+        # as docs/guide/performance.md says: robodyn's memory, not the array's own
         assert not result.flags.owndata, name
         assert np.isfinite(result).all(), name
     for name in ("jacobian", "mass_matrix"):

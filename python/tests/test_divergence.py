@@ -38,7 +38,7 @@ def test_a_too_large_step_on_the_ur5_raises_with_time_joint_and_a_stable_step():
 
 
 def test_a_stiff_damping_gain_reports_the_step_it_needs():
-    """The README's example: kd = 5 on the UR5's light wrist needs a step below a millisecond."""
+    """docs/guide/simulation.md's example: kd = 5 on the UR5's light wrist needs a step below a millisecond."""
     m = robodyn.load("ur5")
     pd = robodyn.PD(kp=100.0, kd=5.0, q_ref=m.neutral())
     with pytest.raises(robodyn.SimulationError) as error:

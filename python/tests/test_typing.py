@@ -1,13 +1,13 @@
-"""mypy --strict passes on every Python block of the README and every script in examples/, as a
-user's type checker sees them (robodyn's stubs, simulate's overloads)."""
+"""mypy --strict passes on every Python block of the README and the guide (test_readme's pages) and
+every script in examples/, as a user's type checker sees them (robodyn's stubs, simulate's overloads)."""
 
 from __future__ import annotations
 
-import re
 import subprocess
 import sys
 
 from conftest import REPOSITORY
+from test_readme import BLOCKS
 
 #: simulate's overloads: one configuration gives a Trajectory, a batch a list of them
 OVERLOADS = '''
@@ -23,10 +23,9 @@ print(one.t, many[0].q, listed.energy)
 
 
 def test_mypy_strict_on_the_readme_and_examples(tmp_path):
-    blocks = re.findall(r"```python\n(.*?)```", (REPOSITORY / "README.md").read_text(), re.S)
     files = []
-    for k, block in enumerate(blocks):
-        path = tmp_path / f"readme_block_{k}.py"
+    for k, (_, _, block) in enumerate(BLOCKS):
+        path = tmp_path / f"doc_block_{k}.py"
         path.write_text(block)
         files.append(str(path))
     (tmp_path / "overloads.py").write_text(OVERLOADS)

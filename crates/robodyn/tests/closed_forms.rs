@@ -1,4 +1,4 @@
-//! Closed forms from the lecture notes (cited by course; the README lists them).
+//! Closed forms from the lecture notes (cited by course; `docs/guide/dynamics.md` lists them).
 
 mod common;
 

@@ -169,8 +169,8 @@ def _pose(table: dict | None, place: str, tolerance: float, unit) -> sp.Matrix:
 
 def from_dh(table, convention: str | None = None, *, symbolic_params=False, gravity=None,
             angle_tolerance: float = ANGLE_TOLERANCE, coordinate: str = "q") -> Chain:
-    """A chain from a DH table: a path to the TOML format ``robodyn.load`` reads (README, "Robots
-    from DH tables"), or a list of rows (dicts with the same keys: ``type``, ``a``, ``alpha``,
+    """A chain from a DH table: a path to the TOML format ``robodyn.load`` reads (see
+    docs/guide/loading-models.md), or a list of rows (dicts with the same keys: ``type``, ``a``, ``alpha``,
     ``d``, ``theta``, ``mass``, ``com``, ``inertia`` = [ixx, iyy, izz, ixy, ixz, iyz], whose values
     may be SymPy expressions) with ``convention`` "standard" or "modified".
 

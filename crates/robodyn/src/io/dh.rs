@@ -196,7 +196,7 @@ pub fn build_dh(table: &DhTable) -> Result<Model> {
     Ok(builder.build())
 }
 
-/// Loads a DH table file (TOML; the format is in the README).
+/// Loads a DH table file (TOML; the format is in `docs/guide/loading-models.md`).
 pub fn load_dh_file(path: &std::path::Path) -> Result<Model> {
     let text = read_model_file(path)?;
     load_dh_str(&text, &path.display().to_string())
