@@ -1,4 +1,6 @@
-"""Trajectory optimisation with the derivatives of a simulation step: iLQR (Li & Todorov, 2004;
+"""# iLQR with the derivatives of a simulation step
+
+Trajectory optimisation with the derivatives of a simulation step: iLQR (Li & Todorov, 2004;
 the regularisation and line search of Tassa, Erez & Todorov, 2012) swings the pendulum up and
 moves the UR5 to a pose.
 
