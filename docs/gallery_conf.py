@@ -16,24 +16,27 @@ from typing import Any
 
 #: The height of an embedded viewer page in pixels (its width is the text's).
 VIEWER_HEIGHT = 480
-#: Pictures shown as images.
+#: Pictures shown as images (those mkdocs-gallery takes as an example's figures).
 PICTURES = {".png", ".svg", ".gif", ".jpg"}
 
 
 def written_files(block: Any, script: Any, **kwargs: Any) -> str:
     """Markdown showing every ``*.html`` page and picture that the block wrote into the working
-    folder, each moved into the gallery's images folder first."""
+    folder, each moved into the gallery's images folder first. Pictures are numbered with the
+    example's figures (the first one is its thumbnail in the gallery)."""
     images = Path(script.gallery.images_dir)
     images.mkdir(parents=True, exist_ok=True)
     markdown = ""
     for written in sorted(Path.cwd().iterdir()):
-        if written.suffix not in PICTURES | {".html"} or not written.is_file():
+        if not written.is_file() or written.suffix not in PICTURES | {".html"}:
+            continue
+        if written.suffix in PICTURES:
+            target = next(script.run_vars.image_path_iterator).with_suffix(written.suffix)
+            written.replace(target)
+            markdown += f"\n![{written.stem}](./images/{target.name})\n\n"
             continue
         name = f"mkd_glr_{script.src_py_file.stem}_{written.name}"
         written.replace(images / name)
-        if written.suffix in PICTURES:
-            markdown += f"\n![{written.stem}](./images/{name})\n\n"
-            continue
         # the example's page is gallery/<example>/index.html (directory URLs): its images are one
         # level up; the Markdown link below is rewritten by MkDocs, the frame's address is not
         markdown += (

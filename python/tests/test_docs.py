@@ -72,11 +72,13 @@ def test_the_gallery_scraper_embeds_the_pages_and_pictures_a_block_wrote(tmp_pat
     (work / "swing.png").write_bytes(b"\x89PNG")
     (work / "notes.txt").write_text("not shown", encoding="utf-8")
     monkeypatch.chdir(work)
-    script = SimpleNamespace(gallery=SimpleNamespace(images_dir=images), src_py_file=work / "demo.py")
+    figures = iter([images / "mkd_glr_demo_002.png"])
+    script = SimpleNamespace(gallery=SimpleNamespace(images_dir=images), src_py_file=work / "demo.py",
+                             run_vars=SimpleNamespace(image_path_iterator=figures))
     markdown = scraper.written_files(None, script)
     assert '<iframe class="robodyn-viewer" src="../images/mkd_glr_demo_swing.html"' in markdown
-    assert "![swing](./images/mkd_glr_demo_swing.png)" in markdown
-    assert sorted(p.name for p in images.iterdir()) == ["mkd_glr_demo_swing.html", "mkd_glr_demo_swing.png"]
+    assert "![swing](./images/mkd_glr_demo_002.png)" in markdown
+    assert sorted(p.name for p in images.iterdir()) == ["mkd_glr_demo_002.png", "mkd_glr_demo_swing.html"]
     assert sorted(p.name for p in work.iterdir()) == ["notes.txt"]
 
 
