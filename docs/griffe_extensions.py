@@ -5,7 +5,8 @@
   docstrings are the Rust binding's ``///`` comments, which PyO3 makes the runtime ``__doc__`` of
   each class, method, property and function. The extension imports the module and gives every
   stub object without a docstring the one its runtime object has, so each page shows the stub's
-  signature with the binding's text.
+  signature with the binding's text. A method the stub states only by its ``@overload``
+  signatures becomes a member too (griffe keeps such signatures aside).
 - :class:`SphinxRoles`: robodyn's docstrings are written for any reader (``help()``, an editor),
   with Sphinx's cross-reference roles (``:func:`load```) and ``::`` before an indented example.
   The site renders docstrings as Markdown: a role becomes a link to the object where it has a
@@ -50,6 +51,7 @@ class SphinxRoles(griffe.Extension):
 
 def _fill(stub: griffe.Object, runtime: object) -> None:
     """Gives ``stub`` and its members the runtime objects' docstrings where the stub has none."""
+    _overloads_as_members(stub)
     if stub.docstring is None:
         text = _own_doc(stub, runtime)
         if text:
@@ -58,6 +60,21 @@ def _fill(stub: griffe.Object, runtime: object) -> None:
         if not member.is_alias and hasattr(runtime, name):
             # the attribute itself (a property, a method), not its value on the class
             _fill(member, inspect.getattr_static(runtime, name))
+
+
+def _overloads_as_members(stub: griffe.Object) -> None:
+    """A stub states an overloaded method by its ``@overload`` signatures alone, with no
+    implementation, which griffe keeps aside (in ``overloads``) rather than as a member: each
+    becomes a member here, with the last signature as its own and all of them as its overloads."""
+    if not (stub.is_class or stub.is_module):
+        return
+    for name, signatures in list(stub.overloads.items()):
+        if signatures and name not in stub.members:
+            last = signatures[-1]
+            function = griffe.Function(name, parameters=last.parameters, returns=last.returns,
+                                       lineno=last.lineno, endlineno=last.endlineno)
+            function.overloads = list(signatures)
+            stub.set_member(name, function)
 
 
 def _own_doc(stub: griffe.Object, runtime: object) -> str | None:
