@@ -6,7 +6,9 @@
   each class, method, property and function. The extension imports the module and gives every
   stub object without a docstring the one its runtime object has, so each page shows the stub's
   signature with the binding's text. A method the stub states only by its ``@overload``
-  signatures becomes a member too (griffe keeps such signatures aside).
+  signatures becomes a member too (griffe keeps such signatures aside). A public class,
+  function, method or property with no docstring in either place is a warning, which fails the
+  strict build.
 - :class:`SphinxRoles`: robodyn's docstrings are written for any reader (``help()``, an editor),
   with Sphinx's cross-reference roles (``:func:`load```) and ``::`` before an indented example.
   The site renders docstrings as Markdown: a role becomes a link to the object where it has a
@@ -35,8 +37,14 @@ class RuntimeDocstrings(griffe.Extension):
 
     def on_package(self, *, pkg: griffe.Module, **kwargs: Any) -> None:
         package, name = COMPILED.split(".", 1)
-        if pkg.path == package:
-            _fill(pkg[name], importlib.import_module(COMPILED))
+        if pkg.path != package:
+            return
+        _fill(pkg[name], importlib.import_module(COMPILED))
+        # a strict build fails on a public class, function, method or property left undocumented
+        for obj in _objects(pkg[name]):
+            public = not any(part.startswith("_") for part in obj.path.split(".")[2:])
+            if public and obj.docstring is None and (obj.is_class or obj.is_function or obj.parent.is_class):
+                griffe.logger.warning(f"{obj.path} has no docstring: the stub has none, nor the binding (a /// comment)")
 
 
 class SphinxRoles(griffe.Extension):
