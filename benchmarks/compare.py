@@ -2,7 +2,8 @@
 a 10 000-state batch against a Python loop, a 10 s UR5 rollout (RK4, PD) against mj_step and 64
 rollouts of 1 s against mujoco.rollout, printed as ratios (< 1 means robodyn is faster).
 
-Run: .venv/bin/python benchmarks/compare.py [--batch 10000] [--robots ur5 panda talos]
+Run: .venv/bin/python benchmarks/compare.py [--batch 10000] [--robots ur5 panda talos] [--json out.json]
+(--json also writes the tables as JSON, which scripts/benchmarks_page.py turns into docs/benchmarks.md).
 Needs the bench extras (pip install '.[bench]'). Times are the best of several repeats; a batch
 round repeats the batch for at least BATCH_ROUND_S (a Python loop takes that long once).
 
@@ -14,6 +15,8 @@ from q, so each MuJoCo case is the pipeline of mj_* calls a Python user would ma
 from __future__ import annotations
 
 import argparse
+import datetime
+import json
 import os
 import platform
 import re
@@ -327,12 +330,42 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--batch", type=int, default=10_000)
     parser.add_argument("--robots", nargs="+", default=list(ROBOTS), choices=list(ROBOTS))
+    parser.add_argument("--json", type=Path, help="also write the tables to this file (times in seconds)")
     args = parser.parse_args()
-    print(f"robodyn {robodyn.__version__}, Pinocchio {pin.__version__}, MuJoCo {mujoco.__version__}; "
-          f"Python {platform.python_version()}, {platform.machine()}, {os.cpu_count()} cores")
-    print_table("robodyn vs Pinocchio", "pinocchio", [row for name in args.robots for row in compare_robot(name, args.batch)])
-    print_table("robodyn vs MuJoCo (fixed base)", "mujoco", [row for name in args.robots for row in compare_mujoco(name, args.batch)])
-    print_table("Simulation: robodyn.simulate vs mj_step and mujoco.rollout", "mujoco", compare_rollout("ur5") + compare_batched_rollouts("ur5"))
+    versions = {"robodyn": robodyn.__version__, "pinocchio": pin.__version__, "mujoco": mujoco.__version__,
+                "python": platform.python_version()}
+    machine = {"machine": platform.machine(), "processor": _processor_name(), "cores": os.cpu_count(),
+               "load_average": [os.getloadavg()[0]]}
+    print(f"robodyn {versions['robodyn']}, Pinocchio {versions['pinocchio']}, MuJoCo {versions['mujoco']}; "
+          f"Python {versions['python']}, {machine['machine']}, {machine['cores']} cores")
+    sections = [
+        ("robodyn vs Pinocchio", "pinocchio", lambda: [row for name in args.robots for row in compare_robot(name, args.batch)]),
+        ("robodyn vs MuJoCo (fixed base)", "mujoco", lambda: [row for name in args.robots for row in compare_mujoco(name, args.batch)]),
+        ("Simulation: robodyn.simulate vs mj_step and mujoco.rollout", "mujoco",
+         lambda: compare_rollout("ur5") + compare_batched_rollouts("ur5")),
+    ]
+    tables = []
+    for title, other, run in sections:
+        rows = run()
+        print_table(title, other, rows)
+        tables.append({"title": title, "other": other, "rows": [list(row) for row in rows]})
+    if args.json:
+        # the one-minute load average at the start and at the end: other jobs sharing the machine
+        machine["load_average"].append(os.getloadavg()[0])
+        result = {"date": datetime.date.today().isoformat(), "versions": versions, "machine": machine, "batch": args.batch,
+                  "tables": tables}
+        args.json.write_text(json.dumps(result, indent=1) + "\n", encoding="utf-8")
+        print(f"wrote {args.json}")
+
+
+def _processor_name() -> str:
+    """The CPU's model name (Linux's /proc/cpuinfo), else what `platform` knows."""
+    cpuinfo = Path("/proc/cpuinfo")
+    if cpuinfo.exists():
+        found = re.search(r"^model name\s*:\s*(.+)$", cpuinfo.read_text(), re.MULTILINE)
+        if found:
+            return found.group(1).strip()
+    return platform.processor() or platform.machine()
 
 
 if __name__ == "__main__":

@@ -1,4 +1,6 @@
-"""The TUM notes, "Cartesian state space equation": the 2-link arm's tool (x, y) task, F = M_x ẍ + V_x + G_x
+"""# Cartesian dynamics of the 2-link arm
+
+The TUM notes, "Cartesian state space equation": the 2-link arm's tool (x, y) task, F = M_x ẍ + V_x + G_x
 with M_x = J⁻ᵀ M J⁻¹, V_x = J⁻ᵀ (V − M J⁻¹ J̇ q̇), G_x = J⁻ᵀ G, next to robodyn's Λ, μ, p.
 
     python examples/cartesian_dynamics.py

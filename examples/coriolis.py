@@ -1,4 +1,6 @@
-"""The TU Berlin and TUM notes: the 2-link arm's velocity terms, as the Coriolis matrix C(q, q̇), as Christoffel
+"""# Coriolis and centrifugal terms, four ways
+
+The TU Berlin and TUM notes: the 2-link arm's velocity terms, as the Coriolis matrix C(q, q̇), as Christoffel
 symbols, and as Craig's centrifugal C(q) and Coriolis B(q) matrices.
 
     python examples/coriolis.py

@@ -1,4 +1,6 @@
-"""Energy and momentum: T = ½ q̇ᵀ M q̇, the power balance d(T + V)/dt = q̇ᵀ τ, and the centroidal
+"""# Energy, power and momentum
+
+Energy and momentum: T = ½ q̇ᵀ M q̇, the power balance d(T + V)/dt = q̇ᵀ τ, and the centroidal
 momentum, whose linear part is m ċ.
 
     python examples/energy_momentum.py

@@ -1,4 +1,6 @@
-"""The UR5 dynamics notes, "Free Floating Body": Euler's equations against the engine (a free joint and ABA), the
+"""# A free-floating body: Euler's equations
+
+The UR5 dynamics notes, "Free Floating Body": Euler's equations against the engine (a free joint and ABA), the
 precession of a symmetric body, and the Dzhanibekov flip of the intermediate axis.
 
     python examples/free_floating_body.py

@@ -1,4 +1,6 @@
-"""Identifying a robot's inertial parameters from measured torques (Atkeson, An & Hollerbach, 1986).
+"""# Identifying inertial parameters
+
+Identifying a robot's inertial parameters from measured torques (Atkeson, An & Hollerbach, 1986).
 
 The joint torques are linear in the ten standard parameters of every link, τ = Y(q, q̇, q̈) π
 (`m.torque_regressor`, π = `m.inertial_parameters.ravel()`). Drive the UR5 along an exciting

@@ -1,4 +1,6 @@
-"""Trajectory optimisation with the derivatives of a simulation step: iLQR (Li & Todorov, 2004;
+"""# iLQR with the derivatives of a simulation step
+
+Trajectory optimisation with the derivatives of a simulation step: iLQR (Li & Todorov, 2004;
 the regularisation and line search of Tassa, Erez & Todorov, 2012) swings the pendulum up and
 moves the UR5 to a pose.
 
@@ -13,6 +15,7 @@ the same code serves floating robots. The cost printed per iteration decreases m
 
 from typing import Any
 
+import matplotlib.pyplot as plt
 import numpy as np
 from _compare import show
 
@@ -113,6 +116,7 @@ Q, V, U, costs = ilqr(pendulum, [0.0], top, np.zeros((100, 1)), dt, weights, lab
 assert np.all(np.diff(costs) < 0), "the cost must decrease at every accepted iteration"
 show("pendulum at the top after 2 s: θ (rad), θ̇ (rad/s)", [np.pi, 0.0], [Q[-1, 0], V[-1, 0]], 2e-2)
 print(f"pendulum: cost {costs[0]:.4g} -> {costs[-1]:.4g} in {len(costs) - 1} iterations, peak torque {np.max(np.abs(U)):.2f} N·m")
+pendulum_costs = costs
 
 # move the UR5 from one pose to another in 1 s, starting from gravity compensation
 ur5 = robodyn.load("ur5")
@@ -126,3 +130,13 @@ Q, V, U, costs = ilqr(ur5, start, goal, hold, dt, weights, label="ur5")
 assert np.all(np.diff(costs) < 0), "the cost must decrease at every accepted iteration"
 show("UR5 pose after 1 s (rad)", goal, Q[-1], 2e-2)
 print(f"ur5: cost {costs[0]:.4g} -> {costs[-1]:.4g} in {len(costs) - 1} iterations")
+
+# the cost of each accepted iteration, relative to the first
+figure, axis = plt.subplots(figsize=(8, 3.5))
+for label, run in (("pendulum swing-up", pendulum_costs), ("UR5 to a pose", costs)):
+    axis.semilogy(run / run[0], marker="o", markersize=3, label=label)
+axis.set_xlabel("iteration")
+axis.set_ylabel("cost / initial cost")
+axis.set_title("iLQR: the cost decreases at every accepted iteration")
+axis.grid(True, alpha=0.3)
+axis.legend()

@@ -1,4 +1,6 @@
-"""The TU Berlin notes, "Inertia Tensor Example": a uniform box of sides w, l, h about its corner, the
+"""# Inertia tensors of a box
+
+The TU Berlin notes, "Inertia Tensor Example": a uniform box of sides w, l, h about its corner, the
 parallel-axis theorem, and its principal moments; the UR5 dynamics notes: I = R I_b Rᵀ.
 
     python examples/inertia_tensor.py

@@ -1,4 +1,6 @@
-"""The TU Berlin and UR5 dynamics notes: the 2-link arm's mass matrix by CRBA, by n RNEA calls and by Σ m Jᵀ J, and its
+"""# The mass matrix three ways
+
+The TU Berlin and UR5 dynamics notes: the 2-link arm's mass matrix by CRBA, by n RNEA calls and by Σ m Jᵀ J, and its
 gravity vector by RNEA and by -Σ J_cᵀ m g, next to the closed forms.
 
     python examples/mass_matrix_three_ways.py

@@ -1,4 +1,6 @@
-"""The ECE 470, TUM and UR5 dynamics notes: the equations of motion derived symbolically, as the notes derive them by
+"""# Equations of motion, symbolically
+
+The ECE 470, TUM and UR5 dynamics notes: the equations of motion derived symbolically, as the notes derive them by
 hand: Euler–Lagrange for the 2-link arm (M, V, G), Newton–Euler giving the same τ, the pendulum,
 and the closed forms evaluated next to the numeric core.
 

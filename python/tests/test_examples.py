@@ -16,7 +16,9 @@ def test_there_is_an_example_per_section_of_the_notes_dynamics():
 
 
 @pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.stem)
-def test_example_runs(script, monkeypatch, capsys):
+def test_example_runs(script, monkeypatch, capsys, tmp_path):
     monkeypatch.setattr(sys, "path", [str(script.parent), *sys.path])
+    # the pages and figures an example writes land in its working folder
+    monkeypatch.chdir(tmp_path)
     runpy.run_path(str(script), run_name="__main__")
     assert "textbook" in capsys.readouterr().out
