@@ -24,31 +24,46 @@ pub enum MeshSource {
 /// The shape of a visual, in its own frame (the z axis is the axis of cylinders and capsules).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Shape {
+    /// A box centred on the origin.
     Box {
+        /// Half its sides along x, y and z.
         half_extents: Vec3,
     },
+    /// A sphere centred on the origin.
     Sphere {
+        /// Its radius.
         radius: f64,
     },
+    /// A cylinder along z, centred on the origin.
     Cylinder {
+        /// Its radius.
         radius: f64,
+        /// Half its length along z.
         half_length: f64,
     },
+    /// A capsule along z: a cylinder with a half-sphere on each end.
     Capsule {
+        /// The radius of the cylinder and of its end caps.
         radius: f64,
+        /// Half the length of its cylinder along z (the caps not counted).
         half_length: f64,
     },
+    /// An ellipsoid centred on the origin, its axes along x, y and z.
     Ellipsoid {
+        /// Its semi-axes along x, y and z.
         radii: Vec3,
     },
     /// A plane z = 0 of half-sides x, y (0: unbounded, drawn as the viewer's ground).
     Plane {
+        /// Half its sides along x and y.
         half_extents: [f64; 2],
     },
     /// A triangle mesh; `file_to_visual` maps the file's coordinates into the visual's frame
     /// (scale, and MJCF's `refpos`/`refquat`), an affine map that may scale.
     Mesh {
+        /// Where its triangles come from.
         source: MeshSource,
+        /// The homogeneous map from the file's coordinates to the visual's frame.
         file_to_visual: Matrix4<f64>,
     },
 }
@@ -77,6 +92,7 @@ pub struct Visual {
     pub body: usize,
     /// `X_{visual←body}`: the visual's frame relative to its body.
     pub placement: Transform,
+    /// Its shape, in the visual's frame.
     pub shape: Shape,
     /// Colour and opacity, each in [0, 1].
     pub rgba: [f64; 4],
@@ -116,13 +132,19 @@ impl TextureKind {
 pub struct BuiltinTexture {
     /// "gradient", "checker" or "flat".
     pub pattern: String,
+    /// The first colour of the pattern (RGB in [0, 1]).
     pub rgb1: [f64; 3],
+    /// The second colour of the pattern (RGB in [0, 1]).
     pub rgb2: [f64; 3],
     /// "none", "edge", "cross" or "random" (dots, each pixel with probability `random`).
     pub mark: String,
+    /// The colour of the mark (RGB in [0, 1]).
     pub mark_rgb: [f64; 3],
+    /// The probability of a random dot per pixel (mark "random").
     pub random: f64,
+    /// Its width in pixels.
     pub width: usize,
+    /// Its height in pixels.
     pub height: usize,
 }
 
@@ -131,10 +153,14 @@ pub struct BuiltinTexture {
 pub enum TextureImage {
     /// A PNG file, mirrored left to right (`hflip`) or top to bottom (`vflip`) when drawn.
     File {
+        /// The PNG file, found when the model loaded.
         path: PathBuf,
+        /// Mirror it left to right.
         hflip: bool,
+        /// Mirror it top to bottom.
         vflip: bool,
     },
+    /// An image MuJoCo draws itself.
     Builtin(BuiltinTexture),
     /// A texture robodyn cannot draw, and why (a file not found, not a PNG, a cube's faces from
     /// files): the viewer draws the material's colour and warns.
@@ -146,7 +172,9 @@ pub enum TextureImage {
 pub struct Texture {
     /// Its name in the file (or one made from its position there).
     pub name: String,
+    /// What it is for.
     pub kind: TextureKind,
+    /// Where its image comes from.
     pub image: TextureImage,
     /// The element it comes from (file, element, line), for messages about it.
     pub element: String,
@@ -156,7 +184,10 @@ pub struct Texture {
 /// per two spatial units where `uniform` (`texuniform`).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TextureMapping {
+    /// The texture laid on.
     pub texture: Texture,
+    /// How many times it repeats over the geom in each direction (`texrepeat`).
     pub repeat: [f64; 2],
+    /// Repeat per two spatial units rather than over the whole geom (`texuniform`).
     pub uniform: bool,
 }

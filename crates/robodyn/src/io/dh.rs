@@ -8,7 +8,7 @@
 //!
 //! Each row's mass, centre of mass and inertia (about the centre of mass) are given in DH frame i,
 //! the frame the row ends in. The frames named after the rows are DH frames 1..n (with the
-//! standard convention the bodies' own frames, at the joints, are "<row>_joint"); "base" is DH
+//! standard convention the bodies' own frames, at the joints, are "`<row>_joint`"); "base" is DH
 //! frame 0 and "tool" the tool frame. Every table ends in the same [`ModelBuilder`] as the URDF
 //! loader; the joints are named after the rows.
 
@@ -24,7 +24,9 @@ use crate::spatial::{Inertia, Mat3, Transform, Vec3};
 /// Which DH convention a table uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DhConvention {
+    /// Denavit–Hartenberg's: `ⁱ⁻¹T_i = Rz(θ_i) Tz(d_i) Tx(a_i) Rx(α_i)`.
     Standard,
+    /// Craig's: `ⁱ⁻¹T_i = Rx(α_{i-1}) Tx(a_{i-1}) Rz(θ_i) Tz(d_i)`.
     Modified,
 }
 
@@ -40,26 +42,38 @@ pub enum DhJoint {
 /// One row of a DH table with the link's mass properties (in DH frame i).
 #[derive(Debug, Clone, PartialEq)]
 pub struct DhRow {
+    /// The row's name: its joint's and its DH frame's.
     pub name: String,
+    /// Whether q adds to θ or to d.
     pub joint: DhJoint,
+    /// Link length a (m).
     pub a: f64,
+    /// Link twist α (rad).
     pub alpha: f64,
+    /// Link offset d (m); the joint offset of a prismatic joint.
     pub d: f64,
+    /// Joint angle θ (rad); the joint offset of a revolute joint.
     pub theta: f64,
+    /// The link's mass (kg).
     pub mass: f64,
     /// Centre of mass in DH frame i.
     pub com: Vec3,
     /// Rotational inertia about the centre of mass, in DH frame i's axes.
     pub inertia: Mat3,
+    /// The joint's lower position limit.
     pub lower: f64,
+    /// The joint's upper position limit.
     pub upper: f64,
 }
 
 /// A robot given as a DH table.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DhTable {
+    /// The robot's name.
     pub name: String,
+    /// Which convention the rows follow.
     pub convention: DhConvention,
+    /// The rows, from the base outwards.
     pub rows: Vec<DhRow>,
     /// Pose of DH frame 0 in the world.
     pub base: Transform,

@@ -32,7 +32,9 @@ const MIN_VALUE: f64 = 1e-15;
 /// A mesh as read from its file: vertices and triangles (indices into the vertices).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TriangleMesh {
+    /// The vertices, in the file's coordinates.
     pub vertices: Vec<Vec3>,
+    /// The triangles, as indices into `vertices`, counter-clockwise seen from outside.
     pub faces: Vec<[usize; 3]>,
 }
 
@@ -43,7 +45,9 @@ pub const MAX_POLYGON_CORNERS: usize = 100;
 /// A mesh file as read: its triangles, and the polygons left out as MuJoCo leaves them out.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeshFile {
+    /// The triangles read.
     pub mesh: TriangleMesh,
+    /// The polygons that gave no triangles.
     pub dropped_polygons: Vec<DroppedPolygon>,
 }
 
@@ -52,6 +56,7 @@ pub struct MeshFile {
 pub struct DroppedPolygon {
     /// Its line in the file (1-based), when the face lines could be matched to the polygons.
     pub line: Option<usize>,
+    /// How many corners it has.
     pub corners: usize,
 }
 
@@ -71,9 +76,13 @@ impl DroppedPolygon {
 /// How a mesh's inertia is computed (`<mesh inertia>`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MeshInertia {
+    /// MuJoCo's former rule: every triangle's pyramid counts with a positive volume.
     Legacy,
+    /// The solid the (closed, consistently oriented) mesh encloses.
     Exact,
+    /// A thin shell: the mass spread over the surface.
     Shell,
+    /// The solid of the mesh's convex hull.
     Convex,
 }
 
@@ -109,8 +118,11 @@ impl MeshInertia {
 /// and rotational inertia about the centre of mass, in the mesh's (transformed) frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MeshMassProperties {
+    /// Volume (m³), or area (m²) for a shell: the mass at unit density.
     pub volume: f64,
+    /// Centre of mass.
     pub com: Vec3,
+    /// Rotational inertia about the centre of mass, at unit density.
     pub inertia: Mat3,
 }
 

@@ -1,5 +1,5 @@
 //! What elements and attributes a model format knows, and the walk that checks a document against
-//! it: an unknown name is reported with the nearest known one ("did you mean <inertial>?").
+//! it: an unknown name is reported with the nearest known one ("did you mean `<inertial>`?").
 //!
 //! A schema is a table of elements; an element lists its attributes and the indices of the
 //! elements it may contain, so a recursive element (MJCF's `<body>` in a `<body>`) points to itself.
