@@ -19,8 +19,6 @@ import sys
 import warnings
 from pathlib import Path
 
-import numpy as np
-
 from robodyn._core import (
     Model,
     SimulationError,
@@ -33,6 +31,7 @@ from robodyn._core import (
     load_urdf,
     load_urdf_string,
 )
+from robodyn import _arguments
 from robodyn.operational_space import operational_space as _operational_space
 from robodyn.simulation import (
     PD,
@@ -46,8 +45,14 @@ from robodyn.simulation import (
 )
 from robodyn.datasets import dataset, read_dataset, simulate_many
 
-# methods composed in NumPy from the core's batched calls
-Model.operational_space = _operational_space
+
+def _operational_space_method(self, q, v, frame, task="full", damping=None, reference="world"):
+    """Λ, μ, p and J̄ of a frame's task (:func:`robodyn.operational_space.operational_space` of
+    this model), composed in NumPy from the core's batched calls."""
+    return _operational_space(self, q, v, frame, task, damping, reference)
+
+
+Model.operational_space = _operational_space_method
 
 
 def _view(self, q=None, **options):
@@ -143,12 +148,6 @@ def _find_file(name: str) -> Path:
     )
 
 
-def _check_flag(value: object, argument: str) -> bool:
-    if not isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"argument '{argument}': expected True or False, got {value!r}")
-    return bool(value)
-
-
 def load(
     name_or_path: str | os.PathLike[str], floating_base: bool = False, check_inertia: bool = True, strict: bool = False
 ) -> Model:
@@ -172,12 +171,10 @@ def load(
     Raises ``FileNotFoundError`` for a missing file (saying where robodyn looked) and ``ValueError``
     for an invalid model, naming the file, element and line, or for a wrong argument.
     """
-    if not isinstance(name_or_path, (str, os.PathLike)):
-        raise ValueError(f"argument 'name_or_path': expected a model name or a path, got {name_or_path!r}")
-    floating_base = _check_flag(floating_base, "floating_base")
-    check_inertia = _check_flag(check_inertia, "check_inertia")
-    strict = _check_flag(strict, "strict")
-    text = os.fspath(name_or_path)
+    text = _arguments.path("name_or_path", name_or_path, "a model name or a path")
+    floating_base = _arguments.flag("floating_base", floating_base)
+    check_inertia = _arguments.flag("check_inertia", check_inertia)
+    strict = _arguments.flag("strict", strict)
     model = _load_model(text, floating_base, check_inertia)
     if strict and model.warnings:
         raise ValueError("strict=True: " + " | ".join(model.warnings))

@@ -19,7 +19,9 @@ from typing import Any, Callable, NoReturn, Sequence, TextIO
 import numpy as np
 
 import robodyn
-from robodyn.simulation import INTEGRATORS, _coordinate_names
+from robodyn import _arguments
+from robodyn._joints import JOINT_KINDS, coordinate_names
+from robodyn.simulation import INTEGRATORS
 
 #: forward_dynamics(inverse_dynamics(a)) must return a to this relative accuracy.
 ROUND_TRIP_TOLERANCE = 1e-9
@@ -46,24 +48,27 @@ class _Parser(argparse.ArgumentParser):
 # argument types: each names what it expected and what came
 
 
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got '{text}'") from None
-    if value <= 0:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {value}")
-    return value
+def _option(check: Callable[[str, Any], Any]) -> Callable[[str], Any]:
+    """An option's type from a check of ``robodyn._arguments``: the text read as a number (1e6
+    is a whole number), then checked."""
+
+    def convert(text: str) -> Any:
+        try:
+            number = float(text)
+            value: Any = int(number) if number.is_integer() else number
+        except ValueError:
+            value = text
+        try:
+            return check("option", value)
+        except ValueError as error:
+            # argparse puts the option's name before the message
+            raise argparse.ArgumentTypeError(str(error).removeprefix("argument 'option': ")) from None
+
+    return convert
 
 
-def _positive_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive number, got '{text}'") from None
-    if not (np.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {text}")
-    return value
+_positive_int = _option(_arguments.count)
+_positive_float = _option(_arguments.positive)
 
 
 def _load(model: str, show_warnings: bool = True) -> robodyn.Model:
@@ -133,7 +138,7 @@ def _matrix(rows: np.ndarray, names: list[str]) -> str:
 def demo(model: str = "ur5", batch: int = 10_000) -> int:
     """Print the dynamics of a robot at a sample state and time a batch."""
     m = _load(model)
-    q_names, v_names = _coordinate_names(m)
+    q_names, v_names = coordinate_names(m)
     q = m.random_configuration(seed=1)
     v = np.linspace(-1.0, 1.0, m.nv)
     a = np.linspace(0.5, -0.5, m.nv)
@@ -168,10 +173,6 @@ def demo(model: str = "ur5", batch: int = 10_000) -> int:
 # robodyn info
 
 
-def _unit(kind: str) -> str:
-    return {"revolute": "rad", "prismatic": "m"}.get(kind, "")
-
-
 def info(model: str) -> int:
     """Print what a model holds: sizes, joints, bodies, frames, warnings."""
     m = _load(model, show_warnings=False)
@@ -181,7 +182,7 @@ def info(model: str) -> int:
     width = max(len(n) for n in m.joint_names)
     print(f"  {'joint':<{width}}  {'type':<10} {'q index':>7} {'v index':>7} {'lower':>12} {'upper':>12}")
     for name, kind, iq, iv in zip(m.joint_names, m.joint_types, m.joint_idx_q, m.joint_idx_v):
-        unit = _unit(kind)
+        unit = JOINT_KINDS[kind].unit
         lower = f"{m.lower_position_limit[iq]:.6g} {unit}" if unit else "-"
         upper = f"{m.upper_position_limit[iq]:.6g} {unit}" if unit else "-"
         print(f"  {name:<{width}}  {kind:<10} {iq:>7} {iv:>7} {lower:>12} {upper:>12}")
@@ -265,7 +266,7 @@ def derive(model: str, rods: bool, latex: str | None, codegen: str | None, symbo
     from robodyn import symbolic as sym
 
     if output:
-        _check_writable(output, "-o/--output")
+        _arguments.writable_folder("-o/--output", output)
     chain = _symbolic_chain(model, rods, symbolic_params)
     start = time.perf_counter()
     stop = _elapsed_status(f"Euler–Lagrange equations of {model}")
@@ -301,14 +302,6 @@ def derive(model: str, rods: bool, latex: str | None, codegen: str | None, symbo
 # robodyn simulate
 
 
-def _check_writable(path: str, option: str) -> None:
-    folder = Path(path).resolve().parent
-    if not folder.is_dir():
-        raise UsageError(f"argument {option}: the folder {folder} does not exist")
-    if not os.access(folder, os.W_OK):
-        raise UsageError(f"argument {option}: the folder {folder} is not writable")
-
-
 def _check_outputs(plot: str | None, animate: str | None, csv: str | None, npz: str | None,
                    html: str | None = None) -> None:
     """Everything the outputs need, checked before simulating rather than after."""
@@ -328,7 +321,7 @@ def _check_outputs(plot: str | None, animate: str | None, csv: str | None, npz: 
         raise UsageError(str(error)) from None
     for path, option in ((csv, "--csv"), (npz, "--npz")):
         if path:
-            _check_writable(path, option)
+            _arguments.writable_folder(option, path)
 
 
 def simulate(model: str, t_end: float, dt: float, integrator: str, q0: Sequence[float] | None, controller: str,
@@ -365,7 +358,7 @@ def simulate(model: str, t_end: float, dt: float, integrator: str, q0: Sequence[
         print(f"accuracy: {trajectory.accuracy_issue['message']}")
     kinds = dict(zip(m.joint_names, m.joint_types))
     for violation in trajectory.limit_violations:
-        unit = _unit(kinds[violation["joint"]])
+        unit = JOINT_KINDS[kinds[violation["joint"]]].unit
         print(f"limit: {violation['coordinate']} left its range at t = {violation['first_time']:.3f} s, "
               f"by up to {violation['worst_excess']:.3g} {unit}".rstrip())
     if plot:
@@ -475,7 +468,7 @@ def _parser() -> _Parser:
                              help="open the page in a browser (default: when a desktop session is there)")
     dataset_parser = commands.add_parser("dataset", help="sample states and write their dynamics to a Zarr store or Parquet files")
     dataset_parser.add_argument("model", help=MODEL_HELP)
-    dataset_parser.add_argument("--n", type=_count, required=True, help="number of states, e.g. 1e6")
+    dataset_parser.add_argument("--n", type=_positive_int, required=True, help="number of states, e.g. 1e6")
     dataset_parser.add_argument("--out", required=True, help="the Zarr store to write (a folder), or, ending in .parquet, a folder of Parquet files "
                                 "(vector quantities)")
     dataset_parser.add_argument("--quantities", nargs="+", default=["tau"], choices=["tau", "M", "g", "qdd"],
@@ -496,23 +489,12 @@ def _parser() -> _Parser:
 # robodyn dataset
 
 
-def _count(text: str) -> int:
-    """A positive whole number, also written as 1e8."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive whole number such as 1000000 or 1e6, got '{text}'") from None
-    if not (np.isfinite(value) and value >= 1 and value == int(value)):
-        raise argparse.ArgumentTypeError(f"expected a positive whole number such as 1000000 or 1e6, got {text}")
-    return int(value)
-
-
 def dataset(model: str, n: int, out: str, quantities: list[str], seed: int, chunk: int, sampler: str,
             scheduler: str | None, resume: bool, progress: bool | None) -> int:
     """Samples n states of a model and writes them with their dynamics to a Zarr store or Parquet
     files."""
     m = _load(model)
-    _check_writable(out, "--out")
+    _arguments.writable_folder("--out", out)
     client = None
     if scheduler is not None:
         from dask.distributed import Client

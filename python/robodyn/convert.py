@@ -26,6 +26,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from robodyn._joints import JOINT_KINDS
+
 __all__ = ["PinocchioLayout", "MujocoLayout"]
 
 
@@ -139,7 +141,7 @@ class MujocoLayout:
             self.mujoco_joints.append(j)
             mj_iq, mj_iv = int(mj_model.jnt_qposadr[j]), int(mj_model.jnt_dofadr[j])
             self._joints.append((kind, iq, iv, mj_iq))
-            nv = {"free": 6, "spherical": 3}.get(kind, 1)
+            nv = JOINT_KINDS[kind].nv
             self.v_index[iv : iv + nv] = np.arange(mj_iv, mj_iv + nv)
         if mj_model.nv != model.nv:
             raise ValueError(f"argument 'mj_model': expected {model.nv} velocity coordinates as the robodyn model has, got {mj_model.nv}")

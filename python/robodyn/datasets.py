@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from robodyn import _core
+from robodyn import _arguments, _core
 
 #: States per independently seeded block: a chunk draws the blocks it overlaps and keeps its
 #: states, so the chunking changes nothing.
@@ -138,7 +138,7 @@ def _write_part(directory: Path, index: int, arrays: dict[str, FloatArray]) -> N
 def read_dataset(path: str | Path) -> dict[str, FloatArray]:
     """A dataset written by `dataset` (a Zarr store or a Parquet folder) as arrays: `q`, `v`,
     `a`, `tau_applied` and the quantities, each (n, ...); raises if chunks are missing."""
-    path = Path(path)
+    path = Path(_arguments.path("path", path))
     if (path / PARQUET_ATTRIBUTES).exists():
         import pyarrow.parquet as pq
 
@@ -172,18 +172,15 @@ def _describe(sampler: Any) -> dict[str, Any]:
 
 def _sampler(model: _core.Model, sampler: Any, n: int, center: Any, std: float) -> dict[str, Any]:
     """The sampler argument checked: "uniform", "gaussian" (around `center`) or an (n, nq) array."""
+    center = _arguments.array("center", model.neutral() if center is None else center, (model.nq,))
+    std = _arguments.positive("std", std)
     if isinstance(sampler, str):
         if sampler == "uniform":
             return {"kind": "uniform"}
         if sampler == "gaussian":
-            c = np.asarray(model.neutral() if center is None else center, dtype=np.float64)
-            if c.shape != (model.nq,) or not np.all(np.isfinite(c)):
-                raise ValueError(f"argument 'center': expected {model.nq} finite numbers, got shape {c.shape}")
-            if not (np.isfinite(std) and std > 0):
-                raise ValueError(f"argument 'std': expected a positive number, got {std!r}")
-            return {"kind": "gaussian", "center": c, "std": float(std)}
+            return {"kind": "gaussian", "center": center, "std": std}
         raise ValueError(f"argument 'sampler': expected 'uniform', 'gaussian' or an (n, nq) array, got {sampler!r}")
-    q = np.asarray(sampler, dtype=np.float64)
+    q = _arguments.numbers("sampler", sampler)
     if q.shape != (n, model.nq):
         raise ValueError(f"argument 'sampler': expected an array of shape ({n}, {model.nq}), got {q.shape}")
     return {"kind": "array", "q": q}
@@ -230,18 +227,23 @@ def dataset(
     record the model's name and content hash, the robodyn version, the seed, the sampler, the
     chunk size and the quantities.
     """
-    n = int(n)
-    if n < 1:
-        raise ValueError(f"argument 'n': expected a positive number of states, got {n}")
+    _arguments.robot_model("model", model)
+    n = _arguments.count("n", n)
     if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
         raise ValueError(f"argument 'chunk': expected a positive whole number of states, got {chunk!r}")
     chunk = int(chunk)
+    if isinstance(quantities, str) or not isinstance(quantities, Sequence):
+        raise _arguments.bad("quantities", f"a list of names among {sorted(QUANTITIES)}", repr(quantities))
     unknown = [q for q in quantities if q not in QUANTITIES]
     if unknown:
         raise ValueError(f"argument 'quantities': expected names among {sorted(QUANTITIES)}, got {unknown}")
+    path = _arguments.path("out", out)
+    seed = _arguments.count("seed", seed, 0)
+    resume = _arguments.flag("resume", resume)
+    _arguments.callback("progress", progress)
+    _client(client)
     form = _format(out, format, model, quantities)
     spec = _sampler(model, sampler, n, center, std)
-    path = str(out)
     model_bytes = pickle.dumps(model)
     attributes = {
         "model": model.name,
@@ -302,7 +304,7 @@ def dataset(
 def _format(out: str | Path, format: str | None, model: _core.Model, quantities: Sequence[str]) -> str:
     """"zarr" or "parquet", from `format` or else `out`'s suffix; Parquet holds vectors only."""
     form = format if format is not None else ("parquet" if Path(out).suffix == ".parquet" else "zarr")
-    if form not in ("zarr", "parquet"):
+    if not isinstance(form, str) or form not in ("zarr", "parquet"):
         raise ValueError(f"argument 'format': expected 'zarr' or 'parquet', got {format!r}")
     matrices = [name for name in quantities if len(QUANTITIES[name][1](model)) > 1]
     if form == "parquet" and matrices:
@@ -349,6 +351,12 @@ def _done(path: str, form: str, chunks: int) -> list[bool]:
     return [bool(x) for x in zarr.open_group(path, mode="r")["done"][:]]
 
 
+def _client(client: Any) -> None:
+    """None or a Dask client."""
+    if client is not None and not (hasattr(client, "submit") and hasattr(client, "scatter")):
+        raise _arguments.bad("client", "None or a dask.distributed.Client", repr(client))
+
+
 def _rollouts(model: _core.Model, q0: FloatArray, v0: FloatArray, options: dict[str, Any]) -> list[Any]:
     """One task: a batch of rollouts, in parallel on the worker's cores."""
     from robodyn.simulation import simulate
@@ -377,16 +385,18 @@ def simulate_many(
     Returns the N trajectories in order (each equal to `robodyn.simulate`'s), or, with `out`, writes
     a Zarr store with `t` (T,) and `q`, `v`, `a`, `tau` (N, T, ...) and returns it.
     """
-    q0 = np.atleast_2d(np.asarray(q0, dtype=np.float64))
+    _arguments.robot_model("model", model)
+    q0 = np.atleast_2d(_arguments.numbers("q0", q0))
     if q0.ndim != 2 or q0.shape[1] != model.nq:
         raise ValueError(f"argument 'q0': expected an array of shape (N, {model.nq}), got {q0.shape}")
     count = q0.shape[0]
-    v0 = np.zeros((count, model.nv)) if v0 is None else np.atleast_2d(np.asarray(v0, dtype=np.float64))
+    v0 = np.zeros((count, model.nv)) if v0 is None else np.atleast_2d(_arguments.numbers("v0", v0))
     if v0.shape != (count, model.nv):
         raise ValueError(f"argument 'v0': expected an array of shape ({count}, {model.nv}), got {v0.shape}")
-    if per_task < 1:
-        raise ValueError(f"argument 'per_task': expected a positive number of rollouts, got {per_task}")
-    if out is not None and Path(out).exists():
+    per_task = _arguments.count("per_task", per_task)
+    _arguments.callback("progress", progress)
+    _client(client)
+    if out is not None and Path(_arguments.path("out", out)).exists():
         raise ValueError(f"argument 'out': {out} exists; remove it or choose another")
     groups = [(start, min(start + per_task, count)) for start in range(0, count, per_task)]
     parts: list[list[Any]] = [[] for _ in groups]

@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from robodyn._arguments import array, positive, real
+
 __all__ = [
     "GimbalLockError",
     "angular_acceleration",
@@ -43,17 +45,13 @@ class GimbalLockError(ValueError):
 
 def _vector(name, value, size=3, batch=False) -> np.ndarray:
     """`size` finite numbers; with ``batch``, also a stack of them, shape (N, size)."""
-    array = np.asarray(value, dtype=float)
-    shape_ok = array.shape == (size,) or (batch and array.ndim == 2 and array.shape[1] == size)
-    if not shape_ok or not np.all(np.isfinite(array)):
-        raise ValueError(f"argument '{name}': expected {size} finite numbers{' (or N of them)' if batch else ''}, got {np.asarray(value).tolist()}")
-    return array
+    return array(name, value, (size,), (None, size)) if batch else array(name, value, (size,))
 
 
 def angular_acceleration(inertia_body, omega_body, moment_body=(0.0, 0.0, 0.0)) -> np.ndarray:
     """Euler's equations: ω̇_b = I_b⁻¹ [M_b − ω_b × (I_b ω_b)]. ``omega_body`` and
     ``moment_body`` may be stacks (N, 3)."""
-    inertia_body = np.asarray(inertia_body, dtype=float)
+    inertia_body = array("inertia_body", inertia_body, (3, 3))
     omega = _vector("omega_body", omega_body, batch=True)
     moment = _vector("moment_body", moment_body, batch=True)
     rhs = moment - np.cross(omega, omega @ inertia_body.T)
@@ -112,7 +110,8 @@ def euler123_rates(angles, omega_body) -> np.ndarray:
 def precession_rate(inertia_transverse: float, inertia_axial: float, omega_axial: float) -> float:
     """A symmetric body (I₁ = I₂ = I_t, I₃ = I_a) spinning at ω₃: its transverse angular velocity
     turns about the body's symmetry axis at Ω = (I_a − I_t) / I_t · ω₃ (body frame)."""
-    return (inertia_axial - inertia_transverse) / inertia_transverse * omega_axial
+    transverse, axial = positive("inertia_transverse", inertia_transverse), positive("inertia_axial", inertia_axial)
+    return (axial - transverse) / transverse * real("omega_axial", omega_axial)
 
 
 def simulate(inertia_body, omega_body, t_end: float, dt: float, orientation="quaternion", initial=None, moment_body=(0.0, 0.0, 0.0)) -> dict:
@@ -123,7 +122,8 @@ def simulate(inertia_body, omega_body, t_end: float, dt: float, orientation="qua
     Returns a dict with ``t``, ``omega_body`` (N×3), ``orientation`` (N×4 or N×3), ``rotation``
     (N×3×3), ``angular_momentum`` (world axes, R I_b ω_b) and ``kinetic_energy`` (½ ω_bᵀ I_b ω_b).
     """
-    inertia_body = np.asarray(inertia_body, dtype=float)
+    inertia_body = array("inertia_body", inertia_body, (3, 3))
+    t_end, dt = positive("t_end", t_end), positive("dt", dt)
     if orientation == "quaternion":
         state_orientation = _vector("initial", [0.0, 0.0, 0.0, 1.0] if initial is None else initial, 4)
         rate, rotation = quaternion_rate, quaternion_rotation
@@ -132,8 +132,6 @@ def simulate(inertia_body, omega_body, t_end: float, dt: float, orientation="qua
         rate, rotation = euler123_rates, euler123_rotation
     else:
         raise ValueError(f"argument 'orientation': expected 'quaternion' or 'euler123', got {orientation!r}")
-    if not (np.isfinite(t_end) and np.isfinite(dt) and dt > 0 and t_end > 0):
-        raise ValueError(f"arguments 't_end', 'dt': expected positive finite numbers, got {t_end!r}, {dt!r}")
 
     def derivative(state):
         omega, attitude = state[:3], state[3:]

@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from robodyn import _core
+from robodyn._arguments import array, choice, positive, real
 
 __all__ = [
     "solid_box",
@@ -42,17 +43,8 @@ VALIDITY_TOLERANCE = 1e-12
 _AXES = {"x": 0, "y": 1, "z": 2}
 
 
-def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not np.isfinite(value) or value <= 0.0:
-        raise ValueError(f"argument '{name}': expected a positive finite number, got {value!r}")
-    return value
-
-
 def _axis_index(axis: str) -> int:
-    if axis not in _AXES:
-        raise ValueError(f"argument 'axis': expected 'x', 'y' or 'z', got {axis!r}")
-    return _AXES[axis]
+    return _AXES[choice("axis", axis, tuple(_AXES))]
 
 
 def _about_axis(along: float, across: float, axis: str) -> np.ndarray:
@@ -67,8 +59,8 @@ def solid_box(mass: float, size, about: str = "center") -> np.ndarray:
     diag(m(b²+c²)/12, m(a²+c²)/12, m(a²+b²)/12). ``about="corner"``: about the corner at the
     origin with the box along +x, +y, +z (the TU Berlin notes' example, sides w, l, h):
     I_xx = m/3 (b² + c²), I_xy = m/4 a b, …, i.e. the matrix [[m/3(l²+h²), −m/4 wl, −m/4 hw], …]."""
-    mass = _positive("mass", mass)
-    a, b, c = (_positive("size", s) for s in np.asarray(size, dtype=float).reshape(3))
+    mass = positive("mass", mass)
+    a, b, c = (positive("size", s) for s in array("size", size, (3,)))
     squares = np.array([b * b + c * c, a * a + c * c, a * a + b * b])
     if about == "center":
         return np.diag(mass * squares / 12.0)
@@ -80,16 +72,16 @@ def solid_box(mass: float, size, about: str = "center") -> np.ndarray:
 
 def solid_sphere(mass: float, radius: float) -> np.ndarray:
     """⅖ m r² about every axis through the centre."""
-    return np.eye(3) * 0.4 * _positive("mass", mass) * _positive("radius", radius) ** 2
+    return np.eye(3) * 0.4 * positive("mass", mass) * positive("radius", radius) ** 2
 
 
 def hollow_sphere(mass: float, radius: float, inner_radius: float = 0.0) -> np.ndarray:
     """A spherical shell between ``inner_radius`` and ``radius``:
     ⅖ m (r⁵ − rᵢ⁵)/(r³ − rᵢ³); ``inner_radius = 0`` (the default) is a thin shell, ⅔ m r²."""
-    mass, radius = _positive("mass", mass), _positive("radius", radius)
+    mass, radius = positive("mass", mass), positive("radius", radius)
     if inner_radius == 0.0:
         return np.eye(3) * 2.0 / 3.0 * mass * radius**2
-    inner = _positive("inner_radius", inner_radius)
+    inner = positive("inner_radius", inner_radius)
     if inner >= radius:
         raise ValueError(f"argument 'inner_radius': expected less than radius {radius}, got {inner}")
     return np.eye(3) * 0.4 * mass * (radius**5 - inner**5) / (radius**3 - inner**3)
@@ -97,15 +89,15 @@ def hollow_sphere(mass: float, radius: float, inner_radius: float = 0.0) -> np.n
 
 def solid_cylinder(mass: float, radius: float, length: float, axis: str = "z") -> np.ndarray:
     """m r²/2 along the axis, m(3r² + L²)/12 across."""
-    mass, radius, length = _positive("mass", mass), _positive("radius", radius), _positive("length", length)
+    mass, radius, length = positive("mass", mass), positive("radius", radius), positive("length", length)
     return _about_axis(mass * radius**2 / 2.0, mass * (3.0 * radius**2 + length**2) / 12.0, axis)
 
 
 def hollow_cylinder(mass: float, radius: float, length: float, inner_radius: float = 0.0, axis: str = "z") -> np.ndarray:
     """A tube between ``inner_radius`` and ``radius``: m(r² + rᵢ²)/2 along the axis,
     m(3(r² + rᵢ²) + L²)/12 across; ``inner_radius = 0`` is a thin-walled tube (rᵢ = r)."""
-    mass, radius, length = _positive("mass", mass), _positive("radius", radius), _positive("length", length)
-    inner = radius if inner_radius == 0.0 else _positive("inner_radius", inner_radius)
+    mass, radius, length = positive("mass", mass), positive("radius", radius), positive("length", length)
+    inner = radius if inner_radius == 0.0 else positive("inner_radius", inner_radius)
     if inner > radius:
         raise ValueError(f"argument 'inner_radius': expected at most radius {radius}, got {inner}")
     squares = radius**2 + inner**2
@@ -116,7 +108,7 @@ def capsule(mass: float, radius: float, length: float, axis: str = "z") -> np.nd
     """A cylinder of ``length`` capped by two hemispheres of ``radius`` (MuJoCo's capsule), the mass
     shared by volume: cylinder m_c, hemispheres together m_s;
     across m_c(L²/12 + r²/4) + m_s(2r²/5 + L²/4 + 3Lr/8), along m_c r²/2 + m_s 2r²/5."""
-    mass, r, length = _positive("mass", mass), _positive("radius", radius), _positive("length", length)
+    mass, r, length = positive("mass", mass), positive("radius", radius), positive("length", length)
     cylinder, sphere = np.pi * r * r * length, 4.0 / 3.0 * np.pi * r**3
     m_c, m_s = mass * cylinder / (cylinder + sphere), mass * sphere / (cylinder + sphere)
     across = m_c * (length**2 / 12.0 + r * r / 4.0) + m_s * (0.4 * r * r + length**2 / 4.0 + 3.0 * length * r / 8.0)
@@ -126,28 +118,12 @@ def capsule(mass: float, radius: float, length: float, axis: str = "z") -> np.nd
 def rod(mass: float, length: float, axis: str = "z", about: str = "center") -> np.ndarray:
     """A thin rod along ``axis``: m L²/12 across about its centre, m L²/3 about an end
     (``about="end"``, the end at the origin, the rod along +axis), 0 along it."""
-    mass, length = _positive("mass", mass), _positive("length", length)
+    mass, length = positive("mass", mass), positive("length", length)
     if about == "center":
         return _about_axis(0.0, mass * length**2 / 12.0, axis)
     if about == "end":
         return _about_axis(0.0, mass * length**2 / 3.0, axis)
     raise ValueError(f"argument 'about': expected 'center' or 'end', got {about!r}")
-
-
-def _matrix(name: str, value) -> np.ndarray:
-    matrix = np.asarray(value, dtype=float)
-    if matrix.shape != (3, 3):
-        raise ValueError(f"argument '{name}': expected a 3x3 matrix, got shape {matrix.shape}")
-    if not np.all(np.isfinite(matrix)):
-        raise ValueError(f"argument '{name}': expected finite numbers, got {matrix.tolist()}")
-    return matrix
-
-
-def _vector(name: str, value) -> np.ndarray:
-    vector = np.asarray(value, dtype=float)
-    if vector.shape != (3,) or not np.all(np.isfinite(vector)):
-        raise ValueError(f"argument '{name}': expected 3 finite numbers, got {np.asarray(value).tolist()}")
-    return vector
 
 
 def _point_term(mass: float, p: np.ndarray) -> np.ndarray:
@@ -159,27 +135,27 @@ def shift_from_com(inertia_com, mass: float, com) -> np.ndarray:
     """Parallel-axis theorem (the TU Berlin notes): the inertia about a frame's origin A, given the inertia
     about the centre of mass C (same axes) and C's position p_C in A:
     ᴬI = ᶜI + m [(p_Cᵀ p_C) 1 − p_C p_Cᵀ]."""
-    return _matrix("inertia_com", inertia_com) + _point_term(float(mass), _vector("com", com))
+    return array("inertia_com", inertia_com, (3, 3)) + _point_term(real("mass", mass), array("com", com, (3,)))
 
 
 def shift_to_com(inertia, mass: float, com) -> np.ndarray:
     """The parallel-axis theorem backwards: ᶜI = ᴬI − m [(p_Cᵀ p_C) 1 − p_C p_Cᵀ]."""
-    return _matrix("inertia", inertia) - _point_term(float(mass), _vector("com", com))
+    return array("inertia", inertia, (3, 3)) - _point_term(real("mass", mass), array("com", com, (3,)))
 
 
 def rotate(inertia, rotation) -> np.ndarray:
     """The same tensor in other axes (the TU Berlin notes "Rotation Transformation"): ᴮI = ᴮR_A ᴬI ᴮR_Aᵀ,
     with ``rotation`` = ᴮR_A mapping A coordinates to B coordinates."""
-    rotation = _matrix("rotation", rotation)
+    rotation = array("rotation", rotation, (3, 3))
     if not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-9) or np.linalg.det(rotation) <= 0:
         raise ValueError("argument 'rotation': expected a rotation matrix (orthonormal, det +1)")
-    return rotation @ _matrix("inertia", inertia) @ rotation.T
+    return rotation @ array("inertia", inertia, (3, 3)) @ rotation.T
 
 
 def principal_axes(inertia) -> tuple[np.ndarray, np.ndarray]:
     """Principal moments (eigenvalues, ascending) and principal axes (the eigenvectors as the
     columns of a right-handed rotation R), so that inertia = R diag(moments) Rᵀ."""
-    inertia = _matrix("inertia", inertia)
+    inertia = array("inertia", inertia, (3, 3))
     moments, axes = np.linalg.eigh(0.5 * (inertia + inertia.T))
     if np.linalg.det(axes) < 0:
         axes[:, 2] = -axes[:, 2]
@@ -196,10 +172,10 @@ def check_physical(inertia, mass: float | None = None) -> None:
     breaks the triangle inequality alone (every algorithm still computes with it): a loaded file
     and the setter report it as a ``ModelWarning`` (``load(..., strict=True)`` refuses it), while
     this check raises."""
-    inertia = _matrix("inertia", inertia)
+    inertia = array("inertia", inertia, (3, 3))
     scale = max(1e-300, float(np.abs(inertia).max()))
-    if mass is not None and not (np.isfinite(mass) and mass > 0):
-        raise ValueError(f"argument 'mass': expected a positive finite number, got {mass!r}")
+    if mass is not None:
+        mass = positive("mass", mass)
     if np.abs(inertia - inertia.T).max() > VALIDITY_TOLERANCE * scale:
         raise ValueError(f"argument 'inertia': expected a symmetric matrix, got {inertia.tolist()}")
     # the ten parameters [m, m c, I] of a body whose centre of mass is its origin
@@ -215,18 +191,16 @@ def spatial_inertia(mass: float, com, inertia_com) -> np.ndarray:
     """The 6×6 spatial inertia about a frame's origin, acting on [linear; angular] velocities
     (robodyn's order) to give [force; moment] momenta:
     [[m 1, −m c×], [m c×, ᶜI − m c× c×]] (Featherstone eq. 2.63, reordered)."""
-    c = _vector("com", com)
+    c = array("com", com, (3,))
     cross = np.array([[0.0, -c[2], c[1]], [c[2], 0.0, -c[0]], [-c[1], c[0], 0.0]])
-    mass = float(mass)
-    return np.block([[mass * np.eye(3), -mass * cross], [mass * cross, _matrix("inertia_com", inertia_com) - mass * cross @ cross]])
+    mass = real("mass", mass)
+    return np.block([[mass * np.eye(3), -mass * cross], [mass * cross, array("inertia_com", inertia_com, (3, 3)) - mass * cross @ cross]])
 
 
 def from_spatial_inertia(matrix) -> tuple[float, np.ndarray, np.ndarray]:
     """(mass, centre of mass, inertia about the centre of mass) from a 6×6 spatial inertia in
     robodyn's [linear; angular] order; the inverse of :func:`spatial_inertia`."""
-    matrix = np.asarray(matrix, dtype=float)
-    if matrix.shape != (6, 6) or not np.all(np.isfinite(matrix)):
-        raise ValueError(f"argument 'matrix': expected a finite 6x6 matrix, got shape {matrix.shape}")
+    matrix = array("matrix", matrix, (6, 6))
     mass = float(matrix[0, 0])
     if mass <= 0.0:
         raise ValueError(f"argument 'matrix': expected a positive mass in entry (0, 0), got {mass}")

@@ -25,6 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from robodyn._arguments import bad, choice, count, real, robot_model
+
 __all__ = ["operational_space", "task_rows", "SINGULARITY_RATIO", "DAMPING_RATIO"]
 
 #: J M⁻¹ Jᵀ counts as singular when its eigenvalues span more than this ratio.
@@ -39,12 +41,13 @@ def task_rows(task) -> list[int]:
     """The Jacobian rows of a task: "full", "position", "orientation" or a list of rows of
     [linear; angular]."""
     if isinstance(task, str):
-        if task not in _TASKS:
-            raise ValueError(f"argument 'task': expected 'full', 'position', 'orientation' or a list of rows 0-5, got {task!r}")
-        return _TASKS[task]
-    rows = [int(r) for r in task]
-    if not rows or len(set(rows)) != len(rows) or any(r < 0 or r > 5 for r in rows):
-        raise ValueError(f"argument 'task': expected distinct rows among 0-5, got {list(task)!r}")
+        return _TASKS[choice("task", task, tuple(_TASKS), " or a list of rows 0-5")]
+    try:
+        rows = [count("task", row, 0) for row in task]
+    except TypeError:
+        raise bad("task", "'full', 'position', 'orientation' or a list of rows 0-5", repr(task)) from None
+    if not rows or len(set(rows)) != len(rows) or any(r > 5 for r in rows):
+        raise bad("task", "distinct rows among 0-5", repr(list(task)))
     return rows
 
 
@@ -52,6 +55,7 @@ def operational_space(model, q, v, frame, task="full", damping=None, reference="
     """Λ, μ, p and J̄ of a frame's task (see the module's docstring). Returns a dict with
     ``"Lambda"`` (k × k), ``"mu"`` (k), ``"p"`` (k), ``"J_bar"`` (nv × k), ``"J"`` (k × nv) and
     ``"damping"`` (the λ used), each with a leading batch axis when q is a batch."""
+    robot_model("model", model)
     rows = task_rows(task)
     jacobian = model.jacobian(q, frame, reference)[..., rows, :]
     jacobian_dot = model.jacobian_time_variation(q, v, frame, reference)[..., rows, :]
@@ -67,9 +71,9 @@ def operational_space(model, q, v, frame, task="full", damping=None, reference="
     if damping is None:
         used = np.where(singular, DAMPING_RATIO * largest, 0.0)
     else:
+        if real("damping", damping) < 0:
+            raise bad("damping", "None or a finite number >= 0", repr(damping))
         damping = float(damping)
-        if not np.isfinite(damping) or damping < 0:
-            raise ValueError(f"argument 'damping': expected None or a finite number >= 0, got {damping!r}")
         if damping == 0.0 and np.any(singular):
             raise ValueError(
                 f"frame {frame!r}: the task is singular here (J M⁻¹ Jᵀ has eigenvalues down to {float(np.min(smallest)):.3e}); "

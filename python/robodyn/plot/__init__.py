@@ -12,6 +12,8 @@ from typing import Any, Callable
 
 import numpy as np
 
+from robodyn import _arguments
+
 __all__ = ["animate_trajectory", "check_animation_path", "check_figure_path", "plot_trajectory", "stick_figure_points"]
 
 #: At most this many legend entries per panel; beyond it, the panel says how many it left out.
@@ -59,9 +61,12 @@ def plot_trajectory(trajectory, path: str | os.PathLike[str] | None = None, show
     the joints' names in the legends. Saves to ``path`` (PNG, PDF, SVG by its suffix) when given;
     ``show`` opens a window (default: only when no path is given and a display exists). Returns the
     matplotlib figure."""
-    model = trajectory.model
+    model = _arguments.trajectory("trajectory", trajectory).model
+    if path is not None:
+        check_figure_path(path)
     if show is None:
         show = path is None and bool(os.environ.get("DISPLAY"))
+    show = _arguments.flag("show", show)
     figure = _new_figure(4, show)
     axes = figure.subplots(4, 1, sharex=True)
     q_unit, v_unit, tau_unit = _units(model)
@@ -122,7 +127,8 @@ def stick_figure_points(model, q) -> tuple[np.ndarray, list[tuple[int, int]]]:
     """The robot as points and segments: the origins of the world, every body and every frame for
     configurations ``q`` (T, nq), shape (T, P, 3), and the index pairs joined by a segment (body to
     parent body, frame to its body)."""
-    q = np.atleast_2d(np.asarray(q, dtype=float))
+    _arguments.robot_model("model", model)
+    q = np.atleast_2d(_arguments.array("q", q, (model.nq,), (None, model.nq)))
     frames = model.frame_names
     # point 0 is the world origin, then one per frame
     points = np.zeros((len(q), len(frames) + 1, 3))
@@ -143,26 +149,18 @@ def stick_figure_points(model, q) -> tuple[np.ndarray, list[tuple[int, int]]]:
     return points, segments
 
 
-def _writable_folder(path: Path, argument: str) -> None:
-    folder = path.resolve().parent
-    if not folder.is_dir():
-        raise ValueError(f"argument '{argument}': the folder {folder} does not exist")
-    if not os.access(folder, os.W_OK):
-        raise ValueError(f"argument '{argument}': the folder {folder} is not writable")
-
-
 def check_figure_path(path: str | os.PathLike[str], argument: str = "path") -> Path:
     """``path`` if a figure can be saved there (a format matplotlib writes, a writable folder), else a
     ValueError naming ``argument``."""
     _matplotlib()
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-    path = Path(path)
+    path = Path(_arguments.path(argument, path))
     formats = FigureCanvasAgg.get_supported_filetypes()
     if path.suffix.lower().lstrip(".") not in formats:
         raise ValueError(f"argument '{argument}': expected a file ending in one of "
                          f"{', '.join('.' + f for f in sorted(formats))}, got '{path}'")
-    _writable_folder(path, argument)
+    _arguments.writable_folder(argument, path)
     return path
 
 
@@ -172,14 +170,14 @@ def check_animation_path(path: str | os.PathLike[str], argument: str = "path") -
     _matplotlib()
     from matplotlib import animation
 
-    path = Path(path)
+    path = Path(_arguments.path(argument, path))
     suffix = path.suffix.lower()
     if suffix not in (".gif", ".mp4"):
         raise ValueError(f"argument '{argument}': expected a .gif or .mp4 file, got '{path}'")
     if suffix == ".mp4" and not animation.writers.is_available("ffmpeg"):
         raise ValueError(f"argument '{argument}': writing {path.name} needs ffmpeg, which is not installed; "
                          "write a .gif instead")
-    _writable_folder(path, argument)
+    _arguments.writable_folder(argument, path)
     return path
 
 
@@ -191,10 +189,11 @@ def animate_trajectory(trajectory, path: str | os.PathLike[str], fps: int = 30, 
     the path."""
     from matplotlib import animation
 
+    _arguments.trajectory("trajectory", trajectory)
     path = check_animation_path(path)
+    fps, speed = _arguments.positive("fps", fps), _arguments.positive("speed", speed)
+    _arguments.callback("progress", progress)
     writer = animation.FFMpegWriter(fps=fps) if path.suffix.lower() == ".mp4" else animation.PillowWriter(fps=fps)
-    if not (fps > 0 and speed > 0):
-        raise ValueError(f"arguments 'fps' and 'speed': expected positive numbers, got {fps} and {speed}")
     t = trajectory.t
     frame_times = np.arange(0.0, t[-1] + 1e-12, speed / fps)
     samples = np.minimum(np.searchsorted(t, frame_times), len(t) - 1)

@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from robodyn import _arguments
 from robodyn.viewer.geometry import MUJOCO_VISIBLE_GROUPS, stick_pieces, visual_pieces
 from robodyn.viewer.scene import RobotScene
 
@@ -61,17 +62,35 @@ def _stop(server) -> None:
 
 def _pieces(model, groups: tuple[int, ...] | None):
     """What is drawn: the model's visuals, or its stick figure when it has none."""
+    if groups is not None:
+        try:
+            groups = tuple(_arguments.count("groups", group, 0) for group in groups)
+        except TypeError:
+            raise _arguments.bad("groups", "None or a tuple of geom group numbers", repr(groups)) from None
     return visual_pieces(model, groups) if model.visuals else stick_pieces(model)
 
 
 def _configuration(model, q, argument: str = "q") -> np.ndarray:
     """``q`` (default: the neutral configuration) as a checked configuration."""
+    _arguments.robot_model("model", model)
     if q is None:
         return np.asarray(model.neutral(), dtype=float)
-    q = np.asarray(q, dtype=float)
+    q = _arguments.numbers(argument, q)
     if q.shape != (model.nq,):
         raise ValueError(f"argument '{argument}': expected one configuration of shape ({model.nq},), got shape {q.shape}")
     return q
+
+
+def _options(frames: Any, com: Any, ground: Any, camera: Any) -> dict[str, Any]:
+    """The overlays and the first view's camera, checked, as the scene takes them."""
+    if camera is not None:
+        try:
+            position, look_at = camera
+        except (TypeError, ValueError):
+            raise _arguments.bad("camera", "None or (position, point looked at)", repr(camera)) from None
+        camera = (_arguments.array("camera", position, (3,)), _arguments.array("camera", look_at, (3,)))
+    return dict(frames=_arguments.flag("frames", frames), com_marker=_arguments.flag("com", com),
+                ground=_arguments.flag("ground", ground), camera=camera)
 
 
 def _browser_available() -> bool:
@@ -81,17 +100,10 @@ def _browser_available() -> bool:
 
 def check_html_path(path: str | os.PathLike[str], argument: str = "path") -> Path:
     """``path`` as a writable ``.html`` file path, or a ValueError naming the argument."""
-    if not isinstance(path, (str, os.PathLike)):
-        raise ValueError(f"argument '{argument}': expected a file path ending in .html, got {type(path).__name__}")
-    target = Path(path)
+    target = Path(_arguments.path(argument, path, "a file path ending in .html"))
     if target.suffix.lower() not in (".html", ".htm"):
         raise ValueError(f"argument '{argument}': expected a file name ending in .html, got '{target}'")
-    folder = target.parent.resolve()
-    if not folder.is_dir():
-        raise ValueError(f"argument '{argument}': the folder '{target.parent}' does not exist")
-    if not os.access(folder, os.W_OK):
-        raise ValueError(f"argument '{argument}': the folder '{target.parent}' is not writable")
-    return target
+    return _arguments.writable_folder(argument, target)
 
 
 class Viewer:
@@ -113,7 +125,7 @@ class Viewer:
                  port: int = DEFAULT_PORT, open_browser: bool | None = None, camera: tuple[Any, Any] | None = None) -> None:
         q = _configuration(model, q)
         self._serve(model, np.asarray(model.body_poses(q)), np.asarray(model.center_of_mass(q)), None,
-                    dict(frames=frames, com_marker=com, ground=ground, camera=camera), groups, host, port)
+                    _options(frames, com, ground, camera), groups, host, port)
         self._open(open_browser)
 
     def _serve(self, model: Any, poses: np.ndarray, com: np.ndarray, extent_poses: np.ndarray | None,
@@ -152,7 +164,7 @@ class Viewer:
 
 def _samples(trajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Times, body poses (T, nbodies, 4, 4) and centres of mass (T, 3) of a trajectory."""
-    q = np.asarray(trajectory.q, dtype=float)
+    q = np.asarray(_arguments.trajectory("trajectory", trajectory).q, dtype=float)
     model = trajectory.model
     return np.asarray(trajectory.t, dtype=float), np.asarray(model.body_poses(q)).reshape(len(q), -1, 4, 4), \
         np.asarray(model.center_of_mass(q)).reshape(len(q), 3)
@@ -181,7 +193,7 @@ class TrajectoryViewer(Viewer):
             raise ValueError(f"argument 'speed': expected one of {', '.join(SPEEDS)}, got {speed!r}")
         self.times, self.poses, self.coms = _samples(trajectory)
         self._serve(trajectory.model, self.poses[0], self.coms[0], _spread(self.poses),
-                    dict(frames=frames, com_marker=com, ground=ground, camera=camera), groups, host, port)
+                    _options(frames, com, ground, camera), groups, host, port)
         gui = self.server.gui
         duration = float(self.times[-1] - self.times[0])
         self.playing = gui.add_checkbox("Play", True)
@@ -252,10 +264,11 @@ def model_html(model, path: str | os.PathLike[str], q=None, *, frames: bool = Fa
     opens offline in any browser (no server, no network). Returns the path."""
     target = check_html_path(path)
     q = _configuration(model, q)
+    options = _options(frames, com, ground, camera)
     pieces = _pieces(model, groups)
     server = _server(LOOPBACK, 0)
     RobotScene(server, pieces, np.asarray(model.body_poses(q)), np.asarray(model.center_of_mass(q)),
-               frames=frames, com_marker=com, ground=ground, camera=camera, skybox=model.skybox)
+               skybox=model.skybox, **options)
     return _write_html(server, lambda serializer: None, target)
 
 
@@ -267,10 +280,11 @@ def trajectory_html(trajectory, path: str | os.PathLike[str], *, frames: bool = 
     Returns the path."""
     target = check_html_path(path)
     times, poses, coms = _samples(trajectory)
+    options = _options(frames, com, ground, camera)
     pieces = _pieces(trajectory.model, groups)
     server = _server(LOOPBACK, 0)
-    scene = RobotScene(server, pieces, poses[0], coms[0], frames=frames, com_marker=com, ground=ground,
-                       extent_poses=_spread(poses), camera=camera, skybox=trajectory.model.skybox)
+    scene = RobotScene(server, pieces, poses[0], coms[0], extent_poses=_spread(poses), skybox=trajectory.model.skybox,
+                       **options)
     frame_times = np.arange(times[0], times[-1] + 0.5 / PLAYBACK_RATE, 1.0 / PLAYBACK_RATE)
 
     def record(serializer) -> None:
