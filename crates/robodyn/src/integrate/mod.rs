@@ -9,6 +9,9 @@
 //!
 //! - [`lie_group`]: the rate of the tangent coordinates ξ in q = q₀ ⊕ ξ, so that spherical and free
 //!   joints are integrated on their group (quaternions stay unit by construction).
+//! - [`forward_dynamics`]: the [`ForwardDynamics`] strategy q̈ = FD(q, v, τ, f_ext) that the
+//!   simulator, the single step and the rollouts in lockstep integrate, and its free-space
+//!   implementation [`Aba`].
 //! - [`forces`]: passive joint forces (damping, smoothed Coulomb friction, springs, the optional
 //!   joint-limit penalty).
 //! - [`control`]: the [`Controller`] trait and the native controllers (constant torque, PD,
@@ -17,10 +20,12 @@
 //! - [`step`]: one fixed step and its Jacobians A = ∂x₁/∂x₀, B = ∂x₁/∂τ (trajectory optimisation).
 //! - [`simulator`]: the loop, fixed-step or adaptive with dense output, recording a [`Trajectory`].
 //!
-//! Forward dynamics is [`crate::algo::aba`]; armature is part of the model's M there.
+//! Forward dynamics is [`Aba`] ([`crate::algo::aba`]; armature is part of the model's M there)
+//! unless another [`ForwardDynamics`] is given to the `_with` forms.
 
 pub mod control;
 pub mod forces;
+pub mod forward_dynamics;
 pub mod lie_group;
 pub mod schemes;
 pub mod simulator;
@@ -28,9 +33,10 @@ pub mod step;
 
 pub use control::{ControlLaw, Controller, DesiredMotion, ExternalWrenches, NativeController};
 pub use forces::{LimitModel, PassiveForces};
+pub use forward_dynamics::{Aba, AccelerationDerivatives, ForwardDynamics};
 pub use schemes::Integrator;
 pub use simulator::{
-    simulate, simulate_lockstep, Accuracy, AccuracyIssue, AccuracyMeasure, SimulationOptions,
-    Statistics, Trajectory,
+    simulate, simulate_lockstep, simulate_lockstep_with, simulate_with, Accuracy, AccuracyIssue,
+    AccuracyMeasure, SimulationOptions, Statistics, Trajectory,
 };
 pub use step::StepWorkspace;

@@ -7,10 +7,10 @@
 //! Every recorded sample holds q̈, τ and τ_passive evaluated at that sample's state.
 //! After [`simulate`] has allocated its buffers, a step allocates nothing.
 
-use crate::algo::aba;
 use crate::error::{check_vector, Error, Result};
 use crate::integrate::control::{Controller, ExternalWrenches};
 use crate::integrate::forces::PassiveForces;
+use crate::integrate::forward_dynamics::{Aba, ForwardDynamics};
 use crate::integrate::schemes::{Integrator, State, Stepper};
 use crate::model::Model;
 use crate::spatial::Force;
@@ -23,7 +23,7 @@ mod lockstep;
 
 pub use accuracy::{Accuracy, AccuracyIssue, AccuracyMeasure, DEFAULT_ACCURACY_RTOL};
 pub use guard::{ENERGY_GROWTH_BOUND, SPEED_BOUND};
-pub use lockstep::{simulate_lockstep, RolloutError};
+pub use lockstep::{simulate_lockstep, simulate_lockstep_with, RolloutError};
 
 /// The most samples one simulation records, so that a tiny `dt` fails clearly instead of
 /// exhausting memory.
@@ -161,9 +161,11 @@ impl Trajectory {
     }
 }
 
-/// The equations of motion q̈(t, q, v) with the controller, passive forces and wrenches.
-struct Dynamics<'a> {
+/// The equations of motion q̈(t, q, v): the forward dynamics with the controller, passive forces
+/// and wrenches.
+struct Dynamics<'a, F> {
     model: &'a Model,
+    forward: F,
     passive: PassiveForces,
     controller: &'a mut dyn Controller,
     wrenches: Option<&'a mut dyn ExternalWrenches>,
@@ -177,19 +179,21 @@ struct Dynamics<'a> {
     energy: EnergyAccount,
 }
 
-impl Dynamics<'_> {
-    /// q̈ = ABA(q, v, τ_control + τ_passive, f_ext) into `a`; τ and τ_passive stay in `self`.
+impl<F: ForwardDynamics> Dynamics<'_, F> {
+    /// q̈ = FD(q, v, τ_control + τ_passive, f_ext) into `a`; τ and τ_passive stay in `self`.
     fn acceleration(&mut self, t: f64, q: &[f64], v: &[f64], a: &mut [f64]) -> Result<()> {
         self.torques(t, q, v)?;
         self.forward_dynamics(t, q, v, a)
     }
 
-    /// q̈ = ABA(q, v, `tau_total`, `forces`) into `a`, once [`Self::torques`] has run at (t, q, v).
+    /// q̈ = FD(q, v, `tau_total`, `forces`) into `a`, once [`Self::torques`] has run at (t, q, v).
     fn forward_dynamics(&mut self, t: f64, q: &[f64], v: &[f64], a: &mut [f64]) -> Result<()> {
         let f_ext = self.wrenches.is_some().then_some(&self.forces[..]);
-        let qdd = aba(self.model, &mut self.data, q, v, &self.tau_total, f_ext)
+        let qdd = self
+            .forward
+            .acceleration(self.model, &mut self.data, q, v, &self.tau_total, f_ext)
             .map_err(|e| at_time(t, e))?;
-        a.copy_from_slice(qdd.as_slice());
+        a.copy_from_slice(qdd);
         Ok(())
     }
 
@@ -253,9 +257,9 @@ impl Dynamics<'_> {
 /// A progress callback: the fraction done, in [0, 1].
 pub type Progress<'p> = &'p mut dyn FnMut(f64) -> Result<()>;
 
-/// Simulates `model` from (q₀, v₀) at t = 0 under `controller` (and `wrenches`, if any).
-/// `progress`, if given, is called with the fraction done about a hundred times; an error it
-/// returns stops the simulation with that error.
+/// Simulates `model` in free space ([`Aba`]) from (q₀, v₀) at t = 0 under `controller` (and
+/// `wrenches`, if any). `progress`, if given, is called with the fraction done about a hundred
+/// times; an error it returns stops the simulation with that error.
 pub fn simulate<'a>(
     model: &'a Model,
     q0: &[f64],
@@ -265,7 +269,24 @@ pub fn simulate<'a>(
     wrenches: Option<&'a mut dyn ExternalWrenches>,
     progress: Option<Progress<'a>>,
 ) -> Result<Trajectory> {
-    let mut simulation = Simulation::start(model, (q0, v0), options, controller, wrenches)?;
+    simulate_with(model, q0, v0, options, Aba, controller, wrenches, progress)
+}
+
+/// [`simulate`] with the forward dynamics `forward` (constraints, contacts, or a variant of
+/// [`Aba`]) in place of the articulated-body algorithm.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_with<'a, F: ForwardDynamics>(
+    model: &'a Model,
+    q0: &[f64],
+    v0: &[f64],
+    options: &'a SimulationOptions,
+    forward: F,
+    controller: &'a mut dyn Controller,
+    wrenches: Option<&'a mut dyn ExternalWrenches>,
+    progress: Option<Progress<'a>>,
+) -> Result<Trajectory> {
+    let mut simulation =
+        Simulation::start(model, (q0, v0), options, forward, controller, wrenches)?;
     simulation.progress = progress;
     simulation.report(0)?;
     simulation.run()?;
@@ -273,11 +294,11 @@ pub fn simulate<'a>(
 }
 
 /// Everything one simulation works with.
-struct Simulation<'a> {
+struct Simulation<'a, F> {
     model: &'a Model,
     options: &'a SimulationOptions,
     samples: usize,
-    dynamics: Dynamics<'a>,
+    dynamics: Dynamics<'a, F>,
     stepper: Stepper,
     /// The half steps of the step-doubling check.
     check_stepper: Stepper,
@@ -293,12 +314,13 @@ struct Simulation<'a> {
     statistics: Statistics,
 }
 
-impl<'a> Simulation<'a> {
+impl<'a, F: ForwardDynamics> Simulation<'a, F> {
     /// A simulation of `model` from (q₀, v₀) at t = 0, its first sample recorded.
     fn start(
         model: &'a Model,
         (q0, v0): (&[f64], &[f64]),
         options: &'a SimulationOptions,
+        forward: F,
         controller: &'a mut dyn Controller,
         wrenches: Option<&'a mut dyn ExternalWrenches>,
     ) -> Result<Self> {
@@ -313,6 +335,7 @@ impl<'a> Simulation<'a> {
             samples,
             dynamics: Dynamics {
                 model,
+                forward,
                 passive: options.passive,
                 controller,
                 wrenches,

@@ -18,13 +18,15 @@
 //!   dA_s = ∂q̈/∂q dq_s + ∂q̈/∂q̇ dv_s + ∂q̈/∂τ [0 0 1]
 //!   dΞ_s = ∂T/∂ξ dξ_s + ∂T/∂v dv_s            (Ξ_s = T(ξ_s, v_s) = dexp⁻¹_{-ξ_s} v_s)
 //! ```
-//! and the same weighted sums with b_s for the step. ∂q̈ comes from `aba_derivatives` and the
-//! passive forces' own Jacobians (∂q̈/∂x += M⁻¹ ∂τ_passive/∂x); ⊕ and T from
-//! [`super::lie_group`]. Cost with derivatives: per stage one `aba_derivatives` and O(n³) products.
+//! and the same weighted sums with b_s for the step. q̈ and ∂q̈ come from the forward dynamics
+//! ([`super::ForwardDynamics`], free-space [`Aba`] unless chosen) and the passive forces' own
+//! Jacobians (∂q̈/∂x += ∂q̈/∂τ ∂τ_passive/∂x); ⊕ and T from [`super::lie_group`]. Cost with
+//! derivatives: per stage one evaluation of the derivatives (`aba_derivatives`) and O(n³)
+//! products.
 
-use crate::algo::{aba, aba_derivatives};
 use crate::error::{check_vector, Error, Result};
 use crate::integrate::forces::PassiveForces;
+use crate::integrate::forward_dynamics::{Aba, AccelerationDerivatives, ForwardDynamics};
 use crate::integrate::lie_group::{integrate_jacobians, tangent_rate, tangent_rate_jacobians};
 use crate::integrate::schemes::{Integrator, Tableau};
 use crate::integrate::simulator::positive;
@@ -35,16 +37,17 @@ use nalgebra::DMatrix;
 /// Most stages of a fixed-step scheme (RK4).
 const MAX_STAGES: usize = 4;
 
-/// Everything one step needs, allocated once per model; [`StepWorkspace::step`] allocates
-/// nothing.
-pub struct StepWorkspace {
+/// Everything one step needs, allocated once per model, with the forward dynamics the step
+/// integrates; [`StepWorkspace::step`] allocates nothing.
+pub struct StepWorkspace<F = Aba> {
+    pub forward_dynamics: F,
     data: Data,
     tau_passive: Vec<f64>,
     tau_total: Vec<f64>,
     /// ∂τ_passive/∂q, ∂τ_passive/∂q̇ (nv × nv).
     passive_jacobians: (DMatrix<f64>, DMatrix<f64>),
-    /// ∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂τ at the current stage (nv × nv each).
-    dynamics_jacobians: [DMatrix<f64>; 3],
+    /// q̈ and ∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂τ at the current stage (nv × nv each).
+    acceleration_derivatives: AccelerationDerivatives,
     /// ∂(q₀ ⊕ ξ)/∂q₀ and ∂(q₀ ⊕ ξ)/∂ξ, or ∂T/∂ξ and ∂T/∂v (nv × nv each).
     group_jacobians: (DMatrix<f64>, DMatrix<f64>),
     /// Per stage: A_s and Ξ_s (nv), dA_s and dΞ_s (nv × 3nv).
@@ -69,16 +72,25 @@ pub struct StepWorkspace {
 }
 
 impl StepWorkspace {
+    /// The workspace of a step in free space ([`Aba`]).
     pub fn new(model: &Model) -> Self {
+        StepWorkspace::with_forward_dynamics(model, Aba)
+    }
+}
+
+impl<F: ForwardDynamics> StepWorkspace<F> {
+    /// The workspace of a step that integrates `forward_dynamics`.
+    pub fn with_forward_dynamics(model: &Model, forward_dynamics: F) -> Self {
         let (nq, nv) = (model.nq, model.nv);
         let square = || DMatrix::zeros(nv, nv);
         let wide = || DMatrix::zeros(nv, 3 * nv);
         StepWorkspace {
+            forward_dynamics,
             data: Data::new(model),
             tau_passive: vec![0.0; nv],
             tau_total: vec![0.0; nv],
             passive_jacobians: (square(), square()),
-            dynamics_jacobians: [square(), square(), square()],
+            acceleration_derivatives: AccelerationDerivatives::new(model),
             group_jacobians: (square(), square()),
             accelerations: std::array::from_fn(|_| vec![0.0; nv]),
             tangent_rates: std::array::from_fn(|_| vec![0.0; nv]),
@@ -165,7 +177,9 @@ impl StepWorkspace {
             let mut by_start = self.d_q.columns_mut(0, nv);
             by_start += &*d_group;
             // dA_s = ∂q̈/∂q dq_s + ∂q̈/∂q̇ dv_s + ∂q̈/∂τ [0 0 1]
-            let [by_q, by_v, by_tau] = &self.dynamics_jacobians;
+            let AccelerationDerivatives {
+                by_q, by_v, by_tau, ..
+            } = &self.acceleration_derivatives;
             let d_acceleration = &mut self.d_accelerations[s];
             multiply(d_acceleration, by_q, &self.d_q, 0.0);
             multiply(d_acceleration, by_v, &self.d_v, 1.0);
@@ -180,7 +194,7 @@ impl StepWorkspace {
         Ok(())
     }
 
-    /// q̈ = ABA(q_s, v_s, τ + τ_passive) into A_s, and with `derivatives` its three Jacobians.
+    /// q̈ = FD(q_s, v_s, τ + τ_passive) into A_s, and with `derivatives` its three Jacobians.
     fn dynamics(
         &mut self,
         model: &Model,
@@ -198,25 +212,27 @@ impl StepWorkspace {
         {
             *total = applied + own;
         }
+        let forward = &mut self.forward_dynamics;
         if !derivatives {
-            let qdd = aba(model, &mut self.data, q, v, &self.tau_total, None)?;
-            self.accelerations[s].copy_from_slice(qdd.as_slice());
+            let qdd = forward.acceleration(model, &mut self.data, q, v, &self.tau_total, None)?;
+            self.accelerations[s].copy_from_slice(qdd);
             return Ok(());
         }
-        aba_derivatives(model, &mut self.data, q, v, &self.tau_total, None)?;
-        self.accelerations[s].copy_from_slice(self.data.qdd.as_slice());
-        // ∂q̈/∂x = ∂ABA/∂x + M⁻¹ ∂τ_passive/∂x
+        let jacobians = &mut self.acceleration_derivatives;
+        forward.acceleration_derivatives(
+            model,
+            &mut self.data,
+            q,
+            v,
+            &self.tau_total,
+            jacobians,
+        )?;
+        self.accelerations[s].copy_from_slice(&jacobians.qdd);
+        // ∂q̈/∂x = ∂FD/∂x + ∂q̈/∂τ ∂τ_passive/∂x
         let (passive_q, passive_v) = &mut self.passive_jacobians;
         passive.jacobians(model, q, v, passive_q, passive_v);
-        let [by_q, by_v, by_tau] = &mut self.dynamics_jacobians;
-        let minv = &self.data.mass_matrix_inverse;
-        by_q.as_mut_slice()
-            .copy_from_slice(self.data.dqdd_dq.as_slice());
-        multiply(by_q, minv, passive_q, 1.0);
-        by_v.as_mut_slice()
-            .copy_from_slice(self.data.dqdd_dv.as_slice());
-        multiply(by_v, minv, passive_v, 1.0);
-        by_tau.copy_from(minv);
+        multiply(&mut jacobians.by_q, &jacobians.by_tau, passive_q, 1.0);
+        multiply(&mut jacobians.by_v, &jacobians.by_tau, passive_v, 1.0);
         Ok(())
     }
 

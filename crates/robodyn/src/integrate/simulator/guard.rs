@@ -18,6 +18,7 @@ use super::{Accuracy, Dynamics, Simulation};
 use crate::algo::{kinetic_energy, potential_energy};
 use crate::error::{Error, Result};
 use crate::integrate::forces::spring_energy;
+use crate::integrate::forward_dynamics::ForwardDynamics;
 use crate::integrate::schemes::{Integrator, State, Stepper};
 use crate::model::Model;
 
@@ -63,7 +64,7 @@ impl EnergyAccount {
 }
 
 /// "joint 'name'" of velocity coordinate `k`.
-fn joint_of_coordinate(dynamics: &Dynamics, k: usize) -> String {
+fn joint_of_coordinate<F>(dynamics: &Dynamics<F>, k: usize) -> String {
     let model = dynamics.model;
     let body = (1..model.nbodies())
         .find(|&i| model.v_range(i).contains(&k))
@@ -75,7 +76,7 @@ fn diverged(t: f64, message: String) -> Error {
     Error::Diverged { time: t, message }
 }
 
-impl Dynamics<'_> {
+impl<F: ForwardDynamics> Dynamics<'_, F> {
     /// The bounds at a recorded sample whose q̈ (and torques, and the body velocities in
     /// `data.v`) were just evaluated; the energy checks go into `accuracy` too.
     pub(super) fn check_sample(
@@ -165,10 +166,10 @@ impl Dynamics<'_> {
 }
 
 /// One fixed step of `h` from `start` by `integrator`'s scheme, into `stepper`.
-pub(super) fn fixed_step(
+pub(super) fn fixed_step<F: ForwardDynamics>(
     model: &Model,
     integrator: Integrator,
-    dynamics: &mut Dynamics,
+    dynamics: &mut Dynamics<F>,
     stepper: &mut Stepper,
     start: &State,
     h: f64,
@@ -181,7 +182,7 @@ pub(super) fn fixed_step(
     }
 }
 
-impl Simulation<'_> {
+impl<F: ForwardDynamics> Simulation<'_, F> {
     /// How much the step of `h` just taken (in `self.stepper`) and two half steps from
     /// `self.state` disagree, relative to the size of the state it starts from: max |Δq|, |Δv|
     /// over max(1, |v₀|).

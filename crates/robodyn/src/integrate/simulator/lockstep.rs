@@ -8,28 +8,44 @@
 //! bit.
 
 use super::{at_time, Simulation, SimulationOptions, Trajectory, STEP_CHECK_INTERVAL};
-use crate::algo::lanes::{aba_batch, BatchWorkspace, States};
+use crate::algo::lanes::{BatchWorkspace, States};
 use crate::error::Error;
 use crate::integrate::control::Controller;
+use crate::integrate::forward_dynamics::{Aba, ForwardDynamics};
 use crate::integrate::schemes::Integrator;
 use crate::model::Model;
 
 /// A failed rollout: its index among the starts, and the error its own `simulate` reports.
 pub type RolloutError = (usize, Error);
 
-/// Simulates `model` from each start (q₀, v₀) at t = 0 under its own copy of `controller`, as
-/// [`super::simulate`] does without wrenches or a progress callback, the rollouts in lockstep.
-/// RK45, whose steps each rollout chooses for itself, runs the rollouts one after the other.
+/// Simulates `model` in free space ([`Aba`]) from each start (q₀, v₀) at t = 0 under its own
+/// copy of `controller`, as [`super::simulate`] does without wrenches or a progress callback,
+/// the rollouts in lockstep. RK45, whose steps each rollout chooses for itself, runs the
+/// rollouts one after the other.
 pub fn simulate_lockstep<C: Controller + Clone>(
     model: &Model,
     starts: &[(&[f64], &[f64])],
     options: &SimulationOptions,
     controller: &C,
 ) -> Result<Vec<Trajectory>, RolloutError> {
+    simulate_lockstep_with(model, starts, options, &Aba, controller)
+}
+
+/// [`simulate_lockstep`] with the forward dynamics `forward`, each rollout with its own copy:
+/// in lanes where it has them ([`ForwardDynamics::accelerations_in_lanes`]), else one rollout
+/// after another at each stage.
+pub fn simulate_lockstep_with<F: ForwardDynamics + Clone, C: Controller + Clone>(
+    model: &Model,
+    starts: &[(&[f64], &[f64])],
+    options: &SimulationOptions,
+    forward: &F,
+    controller: &C,
+) -> Result<Vec<Trajectory>, RolloutError> {
     let mut controllers = vec![controller.clone(); starts.len()];
     let mut simulations = Vec::with_capacity(starts.len());
     for (k, (start, controller)) in starts.iter().zip(&mut controllers).enumerate() {
-        let simulation = Simulation::start(model, *start, options, controller, None);
+        let forward = forward.clone();
+        let simulation = Simulation::start(model, *start, options, forward, controller, None);
         simulations.push(simulation.map_err(|e| (k, e))?);
     }
     if let Integrator::Rk45 { .. } = options.integrator {
@@ -50,7 +66,9 @@ pub fn simulate_lockstep<C: Controller + Clone>(
 /// sample, in lockstep; every scheme starts from the acceleration recorded at the step's start.
 /// The first step, and every `STEP_CHECK_INTERVAL`-th, is checked against two half steps; a
 /// divergence reports the step that would keep the motion stable.
-pub(super) fn fixed_steps(simulations: &mut [Simulation]) -> Result<(), RolloutError> {
+pub(super) fn fixed_steps<F: ForwardDynamics>(
+    simulations: &mut [Simulation<F>],
+) -> Result<(), RolloutError> {
     let Some(first) = simulations.first() else {
         return Ok(());
     };
@@ -91,9 +109,9 @@ impl Group {
 
     /// Every rollout's step to sample `k` at `t_next` (of size `h`), as `fixed_sample` takes
     /// one: the step, its check, then the new sample evaluated, checked and recorded.
-    fn step(
+    fn step<F: ForwardDynamics>(
         &mut self,
-        simulations: &mut [Simulation],
+        simulations: &mut [Simulation<F>],
         k: usize,
         t_next: f64,
         h: f64,
@@ -190,34 +208,39 @@ impl Group {
         self.tau[r * nv..(r + 1) * nv].copy_from_slice(tau);
     }
 
-    /// q̈ = ABA(q, v, τ) of every row, at time `t` (for the error of a failing rollout): in lanes,
-    /// or through each rollout's own ABA where there is one rollout or wrenches act.
-    fn accelerations(
+    /// q̈ = FD(q, v, τ) of every row, at time `t` (for the error of a failing rollout): in lanes
+    /// where the forward dynamics has them, else (or where there is one rollout, or wrenches
+    /// act) through each rollout's own.
+    fn accelerations<F: ForwardDynamics>(
         &mut self,
-        simulations: &mut [Simulation],
+        simulations: &mut [Simulation<F>],
         t: f64,
     ) -> Result<(), RolloutError> {
         let model = simulations[0].model;
         let (nq, nv) = (model.nq, model.nv);
-        if simulations.len() == 1 || simulations.iter().any(|s| s.dynamics.wrenches.is_some()) {
-            for (r, simulation) in simulations.iter_mut().enumerate() {
-                let (q, v) = (&self.q[r * nq..(r + 1) * nq], &self.v[r * nv..(r + 1) * nv]);
-                let a = &mut self.qdd[r * nv..(r + 1) * nv];
-                simulation
-                    .dynamics
-                    .forward_dynamics(t, q, v, a)
-                    .map_err(|e| (r, e))?;
+        if simulations.len() > 1 && simulations.iter().all(|s| s.dynamics.wrenches.is_none()) {
+            let states = States {
+                q: &self.q,
+                v: Some(&self.v),
+                a: None,
+                tau: Some(&self.tau),
+            };
+            let forward = &simulations[0].dynamics.forward;
+            if let Some(result) =
+                forward.accelerations_in_lanes(model, &mut self.workspace, states, &mut self.qdd)
+            {
+                return result.map_err(|(r, e)| (r, at_time(t, e)));
             }
-            return Ok(());
         }
-        let states = States {
-            q: &self.q,
-            v: Some(&self.v),
-            a: None,
-            tau: Some(&self.tau),
-        };
-        aba_batch(model, &mut self.workspace, states, &mut self.qdd)
-            .map_err(|(r, e)| (r, at_time(t, e)))
+        for (r, simulation) in simulations.iter_mut().enumerate() {
+            let (q, v) = (&self.q[r * nq..(r + 1) * nq], &self.v[r * nv..(r + 1) * nv]);
+            let a = &mut self.qdd[r * nv..(r + 1) * nv];
+            simulation
+                .dynamics
+                .forward_dynamics(t, q, v, a)
+                .map_err(|e| (r, e))?;
+        }
+        Ok(())
     }
 
     /// Rollout `r`'s q̈.
