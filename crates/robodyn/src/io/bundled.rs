@@ -1,5 +1,6 @@
 //! Robot models written by the project from published parameters, compiled into the library so
-//! they need no file at run time. Sources are cited inside each URDF in `models/`.
+//! they need no file at run time. Sources are cited inside each URDF in `models/` (the crate's
+//! `models/` links to them, so that the published crate holds them).
 
 use crate::error::{Error, Result};
 use crate::io::{urdf::load_urdf_str, LoadOptions};
@@ -10,18 +11,18 @@ use crate::spatial::Vec3;
 const BUNDLED: [(&str, &str, [f64; 3]); 3] = [
     (
         "ur5",
-        include_str!("../../../../models/ur5.urdf"),
+        include_str!("../../models/ur5.urdf"),
         [0.0, 0.0, -STANDARD_GRAVITY],
     ),
     // the seeds' 2-link arm moves in the x-y plane with gravity along -y
     (
         "planar2",
-        include_str!("../../../../models/planar2.urdf"),
+        include_str!("../../models/planar2.urdf"),
         [0.0, -STANDARD_GRAVITY, 0.0],
     ),
     (
         "pendulum",
-        include_str!("../../../../models/pendulum.urdf"),
+        include_str!("../../models/pendulum.urdf"),
         [0.0, 0.0, -STANDARD_GRAVITY],
     ),
 ];
