@@ -21,6 +21,7 @@ use nalgebra::DVector;
 
 /// Anything that gives the joint torque τ(t, q, q̇) (nv) to apply.
 pub trait Controller {
+    /// τ(t, q, q̇) into `tau` (nv; N·m or N), at time `t` (s), `q` (nq) and `v` (nv).
     fn torque(
         &mut self,
         model: &Model,
@@ -32,8 +33,9 @@ pub trait Controller {
 }
 
 /// Anything that gives external wrenches on the moving bodies at (t, q, q̇): one per body
-/// 1..nbodies, in that body's frame, as [`crate::algo::aba`] takes them.
+/// 1..nbodies, in that body's frame, as [`crate::algo::aba()`] takes them.
 pub trait ExternalWrenches {
+    /// Writes the wrench on each body 1..nbodies into `forces` (nbodies − 1) at (t, q, v).
     fn wrenches(&mut self, t: f64, q: &[f64], v: &[f64], forces: &mut [Force]) -> Result<()>;
 }
 
@@ -48,8 +50,11 @@ pub enum DesiredMotion {
     /// so the three are consistent (exactly so on revolute and prismatic joints). `q` holds the
     /// knots row by row (K × nq), `v` likewise (K × nv).
     Samples {
+        /// Knot times t_k (s), at least 2, strictly increasing.
         times: Vec<f64>,
+        /// Knot configurations q_k, row by row (K × nq).
         q: Vec<f64>,
+        /// Knot velocities v_k, row by row (K × nv).
         v: Vec<f64>,
     },
 }
@@ -157,15 +162,22 @@ pub enum ControlLaw {
     GravityCompensation,
     /// τ = K_p (q_d ⊖ q) + K_d (v_d − q̇) [+ g(q)].
     Pd {
+        /// Proportional gains K_p, one per velocity coordinate (N·m/rad or N/m).
         kp: DVector<f64>,
+        /// Derivative gains K_d, one per velocity coordinate (N·m·s/rad or N·s/m).
         kd: DVector<f64>,
+        /// The motion (q_d, v_d) to track.
         reference: DesiredMotion,
+        /// Whether g(q) is added to the PD torque.
         gravity_compensation: bool,
     },
     /// τ = RNEA(q, q̇, a_d + K_d (v_d − q̇) + K_p (q_d ⊖ q)) − τ_passive(q, q̇).
     ComputedTorque {
+        /// Proportional gains K_p, one per velocity coordinate (1/s²: acceleration per error).
         kp: DVector<f64>,
+        /// Derivative gains K_d, one per velocity coordinate (1/s).
         kd: DVector<f64>,
+        /// The motion (q_d, v_d, a_d) to track.
         reference: DesiredMotion,
     },
 }

@@ -36,7 +36,12 @@ pub enum LimitModel {
     /// Nothing: limits are only reported (the trajectory shows where q left its range).
     Report,
     /// A one-sided spring–damper past the limit: stiffness (N·m/rad, N/m) and damping.
-    Penalty { stiffness: f64, damping: f64 },
+    Penalty {
+        /// Stiffness k_l of the penalty (N·m/rad or N/m), ≥ 0.
+        stiffness: f64,
+        /// Damping b_l of the penalty (N·m·s/rad or N·s/m), ≥ 0.
+        damping: f64,
+    },
 }
 
 /// The passive-force model: the model's springs, damping and friction, and the limit model.
@@ -44,6 +49,7 @@ pub enum LimitModel {
 pub struct PassiveForces {
     /// Smoothing speed v_s of Coulomb friction, > 0.
     pub friction_velocity: f64,
+    /// What the simulation does at the joints' position limits.
     pub limits: LimitModel,
 }
 

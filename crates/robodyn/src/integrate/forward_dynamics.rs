@@ -25,7 +25,7 @@ use nalgebra::DMatrix;
 /// - [`Self::acceleration`] (required): q̈ (nv) at the configuration q (nq) and velocity v (nv)
 ///   under the generalised forces τ (nv: the controller's plus the joints' passive forces) and
 ///   the external wrenches `f_ext`, one per body 1..nbodies in that body's frame, as
-///   [`crate::algo::aba`] takes them (`None`: no wrenches). Every scheme needs it: explicit
+///   [`crate::algo::aba()`] takes them (`None`: no wrenches). Every scheme needs it: explicit
 ///   Euler, RK4 and RK45 evaluate it at each stage, semi-implicit Euler once per step (its
 ///   velocity first, v₁ = v₀ + h q̈₀, then q₁ = q₀ ⊕ h v₁), and every recorded sample once more.
 ///   It works in `data` and in its own fields, allocates nothing, and is a function of its
@@ -89,14 +89,18 @@ pub trait ForwardDynamics {
 /// writes them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AccelerationDerivatives {
+    /// q̈ (nv).
     pub qdd: Vec<f64>,
-    /// ∂q̈/∂q (tangent space), ∂q̈/∂v and ∂q̈/∂τ (for a tree in free space, M⁻¹).
+    /// ∂q̈/∂q, with q perturbed in its tangent space (nv × nv).
     pub by_q: DMatrix<f64>,
+    /// ∂q̈/∂v (nv × nv).
     pub by_v: DMatrix<f64>,
+    /// ∂q̈/∂τ (nv × nv; for a tree in free space, M⁻¹).
     pub by_tau: DMatrix<f64>,
 }
 
 impl AccelerationDerivatives {
+    /// Zeros sized for `model` (nv, and nv × nv for each Jacobian).
     pub fn new(model: &Model) -> Self {
         let nv = model.nv;
         AccelerationDerivatives {
@@ -108,7 +112,7 @@ impl AccelerationDerivatives {
     }
 }
 
-/// A tree in free space: the articulated-body algorithm ([`crate::algo::aba`]), its analytical
+/// A tree in free space: the articulated-body algorithm ([`crate::algo::aba()`]), its analytical
 /// derivatives ([`crate::algo::aba_derivatives`]) and its lanes ([`aba_batch`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Aba;

@@ -20,7 +20,7 @@
 //! - [`step`]: one fixed step and its Jacobians A = ∂x₁/∂x₀, B = ∂x₁/∂τ (trajectory optimisation).
 //! - [`simulator`]: the loop, fixed-step or adaptive with dense output, recording a [`Trajectory`].
 //!
-//! Forward dynamics is [`Aba`] ([`crate::algo::aba`]; armature is part of the model's M there)
+//! Forward dynamics is [`Aba`] ([`crate::algo::aba()`]; armature is part of the model's M there)
 //! unless another [`ForwardDynamics`] is given to the `_with` forms.
 
 pub mod control;

@@ -32,7 +32,12 @@ pub enum Integrator {
     Rk4,
     /// Dormand–Prince 5(4): adaptive steps that keep the local error below
     /// `atol + rtol·|x|` per state component, with dense output at the recording times.
-    Rk45 { rtol: f64, atol: f64 },
+    Rk45 {
+        /// Relative tolerance on the local error, > 0.
+        rtol: f64,
+        /// Absolute tolerance on the local error, > 0 (in each state component's unit).
+        atol: f64,
+    },
 }
 
 impl Integrator {

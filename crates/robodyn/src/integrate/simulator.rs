@@ -35,6 +35,7 @@ pub const MIN_RELATIVE_STEP: f64 = 1e-14;
 /// How to simulate.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SimulationOptions {
+    /// The scheme that integrates the equations of motion.
     pub integrator: Integrator,
     /// Step of the fixed-step schemes and recording interval of all (s), > 0.
     pub dt: f64,
@@ -42,6 +43,7 @@ pub struct SimulationOptions {
     pub t_end: f64,
     /// Largest step RK45 may take (s); infinity for no bound.
     pub max_step: f64,
+    /// The passive joint forces: the friction smoothing and what happens at the limits.
     pub passive: PassiveForces,
     /// Tolerance of the fixed-step schemes' accuracy check (local error per step and energy
     /// drift, relative to the state), > 0; see [`Trajectory::accuracy`].
@@ -117,12 +119,19 @@ pub struct Statistics {
 /// (springs, damping, friction, limits); both act on the robot.
 #[derive(Debug, Clone, Default)]
 pub struct Trajectory {
+    /// Sample times (s): k·dt from 0, the last one `t_end`.
     pub t: Vec<f64>,
+    /// Configurations, row by row (T × nq).
     pub q: Vec<f64>,
+    /// Velocities, row by row (T × nv).
     pub v: Vec<f64>,
+    /// Accelerations q̈ evaluated at each sample's state, row by row (T × nv).
     pub a: Vec<f64>,
+    /// The controller's torque at each sample, row by row (T × nv; N·m or N).
     pub tau: Vec<f64>,
+    /// The joints' passive torque at each sample, row by row (T × nv; N·m or N).
     pub tau_passive: Vec<f64>,
+    /// How much work the run did.
     pub statistics: Statistics,
     /// The fixed-step schemes' error estimates and energy drift, and whether they met
     /// `SimulationOptions::accuracy_rtol`.
@@ -156,6 +165,7 @@ impl Trajectory {
         self.t.len()
     }
 
+    /// Whether no sample was recorded.
     pub fn is_empty(&self) -> bool {
         self.t.is_empty()
     }

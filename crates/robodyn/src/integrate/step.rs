@@ -40,6 +40,7 @@ const MAX_STAGES: usize = 4;
 /// Everything one step needs, allocated once per model, with the forward dynamics the step
 /// integrates; [`StepWorkspace::step`] allocates nothing.
 pub struct StepWorkspace<F = Aba> {
+    /// The forward dynamics the step integrates.
     pub forward_dynamics: F,
     data: Data,
     tau_passive: Vec<f64>,
@@ -62,12 +63,15 @@ pub struct StepWorkspace<F = Aba> {
     d_xi: DMatrix<f64>,
     d_v: DMatrix<f64>,
     d_q: DMatrix<f64>,
-    /// The step's result: q₁ (nq) and q̇₁ (nv).
+    /// The step's result q₁ (nq).
     pub q_end: Vec<f64>,
+    /// The step's result q̇₁ (nv).
     pub v_end: Vec<f64>,
-    /// ∂x₁/∂x₀ (2nv × 2nv) and ∂x₁/∂τ (2nv × nv), rows and columns [q (tangent); q̇]; written
-    /// when the step is asked for derivatives.
+    /// A = ∂x₁/∂x₀ (2nv × 2nv), rows and columns [q (tangent); q̇]; written when the step is
+    /// asked for derivatives.
     pub a: DMatrix<f64>,
+    /// B = ∂x₁/∂τ (2nv × nv), rows [q (tangent); q̇]; written when the step is asked for
+    /// derivatives.
     pub b: DMatrix<f64>,
 }
 

@@ -53,9 +53,11 @@ pub struct AccuracyIssue {
     pub time: f64,
     /// The measure's largest value (relative, to compare with `rtol`).
     pub error: f64,
+    /// The tolerance the run missed.
     pub rtol: f64,
-    /// The step the run took (s) and the largest that meets the tolerance (s).
+    /// The step the run took (s).
     pub dt: f64,
+    /// The largest step that meets the tolerance, with a safety margin (s).
     pub largest_step: f64,
 }
 
@@ -85,9 +87,9 @@ impl fmt::Display for AccuracyIssue {
 pub struct Accuracy {
     /// The tolerance the run was checked against.
     pub rtol: f64,
-    /// The start of each step that step doubling checked (s), and that step's estimated local
-    /// error relative to the state's size. Empty for RK45.
+    /// The start of each step that step doubling checked (s); empty for RK45.
     pub check_times: Vec<f64>,
+    /// Each checked step's estimated local error relative to the state's size; empty for RK45.
     pub local_errors: Vec<f64>,
     /// The largest |E − E₀| relative to the largest kinetic energy, over the energy checks made
     /// while the system was conservative; None if it never was (or for RK45).
