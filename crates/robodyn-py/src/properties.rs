@@ -41,19 +41,19 @@ impl PyModel {
     /// Kind of each moving joint: "revolute", "prismatic", "spherical" or "free".
     #[getter]
     fn joint_types(&self) -> Vec<&'static str> {
-        self.model.joints[1..].iter().map(|j| j.kind()).collect()
+        self.model.joints()[1..].iter().map(|j| j.kind()).collect()
     }
 
     /// First index of each joint in q (aligned with joint_names).
     #[getter]
     fn joint_idx_q(&self) -> Vec<usize> {
-        self.model.idx_q[1..].to_vec()
+        self.model.idx_q()[1..].to_vec()
     }
 
     /// First index of each joint in v (aligned with joint_names).
     #[getter]
     fn joint_idx_v(&self) -> Vec<usize> {
-        self.model.idx_v[1..].to_vec()
+        self.model.idx_v()[1..].to_vec()
     }
 
     /// Names of the moving bodies (the child link of each joint, aligned with joint_names); the
@@ -73,7 +73,7 @@ impl PyModel {
     /// into body_names.
     #[getter]
     fn body_parents(&self) -> Vec<isize> {
-        self.model.parent[1..]
+        self.model.parent()[1..]
             .iter()
             .map(|&p| p as isize - 1)
             .collect()

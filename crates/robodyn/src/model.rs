@@ -7,6 +7,7 @@ pub use builder::{ModelBuilder, NewBody};
 
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::joint::Joint;
+use crate::spatial::turn::snapped_signed_permutation;
 use crate::spatial::{Inertia, Mat3, Transform, Turn, Vec3};
 use crate::visual::{Texture, Visual};
 use nalgebra::DVector;
@@ -19,6 +20,9 @@ pub const QUATERNION_NORM_TOLERANCE: f64 = 1e-6;
 pub const INERTIA_EIGENVALUE_TOLERANCE: f64 = 1e-9;
 /// ... and in absolute terms (kg m²), so that round-off on a near-zero tensor is accepted.
 pub const INERTIA_ABSOLUTE_TOLERANCE: f64 = 1e-12;
+/// How far a tree transform's rotation E may be from orthonormal (`|EᵀE − 1|`, largest entry)
+/// before [`Model::set_tree_transform`] rejects it.
+pub const ROTATION_TOLERANCE: f64 = 1e-9;
 /// Standard gravity, m/s², used by the default gravity vector `[0, 0, -9.81]`.
 pub const STANDARD_GRAVITY: f64 = 9.81;
 
@@ -81,9 +85,12 @@ impl Default for JointProperties {
 
 /// A rigid multibody tree. Bodies are numbered so that `parent[i] < i`; body 0 is the world and
 /// has no joint (`Joint::Fixed`). Body `i ≥ 1` moves relative to its parent through `joints[i]`.
-/// The tree's structure (`parent`, `joints`, `idx_q`, `idx_v`, `dof_parent` and what is derived
-/// from them) is made by [`ModelBuilder`] and must not be edited afterwards: add bodies with a
-/// builder instead. Values (inertias, tree transforms, limits, armature, gravity) may be edited.
+/// The tree's structure (`parent`, `joints`, `idx_q`, `idx_v`, `dof_parent`) is made by
+/// [`ModelBuilder`] and read through its accessors ([`Model::parent`], …): add bodies with a
+/// builder instead. What the algorithms derive from it and from the tree transforms (each
+/// joint's turn and motion subspace components, the coordinates' runs and subtrees) is private
+/// and found again by every method that changes its sources ([`Model::set_tree_transform`]).
+/// Values (inertias, limits, armature, gravity) are public fields and may be edited.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Model {
     pub name: String,
@@ -92,46 +99,46 @@ pub struct Model {
     /// Number of velocity coordinates (degrees of freedom).
     pub nv: usize,
     /// Parent body of each body (`parent[0] = 0`).
-    pub parent: Vec<usize>,
+    pub(crate) parent: Vec<usize>,
     /// Joint of each body (`joints[0] = Joint::Fixed`, the world).
-    pub joints: Vec<Joint>,
+    pub(crate) joints: Vec<Joint>,
     /// Name of each body's joint (`"universe"` for the world).
     pub joint_names: Vec<String>,
     /// Name of each body (its link).
     pub body_names: Vec<String>,
     /// `x_tree[i]`: Featherstone's `X_T`, from the parent body frame to body i's joint frame.
-    pub x_tree: Vec<Transform>,
+    pub(crate) x_tree: Vec<Transform>,
     /// Spatial inertia of each body about its own origin, in its own axes (fixed links merged).
     pub inertias: Vec<Inertia>,
     /// First index of body i's joint in q.
-    pub idx_q: Vec<usize>,
+    pub(crate) idx_q: Vec<usize>,
     /// First index of body i's joint in v.
-    pub idx_v: Vec<usize>,
+    pub(crate) idx_v: Vec<usize>,
     /// The parent of each velocity coordinate: the one before it in its joint, or the last of the
     /// nearest ancestor body's joint (`None` at a root); nv. M_ij ≠ 0 only along these chains.
-    pub dof_parent: Vec<Option<usize>>,
+    pub(crate) dof_parent: Vec<Option<usize>>,
     /// Derived from `dof_parent`, nv: the first coordinate of the run ending at coordinate k in
     /// which each coordinate is the parent of the next (`dof_parent[c] = c - 1`). The ancestors
     /// of a coordinate are a few such runs, so a loop over them need not wait on each parent's
     /// load before the next column (see [`Model::ancestor_runs`]). Not stored in snapshots.
     #[serde(skip)]
-    pub dof_run_start: Vec<usize>,
+    dof_run_start: Vec<usize>,
     /// Derived from `parent` and `idx_v` when the model is built, nbodies: one past the last
     /// velocity coordinate of body i's subtree, whose coordinates are then `idx_v[i]..end` —
     /// when the bodies are in depth-first order (each subtree's bodies follow its root without
     /// a gap, as every loader adds them); `None` otherwise. Not stored in snapshots.
     #[serde(skip)]
-    pub subtree_dof_end: Option<Vec<usize>>,
+    subtree_dof_end: Option<Vec<usize>>,
     /// Derived from `joints` and `x_tree` when the model is built, nbodies: [`Joint::turn`] of
     /// each body (asked by every transform of every call, so found once). Not stored in
     /// snapshots.
     #[serde(skip)]
-    pub turns: Vec<Option<Turn>>,
+    turns: Vec<Option<Turn>>,
     /// Derived from `joints` when the model is built, nv: [`Joint::subspace_component`] of
     /// each velocity coordinate (asked for every coordinate of every mass matrix, so found
     /// once). Not stored in snapshots.
     #[serde(skip)]
-    pub subspace_components: Vec<Option<(usize, bool)>>,
+    subspace_components: Vec<Option<(usize, bool)>>,
     /// Position limits, length nq (±inf where none).
     pub lower_position_limit: DVector<f64>,
     pub upper_position_limit: DVector<f64>,
@@ -200,6 +207,109 @@ impl Model {
             model: self,
             top: Some(top),
         }
+    }
+
+    /// Parent body of each body (`parent()[0] = 0`).
+    pub fn parent(&self) -> &[usize] {
+        &self.parent
+    }
+
+    /// Joint of each body (`joints()[0] = Joint::Fixed`, the world).
+    pub fn joints(&self) -> &[Joint] {
+        &self.joints
+    }
+
+    /// `x_tree()[i]`: Featherstone's `X_T`, from the parent body frame to body i's joint frame.
+    pub fn x_tree(&self) -> &[Transform] {
+        &self.x_tree
+    }
+
+    /// First index of each body's joint in q.
+    pub fn idx_q(&self) -> &[usize] {
+        &self.idx_q
+    }
+
+    /// First index of each body's joint in v.
+    pub fn idx_v(&self) -> &[usize] {
+        &self.idx_v
+    }
+
+    /// The parent of each velocity coordinate: the one before it in its joint, or the last of the
+    /// nearest ancestor body's joint (`None` at a root); nv. M_ij ≠ 0 only along these chains.
+    pub fn dof_parent(&self) -> &[Option<usize>] {
+        &self.dof_parent
+    }
+
+    /// For bodies in depth-first order (each subtree's bodies follow its root without a gap, as
+    /// every loader adds them), one past the last velocity coordinate of each body's subtree,
+    /// whose coordinates are then `idx_v[i]..end`; `None` otherwise.
+    pub fn subtree_dof_end(&self) -> Option<&[usize]> {
+        self.subtree_dof_end.as_deref()
+    }
+
+    /// The first coordinate of the run of parent-linked coordinates ending at each coordinate
+    /// (see [`Model::ancestor_runs`]); nv.
+    pub fn dof_run_start(&self) -> &[usize] {
+        &self.dof_run_start
+    }
+
+    /// Sets body i's tree transform `X_T` (parent frame to joint frame; `1 ≤ i < nbodies`) and
+    /// finds again what the algorithms derive from it (the joint's turn), so that every
+    /// algorithm computes with the new placement. A rotation within round-off of a quarter-turn
+    /// pattern is stored exactly, as the builder stores it.
+    pub fn set_tree_transform(&mut self, i: usize, x_tree: Transform) -> Result<()> {
+        let refuse = |message: String| {
+            Err(Error::InvalidValue {
+                argument: "x_tree".into(),
+                message,
+            })
+        };
+        if i == 0 || i >= self.nbodies() {
+            return refuse(format!(
+                "expected a moving body 1..{}, got {i}",
+                self.nbodies()
+            ));
+        }
+        let (rotation, translation) = (&x_tree.rotation, &x_tree.translation);
+        if rotation
+            .iter()
+            .chain(translation.iter())
+            .any(|x| !x.is_finite())
+        {
+            return refuse(format!("body {i}: expected finite entries"));
+        }
+        let departure = (rotation.transpose() * rotation - Mat3::identity())
+            .abs()
+            .max();
+        if departure > ROTATION_TOLERANCE || rotation.determinant() < 0.0 {
+            return refuse(format!(
+                "body {i}: expected a rotation (EᵀE = 1 within {ROTATION_TOLERANCE:e}, det E = 1), \
+                 got EᵀE off by {departure:e} and det E = {}",
+                rotation.determinant()
+            ));
+        }
+        self.x_tree[i] = tree_transform(x_tree);
+        self.derive();
+        Ok(())
+    }
+
+    /// The same model with every joint taking the general products (no turn, no motion subspace
+    /// component): the same values, computed as for any joint axis and tree rotation. For tests
+    /// and benchmarks of the specialisations.
+    pub fn without_joint_specialisations(&self) -> Model {
+        let mut general = self.clone();
+        general.turns = vec![None; self.nbodies()];
+        general.subspace_components = vec![None; self.nv];
+        general
+    }
+
+    /// The same model taking the forms the algorithms have for bodies out of depth-first order
+    /// (no [`Model::subtree_dof_end`]: CRBA in world coordinates). For tests and benchmarks of
+    /// the two forms.
+    pub fn without_subtree_order(&self) -> Model {
+        let mut model = self.clone();
+        model.subtree_dof_end = None;
+        model
     }
 
     /// [`Joint::turn`] of body i's joint and tree transform.
@@ -501,6 +611,13 @@ impl Model {
             .flat_map(|joint| (0..joint.nv()).map(|k| joint.subspace_component(k)))
             .collect();
     }
+}
+
+/// A tree transform as the model stores it: a rotation within round-off of quarter turns stored
+/// exactly, so that the joint's transforms leave out their zeros.
+pub(crate) fn tree_transform(x_tree: Transform) -> Transform {
+    let rotation = snapped_signed_permutation(&x_tree.rotation).unwrap_or(x_tree.rotation);
+    Transform { rotation, ..x_tree }
 }
 
 /// [`Model::dof_run_start`] from the coordinates' parents.

@@ -327,7 +327,11 @@ fn christoffel_symbols_are_the_derivatives_of_the_mass_matrix() {
             IDENTITY_TOLERANCE,
         );
         // the coordinate formula needs velocities that are coordinate rates: no quaternion joints
-        if model.joints.iter().any(|j| j.quaternion_offset().is_some()) {
+        if model
+            .joints()
+            .iter()
+            .any(|j| j.quaternion_offset().is_some())
+        {
             continue;
         }
         // ∂M/∂q_k by central differences
@@ -408,33 +412,38 @@ fn crba_into_writes_crba_s_matrix_which_is_exactly_symmetric() {
 
 /// CRBA's two forms (`algo::crba`), in body coordinates for bodies in depth-first order (every
 /// loader's) and in world coordinates otherwise, give the same M; `Model::subtree_dof_end`
-/// lists each subtree's coordinates, and a snapshot derives it (and `Model::turns`,
-/// `Model::subspace_components`) again. A model whose derived components are missing (not
-/// built) asks its joints and gets the same M bit for bit.
+/// lists each subtree's coordinates, and a snapshot derives it (and each joint's turn and motion
+/// subspace components) again. The model without its joints' specialisations gets the same M
+/// bit for bit.
 #[test]
 fn crba_in_body_and_world_coordinates_agree() {
     let mut rng = rng();
     for (name, model) in test_models() {
         let ends = model
-            .subtree_dof_end
-            .as_ref()
+            .subtree_dof_end()
             .expect("loaders add bodies depth first");
         let reloaded = robodyn::io::model_from_bytes(&robodyn::io::model_to_bytes(&model)).unwrap();
-        assert_eq!(reloaded.subtree_dof_end.as_ref(), Some(ends), "{name}");
-        assert_eq!(reloaded.turns, model.turns, "{name}");
-        assert_eq!(
-            reloaded.subspace_components, model.subspace_components,
-            "{name}"
-        );
-        assert_eq!(model.subspace_components.len(), model.nv, "{name}");
+        assert_eq!(reloaded.subtree_dof_end(), Some(ends), "{name}");
+        for i in 0..model.nbodies() {
+            assert_eq!(reloaded.turn(i), model.turn(i), "{name}: body {i}");
+            for k in 0..model.joints()[i].nv() {
+                let (got, built) = (
+                    reloaded.subspace_component(i, k),
+                    model.subspace_component(i, k),
+                );
+                assert_eq!(got, built, "{name}: body {i}, coordinate {k}");
+            }
+        }
         for (i, &end) in ends.iter().enumerate().skip(1) {
             for j in 1..model.nbodies() {
                 // body j is in body i's subtree when i is on j's path to the world
                 let mut on_path = j;
                 while on_path > i {
-                    on_path = model.parent[on_path];
+                    on_path = model.parent()[on_path];
                 }
-                let listed = model.v_range(j).all(|d| (model.idx_v[i]..end).contains(&d));
+                let listed = model
+                    .v_range(j)
+                    .all(|d| (model.idx_v()[i]..end).contains(&d));
                 assert_eq!(
                     listed,
                     on_path == i || model.v_range(j).is_empty(),
@@ -443,15 +452,17 @@ fn crba_in_body_and_world_coordinates_agree() {
             }
         }
         let world_form = not_depth_first(&model);
-        let mut unbuilt = model.clone();
-        unbuilt.subspace_components.clear();
+        let unbuilt = model.without_joint_specialisations();
         let (mut data, mut world_data) = (Data::new(&model), Data::new(&world_form));
         let mut unbuilt_data = Data::new(&unbuilt);
         for _ in 0..3 {
             let q = model.random_configuration(&mut rng);
             let m_unbuilt = crba(&unbuilt, &mut unbuilt_data, q.as_slice()).unwrap();
             let m = crba(&model, &mut data, q.as_slice()).unwrap();
-            assert_eq!(m, m_unbuilt, "{name}: M without the derived components");
+            assert_eq!(
+                m, m_unbuilt,
+                "{name}: M without the joints' specialisations"
+            );
             let m_world = crba(&world_form, &mut world_data, q.as_slice()).unwrap();
             let label = format!("{name}: M in body and world coordinates");
             assert_close(
@@ -473,7 +484,7 @@ fn bodies_out_of_depth_first_order_take_the_world_form() {
     let depth = |mut i: usize| {
         let mut depth = 0;
         while i != 0 {
-            i = tree.parent[i];
+            i = tree.parent()[i];
             depth += 1;
         }
         depth
@@ -484,10 +495,10 @@ fn bodies_out_of_depth_first_order_take_the_world_form() {
     let (mut index, mut q_of, mut v_of) = (vec![0; tree.nbodies()], vec![], vec![]);
     for &i in &order {
         let body = robodyn::NewBody {
-            parent: index[tree.parent[i]],
-            joint: tree.joints[i],
+            parent: index[tree.parent()[i]],
+            joint: tree.joints()[i],
             joint_name: &tree.joint_names[i],
-            x_tree: tree.x_tree[i],
+            x_tree: tree.x_tree()[i],
             properties: Default::default(),
             name: &tree.body_names[i],
             inertia: tree.inertias[i],
@@ -497,7 +508,7 @@ fn bodies_out_of_depth_first_order_take_the_world_form() {
         v_of.extend(tree.v_range(i));
     }
     let mut shuffled = builder.build();
-    assert_eq!(shuffled.subtree_dof_end, None);
+    assert_eq!(shuffled.subtree_dof_end(), None);
     for (new, &old) in v_of.iter().enumerate() {
         shuffled.armature[new] = tree.armature[old];
     }
@@ -525,13 +536,13 @@ fn bodies_out_of_depth_first_order_take_the_world_form() {
 fn ancestor_runs_are_the_parent_chain() {
     for (name, model) in test_models() {
         let reloaded = robodyn::io::model_from_bytes(&robodyn::io::model_to_bytes(&model)).unwrap();
-        assert_eq!(reloaded.dof_run_start, model.dof_run_start, "{name}");
+        assert_eq!(reloaded.dof_run_start(), model.dof_run_start(), "{name}");
         for top in 0..model.nv {
             let mut chain = vec![];
             let mut next = Some(top);
             while let Some(k) = next {
                 chain.push(k);
-                next = model.dof_parent[k];
+                next = model.dof_parent()[k];
             }
             let runs: Vec<_> = model.ancestor_runs(top).collect();
             let walked: Vec<usize> = runs.iter().flat_map(|run| run.clone().rev()).collect();
@@ -540,7 +551,7 @@ fn ancestor_runs_are_the_parent_chain() {
                 assert!(!run.is_empty(), "{name}: empty run");
                 for c in run.start + 1..run.end {
                     assert_eq!(
-                        model.dof_parent[c],
+                        model.dof_parent()[c],
                         Some(c - 1),
                         "{name}: {run:?} is not a chain"
                     );
@@ -557,8 +568,8 @@ fn every_quaternion_is_checked() {
     let tree = test_model("tree");
     let quaternion_starts: Vec<(String, usize)> = (1..tree.nbodies())
         .filter_map(|i| {
-            let offset = tree.joints[i].quaternion_offset()?;
-            Some((tree.joint_names[i].clone(), tree.idx_q[i] + offset))
+            let offset = tree.joints()[i].quaternion_offset()?;
+            Some((tree.joint_names[i].clone(), tree.idx_q()[i] + offset))
         })
         .collect();
     assert_eq!(
@@ -595,7 +606,7 @@ const AXES_URDF: &str = r#"<robot name="axes">
 </robot>"#;
 
 /// The specialised paths, a joint's transform that turns about a coordinate axis
-/// (`Model::turns`) and a motion subspace that is one unit motion (`Model::subspace_components`,
+/// (`Model::turn`) and a motion subspace that is one unit motion (`Model::subspace_component`,
 /// `Model::unit_axis`), give the values of the general products: the same model without either
 /// gives the same τ (with and without external forces), bias forces, gravity, q̈ and M.
 #[test]
@@ -608,9 +619,7 @@ fn the_specialised_joint_paths_give_the_general_products_values() {
     for (name, model) in models {
         let unit_axes = (1..model.nbodies()).filter(|&i| model.unit_axis(i).is_some());
         assert!(unit_axes.count() > 0, "{name}: no joint along a unit axis");
-        let mut general = model.clone();
-        general.turns = vec![None; model.nbodies()];
-        general.subspace_components = vec![None; model.nv];
+        let general = model.without_joint_specialisations();
         assert!((1..model.nbodies()).all(|i| general.unit_axis(i).is_none()));
         let (mut data, mut general_data) = (Data::new(&model), Data::new(&general));
         for _ in 0..3 {

@@ -46,18 +46,18 @@ fn tree_classes_and_degrees() {
         ["shoulder", "slide", "free_box_joint0"]
     );
     assert_eq!(
-        model.joints[1],
+        model.joints()[1],
         Joint::Revolute {
             axis: nalgebra::Vector3::y()
         }
     );
     assert_eq!(
-        model.joints[2],
+        model.joints()[2],
         Joint::Prismatic {
             axis: nalgebra::Vector3::x()
         }
     );
-    assert_eq!(model.joints[3], Joint::Free);
+    assert_eq!(model.joints()[3], Joint::Free);
     assert_eq!(model.armature.as_slice()[..2], [0.5, 0.5]);
     assert_eq!(
         (model.lower_position_limit[1], model.upper_position_limit[1]),

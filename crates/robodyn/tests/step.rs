@@ -43,9 +43,9 @@ fn models_with_passive_forces() -> Vec<(&'static str, Model)> {
 /// penalty −k δ − b q̇ pushes back for |q̇| < 1.25 (k = 50, b = 2).
 fn push_past_upper_limits(model: &Model, q: &mut DVector<f64>) {
     for i in (1..model.nbodies()).step_by(2) {
-        let index = model.idx_q[i];
+        let index = model.idx_q()[i];
         let upper = model.upper_position_limit[index];
-        if model.joints[i].nq() == 1 && upper.is_finite() {
+        if model.joints()[i].nq() == 1 && upper.is_finite() {
             q[index] = upper + 0.05;
         }
     }

@@ -52,7 +52,7 @@ fn quarter_turns_in_rpy_are_stored_exactly() {
     ));
     let model = load_urdf_str(&text, "quarter.urdf", LoadOptions::default()).unwrap();
     for i in [1, 2] {
-        let rotation = model.x_tree[i].rotation;
+        let rotation = model.x_tree()[i].rotation;
         assert!(
             rotation.iter().all(|x| [0.0, 1.0, -1.0].contains(x)),
             "{rotation}"
@@ -65,7 +65,7 @@ fn quarter_turns_in_rpy_are_stored_exactly() {
         .expect("a z joint after a quarter turn about x");
     assert_eq!((turn.axis, turn.column, turn.tree_rotates), (2, 1, true));
     assert!(model.turn(2).is_some());
-    assert!(model.x_tree[3]
+    assert!(model.x_tree()[3]
         .rotation
         .iter()
         .any(|x| x.abs() > 0.0 && x.abs() < 1.0));
@@ -86,7 +86,7 @@ fn bundled_models_load_with_their_gravity() {
     let floating = bundled_model("ur5", true).unwrap();
     assert_eq!((floating.nq, floating.nv), (13, 12));
     assert_eq!(floating.joint_names[1], "root_joint");
-    assert!(matches!(floating.joints[1], Joint::Free));
+    assert!(matches!(floating.joints()[1], Joint::Free));
     assert!(bundled_model("nope", false)
         .unwrap_err()
         .to_string()
@@ -113,9 +113,9 @@ fn fixed_joints_merge_and_order_is_depth_first() {
     );
     let model = load_urdf_str(&text, "t.urdf", LoadOptions::default()).unwrap();
     assert_eq!(model.joint_names, vec!["universe", "j1", "j2", "j3", "m"]);
-    assert_eq!(model.parent, vec![0, 0, 1, 0, 3]);
+    assert_eq!(model.parent(), vec![0, 0, 1, 0, 3]);
     assert_eq!(
-        model.joints[1],
+        model.joints()[1],
         Joint::Revolute {
             axis: nalgebra::Vector3::z()
         }
@@ -279,7 +279,7 @@ fn floating_joint_becomes_free() {
     );
     let model = load_urdf_str(&text, "f.urdf", LoadOptions::default()).unwrap();
     assert_eq!((model.nq, model.nv), (7, 6));
-    assert_eq!(model.joints[1], Joint::Free);
+    assert_eq!(model.joints()[1], Joint::Free);
     assert_eq!(
         model.neutral().as_slice(),
         &[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]

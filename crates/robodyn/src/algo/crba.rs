@@ -105,7 +105,7 @@ pub(crate) fn mass_matrix_of<S: Real, F: SubtreeForces<S>>(
     q: &[S],
     out: MassMatrixBuffers<S, F>,
 ) {
-    match model.subtree_dof_end.as_deref() {
+    match model.subtree_dof_end() {
         Some(subtree_dof_end) => {
             let buffers = BodyFrameBuffers {
                 x_up: out.x_up,

@@ -1,11 +1,11 @@
 //! [`ModelBuilder`]: a model built body by body, as every loader builds one.
 
 use super::{
-    check_unit_quaternion, run_start, Frame, JointProperties, Mimic, Model, STANDARD_GRAVITY,
+    check_unit_quaternion, run_start, tree_transform, Frame, JointProperties, Mimic, Model,
+    STANDARD_GRAVITY,
 };
 use crate::error::{Error, Result};
 use crate::joint::Joint;
-use crate::spatial::turn::snapped_signed_permutation;
 use crate::spatial::{Inertia, Transform, Vec3};
 use crate::visual::{Texture, Visual};
 use nalgebra::DVector;
@@ -102,9 +102,7 @@ impl ModelBuilder {
         m.joints.push(joint);
         m.joint_names.push(joint_name.to_string());
         m.body_names.push(name.to_string());
-        // quarter turns stored exactly, so that the joint's transforms leave out their zeros
-        let rotation = snapped_signed_permutation(&x_tree.rotation).unwrap_or(x_tree.rotation);
-        m.x_tree.push(Transform { rotation, ..x_tree });
+        m.x_tree.push(tree_transform(x_tree));
         m.inertias.push(inertia);
         m.idx_q.push(m.nq);
         m.idx_v.push(m.nv);

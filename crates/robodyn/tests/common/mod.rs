@@ -81,9 +81,7 @@ pub fn test_model(name: &str) -> Model {
 /// `model` as if its bodies were not in depth-first order (`subtree_dof_end` cleared): the
 /// algorithms with two forms (CRBA) take their world-coordinate one.
 pub fn not_depth_first(model: &Model) -> Model {
-    let mut model = model.clone();
-    model.subtree_dof_end = None;
-    model
+    model.without_subtree_order()
 }
 
 pub fn rng() -> StdRng {
