@@ -8,53 +8,92 @@ use thiserror::Error;
 pub enum Error {
     /// A model file does not exist.
     #[error("model file not found: '{path}'")]
-    FileNotFound { path: String },
+    FileNotFound {
+        /// The path that was looked up.
+        path: String,
+    },
 
     /// A model description is malformed or inconsistent. `location` names the file, element and
     /// line where known.
     #[error("{location}: {message}")]
-    InvalidModel { location: String, message: String },
+    InvalidModel {
+        /// Where the problem is: file, element and line where known.
+        location: String,
+        /// What is wrong there.
+        message: String,
+    },
 
     /// An input array has the wrong length.
     #[error("argument '{argument}': expected {expected}, got {received}")]
     Shape {
+        /// Name of the offending argument.
         argument: String,
+        /// The length or shape that was expected.
         expected: String,
+        /// The length or shape that was received.
         received: String,
     },
 
     /// An input holds NaN or an infinite value.
     #[error("argument '{argument}': expected finite values, got {value} at index {index}")]
     NotFinite {
+        /// Name of the offending argument.
         argument: String,
+        /// Index of the first non-finite entry.
         index: usize,
+        /// The non-finite value found there.
         value: f64,
     },
 
     /// An input value is finite but outside what the argument accepts (e.g. a non-unit quaternion).
     #[error("argument '{argument}': {message}")]
-    InvalidValue { argument: String, message: String },
+    InvalidValue {
+        /// Name of the offending argument.
+        argument: String,
+        /// What was expected and what was received.
+        message: String,
+    },
 
     /// Finite inputs so large that a result overflowed.
     #[error("the result is not finite (entry {index} is {value}): the inputs are too large for float64 arithmetic")]
-    Overflow { index: usize, value: f64 },
+    Overflow {
+        /// Index of the first non-finite entry of the result.
+        index: usize,
+        /// The non-finite value found there.
+        value: f64,
+    },
 
     /// A simulation could not go on at time `time` (s): the state diverged, the controller or
     /// the wrenches gave something unusable, or the equations became too stiff.
     #[error("simulation stopped at t = {time} s: {message}")]
-    Simulation { time: f64, message: String },
+    Simulation {
+        /// Simulation time (s) at which it stopped.
+        time: f64,
+        /// Why it stopped.
+        message: String,
+    },
 
     /// A simulation left the bounds of a sensible motion at time `time` (s): a non-finite state,
     /// a speed or an energy beyond its bound, or a fixed step far too large for the dynamics.
     #[error("simulation diverged at t = {time:.6} s: {message}")]
-    Diverged { time: f64, message: String },
+    Diverged {
+        /// Simulation time (s) at which the divergence was detected.
+        time: f64,
+        /// Which bound was left.
+        message: String,
+    },
 
     /// A frame name that the model does not have.
     #[error("unknown frame '{name}': the model's frames are {available}")]
-    UnknownFrame { name: String, available: String },
+    UnknownFrame {
+        /// The frame name that was asked for.
+        name: String,
+        /// The model's frame names, listed for the message.
+        available: String,
+    },
 }
 
-/// Result with the core's [`Error`].
+/// Result with the core's [`enum@Error`].
 pub type Result<T> = std::result::Result<T, Error>;
 
 impl Error {

@@ -63,11 +63,18 @@ pub enum Joint {
     /// No motion: nq = nv = 0. Only the world (body 0) carries it; the loaders merge fixed joints
     /// into the parent body and keep the child link as a frame.
     Fixed,
-    /// Rotation about a unit `axis` of the joint frame. q = [angle] (rad), v = [angular rate]
+    /// Rotation about a unit `axis` of the joint frame. q = `[angle]` (rad), v = `[angular rate]`
     /// (rad/s). A URDF `continuous` joint is a revolute joint without position limits.
-    Revolute { axis: Vec3 },
-    /// Translation along a unit `axis` of the joint frame. q = [displacement] (m), v = [rate] (m/s).
-    Prismatic { axis: Vec3 },
+    Revolute {
+        /// The unit rotation axis, in joint-frame coordinates.
+        axis: Vec3,
+    },
+    /// Translation along a unit `axis` of the joint frame. q = `[displacement]` (m),
+    /// v = `[rate]` (m/s).
+    Prismatic {
+        /// The unit translation axis, in joint-frame coordinates.
+        axis: Vec3,
+    },
     /// Ball joint. q = [qx, qy, qz, qw], the unit quaternion (scalar last) of the child's rotation
     /// relative to the joint frame; v = [ωx, ωy, ωz], the child's angular velocity in child axes.
     Spherical,

@@ -9,6 +9,8 @@
 //! Conventions: bodies are numbered so that `parent[i] < i`, body 0 is the world; flattened
 //! 6-vectors at the public boundary are `[linear; angular]`; units are SI.
 
+#![warn(missing_docs)]
+
 pub mod algo;
 pub mod data;
 pub mod error;

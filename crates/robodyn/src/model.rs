@@ -30,6 +30,7 @@ pub const STANDARD_GRAVITY: f64 = 9.81;
 /// or a user frame.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Frame {
+    /// The frame's name (a link's or a user frame's).
     pub name: String,
     /// The body it is attached to (0 = world).
     pub body: usize,
@@ -45,7 +46,9 @@ pub struct Mimic {
     pub joint: usize,
     /// Body index of the mimicked joint.
     pub mimicked: usize,
+    /// Factor applied to the mimicked joint's position.
     pub multiplier: f64,
+    /// Offset added after the factor (rad or m).
     pub offset: f64,
 }
 
@@ -53,13 +56,19 @@ pub struct Mimic {
 /// coordinate of the joint; limits to every configuration coordinate.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointProperties {
+    /// Lower position limit (rad or m; -inf where none).
     pub lower: f64,
+    /// Upper position limit (rad or m; +inf where none).
     pub upper: f64,
+    /// Velocity limit (rad/s or m/s; inf where none).
     pub velocity_limit: f64,
+    /// Effort limit (N·m or N; inf where none).
     pub effort_limit: f64,
     /// Rotor inertia reflected through the transmission; adds to M's diagonal.
     pub armature: f64,
+    /// Viscous damping coefficient (torque or force per unit velocity).
     pub damping: f64,
+    /// Dry (Coulomb) friction torque or force.
     pub friction: f64,
     /// Joint spring stiffness (MJCF `stiffness`), pulling q towards `spring_reference`.
     pub stiffness: f64,
@@ -93,6 +102,7 @@ impl Default for JointProperties {
 /// Values (inertias, limits, armature, gravity) are public fields and may be edited.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Model {
+    /// The model's name (the URDF robot name, for instance).
     pub name: String,
     /// Number of configuration coordinates.
     pub nq: usize,
@@ -139,22 +149,26 @@ pub struct Model {
     /// once). Not stored in snapshots.
     #[serde(skip)]
     subspace_components: Vec<Option<(usize, bool)>>,
-    /// Position limits, length nq (±inf where none).
+    /// Lower position limits, length nq (-inf where none).
     pub lower_position_limit: DVector<f64>,
+    /// Upper position limits, length nq (+inf where none).
     pub upper_position_limit: DVector<f64>,
-    /// Velocity and effort limits, length nv (inf where none).
+    /// Velocity limits, length nv (inf where none).
     pub velocity_limit: DVector<f64>,
+    /// Effort limits, length nv (inf where none).
     pub effort_limit: DVector<f64>,
     /// Rotor inertia per velocity coordinate, added to M's diagonal, RNEA and ABA.
     pub armature: DVector<f64>,
-    /// Viscous damping and dry friction per velocity coordinate (kept for simulation; the
-    /// dynamics algorithms do not apply them).
+    /// Viscous damping per velocity coordinate (kept for simulation; the dynamics algorithms do
+    /// not apply it).
     pub damping: DVector<f64>,
+    /// Dry friction per velocity coordinate (kept for simulation, like damping).
     pub friction: DVector<f64>,
-    /// Joint springs: stiffness per velocity coordinate and the configuration where they are
-    /// relaxed, length nq (the neutral configuration for spherical and free joints). Kept for
-    /// simulation, like damping and friction.
+    /// Joint spring stiffness per velocity coordinate, length nv. Kept for simulation, like
+    /// damping and friction.
     pub stiffness: DVector<f64>,
+    /// The configuration where the joint springs are relaxed, length nq (the neutral
+    /// configuration for spherical and free joints).
     pub spring_reference: DVector<f64>,
     /// The configuration [`Model::neutral`] returns, length nq: zero angles and displacements and
     /// identity quaternions, except where the loader knows the pose the file draws (an MJCF

@@ -7,7 +7,7 @@
 //!   subtree's coordinates are consecutive): composites and forces `F = I^c_i S_i` carried to the
 //!   parent joint by joint. A joint that turns about a coordinate axis (after quarter turns)
 //!   makes each carry a turned product (`spatial::turn`), and a coordinate axis makes `S_jᵀ F`
-//!   one component of F. One state keeps its forces by component ([`ForceRows`]) and carries
+//!   one component of F. One state keeps its forces by component (a private row layout) and carries
 //!   four per product.
 //! - Otherwise every quantity once in world coordinates, where composites add without transforms
 //!   and each `H_ij` is a 6-vector dot product.

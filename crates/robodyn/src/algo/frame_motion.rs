@@ -140,7 +140,7 @@ fn frame_motion(
 }
 
 /// J̇(q, q̇) of frame `frame` (6 x nv, rows `[linear; angular]`, the same [`Reference`] as
-/// [`crate::algo::jacobian`]), written into `data.jacobian_dot`. `J̇ q̇` equals
+/// [`crate::algo::jacobian()`]), written into `data.jacobian_dot`. `J̇ q̇` equals
 /// [`frame_acceleration`] with q̈ = 0.
 pub fn jacobian_time_variation<'d>(
     model: &Model,

@@ -51,9 +51,13 @@ impl Default for IkOptions {
 /// the steps taken over all attempts and the final error norm.
 #[derive(Debug, Clone, PartialEq)]
 pub struct IkSolution {
+    /// The configuration with the smallest error found, length nq.
     pub q: DVector<f64>,
+    /// Whether `residual` is below the tolerance.
     pub success: bool,
+    /// Steps taken, summed over all attempts.
     pub iterations: usize,
+    /// The error norm (m and rad) at `q`.
     pub residual: f64,
 }
 

@@ -127,9 +127,13 @@ impl BatchWorkspace {
 /// the algorithm takes zero (Newton–Euler's v and a) or does not take them.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct States<'s> {
+    /// Configurations, n × nq.
     pub q: &'s [f64],
+    /// Velocities, n × nv.
     pub v: Option<&'s [f64]>,
+    /// Accelerations, n × nv.
     pub a: Option<&'s [f64]>,
+    /// Joint torques or forces, n × nv.
     pub tau: Option<&'s [f64]>,
 }
 

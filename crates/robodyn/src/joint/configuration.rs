@@ -89,8 +89,9 @@ impl Joint {
             }
         }
     }
-    /// ∂(q ⊕ v)/∂q = Ad(exp(v))⁻¹ and ∂(q ⊕ v)/∂v = J_r(v), tangent to tangent (see
-    /// [`jacobians`]), written into the leading nv × nv blocks of `d_q` and `d_v`.
+    /// ∂(q ⊕ v)/∂q = Ad(exp(v))⁻¹ and ∂(q ⊕ v)/∂v = J_r(v), tangent to tangent (configurations
+    /// perturbed on the right, as in the joint's Lie-group Jacobians), written into the leading
+    /// nv × nv blocks of `d_q` and `d_v`.
     pub fn integrate_jacobians(&self, v: &[f64], d_q: &mut Mat6, d_v: &mut Mat6) {
         match self {
             Joint::Fixed => {}
@@ -173,8 +174,9 @@ impl Joint {
         }
     }
 
-    /// ∂ξ̇/∂ξ and ∂ξ̇/∂v of [`Joint::tangent_rate`] (see [`jacobians`]), written into the leading
-    /// nv × nv blocks of `d_xi` and `d_v`; identity and zero on revolute and prismatic joints.
+    /// ∂ξ̇/∂ξ and ∂ξ̇/∂v of [`Joint::tangent_rate`] (perturbed on the right), written into the
+    /// leading nv × nv blocks of `d_xi` and `d_v`; identity and zero on revolute and prismatic
+    /// joints.
     pub fn tangent_rate_jacobians(&self, xi: &[f64], v: &[f64], d_xi: &mut Mat6, d_v: &mut Mat6) {
         match self {
             Joint::Fixed => {}

@@ -15,10 +15,13 @@ use nalgebra::DVector;
 pub struct NewBody<'a> {
     /// Index of the parent body (0 = world).
     pub parent: usize,
+    /// The joint connecting it to its parent.
     pub joint: Joint,
+    /// The joint's name.
     pub joint_name: &'a str,
     /// Featherstone's `X_T`: from the parent body's frame to the joint frame.
     pub x_tree: Transform,
+    /// The joint's limits, armature, damping, friction and spring.
     pub properties: JointProperties,
     /// The body's (link's) name.
     pub name: &'a str,

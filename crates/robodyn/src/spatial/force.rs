@@ -8,11 +8,14 @@ use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
 /// in the frame's axes (Featherstone §2.4). `S` as for [`super::Motion`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Force<S = f64> {
+    /// The moment `n_O` about the frame's origin.
     pub angular: Vector3<S>,
+    /// The linear force `f`.
     pub linear: Vector3<S>,
 }
 
 impl<S: Real> Force<S> {
+    /// The force with moment `angular` and linear force `linear`.
     #[inline(always)]
     pub fn new(angular: Vector3<S>, linear: Vector3<S>) -> Self {
         Force { angular, linear }
@@ -59,6 +62,7 @@ impl Default for Force {
 }
 
 impl Force {
+    /// The zero force.
     pub const ZERO: Force = Force {
         angular: Vec3::new(0.0, 0.0, 0.0),
         linear: Vec3::new(0.0, 0.0, 0.0),

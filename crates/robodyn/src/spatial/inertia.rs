@@ -17,6 +17,7 @@ use std::ops::{Add, AddAssign};
     deserialize = "S: nalgebra::Scalar + serde::Deserialize<'de>"
 ))]
 pub struct Inertia<S = f64> {
+    /// The body's mass `m` (kg).
     pub mass: S,
     /// `h = m c`.
     pub first_moment: Vector3<S>,
@@ -89,6 +90,7 @@ impl Default for Inertia {
 }
 
 impl Inertia {
+    /// The inertia of nothing: zero mass, first moment and rotational inertia.
     pub const ZERO: Inertia = Inertia {
         mass: 0.0,
         first_moment: Vec3::new(0.0, 0.0, 0.0),
@@ -173,10 +175,11 @@ impl Inertia {
 
     /// The columns of f = I a + v ×* I v as a linear map of the ten parameters: f = Σ_k π_k
     /// F_k(v, a). With v = (ω, u), a = (ω̇, u̇) on `[angular; linear]` (Atkeson, An and
-    /// Hollerbach 1986, with the Jacobi identity [u]×[ω]× − [ω]×[u]× = [u × ω]×):
-    /// - m: n = 0, f = u̇ + ω × u;
-    /// - h: n = −[u̇ + ω × u]× h, f = ([ω̇]× + [ω]×[ω]×) h;
-    /// - Ī: n = L(ω̇) + [ω]× L(ω), f = 0, with Ī w = L(w) [Ī_xx, Ī_xy, Ī_yy, Ī_xz, Ī_yz, Ī_zz].
+    /// Hollerbach 1986, with the Jacobi identity `[u]×[ω]× − [ω]×[u]× = [u × ω]×`):
+    /// - m: `n = 0`, `f = u̇ + ω × u`;
+    /// - h: `n = −[u̇ + ω × u]× h`, `f = ([ω̇]× + [ω]×[ω]×) h`;
+    /// - Ī: `n = L(ω̇) + [ω]× L(ω)`, `f = 0`, with
+    ///   `Ī w = L(w) [Ī_xx, Ī_xy, Ī_yy, Ī_xz, Ī_yz, Ī_zz]`.
     pub fn force_regressor(v: &Motion, a: &Motion) -> [Force; 10] {
         let (w, u) = (&v.angular, &v.linear);
         let linear_acceleration = a.linear + w.cross(u);
@@ -235,6 +238,7 @@ pub struct CoriolisFactor<S = f64> {
 }
 
 impl CoriolisFactor {
+    /// The factor of a zero inertia or a body at rest: all parts zero.
     pub const ZERO: CoriolisFactor = CoriolisFactor {
         rotational: Mat3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
         coupling: Vec3::new(0.0, 0.0, 0.0),

@@ -9,7 +9,9 @@ use std::ops::{Add, AddAssign, Mul, Neg, Sub};
 /// type for a batch of states (see [`Real`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Motion<S = f64> {
+    /// The angular velocity `ω`.
     pub angular: Vector3<S>,
+    /// The linear velocity `v_O` of the point at the frame's origin.
     pub linear: Vector3<S>,
 }
 
@@ -21,6 +23,7 @@ impl Default for Motion {
 }
 
 impl Motion {
+    /// The zero motion.
     pub const ZERO: Motion = Motion {
         angular: Vec3::new(0.0, 0.0, 0.0),
         linear: Vec3::new(0.0, 0.0, 0.0),
@@ -28,6 +31,7 @@ impl Motion {
 }
 
 impl<S: Real> Motion<S> {
+    /// The motion with angular part `angular` and linear part `linear`.
     #[inline(always)]
     pub fn new(angular: Vector3<S>, linear: Vector3<S>) -> Self {
         Motion { angular, linear }

@@ -8,7 +8,8 @@ use nalgebra::{Matrix3, Matrix6, SimdRealField, Vector3};
 
 /// A number the spatial algebra computes in: `f64` for one state, or a lane type holding one
 /// `f64` per state of a batch (`simba`'s `AutoSimd<[f64; N]>`), so that one kernel serves both
-/// and the same operations run in every lane. Model constants enter by [`SimdValue::splat`].
+/// and the same operations run in every lane. Model constants enter by
+/// [`simba::simd::SimdValue::splat`].
 pub trait Real: SimdRealField<Element = f64> + Copy {
     /// The lanes `(f(0), f(1), ...)`, built in registers (replacing lanes one by one goes
     /// through memory).

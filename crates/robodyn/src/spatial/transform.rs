@@ -35,6 +35,7 @@ impl Default for Transform {
 }
 
 impl Transform {
+    /// The identity: no rotation, no translation.
     pub const IDENTITY: Transform = Transform {
         rotation: Mat3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0),
         translation: Vec3::new(0.0, 0.0, 0.0),
