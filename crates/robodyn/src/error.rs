@@ -1,6 +1,7 @@
 //! The one error type of the core. Messages name the argument or file element, what was expected
 //! and what was received.
 
+use crate::dispatch::multiversion;
 use thiserror::Error;
 
 /// Everything that can go wrong when building a model or calling an algorithm.
@@ -172,33 +173,13 @@ pub fn all_finite(values: &[f64]) -> bool {
     all_finite_wide(values)
 }
 
-/// [`all_finite`] of many values, in the widest vectors the processor has.
-fn all_finite_wide(values: &[f64]) -> bool {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx512f") {
-        // SAFETY: the processor has AVX-512F, just checked.
-        return unsafe { all_finite_avx512(values) };
+multiversion! {
+    /// [`all_finite`] of many values, in the widest vectors the processor has.
+    fn all_finite_wide(values: &[f64]) -> bool {
+        all_finite_avx512 for ["avx512f"] => { all_finite_generic(values) }
+        all_finite_avx2 for ["avx2"] => { all_finite_generic(values) }
+        baseline => { all_finite_generic(values) }
     }
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the processor has AVX2, just checked.
-        return unsafe { all_finite_avx2(values) };
-    }
-    all_finite_generic(values)
-}
-
-/// [`all_finite_generic`] compiled for AVX-512.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn all_finite_avx512(values: &[f64]) -> bool {
-    all_finite_generic(values)
-}
-
-/// [`all_finite_generic`] compiled for AVX2.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn all_finite_avx2(values: &[f64]) -> bool {
-    all_finite_generic(values)
 }
 
 #[inline(always)]

@@ -13,6 +13,7 @@
 
 pub mod algo;
 pub mod data;
+mod dispatch;
 pub mod error;
 pub mod integrate;
 pub mod io;

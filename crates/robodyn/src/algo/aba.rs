@@ -12,6 +12,7 @@ use crate::algo::derivatives::DynamicsState;
 use crate::algo::kinematics::joint_transforms;
 use crate::algo::rnea::check_external_forces;
 use crate::algo::SINGULARITY_TOLERANCE;
+use crate::dispatch::multiversion;
 use crate::error::{check_vector, Error, Result};
 use crate::model::Model;
 use crate::spatial::{
@@ -40,26 +41,23 @@ pub fn aba<'d>(
     Ok(&data.qdd)
 }
 
-/// [`articulated_body_passes`] of one state, built for AVX2 and FMA as well and chosen at run time
-/// (the same operations in the same order, so the same result bit for bit: no product is fused).
-#[inline(never)]
-fn one_state_passes(
-    model: &Model,
-    (q, v, tau, f_ext): DynamicsState,
-    out: AbaBuffers<f64>,
-) -> std::result::Result<(), usize> {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-        // SAFETY: the processor has AVX2 and FMA, just checked.
-        return unsafe { one_state_passes_avx2(model, (q, v, tau, f_ext), out) };
+multiversion! {
+    /// [`articulated_body_passes`] of one state, built for AVX2 and FMA as well
+    /// ([`crate::dispatch`]).
+    #[inline(never)]
+    fn one_state_passes(
+        model: &Model,
+        state: DynamicsState,
+        out: AbaBuffers<f64>,
+    ) -> std::result::Result<(), usize> {
+        one_state_passes_avx2 for ["avx2", "fma"] => { passes_of(model, state, out) }
+        baseline => { passes_of(model, state, out) }
     }
-    articulated_body_passes(model, q, v, tau, f_ext, out)
 }
 
-/// [`one_state_passes`] built for AVX2 and FMA.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn one_state_passes_avx2(
+/// [`articulated_body_passes`] of one state, its arguments in one.
+#[inline(always)]
+fn passes_of(
     model: &Model,
     (q, v, tau, f_ext): DynamicsState,
     out: AbaBuffers<f64>,

@@ -20,6 +20,7 @@
 //! coordinates) per pair (joint, ancestor joint).
 
 use crate::algo::kinematics::{body_placements, joint_transforms};
+use crate::dispatch::multiversion;
 use crate::error::{check_length, Result};
 use crate::model::Model;
 use crate::spatial::{signed, Force, Inertia, Motion, Real, Transform, Turn};
@@ -45,28 +46,15 @@ pub fn crba_into(model: &Model, data: &mut Data, q: &[f64], out: &mut [f64]) -> 
     Ok(())
 }
 
-/// [`mass_matrix_of`] of one state, built for AVX2 and FMA as well and chosen at run time: the
-/// forces' carries take four forces per product ([`ForceRows`]), in one AVX2 vector so built
-/// (the same operations in the same order, so the same result bit for bit: no product is fused).
-#[inline(never)]
-fn one_state_mass_matrix(model: &Model, q: &[f64], out: MassMatrixBuffers<f64, ForceRows>) {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-        // SAFETY: the processor has AVX2 and FMA, just checked.
-        return unsafe { one_state_mass_matrix_avx2(model, q, out) };
+multiversion! {
+    /// [`mass_matrix_of`] of one state, built for AVX2 and FMA as well ([`crate::dispatch`]):
+    /// the forces' carries take four forces per product ([`ForceRows`]), in one AVX2 vector so
+    /// built.
+    #[inline(never)]
+    fn one_state_mass_matrix(model: &Model, q: &[f64], out: MassMatrixBuffers<f64, ForceRows>) {
+        one_state_mass_matrix_avx2 for ["avx2", "fma"] => { mass_matrix_of(model, q, out) }
+        baseline => { mass_matrix_of(model, q, out) }
     }
-    mass_matrix_of(model, q, out);
-}
-
-/// [`one_state_mass_matrix`] built for AVX2 and FMA.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn one_state_mass_matrix_avx2(
-    model: &Model,
-    q: &[f64],
-    out: MassMatrixBuffers<f64, ForceRows>,
-) {
-    mass_matrix_of(model, q, out);
 }
 
 /// What the CRBA writes in either form: one state's, borrowed from [`Data`], or several states'
@@ -127,12 +115,6 @@ pub(crate) fn mass_matrix_of<S: Real, F: SubtreeForces<S>>(
             mass_matrix_of_composites(model, out.world_composites, out.subspaces, out.mass_matrix);
         }
     }
-}
-
-/// M into `mass_matrix` (column-major, nv × nv) from the world-frame composites in `data.i_c`
-/// and subspaces in `data.s_world`, armature on the diagonal.
-pub(crate) fn composite_mass_matrix(model: &Model, data: &Data, mass_matrix: &mut [f64]) {
-    mass_matrix_of_composites(model, &data.i_c, &data.s_world, mass_matrix);
 }
 
 /// M from world-frame composites and subspaces, in `f64` or lanes.

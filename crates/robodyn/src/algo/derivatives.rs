@@ -34,11 +34,11 @@
 //! Cost: O(n · depth) for RNEA's; ABA's add O(n Σ depth) for the solves.
 
 use crate::algo::crba::{
-    add_composites, composite_mass_matrix, mass_matrix_of_composites, world_inertias_of,
-    CompositeBuffers,
+    add_composites, mass_matrix_of_composites, world_inertias_of, CompositeBuffers,
 };
-use crate::algo::ltdl::{factor_into, factor_mass_matrix, solve_rows, solve_rows_with};
+use crate::algo::ltdl::{factor_into, singular_mass_matrix, solve_rows_with};
 use crate::algo::rnea::check_external_forces;
+use crate::dispatch::multiversion;
 use crate::error::{check_length, check_vector, Result};
 use crate::model::Model;
 use crate::spatial::{
@@ -46,10 +46,8 @@ use crate::spatial::{
 };
 use crate::Data;
 use destinations::{Matrices, NegatedRows};
-use one_state::{one_state, AccelerationTerms, DerivativeProducts, VelocityTerms};
 
 mod destinations;
-mod one_state;
 
 pub(crate) use destinations::{RowMajor, TorqueDerivatives};
 
@@ -112,20 +110,12 @@ fn rnea_derivative_passes(
     out: &mut impl TorqueDerivatives<f64>,
 ) -> Result<()> {
     check_arguments(model, q, v, ("a", a), f_ext)?;
-    let mut b = DerivativeBuffers::of(data);
-    // one state: the passes as separate functions (inlined into one, as the lanes need, the f64
-    // code ran about 2 % more instructions)
-    let (b, a) = (&mut b, Some(a));
-    one_state(VelocityTerms {
+    one_state_derivatives(
         model,
-        b,
-        q,
-        v,
-        f_ext,
-    });
-    one_state(AccelerationTerms { model, b, a });
-    one_state(DerivativeProducts::<_, true> { model, b, v, out });
-    add_rotor_torques(model, b, v, a);
+        &mut DerivativeBuffers::of(data),
+        (q, v, a, f_ext),
+        out,
+    );
     Ok(())
 }
 
@@ -182,7 +172,17 @@ pub(crate) struct DerivativeBuffers<'b, S> {
 impl<'b> DerivativeBuffers<'b, f64> {
     /// `data`'s fields.
     fn of(data: &'b mut Data) -> Self {
-        DerivativeBuffers {
+        Self::with_solve(data).0
+    }
+
+    /// `data`'s fields, and those the solves of ABA's derivatives write.
+    fn with_solve(data: &'b mut Data) -> (Self, SolveBuffers<'b, f64>) {
+        let solve = SolveBuffers {
+            factor: data.mass_matrix_factor.as_mut_slice(),
+            qdd: data.qdd.as_mut_slice(),
+            rows: &mut data.derivative_rows,
+        };
+        let buffers = DerivativeBuffers {
             x_up: &mut data.x_up,
             x_world: &mut data.x_world,
             i_c: &mut data.i_c,
@@ -196,7 +196,8 @@ impl<'b> DerivativeBuffers<'b, f64> {
             coriolis_factors: &mut data.coriolis_factors,
             tau: data.tau.as_mut_slice(),
             mass_matrix: data.mass_matrix.as_mut_slice(),
-        }
+        };
+        (buffers, solve)
     }
 }
 
@@ -240,48 +241,9 @@ pub fn aba_derivative_rows(
     (q, v, tau, f_ext): DynamicsState,
 ) -> Result<()> {
     check_arguments(model, q, v, ("tau", tau), f_ext)?;
-    let mut buffers = DerivativeBuffers::of(data);
-    let b = &mut buffers;
-    one_state(VelocityTerms {
-        model,
-        b,
-        q,
-        v,
-        f_ext,
-    });
-
-    // q̈ = M⁻¹ (τ − b), b = ID(q, q̇, 0)
-    one_state(AccelerationTerms { model, b, a: None });
-    joint_torques(model, &mut buffers);
-    add_rotor_torques(model, &mut buffers, v, None);
-    let mut mass_matrix = std::mem::take(&mut data.mass_matrix);
-    composite_mass_matrix(model, data, mass_matrix.as_mut_slice());
-    data.mass_matrix = mass_matrix;
-    factor_mass_matrix(model, data)?;
-    for (qdd, (applied, bias)) in data.qdd.iter_mut().zip(tau.iter().zip(data.tau.iter())) {
-        *qdd = applied - bias;
-    }
-    let mut qdd = std::mem::take(&mut data.qdd);
-    solve_rows(model, data, qdd.as_mut_slice());
-
-    // [∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂τ] = M⁻¹ [−∂τ/∂q, −∂τ/∂q̇, 1] at q̈, solved row by row
-    let nv = model.nv;
-    let mut rows = std::mem::take(&mut data.derivative_rows);
-    rows.fill(0.0);
-    let mut negated = NegatedRows {
-        rows: &mut rows,
-        nv,
-    };
-    let mut buffers = DerivativeBuffers::of(data);
-    let (b, a, out) = (&mut buffers, Some(qdd.as_slice()), &mut negated);
-    one_state(AccelerationTerms { model, b, a });
-    one_state(DerivativeProducts::<_, false> { model, b, v, out });
-    add_rotor_torques(model, &mut buffers, v, Some(qdd.as_slice()));
-    data.qdd = qdd;
-    add_identity(&mut rows, nv);
-    solve_rows(model, data, &mut rows);
-    data.derivative_rows = rows;
-    Ok(())
+    let (mut b, solve) = DerivativeBuffers::with_solve(data);
+    one_state_aba_derivatives(model, &mut b, solve, (q, v, tau, f_ext))
+        .map_err(|()| singular_mass_matrix())
 }
 
 /// [`aba_derivative_rows`] of one state into `out`: ∂q̈/∂q, ∂q̈/∂q̇ and M⁻¹, each nv × nv
@@ -312,17 +274,48 @@ pub(crate) struct SolveBuffers<'b, S> {
     pub rows: &'b mut [S],
 }
 
-/// The passes of [`aba_derivative_rows`] on checked inputs (no external forces), inlined into
-/// one for the lanes, in the same order (so each lane equals the one-state call bit for bit);
-/// an error where a lane's M is refused.
+multiversion! {
+    /// [`derivative_passes`] of one state, built for AVX2 and FMA as well ([`crate::dispatch`]).
+    #[inline(never)]
+    fn one_state_derivatives(
+        model: &Model,
+        b: &mut DerivativeBuffers<f64>,
+        state: DynamicsState,
+        out: &mut impl TorqueDerivatives<f64>,
+    ) {
+        one_state_derivatives_avx2 for ["avx2", "fma"] => { derivative_passes(model, b, state, out) }
+        baseline => { derivative_passes(model, b, state, out) }
+    }
+}
+
+multiversion! {
+    /// [`aba_derivative_passes`] of one state, built for AVX2 and FMA as well
+    /// ([`crate::dispatch`]).
+    #[inline(never)]
+    fn one_state_aba_derivatives(
+        model: &Model,
+        b: &mut DerivativeBuffers<f64>,
+        solve: SolveBuffers<f64>,
+        state: DynamicsState,
+    ) -> std::result::Result<(), ()> {
+        one_state_aba_derivatives_avx2 for ["avx2", "fma"] => {
+            aba_derivative_passes(model, b, solve, state)
+        }
+        baseline => { aba_derivative_passes(model, b, solve, state) }
+    }
+}
+
+/// The passes of [`aba_derivative_rows`] on checked inputs, in `f64` or lanes (the same
+/// operations in every lane, so each lane equals the one-state call bit for bit); an error
+/// where a lane's M is refused.
 #[inline(always)]
 pub(crate) fn aba_derivative_passes<S: Real>(
     model: &Model,
     b: &mut DerivativeBuffers<S>,
     solve: SolveBuffers<S>,
-    (q, v, tau): (&[S], &[S], &[S]),
+    (q, v, tau, f_ext): DynamicsState<S>,
 ) -> std::result::Result<(), ()> {
-    velocity_terms(model, b, q, v, None);
+    velocity_terms(model, b, q, v, f_ext);
     // q̈ = M⁻¹ (τ − b), b = ID(q, q̇, 0)
     acceleration_terms(model, b, None);
     joint_torques(model, b);
@@ -564,5 +557,47 @@ fn add_rotor_torques<S: Real>(
             }
             b.tau[row] += S::splat(model.armature[row]) * rate;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::bundled::floating_ur5_state;
+
+    /// A single call's passes, built for AVX2 and FMA where the processor has them, equal the
+    /// baseline build of the same passes bit for bit (the claim of the dispatched builds).
+    #[test]
+    fn the_dispatched_passes_equal_the_baseline_build_bit_for_bit() {
+        let (model, q, v, a) = floating_ur5_state();
+        let nv = model.nv;
+        let state = (&q[..], &v[..], &a[..], None);
+        let mut dispatched = Data::new(&model);
+        let (mut by_q, mut by_v) = (vec![0.0; nv * nv], vec![0.0; nv * nv]);
+        rnea_derivatives_row_major(&model, &mut dispatched, state, &mut by_q, &mut by_v).unwrap();
+        let mut baseline = vec![vec![0.0; nv * nv]; 2];
+        let [baseline_q, baseline_v] = &mut baseline[..] else {
+            unreachable!()
+        };
+        let mut rows = RowMajor {
+            by_q: baseline_q,
+            by_v: baseline_v,
+            nv,
+        };
+        let mut other = Data::new(&model);
+        derivative_passes(
+            &model,
+            &mut DerivativeBuffers::of(&mut other),
+            state,
+            &mut rows,
+        );
+        assert_eq!(vec![by_q, by_v], baseline);
+        assert_eq!(dispatched.tau, other.tau);
+        aba_derivative_rows(&model, &mut dispatched, state).unwrap();
+        let (mut b, solve) = DerivativeBuffers::with_solve(&mut other);
+        aba_derivative_passes(&model, &mut b, solve, state).unwrap();
+        assert_eq!(dispatched.derivative_rows, other.derivative_rows);
+        assert_eq!(dispatched.qdd, other.qdd);
+        assert_eq!(other.derivative_rows.len(), 3 * nv * nv);
     }
 }

@@ -16,6 +16,7 @@
 //! chains are short against its 50 coordinates, a fraction.
 
 use crate::algo::SINGULARITY_TOLERANCE;
+use crate::dispatch::multiversion;
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::spatial::Real;
@@ -28,12 +29,17 @@ use std::ops::Range;
 /// largest diagonal entry is refused: M is then singular (a massless subtree without armature).
 pub fn factor_mass_matrix(model: &Model, data: &mut Data) -> Result<()> {
     let (mass_matrix, factor) = (data.mass_matrix.as_slice(), &mut data.mass_matrix_factor);
-    factor_into(model, mass_matrix, factor.as_mut_slice()).map_err(|()| Error::InvalidValue {
+    factor_into(model, mass_matrix, factor.as_mut_slice()).map_err(|()| singular_mass_matrix())
+}
+
+/// The error for a mass matrix whose factor refused a pivot.
+pub(crate) fn singular_mass_matrix() -> Error {
+    Error::InvalidValue {
         argument: "q".into(),
         message: "the mass matrix is singular at this configuration (a massless subtree without \
                   armature)"
             .into(),
-    })
+    }
 }
 
 /// [`factor_mass_matrix`] of the column-major `mass_matrix` into `factor`, in `f64` or lanes;
@@ -74,37 +80,16 @@ pub(crate) fn factor_into<S: Real>(
     Ok(())
 }
 
-/// Solves M X = B in place for B stored row by row in `rows` (row i at `i * width..(i + 1) *
-/// width`, width = rows.len() / nv), with the factor of [`factor_mass_matrix`]. Each elimination
-/// step is one row update over all columns at once, vectorised: with AVX-512 or AVX2 where the
-/// processor has it (checked at run time; the same operations in the same order, so the same
-/// result bit for bit), else with the baseline's SSE2.
-pub fn solve_rows(model: &Model, data: &Data, rows: &mut [f64]) {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx512f") {
-        // SAFETY: the processor has AVX-512F, just checked.
-        return unsafe { solve_rows_avx512(model, data, rows) };
+multiversion! {
+    /// Solves M X = B in place for B stored row by row in `rows` (row i at `i * width..(i + 1)
+    /// * width`, width = rows.len() / nv), with the factor of [`factor_mass_matrix`]. Each
+    /// elimination step is one row update over all columns at once, vectorised: with AVX-512 or
+    /// AVX2 where the processor has it ([`crate::dispatch`]), else with the baseline's SSE2.
+    pub fn solve_rows(model: &Model, data: &Data, rows: &mut [f64]) {
+        solve_rows_avx512 for ["avx512f"] => { solve_rows_generic(model, data, rows) }
+        solve_rows_avx2 for ["avx2"] => { solve_rows_generic(model, data, rows) }
+        baseline => { solve_rows_generic(model, data, rows) }
     }
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the processor has AVX2, just checked.
-        return unsafe { solve_rows_avx2(model, data, rows) };
-    }
-    solve_rows_generic(model, data, rows);
-}
-
-/// [`solve_rows_generic`] compiled for AVX2.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn solve_rows_avx2(model: &Model, data: &Data, rows: &mut [f64]) {
-    solve_rows_generic(model, data, rows);
-}
-
-/// [`solve_rows_generic`] compiled for AVX-512.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn solve_rows_avx512(model: &Model, data: &Data, rows: &mut [f64]) {
-    solve_rows_generic(model, data, rows);
 }
 
 #[inline(always)]

@@ -12,6 +12,7 @@
 #![allow(clippy::excessive_precision)]
 
 use super::Real;
+use crate::dispatch::multiversion;
 use nalgebra::SimdBool;
 #[cfg(target_arch = "x86_64")]
 use simba::simd::{AutoF64x4, AutoF64x8};
@@ -87,40 +88,32 @@ pub fn sin_cos<S: Real>(x: S) -> (S, S) {
     (sin, cos)
 }
 
-/// `out[k] = (sin, cos)` of `q[indices[k]]`: four values per evaluation in AVX2 lanes where the
-/// CPU has them (each lane gets the digits of [`sin_cos`] of its value alone), else one by one.
-/// A joint's sine costs as much as the rest of its transform; four at once halve a forward
-/// kinematics' time spent on them.
-#[inline(never)]
-pub fn sin_cos_at(q: &[f64], indices: &[usize], out: &mut [(f64, f64)]) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the processor has AVX-512F, just checked.
-            return unsafe { sin_cos_at_avx512(q, indices, out) };
+multiversion! {
+    /// `out[k] = (sin, cos)` of `q[indices[k]]`: several values per evaluation in vector lanes
+    /// where the CPU has them (each lane gets the digits of [`sin_cos`] of its value alone), else
+    /// one by one. A joint's sine costs as much as the rest of its transform; four at once halve
+    /// a forward kinematics' time spent on them. With AVX-512, eight indices at a time while more
+    /// than four are left, then four in AVX2 lanes (an evaluation in eight lanes costs about two
+    /// in four, so a group of four or fewer takes four); with AVX2, four at a time.
+    #[inline(never)]
+    pub fn sin_cos_at(q: &[f64], indices: &[usize], out: &mut [(f64, f64)]) {
+        sin_cos_at_avx512 for ["avx512f"] => {
+            let mut start = 0;
+            while indices.len() - start > 4 {
+                let end = indices.len().min(start + 8);
+                sin_cos_in_lanes::<AutoF64x8, 8>(q, &indices[start..end], &mut out[start..end]);
+                start = end;
+            }
+            if start < indices.len() {
+                sin_cos_in_lanes::<AutoF64x4, 4>(q, &indices[start..], &mut out[start..]);
+            }
         }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the processor has AVX2, just checked.
-            return unsafe { sin_cos_at_avx2(q, indices, out) };
+        sin_cos_at_avx2 for ["avx2"] => {
+            for (group, turns) in indices.chunks(4).zip(out.chunks_mut(4)) {
+                sin_cos_in_lanes::<AutoF64x4, 4>(q, group, turns);
+            }
         }
-    }
-    sin_cos_one_by_one(q, indices, out);
-}
-
-/// [`sin_cos_at`] in AVX-512 lanes, eight indices at a time while more than four are left,
-/// then four in AVX2 lanes: an evaluation in eight lanes costs about two in four, so a group of
-/// four or fewer takes four.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn sin_cos_at_avx512(q: &[f64], indices: &[usize], out: &mut [(f64, f64)]) {
-    let mut start = 0;
-    while indices.len() - start > 4 {
-        let end = indices.len().min(start + 8);
-        sin_cos_in_lanes::<AutoF64x8, 8>(q, &indices[start..end], &mut out[start..end]);
-        start = end;
-    }
-    if start < indices.len() {
-        sin_cos_in_lanes::<AutoF64x4, 4>(q, &indices[start..], &mut out[start..]);
+        baseline => { sin_cos_one_by_one(q, indices, out) }
     }
 }
 
@@ -129,15 +122,6 @@ unsafe fn sin_cos_at_avx512(q: &[f64], indices: &[usize], out: &mut [(f64, f64)]
 pub(crate) fn sin_cos_one_by_one<S: Real>(q: &[S], indices: &[usize], out: &mut [(S, S)]) {
     for (turn, &index) in out.iter_mut().zip(indices) {
         *turn = sin_cos(q[index]);
-    }
-}
-
-/// [`sin_cos_at`] in AVX2 lanes, four indices at a time.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn sin_cos_at_avx2(q: &[f64], indices: &[usize], out: &mut [(f64, f64)]) {
-    for (group, turns) in indices.chunks(4).zip(out.chunks_mut(4)) {
-        sin_cos_in_lanes::<AutoF64x4, 4>(q, group, turns);
     }
 }
 

@@ -267,7 +267,7 @@ pub(super) fn groups<S: LaneRows>(
                     qdd: inputs.qdd,
                     rows: inputs.rows,
                 };
-                let state = (inputs.q, inputs.v, inputs.tau);
+                let state = (inputs.q, inputs.v, inputs.tau, None);
                 aba_derivative_passes(model, &mut buffers, solve, state).map_err(|()| first)?;
                 // row i = [∂q̈_i/∂q, ∂q̈_i/∂q̇, (M⁻¹)_i]: each third to row i of its block
                 for (i, row) in lanes.rows.chunks_exact(3 * nv).enumerate() {

@@ -8,6 +8,7 @@
 //! numbers per state; `benchmarks/README.md`) and where the kernel is short (a Talos RNEA
 //! gathers 115 numbers per state).
 
+use crate::dispatch::multiversion;
 use crate::spatial::Real;
 use simba::simd::{AutoF64x4, AutoF64x8};
 
@@ -25,48 +26,66 @@ pub(super) trait LaneRows: Real {
 impl LaneRows for AutoF64x4 {
     #[inline(always)]
     fn scatter(lanes: &[Self], rows: &mut [f64], size: usize, offset: usize) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx") {
-            // SAFETY: the CPU has AVX
-            let tiled = unsafe { x86::scatter_four(lanes, rows, size, offset) };
-            return scatter_by_lane(&lanes[tiled..], rows, size, offset + tiled);
-        }
-        scatter_by_lane(lanes, rows, size, offset)
+        let tiled = scatter_four_tiles(lanes, rows, size, offset);
+        scatter_by_lane(&lanes[tiled..], rows, size, offset + tiled)
     }
 
     #[inline(always)]
     fn gather(rows: &[f64], lanes: &mut [Self]) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx") {
-            // SAFETY: the CPU has AVX
-            let tiled = unsafe { x86::gather_four(rows, lanes) };
-            return gather_by_lane(rows, lanes, tiled);
-        }
-        gather_by_lane(rows, lanes, 0)
+        let tiled = gather_four_tiles(rows, lanes);
+        gather_by_lane(rows, lanes, tiled)
     }
 }
 
 impl LaneRows for AutoF64x8 {
     #[inline(always)]
     fn scatter(lanes: &[Self], rows: &mut [f64], size: usize, offset: usize) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU has AVX-512F
-            let tiled = unsafe { x86::scatter_eight(lanes, rows, size, offset) };
-            return scatter_by_lane(&lanes[tiled..], rows, size, offset + tiled);
-        }
-        scatter_by_lane(lanes, rows, size, offset)
+        let tiled = scatter_eight_tiles(lanes, rows, size, offset);
+        scatter_by_lane(&lanes[tiled..], rows, size, offset + tiled)
     }
 
     #[inline(always)]
     fn gather(rows: &[f64], lanes: &mut [Self]) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU has AVX-512F
-            let tiled = unsafe { x86::gather_eight(rows, lanes) };
-            return gather_by_lane(rows, lanes, tiled);
-        }
-        gather_by_lane(rows, lanes, 0)
+        let tiled = gather_eight_tiles(rows, lanes);
+        gather_by_lane(rows, lanes, tiled)
+    }
+}
+
+multiversion! {
+    /// The whole 4 × 4 tiles of [`LaneRows::scatter`], transposed in registers where the CPU has
+    /// AVX ([`crate::dispatch`]); returns how many columns they cover (none without).
+    #[inline(always)]
+    fn scatter_four_tiles(lanes: &[AutoF64x4], rows: &mut [f64], size: usize, offset: usize) -> usize {
+        scatter_four_avx for ["avx"] => { x86::scatter_four(lanes, rows, size, offset) }
+        baseline => { 0 }
+    }
+}
+
+multiversion! {
+    /// The whole 4 × 4 tiles of [`LaneRows::gather`], as [`scatter_four_tiles`].
+    #[inline(always)]
+    fn gather_four_tiles(rows: &[f64], lanes: &mut [AutoF64x4]) -> usize {
+        gather_four_avx for ["avx"] => { x86::gather_four(rows, lanes) }
+        baseline => { 0 }
+    }
+}
+
+multiversion! {
+    /// The whole 8 × 8 tiles of [`LaneRows::scatter`], transposed in registers where the CPU has
+    /// AVX-512F; returns how many columns they cover (none without).
+    #[inline(always)]
+    fn scatter_eight_tiles(lanes: &[AutoF64x8], rows: &mut [f64], size: usize, offset: usize) -> usize {
+        scatter_eight_avx512 for ["avx512f"] => { x86::scatter_eight(lanes, rows, size, offset) }
+        baseline => { 0 }
+    }
+}
+
+multiversion! {
+    /// The whole 8 × 8 tiles of [`LaneRows::gather`], as [`scatter_eight_tiles`].
+    #[inline(always)]
+    fn gather_eight_tiles(rows: &[f64], lanes: &mut [AutoF64x8]) -> usize {
+        gather_eight_avx512 for ["avx512f"] => { x86::gather_eight(rows, lanes) }
+        baseline => { 0 }
     }
 }
 
@@ -233,8 +252,9 @@ mod x86 {
         tiled
     }
 
-    /// [`scatter_tiles`] of 4 × 4. Safety: only on a CPU with AVX.
-    #[target_feature(enable = "avx")]
+    /// [`scatter_tiles`] of 4 × 4. Safety: only on a CPU with AVX, inlined into a function
+    /// built for it.
+    #[inline(always)]
     pub(super) unsafe fn scatter_four(
         lanes: &[AutoF64x4],
         rows: &mut [f64],
@@ -244,14 +264,15 @@ mod x86 {
         scatter_tiles::<__m256d, 4>(lanes, rows, size, offset)
     }
 
-    /// [`gather_tiles`] of 4 × 4. Safety: only on a CPU with AVX.
-    #[target_feature(enable = "avx")]
+    /// [`gather_tiles`] of 4 × 4. Safety: as [`scatter_four`].
+    #[inline(always)]
     pub(super) unsafe fn gather_four(rows: &[f64], lanes: &mut [AutoF64x4]) -> usize {
         gather_tiles::<__m256d, 4>(rows, lanes)
     }
 
-    /// [`scatter_tiles`] of 8 × 8. Safety: only on a CPU with AVX-512F.
-    #[target_feature(enable = "avx512f")]
+    /// [`scatter_tiles`] of 8 × 8. Safety: only on a CPU with AVX-512F, inlined into a function
+    /// built for it.
+    #[inline(always)]
     pub(super) unsafe fn scatter_eight(
         lanes: &[AutoF64x8],
         rows: &mut [f64],
@@ -261,8 +282,8 @@ mod x86 {
         scatter_tiles::<__m512d, 8>(lanes, rows, size, offset)
     }
 
-    /// [`gather_tiles`] of 8 × 8. Safety: only on a CPU with AVX-512F.
-    #[target_feature(enable = "avx512f")]
+    /// [`gather_tiles`] of 8 × 8. Safety: as [`scatter_eight`].
+    #[inline(always)]
     pub(super) unsafe fn gather_eight(rows: &[f64], lanes: &mut [AutoF64x8]) -> usize {
         gather_tiles::<__m512d, 8>(rows, lanes)
     }
