@@ -6,7 +6,7 @@ use crate::model::*;
 use nalgebra::DVector;
 use pyo3::prelude::*;
 use pyo3::types::PyString;
-use robodyn::algo;
+use robodyn::algo::{self, BatchAlgorithm};
 use robodyn::spatial::Force;
 use robodyn::{Data, Model};
 
@@ -50,7 +50,7 @@ impl PyModel {
         arguments: &[Argument<'py>],
         out: Option<&Bound<'py, PyAny>>,
         algorithm: DynamicsAlgorithm,
-        lanes: Option<LaneKernel>,
+        lanes: Option<BatchAlgorithm>,
     ) -> PyResult<Bound<'py, PyAny>> {
         self.evaluate_into(
             py,
@@ -75,13 +75,14 @@ impl PyModel {
         arguments: &[Argument<'py>],
         names: [&Bound<'py, PyString>; 3],
         derivatives: DerivativesAlgorithm,
-        lanes: Option<LaneKernel>,
+        lanes: Option<BatchAlgorithm>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let nv = self.model.nv;
         let kernel: &Kernel = &|m, w, i, out| {
             let Workspace { data, forces, .. } = w;
             let forces = i.get(3).map(|flat| external_forces(forces, flat));
-            derivatives(m, data, (i[0], i[1], i[2], forces), out)
+            let into = algo::DerivativesInto::Stacked(out);
+            derivatives(m, data, i[0], i[1], i[2], forces, into)
         };
         let lanes = lanes.filter(|_| arguments.len() < 4);
         let stack = self.evaluate_to(py, arguments, &[3, nv, nv], Target::Zeros, kernel, lanes)?;
@@ -89,10 +90,16 @@ impl PyModel {
     }
 }
 
-/// A derivatives algorithm `(q, v, x, f_ext)` writing its three nv × nv results row-major, one
-/// after the other.
-type DerivativesAlgorithm =
-    fn(&Model, &mut Data, algo::DynamicsState, &mut [f64]) -> robodyn::Result<()>;
+/// A derivatives algorithm `(q, v, x, f_ext)` writing its three nv × nv results where it is told.
+type DerivativesAlgorithm = fn(
+    &Model,
+    &mut Data,
+    &[f64],
+    &[f64],
+    &[f64],
+    Option<&[Force]>,
+    algo::DerivativesInto,
+) -> robodyn::Result<()>;
 
 /// `forces` filled from the flat (nbodies − 1) × 6 rows of an `f_ext` argument.
 fn external_forces<'w>(forces: &'w mut [Force], flat: &[f64]) -> &'w [Force] {
@@ -128,7 +135,7 @@ impl PyModel {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         self.with_dynamics_arguments((q, v, ("a", a)), f_ext, |arguments| {
-            let lanes = Some(LaneKernel::NewtonEuler);
+            let lanes = Some(BatchAlgorithm::NewtonEuler);
             self.with_external_forces(py, arguments, out, algo::rnea, lanes)
         })
     }
@@ -166,7 +173,7 @@ impl PyModel {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         self.with_dynamics_arguments((q, v, ("tau", tau)), f_ext, |arguments| {
-            let lanes = Some(LaneKernel::ArticulatedBody);
+            let lanes = Some(BatchAlgorithm::ArticulatedBody);
             self.with_external_forces(py, arguments, out, algo::aba, lanes)
         })
     }
@@ -187,8 +194,8 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let names = keys!(py, "dtau_dq", "dtau_dv", "dtau_da");
         self.with_dynamics_arguments((q, v, ("a", a)), f_ext, |arguments| {
-            let lanes = Some(LaneKernel::RneaDerivatives);
-            self.dynamics_derivatives(py, arguments, names, algo::rnea_derivatives_stacked, lanes)
+            let lanes = Some(BatchAlgorithm::RneaDerivatives);
+            self.dynamics_derivatives(py, arguments, names, algo::rnea_derivatives, lanes)
         })
     }
 
@@ -206,8 +213,8 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let names = keys!(py, "dqdd_dq", "dqdd_dv", "dqdd_dtau");
         self.with_dynamics_arguments((q, v, ("tau", tau)), f_ext, |arguments| {
-            let lanes = Some(LaneKernel::AbaDerivatives);
-            self.dynamics_derivatives(py, arguments, names, algo::aba_derivatives_stacked, lanes)
+            let lanes = Some(BatchAlgorithm::AbaDerivatives);
+            self.dynamics_derivatives(py, arguments, names, algo::aba_derivatives, lanes)
         })
     }
 
@@ -229,7 +236,7 @@ impl PyModel {
                 // straight into the result: CRBA mirrors M, so it is exactly symmetric
                 let (shape, arguments) = ([self.model.nv; 2], [self.q_arg("q", q)?]);
                 let kernel: &Kernel = &|m, w, i, out| algo::crba_into(m, &mut w.data, i[0], out);
-                let lanes = Some(LaneKernel::CompositeRigidBody);
+                let lanes = Some(BatchAlgorithm::CompositeRigidBody);
                 return self.evaluate_into(py, &arguments, &shape, out, kernel, lanes);
             }
             MethodName::Rnea => algo::mass_matrix_by_rnea,
@@ -266,7 +273,7 @@ impl PyModel {
                 out.copy_from_slice(algo::bias_forces(m, &mut w.data, i[0], i[1])?.as_slice());
                 Ok(())
             },
-            Some(LaneKernel::NewtonEuler),
+            Some(BatchAlgorithm::NewtonEuler),
         )
     }
 
@@ -307,8 +314,8 @@ impl PyModel {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         type Method = for<'d> fn(&Model, &'d mut Data, &[f64]) -> robodyn::Result<&'d DVector<f64>>;
-        let (algorithm, lanes): (Method, Option<LaneKernel>) = match method {
-            MethodName::Rnea => (algo::generalized_gravity, Some(LaneKernel::NewtonEuler)),
+        let (algorithm, lanes): (Method, Option<BatchAlgorithm>) = match method {
+            MethodName::Rnea => (algo::generalized_gravity, Some(BatchAlgorithm::NewtonEuler)),
             MethodName::Jacobians => (algo::generalized_gravity_by_jacobians, None),
             other => return Err(unknown_method(other.as_str(), "rnea or jacobians")),
         };

@@ -7,7 +7,7 @@ use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rand::{rngs::StdRng, SeedableRng};
-use robodyn::algo;
+use robodyn::algo::{self, BatchAlgorithm};
 use robodyn::Error;
 
 impl PyModel {
@@ -46,7 +46,7 @@ impl PyModel {
             algo::frame_pose(m, &mut w.data, i[0], frame)?.write_homogeneous(out);
             Ok(())
         };
-        let lanes = Some(LaneKernel::FramePose(frame));
+        let lanes = Some(BatchAlgorithm::FramePose { frame });
         self.evaluate_into(py, &[self.q_arg("q", q)?], &[4, 4], out, kernel, lanes)
     }
 
@@ -100,7 +100,7 @@ impl PyModel {
                 algo::jacobian_columns(m, &mut w.data, i[0], frame, reference, column)?;
                 Ok(())
             },
-            Some(LaneKernel::Jacobian(frame, reference)),
+            Some(BatchAlgorithm::Jacobian { frame, reference }),
         )
     }
 

@@ -68,6 +68,7 @@ fn algorithms_allocate_nothing_after_data_new() {
             &mut vec![0.0; model.nv.pow(2)],
             &mut vec![0.0; model.nv.pow(2)],
         );
+        let stacked = &mut vec![0.0; 3 * model.nv.pow(2)];
         let mut jacobians = (
             nalgebra::DMatrix::zeros(model.nv, model.nv),
             nalgebra::DMatrix::zeros(model.nv, model.nv),
@@ -136,7 +137,8 @@ fn algorithms_allocate_nothing_after_data_new() {
             (
                 "rnea_derivatives",
                 allocations(|| {
-                    rnea_derivatives(&model, &mut data, q, v, a, None).unwrap();
+                    rnea_derivatives(&model, &mut data, q, v, a, None, DerivativesInto::Data)
+                        .unwrap();
                 }),
             ),
             (
@@ -146,22 +148,24 @@ fn algorithms_allocate_nothing_after_data_new() {
                 }),
             ),
             (
-                "rnea_derivatives_row_major",
+                "rnea_derivatives into row-major buffers",
                 allocations(|| {
-                    rnea_derivatives_row_major(&model, &mut data, (q, v, a, None), by_q, by_v)
-                        .unwrap();
+                    let into = DerivativesInto::RowMajor { by_q, by_v };
+                    rnea_derivatives(&model, &mut data, q, v, a, None, into).unwrap();
                 }),
             ),
             (
-                "aba_derivative_rows",
+                "aba_derivatives stacked",
                 allocations(|| {
-                    aba_derivative_rows(&model, &mut data, (q, v, a, None)).unwrap();
+                    let into = DerivativesInto::Stacked(stacked);
+                    aba_derivatives(&model, &mut data, q, v, a, None, into).unwrap();
                 }),
             ),
             (
                 "aba_derivatives",
                 allocations(|| {
-                    aba_derivatives(&model, &mut data, q, v, a, None).unwrap();
+                    aba_derivatives(&model, &mut data, q, v, a, None, DerivativesInto::Data)
+                        .unwrap();
                 }),
             ),
             (

@@ -5,11 +5,10 @@ mod common;
 
 use common::*;
 use nalgebra::{DMatrix, DVector};
-use robodyn::algo::aba_derivative_rows;
 use robodyn::algo::{
     aba, aba_derivatives, center_of_mass_jacobian, center_of_mass_velocity_derivatives,
     frame_acceleration, frame_motion_derivatives, frame_velocity, inverse_mass_matrix, rnea,
-    rnea_derivatives, rnea_derivatives_row_major, Reference,
+    rnea_derivatives, DerivativesInto, Reference,
 };
 use robodyn::spatial::{Force, Vec3};
 use robodyn::{Data, Model};
@@ -126,7 +125,7 @@ fn rnea_derivatives_are_finite_differences() {
     check_against_differences(
         ["tau", "dtau/dq", "dtau/dv", "dtau/da"],
         |model, data, q, v, a, f_ext| {
-            rnea_derivatives(model, data, q, v, a, f_ext).unwrap();
+            rnea_derivatives(model, data, q, v, a, f_ext, DerivativesInto::Data).unwrap();
             Linearised {
                 value: data.tau.clone(),
                 derivatives: [
@@ -140,48 +139,62 @@ fn rnea_derivatives_are_finite_differences() {
     );
 }
 
-/// The row-major variants (what Python takes) against the matrices: the same operations into
-/// another layout, so equal bit for bit.
+/// Every destination of the derivatives against `Data`'s matrices: the same operations into
+/// another layout, so equal bit for bit; a buffer of the wrong length is refused, naming it.
 #[test]
-fn row_major_derivatives_equal_the_matrices() {
+fn every_destination_holds_the_matrices() {
     let mut rng = rng();
     for (name, model) in models() {
         let (mut data, nv) = (Data::new(&model), model.nv);
         let (q, v, x) = state(&model, &mut rng);
         let forces = random_forces(&model, &mut rng);
-        let arguments = (q.as_slice(), v.as_slice(), x.as_slice(), Some(&forces[..]));
-        let (q, v, x, f_ext) = arguments;
-
-        let (mut by_q, mut by_v) = (vec![f64::NAN; nv * nv], vec![f64::NAN; nv * nv]);
-        rnea_derivatives_row_major(&model, &mut data, arguments, &mut by_q, &mut by_v).unwrap();
-        let (tau, mass_matrix) = (data.tau.clone(), data.mass_matrix.clone());
-        rnea_derivatives(&model, &mut data, q, v, x, f_ext).unwrap();
-        assert_eq!(by_q, data.dtau_dq.transpose().as_slice(), "{name}: dtau/dq");
-        assert_eq!(by_v, data.dtau_dv.transpose().as_slice(), "{name}: dtau/dv");
-        assert_eq!(tau, data.tau, "{name}: tau");
-        assert_eq!(mass_matrix, data.mass_matrix, "{name}: M");
-        let error = rnea_derivatives_row_major(&model, &mut data, arguments, &mut by_q, &mut [])
-            .unwrap_err()
-            .to_string();
-        assert!(
-            error.contains("dtau_dv") && error.contains("length 0"),
-            "{error}"
-        );
-
-        aba_derivative_rows(&model, &mut data, arguments).unwrap();
-        let rows = data.derivative_rows.clone();
-        aba_derivatives(&model, &mut data, q, v, x, f_ext).unwrap();
-        assert_eq!(rows, data.derivative_rows, "{name}");
-        for (i, row) in rows.chunks_exact(3 * nv).enumerate() {
-            for j in 0..nv {
-                assert_eq!(row[j], data.dqdd_dq[(i, j)], "{name}: dqdd/dq");
-                assert_eq!(row[nv + j], data.dqdd_dv[(i, j)], "{name}: dqdd/dv");
-                assert_eq!(
-                    row[2 * nv + j],
-                    data.mass_matrix_inverse[(i, j)],
-                    "{name}: M^-1"
-                );
+        let (q, v, x, f_ext) = (q.as_slice(), v.as_slice(), x.as_slice(), Some(&forces[..]));
+        let row_major = |m: &DMatrix<f64>| m.transpose().as_slice().to_vec();
+        type Run<'r> = &'r dyn Fn(&mut Data, DerivativesInto) -> robodyn::Result<()>;
+        let rnea: Run = &|data, into| rnea_derivatives(&model, data, q, v, x, f_ext, into);
+        let aba: Run = &|data, into| aba_derivatives(&model, data, q, v, x, f_ext, into);
+        for (algorithm, run, names) in [
+            ("rnea", rnea, ["dtau_dq", "dtau_dv"]),
+            ("aba", aba, ["dqdd_dq", "dqdd_dv"]),
+        ] {
+            run(&mut data, DerivativesInto::Data).unwrap();
+            let matrices = match algorithm {
+                "rnea" => [&data.dtau_dq, &data.dtau_dv, &data.mass_matrix],
+                _ => [&data.dqdd_dq, &data.dqdd_dv, &data.mass_matrix_inverse],
             }
+            .map(row_major);
+            let (tau, qdd) = (data.tau.clone(), data.qdd.clone());
+
+            let (mut by_q, mut by_v) = (vec![f64::NAN; nv * nv], vec![f64::NAN; nv * nv]);
+            let into = DerivativesInto::RowMajor {
+                by_q: &mut by_q,
+                by_v: &mut by_v,
+            };
+            run(&mut data, into).unwrap();
+            assert_eq!(by_q, matrices[0], "{name} {algorithm}: by q");
+            assert_eq!(by_v, matrices[1], "{name} {algorithm}: by v");
+
+            let mut stacked = vec![f64::NAN; 3 * nv * nv];
+            run(&mut data, DerivativesInto::Stacked(&mut stacked)).unwrap();
+            assert_eq!(stacked, matrices.concat(), "{name} {algorithm}: stacked");
+            assert_eq!((&tau, &qdd), (&data.tau, &data.qdd), "{name} {algorithm}");
+
+            let into = DerivativesInto::RowMajor {
+                by_q: &mut by_q,
+                by_v: &mut [],
+            };
+            let error = run(&mut data, into).unwrap_err().to_string();
+            assert!(
+                error.contains(names[1]) && error.contains("length 0"),
+                "{error}"
+            );
+            let error = run(&mut data, DerivativesInto::Stacked(&mut [0.0]))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                error.contains("out") && error.contains("length 1"),
+                "{error}"
+            );
         }
     }
 }
@@ -191,7 +204,7 @@ fn aba_derivatives_are_finite_differences() {
     check_against_differences(
         ["qdd", "dqdd/dq", "dqdd/dv", "dqdd/dtau"],
         |model, data, q, v, tau, f_ext| {
-            aba_derivatives(model, data, q, v, tau, f_ext).unwrap();
+            aba_derivatives(model, data, q, v, tau, f_ext, DerivativesInto::Data).unwrap();
             let linearised = Linearised {
                 value: data.qdd.clone(),
                 derivatives: [

@@ -6,9 +6,9 @@ mod common;
 
 use common::*;
 use robodyn::algo::{
-    aba, aba_batch, aba_derivatives_batch, aba_derivatives_stacked, bias_forces, crba, crba_batch,
-    generalized_gravity, newton_euler_batch, rnea, rnea_derivatives_batch,
-    rnea_derivatives_stacked, BatchWorkspace, LaneWidth, States,
+    aba, aba_batch, aba_derivatives, aba_derivatives_batch, bias_forces, crba, crba_batch,
+    generalized_gravity, newton_euler_batch, rnea, rnea_derivatives, rnea_derivatives_batch,
+    BatchWorkspace, DerivativesInto, DynamicsState, LaneWidth, States,
 };
 use robodyn::{Data, Error, Model};
 
@@ -259,7 +259,27 @@ fn mass_matrices_in_lanes_equal_crba_bit_for_bit() {
 
 /// A derivatives batch function, and the one-state function whose results it must equal.
 type BatchOf = fn(&Model, &mut BatchWorkspace, States, &mut [f64]) -> robodyn::algo::BatchResult;
-type OneOf = fn(&Model, &mut Data, robodyn::algo::DynamicsState, &mut [f64]) -> robodyn::Result<()>;
+type OneOf = fn(&Model, &mut Data, DynamicsState, &mut [f64]) -> robodyn::Result<()>;
+
+/// One state's RNEA derivatives, stacked as a batch stores them.
+fn rnea_derivatives_stacked(
+    model: &Model,
+    data: &mut Data,
+    (q, v, a, f_ext): DynamicsState,
+    out: &mut [f64],
+) -> robodyn::Result<()> {
+    rnea_derivatives(model, data, q, v, a, f_ext, DerivativesInto::Stacked(out))
+}
+
+/// One state's ABA derivatives, stacked as a batch stores them.
+fn aba_derivatives_stacked(
+    model: &Model,
+    data: &mut Data,
+    (q, v, tau, f_ext): DynamicsState,
+    out: &mut [f64],
+) -> robodyn::Result<()> {
+    aba_derivatives(model, data, q, v, tau, f_ext, DerivativesInto::Stacked(out))
+}
 
 /// `batch` at every width on every test model against `one` state by state, the third input
 /// given as a (RNEA) or τ (ABA).

@@ -1,7 +1,6 @@
 //! The one evaluation path every numeric method takes: the arguments' common batch, their values
 //! in place or copied, then one sample in the caller's thread or a batch on all cores.
 
-use super::lanes::LaneKernel;
 use super::output::{output_array, Target};
 use super::pages::advise_huge_pages;
 use super::schedule::{run_kernel, BatchInputs, Kernel, MAX_ARGUMENTS};
@@ -13,6 +12,7 @@ use crate::to_py_err;
 use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use robodyn::algo::BatchAlgorithm;
 
 impl PyModel {
     /// Runs `kernel` on one sample or a batch of the `arguments`, producing `output_shape` per
@@ -39,7 +39,7 @@ impl PyModel {
         output_shape: &[usize],
         out: Option<&Bound<'py, PyAny>>,
         kernel: &Kernel,
-        lanes: Option<LaneKernel>,
+        lanes: Option<BatchAlgorithm>,
     ) -> PyResult<Bound<'py, PyAny>> {
         self.evaluate_to(py, arguments, output_shape, Target::Out(out), kernel, lanes)
     }
@@ -52,7 +52,7 @@ impl PyModel {
         output_shape: &[usize],
         target: Target<'_, 'py>,
         kernel: &Kernel,
-        lanes: Option<LaneKernel>,
+        lanes: Option<BatchAlgorithm>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (out, zeroed) = match target {
             Target::Zeros => (None, true),

@@ -3,18 +3,16 @@
 //! released).
 //!
 //! Its parts: `workspace` (a kernel's workspace and the batch's pool of them), `evaluate` (the
-//! evaluation path), `schedule` (how a batch is spread over the cores and checked), `lanes` (the
-//! batch kernels in lanes), `pages` (huge-page advice), `output` (`out=` checks and result
+//! evaluation path), `schedule` (how a batch is spread over the cores and checked, by one sample at a time or by
+//! the core's batch algorithms in lanes), `pages` (huge-page advice), `output` (`out=` checks and result
 //! layouts); the error mapping is the crate's `errors`.
 
 mod evaluate;
-mod lanes;
 mod output;
 mod pages;
 mod schedule;
 mod workspace;
 
-pub(crate) use lanes::LaneKernel;
 pub(crate) use output::*;
 pub(crate) use schedule::Kernel;
 pub(crate) use workspace::{fill_forces, Workspace, WorkspacePool};

@@ -2,12 +2,12 @@
 //! workspace from the pool, by one sample at a time or by lanes in pieces that fit in cache, and
 //! every result checked for overflow.
 
-use super::lanes::LaneKernel;
 use super::workspace::Workspace;
 use super::PyModel;
 use crate::errors::batch_element_error;
 use pyo3::prelude::*;
 use rayon::prelude::*;
+use robodyn::algo::{self, BatchAlgorithm};
 use robodyn::{Error, Model};
 
 /// One computation on one sample: inputs (flattened, in argument order) to a flattened output.
@@ -72,7 +72,7 @@ impl PyModel {
         batch: &BatchInputs,
         out: &mut [f64],
         kernel: &Kernel,
-        lanes: Option<LaneKernel>,
+        lanes: Option<BatchAlgorithm>,
     ) -> PyResult<()> {
         let (model, pool) = (&self.model, &self.batch_workspaces);
         let output_size = batch.output_size.max(1);
@@ -103,8 +103,9 @@ impl PyModel {
                                 let first = first + p * piece;
                                 let count = outputs.len() / output_size;
                                 let inputs = select(first, count);
-                                lanes
-                                    .run(model, &mut workspace, &inputs[..arguments], outputs)
+                                let states = lanes.states(&inputs[..arguments]);
+                                let width = workspace.lanes(model);
+                                algo::batch(lanes, model, width, states, outputs)
                                     .map_err(|(k, e)| (first + k, e))?;
                                 if let Some(index) = first_overflow(outputs) {
                                     let value = outputs[index];

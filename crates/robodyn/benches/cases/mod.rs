@@ -6,7 +6,7 @@
 use rand::{rngs::StdRng, SeedableRng};
 use robodyn::algo::{
     aba, aba_derivatives, centroidal_momentum_matrix, coriolis_matrix, crba, forward_kinematics,
-    frame_pose, generalized_gravity, jacobian, rnea, rnea_derivatives, Reference,
+    frame_pose, generalized_gravity, jacobian, rnea, rnea_derivatives, DerivativesInto, Reference,
 };
 use robodyn::io::{bundled_model, load_urdf_file, LoadOptions};
 use robodyn::{Data, Model};
@@ -108,11 +108,11 @@ impl<'m> Bench<'m> {
             }
             "aba" => aba(model, data, q, v, a, None).map(|t| t[0]),
             "rnea_derivatives" => {
-                rnea_derivatives(model, data, q, v, a, None).map(|()| data.dtau_dq[0])
+                rnea_derivatives(model, data, q, v, a, None, DerivativesInto::Data)
+                    .map(|()| data.dtau_dq[0])
             }
-            "aba_derivatives" => {
-                aba_derivatives(model, data, q, v, a, None).map(|()| data.dqdd_dq[0])
-            }
+            "aba_derivatives" => aba_derivatives(model, data, q, v, a, None, DerivativesInto::Data)
+                .map(|()| data.dqdd_dq[0]),
             other => panic!("unknown algorithm {other}; expected one of {ALGORITHMS:?}"),
         };
         result.expect("benchmark state")

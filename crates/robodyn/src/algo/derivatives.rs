@@ -36,26 +36,28 @@
 use crate::algo::crba::{
     add_composites, mass_matrix_of_composites, world_inertias_of, CompositeBuffers,
 };
-use crate::algo::ltdl::{factor_into, singular_mass_matrix, solve_rows_with};
+use crate::algo::ltdl::{factor_into, singular_mass_matrix, solve_rows_in, solve_rows_with};
 use crate::algo::rnea::check_external_forces;
 use crate::dispatch::multiversion;
-use crate::error::{check_length, check_vector, Result};
+use crate::error::{check_vector, Result};
 use crate::model::Model;
 use crate::spatial::{
     splat_vector, zero_vector, CoriolisFactor, Force, Inertia, Motion, Real, Transform,
 };
 use crate::Data;
 use destinations::{Matrices, NegatedRows};
+use std::mem::take;
 
 mod destinations;
 
+pub use destinations::DerivativesInto;
 pub(crate) use destinations::{RowMajor, TorqueDerivatives};
 
-/// ∂τ/∂q, ∂τ/∂q̇ and ∂τ/∂q̈ = M of τ = ID(q, q̇, q̈, f_ext), with τ itself: written into
-/// `data.dtau_dq`, `data.dtau_dv`, `data.mass_matrix` and `data.tau`. `f_ext` as in `rnea` (one
-/// force per moving body, in its frame; held fixed in the body as q moves). Also writes
-/// `data.x_up`, `data.x_world`, `data.i_c`, `data.s_world`, `data.v_world`, `data.a_world`,
-/// `data.i_world`, `data.f_velocity`, `data.f_world`, `data.coriolis_factors`,
+/// ∂τ/∂q, ∂τ/∂q̇ and ∂τ/∂q̈ = M of τ = ID(q, q̇, q̈, f_ext), with τ itself: the two
+/// derivatives written where `into` says, M into `data.mass_matrix` and τ into `data.tau`.
+/// `f_ext` as in `rnea` (one force per moving body, in its frame; held fixed in the body as q
+/// moves). Also writes `data.x_up`, `data.x_world`, `data.i_c`, `data.s_world`, `data.v_world`,
+/// `data.a_world`, `data.i_world`, `data.f_velocity`, `data.f_world`, `data.coriolis_factors`,
 /// `data.motion_terms`.
 pub fn rnea_derivatives(
     model: &Model,
@@ -64,78 +66,46 @@ pub fn rnea_derivatives(
     v: &[f64],
     a: &[f64],
     f_ext: Option<&[Force]>,
+    into: DerivativesInto,
 ) -> Result<()> {
-    let mut matrices = Matrices(
-        std::mem::take(&mut data.dtau_dq),
-        std::mem::take(&mut data.dtau_dv),
-    );
-    matrices.0.as_mut_slice().fill(0.0);
-    matrices.1.as_mut_slice().fill(0.0);
-    let result = rnea_derivative_passes(model, data, (q, v, a, f_ext), &mut matrices);
-    (data.dtau_dq, data.dtau_dv) = (matrices.0, matrices.1);
-    result
+    into.check(model, ["dtau_dq", "dtau_dv"])?;
+    check_arguments(model, q, v, ("a", a), f_ext)?;
+    let (state, nv) = ((q, v, a, f_ext), model.nv);
+    match into {
+        DerivativesInto::Data => {
+            let (by_q, by_v) = (take(&mut data.dtau_dq), take(&mut data.dtau_dv));
+            let mut matrices = Matrices(by_q, by_v);
+            matrices.0.fill(0.0);
+            matrices.1.fill(0.0);
+            one_state_derivatives(
+                model,
+                &mut DerivativeBuffers::of(data),
+                state,
+                &mut matrices,
+            );
+            (data.dtau_dq, data.dtau_dv) = (matrices.0, matrices.1);
+        }
+        DerivativesInto::RowMajor { by_q, by_v } => {
+            by_q.fill(0.0);
+            by_v.fill(0.0);
+            let mut rows = RowMajor { by_q, by_v, nv };
+            one_state_derivatives(model, &mut DerivativeBuffers::of(data), state, &mut rows);
+        }
+        DerivativesInto::Stacked(out) => {
+            out.fill(0.0);
+            let (by_q, rest) = out.split_at_mut(nv * nv);
+            let (by_v, by_a) = rest.split_at_mut(nv * nv);
+            let mut rows = RowMajor { by_q, by_v, nv };
+            one_state_derivatives(model, &mut DerivativeBuffers::of(data), state, &mut rows);
+            // M is mirrored: its column-major storage is its row-major one
+            by_a.copy_from_slice(data.mass_matrix.as_slice());
+        }
+    }
+    Ok(())
 }
 
 /// (q, q̇, q̈ or τ, f_ext): the state and inputs of a dynamics algorithm (in `f64`, or lanes).
 pub type DynamicsState<'a, S = f64> = (&'a [S], &'a [S], &'a [S], Option<&'a [Force<S>]>);
-
-/// [`rnea_derivatives`] with ∂τ/∂q and ∂τ/∂q̇ written row-major (nv × nv each) into `dtau_dq` and
-/// `dtau_dv` instead of `data.dtau_dq` and `data.dtau_dv`: for a caller that hands the results on
-/// row by row (NumPy), without a transpose.
-pub fn rnea_derivatives_row_major(
-    model: &Model,
-    data: &mut Data,
-    (q, v, a, f_ext): DynamicsState,
-    dtau_dq: &mut [f64],
-    dtau_dv: &mut [f64],
-) -> Result<()> {
-    let nv = model.nv;
-    check_length("dtau_dq", dtau_dq.len(), nv * nv)?;
-    check_length("dtau_dv", dtau_dv.len(), nv * nv)?;
-    dtau_dq.fill(0.0);
-    dtau_dv.fill(0.0);
-    let mut rows = RowMajor {
-        by_q: dtau_dq,
-        by_v: dtau_dv,
-        nv,
-    };
-    rnea_derivative_passes(model, data, (q, v, a, f_ext), &mut rows)
-}
-
-/// The passes of [`rnea_derivatives`], the two derivatives added into `out` (zeroed).
-fn rnea_derivative_passes(
-    model: &Model,
-    data: &mut Data,
-    (q, v, a, f_ext): DynamicsState,
-    out: &mut impl TorqueDerivatives<f64>,
-) -> Result<()> {
-    check_arguments(model, q, v, ("a", a), f_ext)?;
-    one_state_derivatives(
-        model,
-        &mut DerivativeBuffers::of(data),
-        (q, v, a, f_ext),
-        out,
-    );
-    Ok(())
-}
-
-/// [`rnea_derivatives`] of one state into `out`: ∂τ/∂q, ∂τ/∂q̇ and M, each nv × nv row-major,
-/// one after the other.
-pub fn rnea_derivatives_stacked(
-    model: &Model,
-    data: &mut Data,
-    state: DynamicsState,
-    out: &mut [f64],
-) -> Result<()> {
-    let nv = model.nv;
-    check_length("out", out.len(), 3 * nv * nv)?;
-    let (by_q, rest) = out.split_at_mut(nv * nv);
-    let (by_v, by_a) = rest.split_at_mut(nv * nv);
-    rnea_derivatives_row_major(model, data, state, by_q, by_v)?;
-    // M is mirrored: its column-major storage is its row-major one
-    by_a.copy_from_slice(data.mass_matrix.as_slice());
-    Ok(())
-}
 
 /// The derivative passes on checked inputs, in `f64` or lanes: τ, M and ∂τ/∂q, ∂τ/∂q̇ into `out`.
 #[inline(always)]
@@ -201,10 +171,11 @@ impl<'b> DerivativeBuffers<'b, f64> {
     }
 }
 
-/// ∂q̈/∂q, ∂q̈/∂q̇ and ∂q̈/∂τ = M⁻¹ of q̈ = FD(q, q̇, τ, f_ext), with q̈ itself: written into
-/// `data.dqdd_dq`, `data.dqdd_dv`, `data.mass_matrix_inverse` and `data.qdd`, and row by row
-/// into `data.derivative_rows` (see [`aba_derivative_rows`]). Also writes what
-/// `rnea_derivatives` writes (at q̈) except `data.dtau_dq` and `data.dtau_dv`, and
+/// ∂q̈/∂q, ∂q̈/∂q̇ and ∂q̈/∂τ = M⁻¹ of q̈ = FD(q, q̇, τ, f_ext), with q̈ itself: the derivatives
+/// written where `into` says ([`DerivativesInto::Data`]: `data.dqdd_dq`, `data.dqdd_dv`,
+/// `data.mass_matrix_inverse`), q̈ into `data.qdd`, and in every case row by row into
+/// `data.derivative_rows` (row i is [∂q̈_i/∂q, ∂q̈_i/∂q̇, (M⁻¹)_i], nv rows of 3 nv). Also writes
+/// what `rnea_derivatives` writes (at q̈) except its two derivatives, and
 /// `data.mass_matrix_factor`.
 pub fn aba_derivatives(
     model: &Model,
@@ -213,56 +184,15 @@ pub fn aba_derivatives(
     v: &[f64],
     tau: &[f64],
     f_ext: Option<&[Force]>,
+    into: DerivativesInto,
 ) -> Result<()> {
-    aba_derivative_rows(model, data, (q, v, tau, f_ext))?;
-    // into the matrices, column by column as they are stored
-    let (rows, nv) = (&data.derivative_rows, model.nv);
-    let width = 3 * nv;
-    for j in 0..nv {
-        let (mut by_q, mut by_v) = (data.dqdd_dq.column_mut(j), data.dqdd_dv.column_mut(j));
-        for i in 0..nv {
-            by_q[i] = rows[i * width + j];
-            by_v[i] = rows[i * width + nv + j];
-        }
-        let mut inverse = data.mass_matrix_inverse.column_mut(j);
-        for i in 0..nv {
-            inverse[i] = rows[i * width + 2 * nv + j];
-        }
-    }
-    Ok(())
-}
-
-/// [`aba_derivatives`] with the results only in `data.derivative_rows`: row i is
-/// [∂q̈_i/∂q, ∂q̈_i/∂q̇, (M⁻¹)_i] (nv rows of 3 nv), for a caller that hands them on row by row
-/// (NumPy), without filling the three matrices.
-pub fn aba_derivative_rows(
-    model: &Model,
-    data: &mut Data,
-    (q, v, tau, f_ext): DynamicsState,
-) -> Result<()> {
+    into.check(model, ["dqdd_dq", "dqdd_dv"])?;
     check_arguments(model, q, v, ("tau", tau), f_ext)?;
-    let (mut b, solve) = DerivativeBuffers::with_solve(data);
-    one_state_aba_derivatives(model, &mut b, solve, (q, v, tau, f_ext))
-        .map_err(|()| singular_mass_matrix())
-}
-
-/// [`aba_derivative_rows`] of one state into `out`: ∂q̈/∂q, ∂q̈/∂q̇ and M⁻¹, each nv × nv
-/// row-major, one after the other.
-pub fn aba_derivatives_stacked(
-    model: &Model,
-    data: &mut Data,
-    state: DynamicsState,
-    out: &mut [f64],
-) -> Result<()> {
-    let nv = model.nv;
-    check_length("out", out.len(), 3 * nv * nv)?;
-    aba_derivative_rows(model, data, state)?;
-    // row i = [∂q̈_i/∂q, ∂q̈_i/∂q̇, (M⁻¹)_i]: each third to row i of its block
-    for (i, row) in data.derivative_rows.chunks_exact(3 * nv).enumerate() {
-        for (block, part) in row.chunks_exact(nv).enumerate() {
-            out[(block * nv + i) * nv..][..nv].copy_from_slice(part);
-        }
-    }
+    let (mut b, mut solve) = DerivativeBuffers::with_solve(data);
+    one_state_aba_right_sides(model, &mut b, &mut solve, (q, v, tau, f_ext))
+        .map_err(|()| singular_mass_matrix())?;
+    solve_rows_in(model, solve.factor, solve.rows);
+    into.copy_rows(data);
     Ok(())
 }
 
@@ -289,19 +219,20 @@ multiversion! {
 }
 
 multiversion! {
-    /// [`aba_derivative_passes`] of one state, built for AVX2 and FMA as well
-    /// ([`crate::dispatch`]).
+    /// [`aba_derivative_right_sides`] of one state, built for AVX2 and FMA as well
+    /// ([`crate::dispatch`]); the solve of the rows is dispatched on its own, since AVX-512 serves
+    /// its long rows.
     #[inline(never)]
-    fn one_state_aba_derivatives(
+    fn one_state_aba_right_sides(
         model: &Model,
         b: &mut DerivativeBuffers<f64>,
-        solve: SolveBuffers<f64>,
+        solve: &mut SolveBuffers<f64>,
         state: DynamicsState,
     ) -> std::result::Result<(), ()> {
-        one_state_aba_derivatives_avx2 for ["avx2", "fma"] => {
-            aba_derivative_passes(model, b, solve, state)
+        one_state_aba_right_sides_avx2 for ["avx2", "fma"] => {
+            aba_derivative_right_sides(model, b, solve, state)
         }
-        baseline => { aba_derivative_passes(model, b, solve, state) }
+        baseline => { aba_derivative_right_sides(model, b, solve, state) }
     }
 }
 
@@ -312,7 +243,21 @@ multiversion! {
 pub(crate) fn aba_derivative_passes<S: Real>(
     model: &Model,
     b: &mut DerivativeBuffers<S>,
-    solve: SolveBuffers<S>,
+    mut solve: SolveBuffers<S>,
+    state: DynamicsState<S>,
+) -> std::result::Result<(), ()> {
+    aba_derivative_right_sides(model, b, &mut solve, state)?;
+    solve_rows_with(model, solve.factor, solve.rows);
+    Ok(())
+}
+
+/// q̈, M's factors and the right-hand sides [−∂τ/∂q, −∂τ/∂q̇, 1] at q̈ in `solve.rows`, which
+/// M⁻¹ then turns into [∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂τ]; an error where a lane's M is refused.
+#[inline(always)]
+fn aba_derivative_right_sides<S: Real>(
+    model: &Model,
+    b: &mut DerivativeBuffers<S>,
+    solve: &mut SolveBuffers<S>,
     (q, v, tau, f_ext): DynamicsState<S>,
 ) -> std::result::Result<(), ()> {
     velocity_terms(model, b, q, v, f_ext);
@@ -326,7 +271,7 @@ pub(crate) fn aba_derivative_passes<S: Real>(
         *qdd = *applied - *bias;
     }
     solve_rows_with(model, solve.factor, solve.qdd);
-    // [∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂τ] = M⁻¹ [−∂τ/∂q, −∂τ/∂q̇, 1] at q̈, solved row by row
+    // [∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂τ] = M⁻¹ [−∂τ/∂q, −∂τ/∂q̇, 1] at q̈: the right-hand sides
     let nv = model.nv;
     solve.rows.fill(S::splat(0.0));
     let mut negated = NegatedRows {
@@ -337,7 +282,6 @@ pub(crate) fn aba_derivative_passes<S: Real>(
     derivative_products::<_, false>(model, b, v, &mut negated);
     add_rotor_torques(model, b, v, Some(&*solve.qdd));
     add_identity(solve.rows, nv);
-    solve_rows_with(model, solve.factor, solve.rows);
     Ok(())
 }
 
@@ -574,7 +518,11 @@ mod tests {
         let state = (&q[..], &v[..], &a[..], None);
         let mut dispatched = Data::new(&model);
         let (mut by_q, mut by_v) = (vec![0.0; nv * nv], vec![0.0; nv * nv]);
-        rnea_derivatives_row_major(&model, &mut dispatched, state, &mut by_q, &mut by_v).unwrap();
+        let into = DerivativesInto::RowMajor {
+            by_q: &mut by_q,
+            by_v: &mut by_v,
+        };
+        rnea_derivatives(&model, &mut dispatched, &q, &v, &a, None, into).unwrap();
         let mut baseline = vec![vec![0.0; nv * nv]; 2];
         let [baseline_q, baseline_v] = &mut baseline[..] else {
             unreachable!()
@@ -593,7 +541,8 @@ mod tests {
         );
         assert_eq!(vec![by_q, by_v], baseline);
         assert_eq!(dispatched.tau, other.tau);
-        aba_derivative_rows(&model, &mut dispatched, state).unwrap();
+        let into = DerivativesInto::Data;
+        aba_derivatives(&model, &mut dispatched, &q, &v, &a, None, into).unwrap();
         let (mut b, solve) = DerivativeBuffers::with_solve(&mut other);
         aba_derivative_passes(&model, &mut b, solve, state).unwrap();
         assert_eq!(dispatched.derivative_rows, other.derivative_rows);

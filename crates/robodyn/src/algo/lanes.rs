@@ -10,14 +10,20 @@
 //! width is chosen at run time by the CPU found ([`LaneWidth::detect`]); the wide kernels are
 //! compiled once per instruction set (`#[target_feature]`), so one binary serves every x86-64 CPU.
 
+mod algorithms;
 mod groups;
 mod scatter;
 
+pub use algorithms::{
+    aba_batch, aba_derivatives_batch, batch, crba_batch, frame_pose_batch, jacobian_batch,
+    newton_euler_batch, rnea_derivatives_batch, BatchAlgorithm,
+};
+
 use crate::algo::aba::aba;
 use crate::algo::crba::crba_into;
-use crate::algo::derivatives::{aba_derivatives_stacked, rnea_derivatives_stacked};
-use crate::algo::jacobian::{jacobian_columns, Reference};
-use crate::algo::kinematics::{check_frame, frame_pose};
+use crate::algo::derivatives::{aba_derivatives, rnea_derivatives, DerivativesInto};
+use crate::algo::jacobian::jacobian_columns;
+use crate::algo::kinematics::frame_pose;
 use crate::algo::rnea::newton_euler;
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::model::Model;
@@ -140,176 +146,10 @@ pub struct States<'s> {
 /// A batch error: the state it came from and what was wrong with it.
 pub type BatchResult = std::result::Result<(), (usize, Error)>;
 
-/// The algorithms that run in lanes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Algorithm {
-    /// τ = ID(q, v, a) (Newton–Euler; bias forces without a, gravity without v and a).
-    NewtonEuler,
-    /// q̈ = FD(q, v, τ) (the articulated-body algorithm).
-    ArticulatedBody,
-    /// M(q) (the composite-rigid-body algorithm).
-    CompositeRigidBody,
-    /// ∂τ/∂q, ∂τ/∂q̇ and M of τ = ID(q, v, a), stacked.
-    RneaDerivatives,
-    /// ∂q̈/∂q, ∂q̈/∂q̇ and M⁻¹ of q̈ = FD(q, v, τ), stacked.
-    AbaDerivatives,
-    /// The pose of frame `frame` in the world, a 4 × 4 homogeneous matrix (forward kinematics
-    /// along the frame's support).
-    FramePose { frame: usize },
-    /// The Jacobian of frame `frame` (6 × nv, row-major) in `reference`'s coordinates.
-    Jacobian { frame: usize, reference: Reference },
-}
-
-impl Algorithm {
-    /// The values of one state's result.
-    fn output_size(self, model: &Model) -> usize {
-        match self {
-            Algorithm::CompositeRigidBody => model.nv * model.nv,
-            Algorithm::RneaDerivatives | Algorithm::AbaDerivatives => 3 * model.nv * model.nv,
-            Algorithm::FramePose { .. } => 16,
-            Algorithm::Jacobian { .. } => 6 * model.nv,
-            _ => model.nv,
-        }
-    }
-}
-
-/// Newton–Euler over a batch, `tau` (n × nv) = ID(q, v, a) of every state: inverse dynamics,
-/// bias forces (`a = None`) or gravity (`v = a = None`). Every state is checked first (the error
-/// names the first bad one); then the states run in groups of the workspace's width.
-pub fn newton_euler_batch(
-    model: &Model,
-    workspace: &mut BatchWorkspace,
-    states: States,
-    tau: &mut [f64],
-) -> BatchResult {
-    run_batch(Algorithm::NewtonEuler, model, workspace, states, tau)
-}
-
-/// The articulated-body algorithm over a batch, `qdd` (n × nv) = FD(q, v, τ) of every state
-/// (`states.v` and `states.tau` are required), checked and grouped as [`newton_euler_batch`].
-pub fn aba_batch(
-    model: &Model,
-    workspace: &mut BatchWorkspace,
-    states: States,
-    qdd: &mut [f64],
-) -> BatchResult {
-    require(&[("v", states.v), ("tau", states.tau)], "forward dynamics")?;
-    run_batch(Algorithm::ArticulatedBody, model, workspace, states, qdd)
-}
-
-/// CRBA over a batch, `mass_matrix` (n × nv × nv) = M(q) of every state (only `states.q` is
-/// read), checked and grouped as [`newton_euler_batch`].
-pub fn crba_batch(
-    model: &Model,
-    workspace: &mut BatchWorkspace,
-    q: &[f64],
-    mass_matrix: &mut [f64],
-) -> BatchResult {
-    let states = States {
-        q,
-        ..States::default()
-    };
-    run_batch(
-        Algorithm::CompositeRigidBody,
-        model,
-        workspace,
-        states,
-        mass_matrix,
-    )
-}
-
-/// The RNEA derivatives over a batch: per state, ∂τ/∂q, ∂τ/∂q̇ and M (each nv × nv row-major,
-/// stacked: `out` is n × 3 × nv × nv) at (q, v, a) (`states.v` and `states.a` are required),
-/// checked and grouped as [`newton_euler_batch`].
-pub fn rnea_derivatives_batch(
-    model: &Model,
-    workspace: &mut BatchWorkspace,
-    states: States,
-    out: &mut [f64],
-) -> BatchResult {
-    require(
-        &[("v", states.v), ("a", states.a)],
-        "the derivatives of inverse dynamics",
-    )?;
-    run_batch(Algorithm::RneaDerivatives, model, workspace, states, out)
-}
-
-/// The ABA derivatives over a batch: per state, ∂q̈/∂q, ∂q̈/∂q̇ and M⁻¹ (each nv × nv row-major,
-/// stacked: `out` is n × 3 × nv × nv) at (q, v, τ) (`states.v` and `states.tau` are required),
-/// checked and grouped as [`newton_euler_batch`].
-pub fn aba_derivatives_batch(
-    model: &Model,
-    workspace: &mut BatchWorkspace,
-    states: States,
-    out: &mut [f64],
-) -> BatchResult {
-    require(
-        &[("v", states.v), ("tau", states.tau)],
-        "the derivatives of forward dynamics",
-    )?;
-    run_batch(Algorithm::AbaDerivatives, model, workspace, states, out)
-}
-
-/// The pose of frame `frame` for every configuration of `q` (n × nq): `poses` (n × 4 × 4, each
-/// the homogeneous matrix `[R p; 0 1]` row by row), checked and grouped as [`newton_euler_batch`].
-pub fn frame_pose_batch(
-    model: &Model,
-    workspace: &mut BatchWorkspace,
-    q: &[f64],
-    frame: usize,
-    poses: &mut [f64],
-) -> BatchResult {
-    check_frame(model, frame).map_err(|e| (0, e))?;
-    let states = States {
-        q,
-        ..States::default()
-    };
-    run_batch(
-        Algorithm::FramePose { frame },
-        model,
-        workspace,
-        states,
-        poses,
-    )
-}
-
-/// The Jacobian of frame `frame` in `reference`'s coordinates for every configuration of `q`
-/// (n × nq): `jacobians` (n × 6 × nv, each row-major), checked and grouped as
-/// [`newton_euler_batch`].
-pub fn jacobian_batch(
-    model: &Model,
-    workspace: &mut BatchWorkspace,
-    q: &[f64],
-    (frame, reference): (usize, Reference),
-    jacobians: &mut [f64],
-) -> BatchResult {
-    check_frame(model, frame).map_err(|e| (0, e))?;
-    let states = States {
-        q,
-        ..States::default()
-    };
-    let algorithm = Algorithm::Jacobian { frame, reference };
-    run_batch(algorithm, model, workspace, states, jacobians)
-}
-
-/// An error if one of `inputs` is missing.
-fn require(inputs: &[(&str, Option<&[f64]>)], what: &str) -> BatchResult {
-    match inputs.iter().find(|(_, values)| values.is_none()) {
-        Some((name, _)) => Err((
-            0,
-            Error::InvalidValue {
-                argument: (*name).into(),
-                message: format!("{what} needs it"),
-            },
-        )),
-        None => Ok(()),
-    }
-}
-
 /// Checks the states, runs the full groups in lanes and the rest (and any group where a lane
 /// failed, to name the state) one state at a time.
 fn run_batch(
-    algorithm: Algorithm,
+    algorithm: BatchAlgorithm,
     model: &Model,
     workspace: &mut BatchWorkspace,
     states: States,
@@ -345,33 +185,35 @@ fn run_batch(
         let data = &mut workspace.data;
         let out = &mut out[k * size..(k + 1) * size];
         let result = match algorithm {
-            Algorithm::NewtonEuler => newton_euler(model, data, state.q, state.v, state.a, None),
-            Algorithm::ArticulatedBody => {
+            BatchAlgorithm::NewtonEuler => {
+                newton_euler(model, data, state.q, state.v, state.a, None)
+            }
+            BatchAlgorithm::ArticulatedBody => {
                 let (v, tau) = (state.v.unwrap_or_default(), state.tau.unwrap_or_default());
                 aba(model, data, state.q, v, tau, None)
             }
-            Algorithm::CompositeRigidBody => {
+            BatchAlgorithm::CompositeRigidBody => {
                 crba_into(model, data, state.q, out).map_err(|e| (k, e))?;
                 continue;
             }
-            Algorithm::RneaDerivatives => {
+            BatchAlgorithm::RneaDerivatives => {
                 let (v, a) = (state.v.unwrap_or_default(), state.a.unwrap_or_default());
-                let one = (state.q, v, a, None);
-                rnea_derivatives_stacked(model, data, one, out).map_err(|e| (k, e))?;
+                let into = DerivativesInto::Stacked(out);
+                rnea_derivatives(model, data, state.q, v, a, None, into).map_err(|e| (k, e))?;
                 continue;
             }
-            Algorithm::AbaDerivatives => {
+            BatchAlgorithm::AbaDerivatives => {
                 let (v, tau) = (state.v.unwrap_or_default(), state.tau.unwrap_or_default());
-                let one = (state.q, v, tau, None);
-                aba_derivatives_stacked(model, data, one, out).map_err(|e| (k, e))?;
+                let into = DerivativesInto::Stacked(out);
+                aba_derivatives(model, data, state.q, v, tau, None, into).map_err(|e| (k, e))?;
                 continue;
             }
-            Algorithm::FramePose { frame } => {
+            BatchAlgorithm::FramePose { frame } => {
                 let pose = frame_pose(model, data, state.q, frame).map_err(|e| (k, e))?;
                 pose.write_homogeneous(out);
                 continue;
             }
-            Algorithm::Jacobian { frame, reference } => {
+            BatchAlgorithm::Jacobian { frame, reference } => {
                 out.fill(0.0);
                 let column = |c: usize, linear: &Vec3, angular: &Vec3| {
                     write_jacobian_column(out, nv, c, linear, angular)
@@ -439,13 +281,14 @@ fn check_states(model: &Model, states: &States, n: usize) -> BatchResult {
 mod tests {
     use super::groups::groups;
     use super::*;
+    use crate::algo::Reference;
     use crate::io::bundled_model;
     use crate::spatial::Inertia;
     use crate::spatial::{Mat3, Vec3};
 
     /// The lane kernels themselves, compiled without the wide instruction sets, so that they are
     /// checked on a CPU that lacks them too: each lane equals the one-state call bit for bit.
-    fn lanes_equal_one_state<S: scatter::LaneRows>(algorithm: Algorithm) {
+    fn lanes_equal_one_state<S: scatter::LaneRows>(algorithm: BatchAlgorithm) {
         let mut model = bundled_model("ur5", true).unwrap();
         // a floating UR5 needs a base inertia for forward dynamics
         let base = Mat3::from_diagonal_element(0.01);
@@ -458,41 +301,8 @@ mod tests {
             v.extend((0..model.nv).map(|j| (k + j) as f64 * 0.1 - 0.3));
             a.extend((0..model.nv).map(|j| (k * j) as f64 * 0.05 - 0.2));
         }
-        let (v, a) = (Some(&v[..]), Some(&a[..]));
-        let states = match algorithm {
-            Algorithm::NewtonEuler => States {
-                q: &q,
-                v,
-                a,
-                tau: None,
-            },
-            Algorithm::ArticulatedBody => States {
-                q: &q,
-                v,
-                a: None,
-                tau: a,
-            },
-            Algorithm::CompositeRigidBody => States {
-                q: &q,
-                ..States::default()
-            },
-            Algorithm::RneaDerivatives => States {
-                q: &q,
-                v,
-                a,
-                tau: None,
-            },
-            Algorithm::AbaDerivatives => States {
-                q: &q,
-                v,
-                a: None,
-                tau: a,
-            },
-            Algorithm::FramePose { .. } | Algorithm::Jacobian { .. } => States {
-                q: &q,
-                ..States::default()
-            },
-        };
+        let inputs = [&q[..], &v[..], &a[..]];
+        let states = algorithm.states(&inputs[..algorithm.inputs().len()]);
         let size = algorithm.output_size(&model);
         let mut lanes = vec![0.0; n * size];
         groups(
@@ -516,21 +326,21 @@ mod tests {
     #[test]
     fn four_and_eight_lanes_equal_one_state_without_wide_instructions() {
         for algorithm in [
-            Algorithm::NewtonEuler,
-            Algorithm::ArticulatedBody,
-            Algorithm::CompositeRigidBody,
-            Algorithm::RneaDerivatives,
-            Algorithm::AbaDerivatives,
-            Algorithm::FramePose { frame: 7 },
-            Algorithm::Jacobian {
+            BatchAlgorithm::NewtonEuler,
+            BatchAlgorithm::ArticulatedBody,
+            BatchAlgorithm::CompositeRigidBody,
+            BatchAlgorithm::RneaDerivatives,
+            BatchAlgorithm::AbaDerivatives,
+            BatchAlgorithm::FramePose { frame: 7 },
+            BatchAlgorithm::Jacobian {
                 frame: 7,
                 reference: Reference::World,
             },
-            Algorithm::Jacobian {
+            BatchAlgorithm::Jacobian {
                 frame: 5,
                 reference: Reference::Local,
             },
-            Algorithm::Jacobian {
+            BatchAlgorithm::Jacobian {
                 frame: 7,
                 reference: Reference::Spatial,
             },

@@ -81,20 +81,19 @@ pub(crate) fn factor_into<S: Real>(
 }
 
 multiversion! {
-    /// Solves M X = B in place for B stored row by row in `rows` (row i at `i * width..(i + 1)
-    /// * width`, width = rows.len() / nv), with the factor of [`factor_mass_matrix`]. Each
-    /// elimination step is one row update over all columns at once, vectorised: with AVX-512 or
+    /// [`solve_rows`] with the column-major `factor` of [`factor_into`]. Each elimination step is one row update over all columns at once, vectorised: with AVX-512 or
     /// AVX2 where the processor has it ([`crate::dispatch`]), else with the baseline's SSE2.
-    pub fn solve_rows(model: &Model, data: &Data, rows: &mut [f64]) {
-        solve_rows_avx512 for ["avx512f"] => { solve_rows_generic(model, data, rows) }
-        solve_rows_avx2 for ["avx2"] => { solve_rows_generic(model, data, rows) }
-        baseline => { solve_rows_generic(model, data, rows) }
+    pub(crate) fn solve_rows_in(model: &Model, factor: &[f64], rows: &mut [f64]) {
+        solve_rows_avx512 for ["avx512f"] => { solve_rows_with(model, factor, rows) }
+        solve_rows_avx2 for ["avx2"] => { solve_rows_with(model, factor, rows) }
+        baseline => { solve_rows_with(model, factor, rows) }
     }
 }
 
-#[inline(always)]
-fn solve_rows_generic(model: &Model, data: &Data, rows: &mut [f64]) {
-    solve_rows_with(model, data.mass_matrix_factor.as_slice(), rows);
+/// Solves M X = B in place for B stored row by row in `rows` (row i at `i * width..(i + 1) *
+/// width`, width = rows.len() / nv), with the factor of [`factor_mass_matrix`] in `data`.
+pub fn solve_rows(model: &Model, data: &Data, rows: &mut [f64]) {
+    solve_rows_in(model, data.mass_matrix_factor.as_slice(), rows);
 }
 
 /// [`solve_rows`] with the column-major `factor` of [`factor_into`], in `f64` or lanes. The
@@ -280,7 +279,7 @@ mod tests {
                 .map(|k| ((k * 7919) % 1000) as f64 / 997.0 - 0.5)
                 .collect();
             let mut generic = rows.clone();
-            solve_rows_generic(&model, &data, &mut generic);
+            solve_rows_with(&model, data.mass_matrix_factor.as_slice(), &mut generic);
             let mut dispatched = rows.clone();
             solve_rows(&model, &data, &mut dispatched);
             assert_eq!(generic, dispatched, "width {width}");
@@ -288,14 +287,16 @@ mod tests {
             if std::arch::is_x86_feature_detected!("avx2") {
                 let mut avx2 = rows.clone();
                 // SAFETY: the processor has AVX2, just checked.
-                unsafe { solve_rows_avx2(&model, &data, &mut avx2) };
+                unsafe { solve_rows_avx2(&model, data.mass_matrix_factor.as_slice(), &mut avx2) };
                 assert_eq!(generic, avx2, "width {width}");
             }
             #[cfg(target_arch = "x86_64")]
             if std::arch::is_x86_feature_detected!("avx512f") {
                 let mut avx512 = rows.clone();
                 // SAFETY: the processor has AVX-512F, just checked.
-                unsafe { solve_rows_avx512(&model, &data, &mut avx512) };
+                unsafe {
+                    solve_rows_avx512(&model, data.mass_matrix_factor.as_slice(), &mut avx512)
+                };
                 assert_eq!(generic, avx512, "width {width}");
             }
         }

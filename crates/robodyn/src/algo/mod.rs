@@ -29,10 +29,7 @@ pub use aba::aba;
 pub use centroidal::centroidal_momentum_matrix;
 pub use coriolis::{christoffel_symbols, coriolis_matrix};
 pub use crba::{crba, crba_into};
-pub use derivatives::{
-    aba_derivative_rows, aba_derivatives, aba_derivatives_stacked, rnea_derivatives,
-    rnea_derivatives_row_major, rnea_derivatives_stacked, DynamicsState,
-};
+pub use derivatives::{aba_derivatives, rnea_derivatives, DerivativesInto, DynamicsState};
 pub use energy::{center_of_mass, center_of_mass_jacobian, kinetic_energy, potential_energy};
 pub use frame_derivatives::{center_of_mass_velocity_derivatives, frame_motion_derivatives};
 pub use frame_motion::{frame_acceleration, frame_velocity, jacobian_time_variation};
@@ -40,9 +37,9 @@ pub use inverse_kinematics::{inverse_kinematics, IkOptions, IkSolution};
 pub use jacobian::{jacobian, jacobian_columns, Reference};
 pub use kinematics::{forward_kinematics, frame_placement, frame_pose};
 pub use lanes::{
-    aba_batch, aba_derivatives_batch, crba_batch, frame_pose_batch, jacobian_batch,
-    newton_euler_batch, rnea_derivatives_batch, write_jacobian_column, BatchResult, BatchWorkspace,
-    LaneWidth, States,
+    aba_batch, aba_derivatives_batch, batch, crba_batch, frame_pose_batch, jacobian_batch,
+    newton_euler_batch, rnea_derivatives_batch, write_jacobian_column, BatchAlgorithm, BatchResult,
+    BatchWorkspace, LaneWidth, States,
 };
 pub use manipulability::manipulability;
 pub use minv::inverse_mass_matrix;

@@ -11,7 +11,7 @@
 //! Dynamics with constraints or contacts implement the same trait (the `_with` forms take them).
 
 use crate::algo::lanes::{aba_batch, BatchResult, BatchWorkspace, States};
-use crate::algo::{aba, aba_derivatives};
+use crate::algo::{aba, aba_derivatives, DerivativesInto};
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::spatial::Force;
@@ -139,7 +139,7 @@ impl ForwardDynamics for Aba {
         tau: &[f64],
         out: &mut AccelerationDerivatives,
     ) -> Result<()> {
-        aba_derivatives(model, data, q, v, tau, None)?;
+        aba_derivatives(model, data, q, v, tau, None, DerivativesInto::Data)?;
         out.qdd.copy_from_slice(data.qdd.as_slice());
         out.by_q.copy_from(&data.dqdd_dq);
         out.by_v.copy_from(&data.dqdd_dv);

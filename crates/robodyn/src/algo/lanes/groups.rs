@@ -2,7 +2,7 @@
 //! generic passes, scattered back; compiled once per instruction set.
 
 use super::scatter::LaneRows;
-use super::{write_jacobian_column, Algorithm, States};
+use super::{write_jacobian_column, BatchAlgorithm, States};
 use crate::algo::aba::{articulated_body_passes, AbaBuffers};
 use crate::algo::crba::{mass_matrix_of, MassMatrixBuffers};
 use crate::algo::derivatives::{
@@ -152,7 +152,7 @@ impl<S: Real> Lanes<S> {
 /// [`groups`] compiled for AVX2. Safety: only on a CPU with AVX2 and FMA.
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx2,fma"))]
 pub(super) unsafe fn groups_four(
-    algorithm: Algorithm,
+    algorithm: BatchAlgorithm,
     model: &Model,
     lanes: &mut Lanes<AutoF64x4>,
     states: States,
@@ -164,7 +164,7 @@ pub(super) unsafe fn groups_four(
 /// [`groups`] compiled for AVX-512. Safety: only on a CPU with AVX-512F.
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx512f"))]
 pub(super) unsafe fn groups_eight(
-    algorithm: Algorithm,
+    algorithm: BatchAlgorithm,
     model: &Model,
     lanes: &mut Lanes<AutoF64x8>,
     states: States,
@@ -177,7 +177,7 @@ pub(super) unsafe fn groups_eight(
 /// first state of a group where a lane failed (a singular articulated inertia or mass matrix).
 #[inline(always)]
 pub(super) fn groups<S: LaneRows>(
-    algorithm: Algorithm,
+    algorithm: BatchAlgorithm,
     model: &Model,
     lanes: &mut Lanes<S>,
     states: States,
@@ -197,7 +197,7 @@ pub(super) fn groups<S: LaneRows>(
             }
         }
         match algorithm {
-            Algorithm::NewtonEuler => {
+            BatchAlgorithm::NewtonEuler => {
                 let buffers = NewtonEulerBuffers {
                     x_up: &mut lanes.x_up,
                     v: &mut lanes.velocities,
@@ -209,7 +209,7 @@ pub(super) fn groups<S: LaneRows>(
                 let a = states.a.map(|_| &lanes.a[..]);
                 newton_euler_passes(model, &lanes.q, v, a, None, buffers);
             }
-            Algorithm::ArticulatedBody => {
+            BatchAlgorithm::ArticulatedBody => {
                 let buffers = AbaBuffers {
                     x_up: &mut lanes.x_up,
                     v: &mut lanes.velocities,
@@ -225,7 +225,7 @@ pub(super) fn groups<S: LaneRows>(
                 articulated_body_passes(model, &lanes.q, &lanes.v, &lanes.tau, None, buffers)
                     .map_err(|_| first)?;
             }
-            Algorithm::CompositeRigidBody => {
+            BatchAlgorithm::CompositeRigidBody => {
                 let buffers = MassMatrixBuffers {
                     x_up: &mut lanes.x_up,
                     x_world: &mut lanes.x_world,
@@ -239,7 +239,7 @@ pub(super) fn groups<S: LaneRows>(
                 S::scatter(&lanes.mass_matrix, out, size, 0);
                 continue;
             }
-            Algorithm::RneaDerivatives => {
+            BatchAlgorithm::RneaDerivatives => {
                 let zero = S::splat(0.0);
                 lanes.dtau_dq.fill(zero);
                 lanes.dtau_dv.fill(zero);
@@ -260,7 +260,7 @@ pub(super) fn groups<S: LaneRows>(
                 }
                 continue;
             }
-            Algorithm::AbaDerivatives => {
+            BatchAlgorithm::AbaDerivatives => {
                 let (mut buffers, inputs) = lanes.derivative_buffers();
                 let solve = SolveBuffers {
                     factor: inputs.factor,
@@ -277,7 +277,7 @@ pub(super) fn groups<S: LaneRows>(
                 }
                 continue;
             }
-            Algorithm::FramePose { frame } => {
+            BatchAlgorithm::FramePose { frame } => {
                 let x_world = &mut lanes.x_world;
                 support_of(model, model.frames[frame].body, &mut lanes.support);
                 support_placements(model, &lanes.q, &lanes.support, &mut lanes.x_up, x_world);
@@ -285,7 +285,7 @@ pub(super) fn groups<S: LaneRows>(
                 S::scatter(&lanes.pose, out, size, 0);
                 continue;
             }
-            Algorithm::Jacobian { frame, reference } => {
+            BatchAlgorithm::Jacobian { frame, reference } => {
                 let x_world = &mut lanes.x_world;
                 support_of(model, model.frames[frame].body, &mut lanes.support);
                 support_placements(model, &lanes.q, &lanes.support, &mut lanes.x_up, x_world);
