@@ -275,15 +275,8 @@ mod tests {
         let zero = vec![0.0; nv];
         let q0: Vec<f64> = (0..nq).map(|j| 0.3 - 0.1 * j as f64).collect();
         let v0: Vec<f64> = (0..nv).map(|j| 0.05 * j as f64).collect();
-        for integrator in [
-            Integrator::ExplicitEuler,
-            Integrator::SemiImplicitEuler,
-            Integrator::Rk4,
-            Integrator::Rk45 {
-                rtol: 1e-6,
-                atol: 1e-9,
-            },
-        ] {
+        for name in Integrator::NAMES {
+            let integrator = Integrator::from_name(name, 1e-6, 1e-9).unwrap();
             let what = format!("{integrator:?}");
             let options = SimulationOptions::new(integrator, 1e-3, 0.05);
             let (mut idle, mut pushing) = (

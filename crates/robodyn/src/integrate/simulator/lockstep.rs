@@ -283,15 +283,8 @@ mod tests {
             .collect();
         let borrowed: Vec<(&[f64], &[f64])> =
             starts.iter().map(|(q, v)| (&q[..], &v[..])).collect();
-        for integrator in [
-            Integrator::ExplicitEuler,
-            Integrator::SemiImplicitEuler,
-            Integrator::Rk4,
-            Integrator::Rk45 {
-                rtol: 1e-6,
-                atol: 1e-9,
-            },
-        ] {
+        for name in Integrator::NAMES {
+            let integrator = Integrator::from_name(name, 1e-6, 1e-9).unwrap();
             let options = SimulationOptions::new(integrator, 1e-3, 0.12);
             let controller =
                 NativeController::new(&model, law.clone(), options.passive, 0.12).unwrap();
