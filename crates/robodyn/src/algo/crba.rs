@@ -229,23 +229,19 @@ pub(crate) fn body_frame_mass_matrix<S: Real, F: SubtreeForces<S>>(
     }
     out.mass_matrix.fill(S::splat(0.0));
     let mut forces = out.forces;
+    let mut columns = MassColumns {
+        mass_matrix: out.mass_matrix,
+        nv,
+        armature: model.armature.as_slice(),
+    };
     for i in (1..model.nbodies()).rev() {
         let subtree = model.idx_v[i]..subtree_dof_end[i];
+        // F_k = I^c_i S_k;  H_dk = S_kᵀ F_d for the coordinates d ≥ k of the subtree (F_d in
+        // body i's coordinates by now)
         let composite = &out.composites[i];
-        match model.unit_axis(i) {
-            // one coordinate, S = ±e_c: F = ±column c of I^c_i, and H_d = ±component c of F_d
-            Some((c, negative)) => {
-                let dof = subtree.start;
-                forces.set(dof, &composite.mul_unit_motion(c, negative));
-                let armature = S::splat(model.armature[dof]);
-                let values = forces.unit_projections(c, negative, subtree.clone());
-                store_column(out.mass_matrix, nv, dof, armature, values);
-            }
-            None => {
-                let columns = (&mut forces, &mut *out.mass_matrix);
-                joint_columns(model, i, composite, subtree.clone(), columns);
-            }
-        }
+        model
+            .subspace(i)
+            .composite_columns(composite, subtree.end, &mut forces, &mut columns);
         // the subtree's inertia and forces into the parent's coordinates
         let parent = model.parent[i];
         if parent != 0 {
@@ -257,60 +253,27 @@ pub(crate) fn body_frame_mass_matrix<S: Real, F: SubtreeForces<S>>(
     }
 }
 
-/// The forces `F_k = I^c_i S_k` of body i's joint's coordinates k and the columns
-/// `H_dk = S_kᵀ F_d` of M for the coordinates d ≥ k of its `subtree`, for any joint (a column
-/// of I^c_i and a component of F_d where S_k is a coordinate axis).
-#[inline(always)]
-fn joint_columns<S: Real, F: SubtreeForces<S>>(
-    model: &Model,
-    i: usize,
-    composite: &Inertia<S>,
-    subtree: Range<usize>,
-    (forces, mass_matrix): (&mut F, &mut [S]),
-) {
-    let joint = &model.joints[i];
-    // all the joint's forces first: column k takes those of its later coordinates
-    for (k, dof) in model.v_range(i).enumerate() {
-        let force = match model.subspace_component(i, k) {
-            Some((c, negative)) => composite.mul_unit_motion(c, negative),
-            None => composite.mul_motion(&Motion::splat(&joint.subspace_column(k))),
-        };
-        forces.set(dof, &force);
-    }
-    for (k, col) in model.v_range(i).enumerate() {
-        let rows = col..subtree.end;
-        let armature = S::splat(model.armature[col]);
-        match model.subspace_component(i, k) {
-            Some((c, negative)) => {
-                let values = forces.unit_projections(c, negative, rows);
-                store_column(mass_matrix, model.nv, col, armature, values);
-            }
-            None => {
-                let values = rows.map(|d| joint.project_force(k, &forces.force(d)));
-                store_column(mass_matrix, model.nv, col, armature, values);
-            }
-        }
-    }
+/// M's storage as the body-coordinate CRBA fills it: column-major nv × nv, with the joints'
+/// armature on the diagonal.
+pub(crate) struct MassColumns<'b, S> {
+    mass_matrix: &'b mut [S],
+    nv: usize,
+    armature: &'b [f64],
 }
 
-/// `H[d, col] = H[col, d] = h_d` for the values `h_col, h_col+1, …` (column col of the
-/// column-major nv × nv `mass_matrix` from its diagonal down, and row col from its diagonal
-/// right), `armature` added to the diagonal.
-#[inline(always)]
-fn store_column<S: Real>(
-    mass_matrix: &mut [S],
-    nv: usize,
-    col: usize,
-    armature: S,
-    values: impl Iterator<Item = S>,
-) {
-    // H[col + j, col] down the column, H[col, col + j] a column apart along the row
-    let diagonal = col * nv + col;
-    for (j, h) in values.enumerate() {
-        mass_matrix[diagonal + j] = h;
-        mass_matrix[diagonal + j * nv] = h;
+impl<S: Real> MassColumns<'_, S> {
+    /// `H[d, col] = H[col, d] = h_d` for the values `h_col, h_col+1, …` (column col from its
+    /// diagonal down, and row col from its diagonal right), the armature added to the diagonal.
+    #[inline(always)]
+    pub(crate) fn store(&mut self, col: usize, values: impl Iterator<Item = S>) {
+        // H[col + j, col] down the column, H[col, col + j] a column apart along the row
+        let diagonal = col * self.nv + col;
+        for (j, h) in values.enumerate() {
+            self.mass_matrix[diagonal + j] = h;
+            self.mass_matrix[diagonal + j * self.nv] = h;
+        }
+        self.mass_matrix[diagonal] += S::splat(self.armature[col]);
     }
-    mass_matrix[diagonal] += armature;
 }
 
 /// Where the body-coordinate CRBA keeps the forces `F_d = I^c S_d` of the coordinates d: one

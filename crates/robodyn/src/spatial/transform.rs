@@ -1,6 +1,8 @@
 //! Plücker coordinate transforms (Featherstone §2.8).
 
-use super::turn::{with_axis_rotation, with_rotation, AnyRotation, Rotation, Turn, TurnAbout};
+use super::turn::{
+    for_rotation_of, with_axis_rotation, with_rotation, AnyRotation, Rotation, Turn, TurnAbout,
+};
 use super::{
     add_blocks, block, cross, matrix3, matrix6, rotate, rotate_back, skew, transposed, Force,
     Inertia, Mat3, Mat6, Motion, Real, Vec3,
@@ -158,8 +160,14 @@ impl<S: Real> Transform<S> {
         with_rotation!(turn, self.apply_motion_by(m))
     }
 
+    /// `E v`, for a rotation of the pattern `turn` as [`Transform::apply_motion_turned`].
     #[inline(always)]
-    pub(crate) fn apply_motion_by<R: Rotation>(&self, m: &Motion<S>) -> Motion<S> {
+    pub fn rotate_turned(&self, turn: Option<Turn>, v: &Vector3<S>) -> Vector3<S> {
+        for_rotation_of!(turn, R => R::rotate(&self.rotation, v))
+    }
+
+    #[inline(always)]
+    fn apply_motion_by<R: Rotation>(&self, m: &Motion<S>) -> Motion<S> {
         Motion {
             angular: R::rotate(&self.rotation, &m.angular),
             linear: R::rotate(
@@ -218,7 +226,7 @@ impl<S: Real> Transform<S> {
     }
 
     #[inline(always)]
-    pub(crate) fn transpose_apply_force_by<R: Rotation>(&self, f: &Force<S>) -> Force<S> {
+    fn transpose_apply_force_by<R: Rotation>(&self, f: &Force<S>) -> Force<S> {
         let linear = R::rotate_back(&self.rotation, &f.linear);
         Force {
             angular: R::rotate_back(&self.rotation, &f.angular) + cross(&self.translation, &linear),
