@@ -1,6 +1,7 @@
 //! The workspace every algorithm writes into, allocated once per model by [`Data::new`].
 //! After that, the algorithms in [`crate::algo`] allocate nothing.
 
+use crate::algo::crba::ForceRowsRoom;
 use crate::model::Model;
 use crate::spatial::{CoriolisFactor, Force, Inertia, Mat6, Motion, Transform};
 use nalgebra::{DMatrix, DVector};
@@ -37,10 +38,9 @@ pub struct Data {
     /// nbodies. Written by `crba` on a model it computes in body coordinates.
     pub i_c_body: Vec<Inertia>,
     /// `F = I^c_i S_k` of each velocity coordinate k (of body i's joint), in the frame of the
-    /// last body `crba` carried it to (body coordinates: the root's child), by component:
-    /// component c (`Force::plucker`'s order) of coordinate k's at `c (nv + 3) + 3 + k` (each row
-    /// of a component starts with three unused values); 6 (nv + 3). Written with `i_c_body`.
-    pub f_subspace: Vec<f64>,
+    /// last body `crba` carried it to, in the layout `crba` keeps them in. Written with
+    /// `i_c_body`.
+    pub(crate) crba_forces: ForceRowsRoom,
     /// Spatial velocity of body i in world coordinates; nbodies. Written by `coriolis_matrix`.
     pub v_world: Vec<Motion>,
     /// Rate Ṡ = v_i × ⁰S of each world-frame subspace column; nv. Written by `coriolis_matrix`.
@@ -148,7 +148,7 @@ impl Data {
             i_c: vec![Inertia::ZERO; nb],
             s_world: vec![Motion::ZERO; nv],
             i_c_body: vec![Inertia::ZERO; nb],
-            f_subspace: vec![0.0; crate::algo::crba::ForceRows::size(nv)],
+            crba_forces: ForceRowsRoom::new(nv),
             v_world: vec![Motion::ZERO; nb],
             s_dot_world: vec![Motion::ZERO; nv],
             coriolis: DMatrix::zeros(nv, nv),

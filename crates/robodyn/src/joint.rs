@@ -17,6 +17,9 @@ use nalgebra::{Matrix3, Matrix6, Quaternion, UnitQuaternion, Vector3};
 
 mod configuration;
 mod jacobians;
+mod subspace;
+
+pub(crate) use subspace::{ArticulatedTerms, MotionSubspace};
 
 /// Below this rotation angle the SE(3)/SO(3) exponential and logarithm use their Taylor series.
 const SMALL_ANGLE: f64 = 1e-6;

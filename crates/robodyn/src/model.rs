@@ -6,7 +6,7 @@ mod builder;
 pub use builder::{ModelBuilder, NewBody};
 
 use crate::error::{check_length, check_vector, Error, Result};
-use crate::joint::Joint;
+use crate::joint::{Joint, MotionSubspace};
 use crate::spatial::turn::snapped_signed_permutation;
 use crate::spatial::{Inertia, Mat3, Transform, Turn, Vec3};
 use crate::visual::{Texture, Visual};
@@ -352,6 +352,26 @@ impl Model {
             self.subspace_component(i, 0)
         } else {
             None
+        }
+    }
+
+    /// Body i's motion subspace as the algorithms take it: one coordinate axis where
+    /// [`Model::unit_axis`] finds one, else the joint's columns with their
+    /// [`Model::subspace_component`]s.
+    #[inline(always)]
+    pub(crate) fn subspace(&self, i: usize) -> MotionSubspace<'_> {
+        match self.unit_axis(i) {
+            Some((c, negative)) => MotionSubspace::Axis {
+                c,
+                negative,
+                dof: self.idx_v[i],
+            },
+            None => MotionSubspace::Columns {
+                joint: &self.joints[i],
+                first: self.idx_v[i],
+                // empty where the model was not built: asked of the joint
+                components: self.subspace_components.get(self.v_range(i)).unwrap_or(&[]),
+            },
         }
     }
 

@@ -5,15 +5,13 @@
 //! of the subtree rooted at body i. Two forms, the same M:
 //! - Table 6.2 in body coordinates (bodies in depth-first order, as every loader gives, so that a
 //!   subtree's coordinates are consecutive): composites and forces `F = I^c_i S_i` carried to the
-//!   parent joint by joint. A joint that turns about a coordinate axis (after quarter turns)
-//!   makes each carry a turned product (`spatial::turn`), and a coordinate axis makes `S_jᵀ F`
-//!   one component of F. One state keeps its forces by component (a private row layout) and carries
-//!   four per product.
+//!   parent joint by joint. The products with `S` are the joint's (`joint::subspace`); where the
+//!   forces are kept, and how a joint carries them, is `layout`'s.
 //! - Otherwise every quantity once in world coordinates, where composites add without transforms
 //!   and each `H_ij` is a 6-vector dot product.
 //!
 //! The UR5 dynamics notes obtain the same M from n RNEA calls; the tests check it.
-//! Input: q (nq). Writes `data.x_up`; `data.i_c_body`, `data.f_subspace` (body coordinates) or
+//! Input: q (nq). Writes `data.x_up`; `data.i_c_body` (body coordinates) or
 //! `data.x_world`, `data.s_world`, `data.i_c` (world coordinates); `data.mass_matrix` (full,
 //! symmetric, armature on the diagonal).
 //! Cost: O(n) transforms plus a force carried (body coordinates) or a dot product (world
@@ -23,10 +21,13 @@ use crate::algo::kinematics::{body_placements, joint_transforms};
 use crate::dispatch::multiversion;
 use crate::error::{check_length, Result};
 use crate::model::Model;
-use crate::spatial::{signed, Force, Inertia, Motion, Real, Transform, Turn};
+use crate::spatial::{Inertia, Motion, Real, Transform};
 use crate::Data;
 use nalgebra::DMatrix;
-use std::ops::Range;
+
+mod layout;
+
+pub(crate) use layout::{ForceRows, ForceRowsRoom, MassColumns, SubtreeForces};
 
 /// M(q), written into `data.mass_matrix`.
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMatrix<f64>> {
@@ -42,7 +43,7 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMat
 pub fn crba_into(model: &Model, data: &mut Data, q: &[f64], out: &mut [f64]) -> Result<()> {
     model.check_configuration(q)?;
     check_length("out", out.len(), model.nv * model.nv)?;
-    one_state_mass_matrix(model, q, MassMatrixBuffers::of(data, model.nv, out));
+    one_state_mass_matrix(model, q, MassMatrixBuffers::of(data, out));
     Ok(())
 }
 
@@ -70,16 +71,15 @@ pub(crate) struct MassMatrixBuffers<'b, S, F> {
 }
 
 impl<'b> MassMatrixBuffers<'b, f64, ForceRows<'b>> {
-    /// One state's buffers, borrowed from `data` (of a model with `nv` coordinates), M written
-    /// into `mass_matrix`.
-    fn of(data: &'b mut Data, nv: usize, mass_matrix: &'b mut [f64]) -> Self {
+    /// One state's buffers, borrowed from `data`, M written into `mass_matrix`.
+    fn of(data: &'b mut Data, mass_matrix: &'b mut [f64]) -> Self {
         MassMatrixBuffers {
             x_up: &mut data.x_up,
             x_world: &mut data.x_world,
             world_composites: &mut data.i_c,
             subspaces: &mut data.s_world,
             body_composites: &mut data.i_c_body,
-            forces: ForceRows::new(&mut data.f_subspace, nv),
+            forces: data.crba_forces.rows(),
             mass_matrix,
         }
     }
@@ -229,23 +229,19 @@ pub(crate) fn body_frame_mass_matrix<S: Real, F: SubtreeForces<S>>(
     }
     out.mass_matrix.fill(S::splat(0.0));
     let mut forces = out.forces;
+    let mut columns = MassColumns {
+        mass_matrix: out.mass_matrix,
+        nv,
+        armature: model.armature.as_slice(),
+    };
     for i in (1..model.nbodies()).rev() {
         let subtree = model.idx_v[i]..subtree_dof_end[i];
+        // F_k = I^c_i S_k;  H_dk = S_kᵀ F_d for the coordinates d ≥ k of the subtree (F_d in
+        // body i's coordinates by now)
         let composite = &out.composites[i];
-        match model.unit_axis(i) {
-            // one coordinate, S = ±e_c: F = ±column c of I^c_i, and H_d = ±component c of F_d
-            Some((c, negative)) => {
-                let dof = subtree.start;
-                forces.set(dof, &composite.mul_unit_motion(c, negative));
-                let armature = S::splat(model.armature[dof]);
-                let values = forces.unit_projections(c, negative, subtree.clone());
-                store_column(out.mass_matrix, nv, dof, armature, values);
-            }
-            None => {
-                let columns = (&mut forces, &mut *out.mass_matrix);
-                joint_columns(model, i, composite, subtree.clone(), columns);
-            }
-        }
+        model
+            .subspace(i)
+            .composite_columns(composite, subtree.end, &mut forces, &mut columns);
         // the subtree's inertia and forces into the parent's coordinates
         let parent = model.parent[i];
         if parent != 0 {
@@ -254,188 +250,6 @@ pub(crate) fn body_frame_mass_matrix<S: Real, F: SubtreeForces<S>>(
             out.composites[parent] += carried;
             forces.carry(x_up, turn, subtree);
         }
-    }
-}
-
-/// The forces `F_k = I^c_i S_k` of body i's joint's coordinates k and the columns
-/// `H_dk = S_kᵀ F_d` of M for the coordinates d ≥ k of its `subtree`, for any joint (a column
-/// of I^c_i and a component of F_d where S_k is a coordinate axis).
-#[inline(always)]
-fn joint_columns<S: Real, F: SubtreeForces<S>>(
-    model: &Model,
-    i: usize,
-    composite: &Inertia<S>,
-    subtree: Range<usize>,
-    (forces, mass_matrix): (&mut F, &mut [S]),
-) {
-    let joint = &model.joints[i];
-    // all the joint's forces first: column k takes those of its later coordinates
-    for (k, dof) in model.v_range(i).enumerate() {
-        let force = match model.subspace_component(i, k) {
-            Some((c, negative)) => composite.mul_unit_motion(c, negative),
-            None => composite.mul_motion(&Motion::splat(&joint.subspace_column(k))),
-        };
-        forces.set(dof, &force);
-    }
-    for (k, col) in model.v_range(i).enumerate() {
-        let rows = col..subtree.end;
-        let armature = S::splat(model.armature[col]);
-        match model.subspace_component(i, k) {
-            Some((c, negative)) => {
-                let values = forces.unit_projections(c, negative, rows);
-                store_column(mass_matrix, model.nv, col, armature, values);
-            }
-            None => {
-                let values = rows.map(|d| joint.project_force(k, &forces.force(d)));
-                store_column(mass_matrix, model.nv, col, armature, values);
-            }
-        }
-    }
-}
-
-/// `H[d, col] = H[col, d] = h_d` for the values `h_col, h_col+1, …` (column col of the
-/// column-major nv × nv `mass_matrix` from its diagonal down, and row col from its diagonal
-/// right), `armature` added to the diagonal.
-#[inline(always)]
-fn store_column<S: Real>(
-    mass_matrix: &mut [S],
-    nv: usize,
-    col: usize,
-    armature: S,
-    values: impl Iterator<Item = S>,
-) {
-    // H[col + j, col] down the column, H[col, col + j] a column apart along the row
-    let diagonal = col * nv + col;
-    for (j, h) in values.enumerate() {
-        mass_matrix[diagonal + j] = h;
-        mass_matrix[diagonal + j * nv] = h;
-    }
-    mass_matrix[diagonal] += armature;
-}
-
-/// Where the body-coordinate CRBA keeps the forces `F_d = I^c S_d` of the coordinates d: one
-/// state's by component ([`ForceRows`]), so that a joint carries four of its subtree's forces
-/// per product; lanes' as forces, one after the other (each lane is a state already).
-pub(crate) trait SubtreeForces<S: Real> {
-    /// `F_d = force`.
-    fn set(&mut self, d: usize, force: &Force<S>);
-
-    /// `S_kᵀ F_d` for `S_k = ±e_c` (c in [`Force::plucker`]'s order; `negative`: −): ±
-    /// component c of `F_d`, for the coordinates d of `rows` in turn.
-    fn unit_projections(
-        &self,
-        c: usize,
-        negative: bool,
-        rows: Range<usize>,
-    ) -> impl Iterator<Item = S>;
-
-    /// `F_d`.
-    fn force(&self, d: usize) -> Force<S>;
-
-    /// `F_d ← Xᵀ F_d` for the coordinates d of `subtree`, X of the pattern `turn` where it is
-    /// `Some` ([`Transform::transpose_apply_force_turned`]).
-    fn carry(&mut self, x: &Transform<S>, turn: Option<Turn>, subtree: Range<usize>);
-}
-
-impl<S: Real> SubtreeForces<S> for &mut [Force<S>] {
-    #[inline(always)]
-    fn set(&mut self, d: usize, force: &Force<S>) {
-        self[d] = *force;
-    }
-
-    #[inline(always)]
-    fn unit_projections(
-        &self,
-        c: usize,
-        negative: bool,
-        rows: Range<usize>,
-    ) -> impl Iterator<Item = S> {
-        self[rows]
-            .iter()
-            .map(move |force| signed(force.component(c), negative))
-    }
-
-    #[inline(always)]
-    fn force(&self, d: usize) -> Force<S> {
-        self[d]
-    }
-
-    #[inline(always)]
-    fn carry(&mut self, x: &Transform<S>, turn: Option<Turn>, subtree: Range<usize>) {
-        x.transpose_apply_forces_turned(turn, &mut self[subtree]);
-    }
-}
-
-/// One state's forces by component: `rows[c (nv + 3) + 3 + d]` is component c of `F_d`. Each
-/// row starts with three unused values, so that a subtree's forces are carried in whole groups
-/// of four ending at its last one; the places before its first hold forces of bodies not
-/// reached yet (written when they are) or the unused values.
-pub(crate) struct ForceRows<'r> {
-    rows: &'r mut [f64],
-    nv: usize,
-}
-
-impl<'r> ForceRows<'r> {
-    /// The values unused at the start of each row.
-    const PADDING: usize = 3;
-
-    /// The values the forces of `nv` coordinates take.
-    pub(crate) fn size(nv: usize) -> usize {
-        6 * (nv + Self::PADDING)
-    }
-
-    pub(crate) fn new(rows: &'r mut [f64], nv: usize) -> Self {
-        assert_eq!(
-            rows.len(),
-            Self::size(nv),
-            "rows of forces for {nv} coordinates"
-        );
-        ForceRows { rows, nv }
-    }
-
-    #[inline(always)]
-    fn at(&self, c: usize, d: usize) -> usize {
-        c * (self.nv + Self::PADDING) + Self::PADDING + d
-    }
-}
-
-impl SubtreeForces<f64> for ForceRows<'_> {
-    #[inline(always)]
-    fn set(&mut self, d: usize, force: &Force) {
-        // the six components, a row apart: one bounds check for all
-        let stride = self.nv + Self::PADDING;
-        let first = self.at(0, d);
-        let components = &mut self.rows[first..=first + 5 * stride];
-        for (c, value) in force.plucker().into_iter().enumerate() {
-            components[c * stride] = value;
-        }
-    }
-
-    #[inline(always)]
-    fn unit_projections(
-        &self,
-        c: usize,
-        negative: bool,
-        rows: Range<usize>,
-    ) -> impl Iterator<Item = f64> {
-        // component c of consecutive forces is consecutive
-        let components = &self.rows[self.at(c, rows.start)..self.at(c, rows.end)];
-        components
-            .iter()
-            .map(move |&component| signed(component, negative))
-    }
-
-    #[inline(always)]
-    fn force(&self, d: usize) -> Force {
-        let c = |c: usize| self.rows[self.at(c, d)];
-        Force::from_plucker([c(0), c(1), c(2), c(3), c(4), c(5)])
-    }
-
-    #[inline(always)]
-    fn carry(&mut self, x: &Transform, turn: Option<Turn>, subtree: Range<usize>) {
-        let (stride, end) = (self.nv + Self::PADDING, Self::PADDING + subtree.end);
-        let groups = subtree.len().div_ceil(4);
-        x.transpose_apply_force_rows_turned(turn, self.rows, stride, end, groups);
     }
 }
 
@@ -453,7 +267,7 @@ mod tests {
         crba(&model, &mut dispatched, &q).unwrap();
         let mut data = Data::new(&model);
         let mut mass_matrix = vec![f64::NAN; model.nv * model.nv];
-        let buffers = MassMatrixBuffers::of(&mut data, model.nv, &mut mass_matrix);
+        let buffers = MassMatrixBuffers::of(&mut data, &mut mass_matrix);
         mass_matrix_of(&model, &q, buffers);
         assert_eq!(dispatched.mass_matrix.as_slice(), &mass_matrix[..]);
     }

@@ -9,8 +9,7 @@
 use crate::algo::kinematics::joint_transforms;
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::model::Model;
-use crate::spatial::turn::{for_rotation_of, Rotation};
-use crate::spatial::{signed, splat_vector, zero_vector, Force, Inertia, Motion, Real, Transform};
+use crate::spatial::{splat_vector, zero_vector, Force, Inertia, Motion, Real, Transform};
 use crate::Data;
 use nalgebra::DVector;
 
@@ -102,35 +101,14 @@ pub(crate) fn newton_euler_passes<S: Real>(
     out.v[0].set_zero();
     out.a[0] = Motion::new(zero_vector(), -splat_vector::<S>(&model.gravity));
     for i in 1..model.nbodies() {
-        for_rotation_of!(model.turn(i), R => outward_body::<R, S>(model, i, v, a, f_ext, &mut out));
+        outward_body(model, i, v, a, f_ext, &mut out);
     }
 
     // inward pass: project onto the joint axes, pass the rest to the parent
     for i in (1..model.nbodies()).rev() {
-        let joint = &model.joints[i];
-        let dofs = model.v_range(i);
-        match model.unit_axis(i) {
-            Some((c, negative)) => {
-                // S = ±e_c: τ_i = ±f_i,c + armature q̈_i (no rotor term: only a free joint has one)
-                let (dof, f_c) = (dofs.start, out.f[i].component(c));
-                let rate = a.map_or(S::zero(), |a| a[dof]);
-                out.tau[dof] = signed(f_c, negative) + S::splat(model.armature[dof]) * rate;
-            }
-            None => {
-                for (k, dof) in dofs.clone().enumerate() {
-                    // τ_i = S_iᵀ f_i + armature (q̈_i + K(q̇_i) q̇_i)
-                    let mut rate = a.map_or(S::zero(), |a| a[dof]);
-                    if let Some(v) = v {
-                        let v_i = &v[dofs.clone()];
-                        for (c, v_c) in v_i.iter().enumerate() {
-                            rate += joint.rotor_velocity_term(k, c, v_i) * *v_c;
-                        }
-                    }
-                    let projected = joint.project_force(k, &out.f[i]);
-                    out.tau[dof] = projected + S::splat(model.armature[dof]) * rate;
-                }
-            }
-        }
+        // τ_i = S_iᵀ f_i + armature (q̈_i + K(q̇_i) q̇_i)
+        let subspace = model.subspace(i);
+        subspace.joint_forces(&out.f[i], a, v, model.armature.as_slice(), out.tau);
         let parent = model.parent[i];
         if parent != 0 {
             // f_λ(i) += X_iᵀ f_i
@@ -140,9 +118,9 @@ pub(crate) fn newton_euler_passes<S: Real>(
     }
 }
 
-/// Body i of the outward pass, its transform's rotation applied as `R`.
+/// Body i of the outward pass.
 #[inline(always)]
-fn outward_body<R: Rotation, S: Real>(
+fn outward_body<S: Real>(
     model: &Model,
     i: usize,
     v: Option<&[S]>,
@@ -150,11 +128,8 @@ fn outward_body<R: Rotation, S: Real>(
     f_ext: Option<&[Force<S>]>,
     out: &mut NewtonEulerBuffers<S>,
 ) {
-    let joint = &model.joints[i];
-    let parent = model.parent[i];
-    // S = ±e_c for most joints: S x is then one component, ±x
-    let unit_axis = model.unit_axis(i);
-    let along_axis = |x: &[S], negative: bool| signed(x[model.idx_v[i]], negative);
+    let (parent, x_up, turn) = (model.parent[i], &out.x_up[i], model.turn(i));
+    let subspace = model.subspace(i);
     // I_i read into each product where it is used (kept whole, it would be copied)
     let inertia = &model.inertias[i];
     // a_i = X_i a_λ(i) + S q̈_i + v_i × v_J   (c_J = 0)
@@ -162,33 +137,19 @@ fn outward_body<R: Rotation, S: Real>(
         // at rest every a_i is gravity's, a linear motion [0; g_i]: g_i = E_i g_λ(i)
         (None, None) => Motion::new(
             zero_vector(),
-            R::rotate(&out.x_up[i].rotation, &out.a[parent].linear),
+            x_up.rotate_turned(turn, &out.a[parent].linear),
         ),
-        _ => out.x_up[i].apply_motion_by::<R>(&out.a[parent]),
+        _ => x_up.apply_motion_turned(turn, &out.a[parent]),
     };
     if let Some(a) = a {
-        match unit_axis {
-            Some((c, negative)) => a_i.add_to_component(c, along_axis(a, negative)),
-            None => a_i += joint.motion(&a[model.v_range(i)]),
-        }
+        subspace.add_motion(&mut a_i, a);
     }
     // f_i = I_i a_i + v_i ×* I_i v_i - f_ext_i
     let mut f_i = match v {
         Some(v) => {
             // v_i = X_i v_λ(i) + v_J
-            let mut v_i = out.x_up[i].apply_motion_by::<R>(&out.v[parent]);
-            match unit_axis {
-                Some((c, negative)) => {
-                    let rate = along_axis(v, negative);
-                    v_i.add_to_component(c, rate);
-                    a_i += v_i.cross_unit_motion(c, rate);
-                }
-                None => {
-                    let v_j = joint.motion(&v[model.v_range(i)]);
-                    v_i += v_j;
-                    a_i += v_i.cross_motion(&v_j);
-                }
-            }
+            let mut v_i = x_up.apply_motion_turned(turn, &out.v[parent]);
+            a_i += subspace.add_velocity(&mut v_i, v);
             out.v[i] = v_i;
             let momentum = Inertia::<S>::splat(inertia).mul_motion(&v_i);
             Inertia::<S>::splat(inertia).mul_motion(&a_i) + v_i.cross_force(&momentum)

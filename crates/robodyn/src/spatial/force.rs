@@ -169,3 +169,25 @@ impl<S: Real> Mul<S> for Force<S> {
         Force::new(self.angular * s, self.linear * s)
     }
 }
+
+/// Forces kept in any layout, each replaced by a product of it in place: what
+/// [`super::Transform::transpose_apply_stored_forces_turned`] carries.
+pub trait ForceStore<S> {
+    /// Every force `f` replaced by `product.of(f)`.
+    fn replace_each(&mut self, product: &impl ForceProduct<S>);
+}
+
+/// A product that takes a force to a force (`Xᵀ f`, say), applied by [`ForceStore::replace_each`].
+pub trait ForceProduct<S> {
+    /// The product of `f`.
+    fn of(&self, f: &Force<S>) -> Force<S>;
+}
+
+impl<S: Real> ForceStore<S> for [Force<S>] {
+    #[inline(always)]
+    fn replace_each(&mut self, product: &impl ForceProduct<S>) {
+        for f in self {
+            *f = product.of(f);
+        }
+    }
+}

@@ -14,7 +14,7 @@ mod transform;
 pub mod trig;
 pub(crate) mod turn;
 
-pub use force::Force;
+pub use force::{Force, ForceProduct, ForceStore};
 pub use inertia::{CoriolisFactor, Inertia};
 pub use motion::Motion;
 pub use products::*;

@@ -1,12 +1,14 @@
 //! Plücker coordinate transforms (Featherstone §2.8).
 
-use super::turn::{with_axis_rotation, with_rotation, AnyRotation, Rotation, Turn, TurnAbout};
+use super::turn::{
+    for_rotation_of, with_axis_rotation, with_rotation, AnyRotation, Rotation, Turn, TurnAbout,
+};
 use super::{
     add_blocks, block, cross, matrix3, matrix6, rotate, rotate_back, skew, transposed, Force,
-    Inertia, Mat3, Mat6, Motion, Real, Vec3,
+    ForceProduct, ForceStore, Inertia, Mat3, Mat6, Motion, Real, Vec3,
 };
 use nalgebra::{Matrix3, Matrix6, Vector3};
-use simba::simd::AutoF64x4;
+use std::marker::PhantomData;
 use std::ops::Mul;
 
 /// Featherstone's `X = B_X_A`: the coordinate transform from frame A to frame B, stored as the
@@ -158,8 +160,14 @@ impl<S: Real> Transform<S> {
         with_rotation!(turn, self.apply_motion_by(m))
     }
 
+    /// `E v`, for a rotation of the pattern `turn` as [`Transform::apply_motion_turned`].
     #[inline(always)]
-    pub(crate) fn apply_motion_by<R: Rotation>(&self, m: &Motion<S>) -> Motion<S> {
+    pub fn rotate_turned(&self, turn: Option<Turn>, v: &Vector3<S>) -> Vector3<S> {
+        for_rotation_of!(turn, R => R::rotate(&self.rotation, v))
+    }
+
+    #[inline(always)]
+    fn apply_motion_by<R: Rotation>(&self, m: &Motion<S>) -> Motion<S> {
         Motion {
             angular: R::rotate(&self.rotation, &m.angular),
             linear: R::rotate(
@@ -207,18 +215,19 @@ impl<S: Real> Transform<S> {
     /// [`Transform::transpose_apply_force_turned`] of every force of `forces`, in place.
     #[inline(always)]
     pub fn transpose_apply_forces_turned(&self, turn: Option<Turn>, forces: &mut [Force<S>]) {
-        with_rotation!(turn, self.transpose_apply_forces_by(forces))
+        with_rotation!(turn, self.transpose_apply_stored_forces_by(forces))
     }
 
     #[inline(always)]
-    fn transpose_apply_forces_by<R: Rotation>(&self, forces: &mut [Force<S>]) {
-        for f in forces {
-            *f = self.transpose_apply_force_by::<R>(f);
-        }
+    fn transpose_apply_stored_forces_by<R: Rotation>(
+        &self,
+        forces: &mut (impl ForceStore<S> + ?Sized),
+    ) {
+        forces.replace_each(&TransposeBy::<S, R>(self, PhantomData));
     }
 
     #[inline(always)]
-    pub(crate) fn transpose_apply_force_by<R: Rotation>(&self, f: &Force<S>) -> Force<S> {
+    fn transpose_apply_force_by<R: Rotation>(&self, f: &Force<S>) -> Force<S> {
         let linear = R::rotate_back(&self.rotation, &f.linear);
         Force {
             angular: R::rotate_back(&self.rotation, &f.angular) + cross(&self.translation, &linear),
@@ -350,6 +359,21 @@ impl<S: Real> Transform<S> {
 }
 
 impl Transform {
+    /// [`Transform::transpose_apply_force_turned`] of every force of `forces`, kept in any
+    /// layout ([`ForceStore`]) and in `f64` or lanes (a force of `f64x4` components is four
+    /// forces, each carried by the same operations as alone), in place: the pattern chosen once
+    /// for all of them, and X put in every lane after that choice.
+    #[inline(always)]
+    pub fn transpose_apply_stored_forces_turned<L: Real>(
+        &self,
+        turn: Option<Turn>,
+        forces: &mut (impl ForceStore<L> + ?Sized),
+    ) {
+        for_rotation_of!(turn, R => Transform::<L>::splat(self).transpose_apply_stored_forces_by::<R>(forces))
+    }
+}
+
+impl Transform {
     /// The pose of B in A as a 4x4 homogeneous matrix `[Eᵀ r; 0 1]` (maps B points to A points).
     #[inline]
     pub fn to_homogeneous(&self) -> nalgebra::Matrix4<f64> {
@@ -370,66 +394,6 @@ impl Transform {
         x.fixed_view_mut::<3, 3>(3, 0)
             .copy_from(&(-self.rotation * skew(&self.translation)));
         x
-    }
-
-    /// [`Transform::transpose_apply_force_turned`] in place of forces kept by component
-    /// (`rows[c * stride + d]` is component c, in [`Force::plucker`]'s order, of force d), four
-    /// at a time: the `groups` groups of four consecutive forces that end before force `end`.
-    /// A component of four forces is read as one vector (`f64x4`), so one product carries four
-    /// forces, each by the same operations as alone.
-    #[inline(always)]
-    pub fn transpose_apply_force_rows_turned(
-        &self,
-        turn: Option<Turn>,
-        rows: &mut [f64],
-        stride: usize,
-        end: usize,
-        groups: usize,
-    ) {
-        with_rotation!(
-            turn,
-            self.transpose_apply_force_rows_by(rows, stride, end, groups)
-        )
-    }
-
-    #[inline(always)]
-    fn transpose_apply_force_rows_by<R: Rotation>(
-        &self,
-        rows: &mut [f64],
-        stride: usize,
-        end: usize,
-        groups: usize,
-    ) {
-        let splat = |x: f64| AutoF64x4::from([x; 4]);
-        let fours = Transform {
-            rotation: self.rotation.map(splat),
-            translation: self.translation.map(splat),
-        };
-        // each component's row from the first group on, in groups of four: the groups' reads
-        // and writes then need no bounds checks
-        let start = end - 4 * groups;
-        let mut component_rows = rows.chunks_mut(stride);
-        let mut next_row = || {
-            let row = component_rows.next().expect("six component rows");
-            &mut row[start..end].as_chunks_mut::<4>().0[..groups]
-        };
-        let (n0, n1, n2) = (next_row(), next_row(), next_row());
-        let (f0, f1, f2) = (next_row(), next_row(), next_row());
-        for g in 0..groups {
-            // four values at once (an array taken whole is one load)
-            let four = AutoF64x4::from;
-            let f = Force::from_plucker([
-                four(n0[g]),
-                four(n1[g]),
-                four(n2[g]),
-                four(f0[g]),
-                four(f1[g]),
-                four(f2[g]),
-            ]);
-            let [a0, a1, a2, l0, l1, l2] = fours.transpose_apply_force_by::<R>(&f).plucker();
-            (n0[g], n1[g], n2[g]) = (a0.into(), a1.into(), a2.into());
-            (f0[g], f1[g], f2[g]) = (l0.into(), l1.into(), l2.into());
-        }
     }
 }
 
@@ -486,4 +450,14 @@ fn cross_columns<S: Real>(r: &Vector3<S>, m: &Matrix3<S>) -> Matrix3<S> {
         let (next, last) = ((row + 1) % 3, (row + 2) % 3);
         r[next] * m[(last, col)] - r[last] * m[(next, col)]
     })
+}
+
+/// `Xᵀ f` with X's rotation applied as `R`, as a [`ForceProduct`].
+struct TransposeBy<'x, S, R>(&'x Transform<S>, PhantomData<R>);
+
+impl<S: Real, R: Rotation> ForceProduct<S> for TransposeBy<'_, S, R> {
+    #[inline(always)]
+    fn of(&self, f: &Force<S>) -> Force<S> {
+        self.0.transpose_apply_force_by::<R>(f)
+    }
 }
