@@ -2,12 +2,19 @@
 //! write goes into [`crate::Data`].
 
 mod builder;
+mod derived;
+mod physical;
 
 pub use builder::{ModelBuilder, NewBody};
+use derived::run_start;
+pub(crate) use derived::tree_transform;
+pub use derived::AncestorRuns;
+pub use physical::{
+    check_mass_and_inertia, check_physical_parameters, check_positive_semidefinite, Unphysical,
+};
 
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::joint::{Joint, MotionSubspace};
-use crate::spatial::turn::snapped_signed_permutation;
 use crate::spatial::{Inertia, Mat3, Transform, Turn, Vec3};
 use crate::visual::{Texture, Visual};
 use nalgebra::DVector;
@@ -532,183 +539,4 @@ pub(crate) fn check_unit_quaternion(q: &[f64]) -> std::result::Result<(), f64> {
         return Err(norm);
     }
     Ok(())
-}
-
-/// Checks that (mass, rotational inertia about the COM) can be computed with: finite, mass ≥ 0,
-/// symmetric. [`check_positive_semidefinite`] checks that the body is physical.
-pub fn check_mass_and_inertia(mass: f64, inertia_com: &Mat3) -> std::result::Result<(), String> {
-    if !mass.is_finite() || mass < 0.0 {
-        return Err(format!("expected a finite mass >= 0, got {mass}"));
-    }
-    if inertia_com.iter().any(|x| !x.is_finite()) {
-        return Err("expected a finite inertia tensor, got a non-finite entry".into());
-    }
-    let asymmetry = (inertia_com - inertia_com.transpose()).abs().max();
-    let scale = inertia_com.abs().max().max(f64::MIN_POSITIVE);
-    if asymmetry > INERTIA_EIGENVALUE_TOLERANCE * scale {
-        return Err("expected a symmetric inertia tensor".into());
-    }
-    Ok(())
-}
-
-/// Checks that a rotational inertia is positive semi-definite (a point mass, zero, is valid).
-pub fn check_positive_semidefinite(inertia_com: &Mat3) -> std::result::Result<(), String> {
-    let scale = inertia_com.abs().max();
-    let eigenvalues = inertia_com.symmetric_eigenvalues();
-    let smallest = eigenvalues.min();
-    if smallest < -(INERTIA_EIGENVALUE_TOLERANCE * scale).max(INERTIA_ABSOLUTE_TOLERANCE) {
-        return Err(format!(
-            "expected a positive semi-definite inertia tensor, got principal moments [{:.6e}, {:.6e}, {:.6e}]",
-            eigenvalues[0], eigenvalues[1], eigenvalues[2]
-        ));
-    }
-    Ok(())
-}
-
-/// Why ten inertial parameters are not those of a rigid body.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Unphysical {
-    /// No algorithm can compute with them: a value not finite, a negative mass, a first moment
-    /// without mass, or an inertia about the centre of mass that is not positive semi-definite.
-    Invalid(String),
-    /// Positive semi-definite, but the principal moments break a triangle inequality: no body of
-    /// matter has them (its density would be negative somewhere), though every algorithm still
-    /// computes with them, as Pinocchio's do; MuJoCo refuses such a body.
-    TriangleInequality(String),
-}
-
-impl std::fmt::Display for Unphysical {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Unphysical::Invalid(message) | Unphysical::TriangleInequality(message) => {
-                f.write_str(message)
-            }
-        }
-    }
-}
-
-/// The one rule for physical inertias, applied by the loaders, the `inertial_parameters`
-/// setter and Python's `robodyn.inertia.check_physical`: ten inertial parameters [m, h, Ī_O]
-/// describe a rigid body when they are finite, m ≥ 0, and the rotational inertia about the
-/// centre of mass I_C = Ī_O − (h·h 1 − h hᵀ)/m is positive semi-definite with principal moments
-/// obeying the triangle inequalities λ_a + λ_b ≥ λ_c (a massless body has h = 0 and I_C = Ī_O),
-/// all within [`INERTIA_EIGENVALUE_TOLERANCE`] of the tensor's largest entry.
-pub fn check_physical_parameters(p: &[f64; 10]) -> std::result::Result<(), Unphysical> {
-    if let Some(k) = p.iter().position(|x| !x.is_finite()) {
-        return Err(Unphysical::Invalid(format!(
-            "expected finite parameters, got {} at index {k}",
-            p[k]
-        )));
-    }
-    let inertia = Inertia::from_parameters(p);
-    let (mass, h) = (inertia.mass, inertia.first_moment);
-    if mass < 0.0 {
-        return Err(Unphysical::Invalid(format!(
-            "expected a mass >= 0, got {mass}"
-        )));
-    }
-    let scale = inertia.rotational.abs().max();
-    let tolerance = (INERTIA_EIGENVALUE_TOLERANCE * scale).max(INERTIA_ABSOLUTE_TOLERANCE);
-    let inertia_com = if mass > 0.0 {
-        inertia.rotational - (Mat3::identity() * h.norm_squared() - h * h.transpose()) / mass
-    } else if h.norm() > INERTIA_ABSOLUTE_TOLERANCE {
-        return Err(Unphysical::Invalid(format!(
-            "a massless body has no first moment, got m c = [{}, {}, {}]",
-            h.x, h.y, h.z
-        )));
-    } else {
-        inertia.rotational
-    };
-    check_positive_semidefinite(&inertia_com).map_err(Unphysical::Invalid)?;
-    // sorted, λ₁ ≤ λ₂ ≤ λ₃, only λ₁ + λ₂ ≥ λ₃ can fail
-    let mut moments: [f64; 3] = inertia_com.symmetric_eigenvalues().into();
-    moments.sort_by(f64::total_cmp);
-    let [a, b, c] = moments;
-    if a + b < c - tolerance {
-        return Err(Unphysical::TriangleInequality(format!(
-            "the principal moments about the centre of mass [{a:.6e}, {b:.6e}, {c:.6e}] break the triangle inequality ({a:.6e} + {b:.6e} < {c:.6e}): no rigid body has them"
-        )));
-    }
-    Ok(())
-}
-
-impl Model {
-    /// The fields derived from the others, not stored in snapshots: found when a model is
-    /// built or read back.
-    pub(crate) fn derive(&mut self) {
-        self.dof_run_start = dof_run_starts(&self.dof_parent);
-        self.subtree_dof_end = subtree_dof_ends(&self.parent, &self.idx_v, self.nv);
-        self.turns = (self.joints.iter().zip(&self.x_tree))
-            .map(|(joint, x)| joint.turn(x))
-            .collect();
-        self.subspace_components = (self.joints.iter())
-            .flat_map(|joint| (0..joint.nv()).map(|k| joint.subspace_component(k)))
-            .collect();
-    }
-}
-
-/// A tree transform as the model stores it: a rotation within round-off of quarter turns stored
-/// exactly, so that the joint's transforms leave out their zeros.
-pub(crate) fn tree_transform(x_tree: Transform) -> Transform {
-    let rotation = snapped_signed_permutation(&x_tree.rotation).unwrap_or(x_tree.rotation);
-    Transform { rotation, ..x_tree }
-}
-
-/// [`Model::dof_run_start`] from the coordinates' parents.
-pub(crate) fn dof_run_starts(dof_parent: &[Option<usize>]) -> Vec<usize> {
-    let mut starts = Vec::with_capacity(dof_parent.len());
-    for (k, parent) in dof_parent.iter().enumerate() {
-        starts.push(run_start(&starts, *parent, k));
-    }
-    starts
-}
-
-/// [`Model::subtree_dof_end`] from the bodies' parents and first coordinates (`nv` in all).
-pub(crate) fn subtree_dof_ends(parent: &[usize], idx_v: &[usize], nv: usize) -> Option<Vec<usize>> {
-    // depth-first order: each body's parent is on the path from the world to the body before it
-    let mut path = vec![0];
-    for (body, &p) in parent.iter().enumerate().skip(1) {
-        while *path.last()? != p {
-            path.pop();
-        }
-        path.push(body);
-    }
-    // then a subtree's bodies are the next `size` ones, its coordinates end where the body
-    // after them begins
-    let mut size = vec![1; parent.len()];
-    for body in (1..parent.len()).rev() {
-        size[parent[body]] += size[body];
-    }
-    let first_coordinate = |body: usize| idx_v.get(body).copied().unwrap_or(nv);
-    Some(
-        (0..parent.len())
-            .map(|body| first_coordinate(body + size[body]))
-            .collect(),
-    )
-}
-
-/// The start of coordinate k's run, given the runs of the coordinates before it.
-fn run_start(starts: &[usize], parent: Option<usize>, k: usize) -> usize {
-    match parent {
-        Some(p) if p + 1 == k => starts[p],
-        _ => k,
-    }
-}
-
-/// Iterator of [`Model::ancestor_runs`].
-pub struct AncestorRuns<'m> {
-    model: &'m Model,
-    top: Option<usize>,
-}
-
-impl Iterator for AncestorRuns<'_> {
-    type Item = std::ops::Range<usize>;
-
-    #[inline(always)]
-    fn next(&mut self) -> Option<Self::Item> {
-        let end = self.top?;
-        let start = self.model.dof_run_start[end];
-        self.top = self.model.dof_parent[start];
-        Some(start..end + 1)
-    }
 }
