@@ -75,8 +75,8 @@ pub fn rnea_derivatives(
         DerivativesInto::Data => {
             let (by_q, by_v) = (take(&mut data.dtau_dq), take(&mut data.dtau_dv));
             let mut matrices = Matrices(by_q, by_v);
-            matrices.0.fill(0.0);
-            matrices.1.fill(0.0);
+            matrices.0.as_mut_slice().fill(0.0);
+            matrices.1.as_mut_slice().fill(0.0);
             one_state_derivatives(
                 model,
                 &mut DerivativeBuffers::of(data),

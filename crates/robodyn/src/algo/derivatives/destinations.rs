@@ -46,33 +46,35 @@ impl DerivativesInto<'_> {
     /// Hands `data.derivative_rows` (row i = [∂q̈_i/∂q, ∂q̈_i/∂q̇, (M⁻¹)_i]) on as `self` says.
     pub(super) fn copy_rows(self, data: &mut Data) {
         let nv = data.qdd.len();
-        let rows = data.derivative_rows.chunks_exact(3 * nv).enumerate();
+        if nv == 0 {
+            return;
+        }
         match self {
             DerivativesInto::Data => {
-                for (i, row) in rows {
-                    let matrices = [
-                        &mut data.dqdd_dq,
-                        &mut data.dqdd_dv,
-                        &mut data.mass_matrix_inverse,
-                    ];
-                    for (matrix, part) in matrices.into_iter().zip(row.chunks_exact(nv)) {
-                        matrix
-                            .row_mut(i)
-                            .iter_mut()
-                            .zip(part)
-                            .for_each(|(x, y)| *x = *y);
+                // into the matrices column by column, as they are stored
+                let width = 3 * nv;
+                let matrices = [
+                    &mut data.dqdd_dq,
+                    &mut data.dqdd_dv,
+                    &mut data.mass_matrix_inverse,
+                ];
+                for (block, matrix) in matrices.into_iter().enumerate() {
+                    for (j, column) in matrix.as_mut_slice().chunks_exact_mut(nv).enumerate() {
+                        for (i, x) in column.iter_mut().enumerate() {
+                            *x = data.derivative_rows[i * width + block * nv + j];
+                        }
                     }
                 }
             }
             DerivativesInto::RowMajor { by_q, by_v } => {
-                for (i, row) in rows {
+                for (i, row) in data.derivative_rows.chunks_exact(3 * nv).enumerate() {
                     by_q[i * nv..][..nv].copy_from_slice(&row[..nv]);
                     by_v[i * nv..][..nv].copy_from_slice(&row[nv..2 * nv]);
                 }
             }
             DerivativesInto::Stacked(out) => {
                 // each third of row i to row i of its block
-                for (i, row) in rows {
+                for (i, row) in data.derivative_rows.chunks_exact(3 * nv).enumerate() {
                     for (block, part) in row.chunks_exact(nv).enumerate() {
                         out[(block * nv + i) * nv..][..nv].copy_from_slice(part);
                     }
