@@ -8,6 +8,7 @@ pub const SINGULARITY_TOLERANCE: f64 = 1e-12;
 
 pub mod aba;
 pub mod centroidal;
+pub mod constrained;
 pub mod coriolis;
 pub mod crba;
 pub mod derivatives;
@@ -27,6 +28,10 @@ pub mod textbook_forms;
 
 pub use aba::aba;
 pub use centroidal::centroidal_momentum_matrix;
+pub use constrained::{
+    constrained_forward_dynamics, constrained_inverse_dynamics, constraint_jacobian, delassus,
+    impulse_dynamics, ConstrainedOptions, ConstraintData,
+};
 pub use coriolis::{christoffel_symbols, coriolis_matrix};
 pub use crba::{crba, crba_into};
 pub use derivatives::{aba_derivatives, rnea_derivatives, DerivativesInto, DynamicsState};

@@ -1,0 +1,284 @@
+//! Dynamics under rigid constraints: forward dynamics, impulses and inverse dynamics with the
+//! constraints of a [`ConstraintSet`], and the constraint Jacobian and Delassus matrix.
+//!
+//! Reference: Featherstone, *Rigid Body Dynamics Algorithms* (2008), §8.1-8.3 (the constrained
+//! equations of motion, solved through the constraint-space inverse inertia) and §6.5 (the
+//! tree-sparse factorisation M = Lᵀ D L); Carpentier, Budhiraja and Mansard, RSS 2021 (the
+//! proximal solve). The equations, with J the constraint rows and γ = J̇ q̇ their drift:
+//! ```text
+//!   M q̈ + h = τ + Jᵀ λ,      J q̈ + γ = −K_d J q̇ − K_p φ   (Baumgarte's terms optional)
+//! ```
+//! With the free acceleration `a_f = M⁻¹ (τ − h)` and the Delassus matrix `Λ⁻¹ = J M⁻¹ Jᵀ`:
+//! ```text
+//!   Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ),      q̈ = a_f + M⁻¹ Jᵀ λ
+//! ```
+//! M⁻¹ Jᵀ comes from M's tree-sparse factor, one solve per row; no matrix of size nv + rows is
+//! formed. Λ⁻¹ is solved by Cholesky, or, with damping μ > 0, by proximal iterations that give
+//! the least-norm forces of a redundant set (a loop closure stated twice).
+//! The results live in a [`ConstraintData`] made for the set.
+
+mod forward;
+mod inverse;
+mod solve;
+
+pub use forward::{constrained_forward_dynamics, impulse_dynamics, ConstrainedOptions};
+pub use inverse::{constrained_inverse_dynamics, CONSTRAINT_ACCELERATION_TOLERANCE};
+pub use solve::{DEPENDENT_ROW_TOLERANCE, PROXIMAL_ACCURACY, PROXIMAL_MAX_ITERATIONS};
+
+use crate::algo::crba::crba;
+use crate::algo::kinematics::update_body_placements;
+use crate::algo::ltdl::{factor_mass_matrix, solve_rows};
+use crate::constraint::{evaluate, BodyMotion, ConstraintRows, ConstraintSet};
+use crate::error::{check_vector, Error, Result};
+use crate::model::Model;
+use crate::spatial::Motion;
+use crate::Data;
+use nalgebra::{DMatrix, DVector};
+use solve::{solve_symmetric, SolveFailure, SolveScratch};
+
+/// The workspace and results of the constrained algorithms for one [`ConstraintSet`] (m rows)
+/// on one model (nv coordinates). Made once by [`ConstraintData::new`].
+#[derive(Debug, Clone)]
+pub struct ConstraintData {
+    /// J (m × nv): the rows' velocity is `J q̇`. Written by every algorithm here.
+    pub jacobian: DMatrix<f64>,
+    /// γ = J̇ q̇ (m): the rows' acceleration is `J q̈ + γ`.
+    pub drift: DVector<f64>,
+    /// φ (m): how far each row is from holding (zero for a point held where it is).
+    pub error: DVector<f64>,
+    /// J M⁻¹ (m × nv).
+    pub jacobian_inverse_inertia: DMatrix<f64>,
+    /// The Delassus matrix J M⁻¹ Jᵀ (m × m).
+    pub delassus: DMatrix<f64>,
+    /// λ (m): the constraint forces (or impulses) on the robot, `M q̈ + h = τ + Jᵀ λ`.
+    pub forces: DVector<f64>,
+    /// q̈ of [`constrained_forward_dynamics`], or q̇ after [`impulse_dynamics`] (nv).
+    pub qdd: DVector<f64>,
+    /// τ of [`constrained_inverse_dynamics`] (nv, zero on coordinates not actuated).
+    pub tau: DVector<f64>,
+    /// The proximal iterations the last solve took (0: solved directly).
+    pub iterations: usize,
+    /// The free acceleration `M⁻¹ (τ − h)` (nv).
+    free_acceleration: DVector<f64>,
+    /// The right-hand side of the last solve.
+    rhs: Vec<f64>,
+    /// Cholesky factor and scratch of the last solve (room for max(m, nv)).
+    factor: Vec<f64>,
+    gram: Vec<f64>,
+    unknowns: Vec<f64>,
+    residual: Vec<f64>,
+    step: Vec<f64>,
+}
+
+impl ConstraintData {
+    /// The workspace for `set` on `model`.
+    pub fn new(model: &Model, set: &ConstraintSet) -> Self {
+        let (m, nv) = (set.rows(), model.nv);
+        let n = m.max(nv);
+        ConstraintData {
+            jacobian: DMatrix::zeros(m, nv),
+            drift: DVector::zeros(m),
+            error: DVector::zeros(m),
+            jacobian_inverse_inertia: DMatrix::zeros(m, nv),
+            delassus: DMatrix::zeros(m, m),
+            forces: DVector::zeros(m),
+            qdd: DVector::zeros(nv),
+            tau: DVector::zeros(nv),
+            iterations: 0,
+            free_acceleration: DVector::zeros(nv),
+            rhs: vec![0.0; n],
+            factor: vec![0.0; n * n],
+            gram: vec![0.0; n * n],
+            unknowns: vec![0.0; n],
+            residual: vec![0.0; n],
+            step: vec![0.0; n],
+        }
+    }
+
+    /// Whether this workspace was made for a set of `set`'s size on `model`.
+    pub fn fits(&self, model: &Model, set: &ConstraintSet) -> bool {
+        self.jacobian.nrows() == set.rows() && self.jacobian.ncols() == model.nv
+    }
+}
+
+/// The constraint Jacobian J(q) of `set` (rows × nv), in `constraints.jacobian`.
+pub fn constraint_jacobian<'c>(
+    model: &Model,
+    data: &mut Data,
+    constraints: &'c mut ConstraintData,
+    set: &ConstraintSet,
+    q: &[f64],
+) -> Result<&'c DMatrix<f64>> {
+    check_fits(model, constraints, set)?;
+    rows_at_rest(model, data, constraints, set, q)?;
+    Ok(&constraints.jacobian)
+}
+
+/// The Delassus matrix J M⁻¹ Jᵀ of `set` at q (rows × rows), in `constraints.delassus`.
+pub fn delassus<'c>(
+    model: &Model,
+    data: &mut Data,
+    constraints: &'c mut ConstraintData,
+    set: &ConstraintSet,
+    q: &[f64],
+) -> Result<&'c DMatrix<f64>> {
+    check_fits(model, constraints, set)?;
+    factor_inertia(model, data, q)?;
+    rows_at_rest(model, data, constraints, set, q)?;
+    delassus_matrix(model, data, constraints);
+    Ok(&constraints.delassus)
+}
+
+/// [`constraint_rows`] at q̇ = 0 (J and φ; γ is then zero).
+fn rows_at_rest(
+    model: &Model,
+    data: &mut Data,
+    constraints: &mut ConstraintData,
+    set: &ConstraintSet,
+    q: &[f64],
+) -> Result<()> {
+    let mut rest = std::mem::take(&mut constraints.free_acceleration);
+    rest.fill(0.0);
+    let result = constraint_rows(model, data, constraints, set, q, rest.as_slice());
+    constraints.free_acceleration = rest;
+    result
+}
+
+/// Refuses a workspace made for another set or model.
+fn check_fits(model: &Model, constraints: &ConstraintData, set: &ConstraintSet) -> Result<()> {
+    if constraints.fits(model, set) {
+        return Ok(());
+    }
+    Err(Error::Shape {
+        argument: "constraints".into(),
+        expected: format!(
+            "a ConstraintData of {} rows and {} columns",
+            set.rows(),
+            model.nv
+        ),
+        received: format!(
+            "{} rows and {} columns",
+            constraints.jacobian.nrows(),
+            constraints.jacobian.ncols()
+        ),
+    })
+}
+
+/// M(q) by CRBA and its factor M = Lᵀ D L (`data.mass_matrix`, `data.mass_matrix_factor`).
+fn factor_inertia(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
+    crba(model, data, q)?;
+    factor_mass_matrix(model, data)
+}
+
+/// J, γ and φ at (q, q̇): the bodies' placements, velocities and accelerations with q̈ = 0 (no
+/// gravity) by the outward pass of Table 5.1, then each constraint's rows. Writes `data.x_up`,
+/// `data.x_world`, `data.v`, `data.a`.
+fn constraint_rows(
+    model: &Model,
+    data: &mut Data,
+    constraints: &mut ConstraintData,
+    set: &ConstraintSet,
+    q: &[f64],
+    v: &[f64],
+) -> Result<()> {
+    model.check_configuration(q)?;
+    check_vector("v", v, model.nv)?;
+    update_body_placements(model, data, q);
+    // v_i = X_i v_λ(i) + S q̇_i;  a_i = X_i a_λ(i) + v_i × S q̇_i
+    data.v[0] = Motion::ZERO;
+    data.a[0] = Motion::ZERO;
+    for i in 1..model.nbodies() {
+        let parent = model.parent[i];
+        let v_j = model.joints[i].motion(&v[model.v_range(i)]);
+        let v_i = data.x_up[i].apply_motion(&data.v[parent]) + v_j;
+        data.a[i] = data.x_up[i].apply_motion(&data.a[parent]) + v_i.cross_motion(&v_j);
+        data.v[i] = v_i;
+    }
+    let bodies = BodyMotion {
+        x_world: &data.x_world,
+        v: &data.v,
+        a: &data.a,
+    };
+    let rows = ConstraintRows {
+        jacobian: &mut constraints.jacobian,
+        drift: constraints.drift.as_mut_slice(),
+        error: constraints.error.as_mut_slice(),
+    };
+    evaluate(model, set, &bodies, (q, v), rows);
+    Ok(())
+}
+
+/// J M⁻¹ by the factor's sweeps (one right-hand side per row), then `Λ⁻¹ = Σ_c J_:c (J M⁻¹)_:cᵀ`.
+fn delassus_matrix(model: &Model, data: &Data, constraints: &mut ConstraintData) {
+    let ConstraintData {
+        jacobian,
+        jacobian_inverse_inertia,
+        delassus,
+        ..
+    } = constraints;
+    // column-major J (m × nv) is Jᵀ row by row: M X = Jᵀ gives X = M⁻¹ Jᵀ, that is J M⁻¹
+    jacobian_inverse_inertia.copy_from(jacobian);
+    solve_rows(model, data, jacobian_inverse_inertia.as_mut_slice());
+    delassus.fill(0.0);
+    for c in 0..model.nv {
+        delassus.ger(
+            1.0,
+            &jacobian.column(c),
+            &jacobian_inverse_inertia.column(c),
+            1.0,
+        );
+    }
+}
+
+/// Solves `Λ⁻¹ λ = rhs` (the right-hand side in `constraints.rhs`) into `constraints.forces`;
+/// a dependent row without damping, or an inconsistent set, is an error naming its rows.
+fn solve_forces(
+    model: &Model,
+    set: &ConstraintSet,
+    constraints: &mut ConstraintData,
+    damping: f64,
+) -> Result<()> {
+    let m = set.rows();
+    let ConstraintData {
+        delassus,
+        forces,
+        rhs,
+        factor,
+        residual,
+        step,
+        iterations,
+        ..
+    } = constraints;
+    let scratch = SolveScratch { residual, step };
+    let solved = solve_symmetric(
+        m,
+        delassus.as_slice(),
+        factor,
+        rhs,
+        forces.as_mut_slice(),
+        damping,
+        scratch,
+    );
+    match solved {
+        Ok(n) => {
+            *iterations = n;
+            Ok(())
+        }
+        Err(SolveFailure::DependentRow(row)) => Err(Error::InvalidValue {
+            argument: "constraints".into(),
+            message: format!(
+                "the constraints are redundant or singular at this configuration: {} is zero or \
+                 a combination of the rows before it; pass damping > 0 for their least-norm \
+                 forces",
+                set.describe_row(model, row)
+            ),
+        }),
+        Err(SolveFailure::Inconsistent { residual }) => Err(Error::InvalidValue {
+            argument: "constraints".into(),
+            message: format!(
+                "the constraints cannot all hold: after {PROXIMAL_MAX_ITERATIONS} proximal \
+                 iterations their acceleration residual is still {residual:.3e}"
+            ),
+        }),
+    }
+}

@@ -1,0 +1,161 @@
+//! Forward dynamics and impulses under rigid constraints.
+//!
+//! Reference: Featherstone, *Rigid Body Dynamics Algorithms* (2008), §8.3 (the constraint forces
+//! from the constraint-space inverse inertia) and §11.6 (impulses); Pinocchio's
+//! `constraintDynamics` and `impulseDynamics` compute the same quantities. See the module's
+//! header for the equations. Inputs: q, q̇, τ (or only q, q̇), the constraint set. Writes
+//! `constraints.qdd`, `constraints.forces` and everything on the way (J, γ, φ, J M⁻¹, Λ⁻¹), and
+//! in `data`: RNEA's fields, the mass matrix and its factor, the body placements. Cost: RNEA,
+//! CRBA and M's factor, one tree-sparse solve per row, O(m² nv) for Λ⁻¹ and O(m³) to solve it.
+
+use super::{constraint_rows, delassus_matrix, factor_inertia, solve_forces, ConstraintData};
+use crate::algo::ltdl::solve_rows;
+use crate::algo::rnea::newton_euler;
+use crate::constraint::ConstraintSet;
+use crate::error::{check_vector, Error, Result};
+use crate::model::Model;
+use crate::spatial::Force;
+use crate::Data;
+
+/// How the constraint equations are solved.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ConstrainedOptions {
+    /// Baumgarte's gains `(K_p, K_d)` (1/s², 1/s): the rows' acceleration is held to
+    /// `−K_d J q̇ − K_p φ` instead of zero, pulling a drifting loop back. `None`: zero.
+    pub baumgarte: Option<(f64, f64)>,
+    /// μ ≥ 0: with μ > 0 the forces are found by proximal iterations on `Λ⁻¹ + μ 1`, which
+    /// accept redundant rows (least-norm forces); with 0 a redundant row is an error naming it.
+    pub damping: f64,
+}
+
+impl ConstrainedOptions {
+    /// Refuses negative or non-finite gains and damping.
+    fn check(&self) -> Result<()> {
+        let (kp, kd) = self.baumgarte.unwrap_or((0.0, 0.0));
+        for (name, value) in [
+            ("baumgarte", kp),
+            ("baumgarte", kd),
+            ("damping", self.damping),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(Error::InvalidValue {
+                    argument: name.into(),
+                    message: format!("expected a finite value ≥ 0, got {value}"),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// q̈ and λ under the constraints of `set`: `M q̈ + h = τ + Jᵀ λ`, `J q̈ + γ = −K_d J q̇ − K_p φ`.
+/// `f_ext` as in [`crate::algo::rnea()`]. Results in `constraints.qdd` and `constraints.forces`.
+#[allow(clippy::too_many_arguments)]
+pub fn constrained_forward_dynamics(
+    model: &Model,
+    data: &mut Data,
+    constraints: &mut ConstraintData,
+    set: &ConstraintSet,
+    (q, v, tau): (&[f64], &[f64], &[f64]),
+    f_ext: Option<&[Force]>,
+    options: &ConstrainedOptions,
+) -> Result<()> {
+    super::check_fits(model, constraints, set)?;
+    check_vector("v", v, model.nv)?;
+    check_vector("tau", tau, model.nv)?;
+    options.check()?;
+
+    // a_f = M⁻¹ (τ − h), h = C q̇ + g − Σ Jᵀ f_ext (RNEA with q̈ = 0), M = Lᵀ D L
+    let h = newton_euler(model, data, q, Some(v), None, f_ext)?;
+    let free = &mut constraints.free_acceleration;
+    for ((a, t), b) in free.iter_mut().zip(tau).zip(h.iter()) {
+        *a = t - b;
+    }
+    factor_inertia(model, data, q)?;
+    solve_rows(model, data, constraints.free_acceleration.as_mut_slice());
+
+    // J, γ, φ; then J M⁻¹ and Λ⁻¹ = J M⁻¹ Jᵀ
+    constraint_rows(model, data, constraints, set, q, v)?;
+    delassus_matrix(model, data, constraints);
+
+    // Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ)
+    let (kp, kd) = options.baumgarte.unwrap_or((0.0, 0.0));
+    let ConstraintData {
+        jacobian,
+        drift,
+        error,
+        free_acceleration,
+        rhs,
+        ..
+    } = constraints;
+    for (r, value) in rhs.iter_mut().take(set.rows()).enumerate() {
+        let row = jacobian.row(r);
+        let (ja, jv) = (
+            row.dot(&free_acceleration.transpose()),
+            row.iter().zip(v).map(|(j, vi)| j * vi).sum::<f64>(),
+        );
+        *value = -(ja + drift[r] + kd * jv + kp * error[r]);
+    }
+    solve_forces(model, set, constraints, options.damping)?;
+
+    // q̈ = a_f + M⁻¹ Jᵀ λ = a_f + (J M⁻¹)ᵀ λ
+    let ConstraintData {
+        jacobian_inverse_inertia,
+        forces,
+        free_acceleration,
+        qdd,
+        ..
+    } = constraints;
+    qdd.copy_from(free_acceleration);
+    qdd.gemv_tr(1.0, jacobian_inverse_inertia, forces, 1.0);
+    Ok(())
+}
+
+/// q̇ after an impact that makes the constraints of `set` hold at velocity level:
+/// `M (q̇⁺ − q̇) = Jᵀ Λ`, `J q̇⁺ = −e J q̇` (e: `restitution`, from 0, plastic, to 1, elastic).
+/// Results: q̇⁺ in `constraints.qdd`, the impulses Λ in `constraints.forces`.
+pub fn impulse_dynamics(
+    model: &Model,
+    data: &mut Data,
+    constraints: &mut ConstraintData,
+    set: &ConstraintSet,
+    (q, v): (&[f64], &[f64]),
+    restitution: f64,
+    damping: f64,
+) -> Result<()> {
+    super::check_fits(model, constraints, set)?;
+    check_vector("v", v, model.nv)?;
+    if !(0.0..=1.0).contains(&restitution) {
+        return Err(Error::InvalidValue {
+            argument: "restitution".into(),
+            message: format!("expected a value from 0 to 1, got {restitution}"),
+        });
+    }
+    let options = ConstrainedOptions {
+        baumgarte: None,
+        damping,
+    };
+    options.check()?;
+    factor_inertia(model, data, q)?;
+    constraint_rows(model, data, constraints, set, q, v)?;
+    delassus_matrix(model, data, constraints);
+
+    // Λ⁻¹ Λ = −(1 + e) J q̇
+    let ConstraintData { jacobian, rhs, .. } = constraints;
+    for (r, value) in rhs.iter_mut().take(set.rows()).enumerate() {
+        let jv: f64 = jacobian.row(r).iter().zip(v).map(|(j, vi)| j * vi).sum();
+        *value = -(1.0 + restitution) * jv;
+    }
+    solve_forces(model, set, constraints, damping)?;
+
+    // q̇⁺ = q̇ + M⁻¹ Jᵀ Λ
+    let ConstraintData {
+        jacobian_inverse_inertia,
+        forces,
+        qdd,
+        ..
+    } = constraints;
+    qdd.copy_from_slice(v);
+    qdd.gemv_tr(1.0, jacobian_inverse_inertia, forces, 1.0);
+    Ok(())
+}

@@ -1,0 +1,207 @@
+//! The small dense solves of constrained dynamics: `A x = b` for a symmetric positive
+//! semi-definite A (the Delassus matrix J M⁻¹ Jᵀ, or a Gram matrix), exactly by Cholesky, or by
+//! proximal iterations where A is singular.
+//!
+//! Reference: Golub and Van Loan, *Matrix Computations* (4th ed.), §4.2 (Cholesky); the proximal
+//! point method for a singular system as used for rigid constraints by Carpentier, Budhiraja and
+//! Mansard, "Proximal and sparse resolution of constrained dynamic equations", RSS 2021:
+//! ```text
+//!   x_{k+1} = x_k + (A + μ 1)⁻¹ (b − A x_k)
+//! ```
+//! which from x_0 = 0 converges, for any μ > 0 and b in the range of A, to the solution of
+//! least norm, each eigen-direction's error shrinking by μ / (σ + μ) per iteration.
+//! Matrices are n × n, column-major, in slices.
+
+/// A Cholesky pivot below this times its row's diagonal entry means the row is a combination of
+/// the rows before it: `L_kk² / A_kk = sin²` of the angle between that row and their span (in
+/// the metric of M⁻¹), so rows closer than 1e-5 rad to dependent are called dependent.
+pub const DEPENDENT_ROW_TOLERANCE: f64 = 1e-10;
+
+/// The proximal iterations stop once `|b − A x|∞ ≤ PROXIMAL_ACCURACY (1 + |b|∞)`.
+pub const PROXIMAL_ACCURACY: f64 = 1e-12;
+
+/// At most this many proximal iterations; a system still unsolved is refused as inconsistent.
+pub const PROXIMAL_MAX_ITERATIONS: usize = 500;
+
+/// Why a solve failed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum SolveFailure {
+    /// Row `k` is a combination of the rows before it (or zero): A is singular.
+    DependentRow(usize),
+    /// The proximal iterations did not reach [`PROXIMAL_ACCURACY`]: `b` is not in A's range.
+    Inconsistent {
+        /// `|b − A x|∞` at the last iteration.
+        residual: f64,
+    },
+}
+
+/// Scratch vectors of length n for the proximal iterations.
+pub(crate) struct SolveScratch<'a> {
+    /// b − A x.
+    pub residual: &'a mut [f64],
+    /// (A + μ 1)⁻¹ (b − A x).
+    pub step: &'a mut [f64],
+}
+
+/// Solves `a x = b` (a: n × n, symmetric positive semi-definite): with `damping` 0 by Cholesky,
+/// refusing a dependent row; with `damping` μ > 0 by proximal iterations on `a + μ 1`.
+/// `factor` (n × n) receives the factor. Returns the number of proximal iterations (0 when
+/// direct).
+pub(crate) fn solve_symmetric(
+    n: usize,
+    a: &[f64],
+    factor: &mut [f64],
+    b: &[f64],
+    x: &mut [f64],
+    damping: f64,
+    scratch: SolveScratch,
+) -> Result<usize, SolveFailure> {
+    factor[..n * n].copy_from_slice(&a[..n * n]);
+    if damping == 0.0 {
+        cholesky(n, factor)?;
+        x[..n].copy_from_slice(&b[..n]);
+        cholesky_solve(n, factor, x);
+        return Ok(0);
+    }
+    for k in 0..n {
+        factor[k + k * n] += damping;
+    }
+    cholesky(n, factor)?;
+    let SolveScratch { residual, step } = scratch;
+    x[..n].fill(0.0);
+    residual[..n].copy_from_slice(&b[..n]);
+    let tolerance = PROXIMAL_ACCURACY * (1.0 + largest(&b[..n]));
+    for iteration in 1..=PROXIMAL_MAX_ITERATIONS {
+        // x ← x + (A + μ 1)⁻¹ (b − A x)
+        step[..n].copy_from_slice(&residual[..n]);
+        cholesky_solve(n, factor, step);
+        for (xi, si) in x[..n].iter_mut().zip(&step[..n]) {
+            *xi += si;
+        }
+        // b − A x
+        residual[..n].copy_from_slice(&b[..n]);
+        for (column, &xj) in x[..n].iter().enumerate() {
+            for (r, aij) in residual[..n]
+                .iter_mut()
+                .zip(&a[column * n..(column + 1) * n])
+            {
+                *r -= aij * xj;
+            }
+        }
+        if largest(&residual[..n]) <= tolerance {
+            return Ok(iteration);
+        }
+    }
+    Err(SolveFailure::Inconsistent {
+        residual: largest(&residual[..n]),
+    })
+}
+
+/// The largest magnitude of `values` (0 when empty).
+pub(crate) fn largest(values: &[f64]) -> f64 {
+    values.iter().fold(0.0, |m, x| m.max(x.abs()))
+}
+
+/// In place, `a = L Lᵀ` with L lower triangular (below and on the diagonal; above is left as it
+/// was). A pivot not above [`DEPENDENT_ROW_TOLERANCE`] times its diagonal entry is refused.
+fn cholesky(n: usize, a: &mut [f64]) -> Result<(), SolveFailure> {
+    let largest_diagonal = (0..n).fold(0.0f64, |m, k| m.max(a[k + k * n]));
+    for k in 0..n {
+        // L_kk² = A_kk − Σ_{j<k} L_kj²
+        let diagonal = a[k + k * n];
+        let mut pivot = diagonal;
+        for j in 0..k {
+            pivot -= a[k + j * n] * a[k + j * n];
+        }
+        let zero_row = diagonal <= f64::EPSILON * largest_diagonal;
+        if zero_row || pivot <= DEPENDENT_ROW_TOLERANCE * diagonal || !pivot.is_finite() {
+            return Err(SolveFailure::DependentRow(k));
+        }
+        let l_kk = pivot.sqrt();
+        a[k + k * n] = l_kk;
+        // L_ik = (A_ik − Σ_{j<k} L_ij L_kj) / L_kk
+        for i in k + 1..n {
+            let mut sum = a[i + k * n];
+            for j in 0..k {
+                sum -= a[i + j * n] * a[k + j * n];
+            }
+            a[i + k * n] = sum / l_kk;
+        }
+    }
+    Ok(())
+}
+
+/// Solves `L Lᵀ x = b` in place (b in `x`) with the factor of [`cholesky`].
+fn cholesky_solve(n: usize, l: &[f64], x: &mut [f64]) {
+    // L y = b
+    for k in 0..n {
+        let mut sum = x[k];
+        for j in 0..k {
+            sum -= l[k + j * n] * x[j];
+        }
+        x[k] = sum / l[k + k * n];
+    }
+    // Lᵀ x = y
+    for k in (0..n).rev() {
+        let mut sum = x[k];
+        for j in k + 1..n {
+            sum -= l[j + k * n] * x[j];
+        }
+        x[k] = sum / l[k + k * n];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A = B Bᵀ for B with a repeated row: rank 2 of 3.
+    fn singular() -> (Vec<f64>, Vec<f64>) {
+        let rows = [[1.0, 2.0, 0.5], [0.0, 1.0, -1.0], [1.0, 2.0, 0.5]];
+        let mut a = vec![0.0; 9];
+        for i in 0..3 {
+            for j in 0..3 {
+                a[i + 3 * j] = (0..3).map(|k| rows[i][k] * rows[j][k]).sum();
+            }
+        }
+        // b = A [1, 2, 3]: in A's range
+        let b = (0..3)
+            .map(|i| (0..3).map(|j| a[i + 3 * j] * (j + 1) as f64).sum())
+            .collect();
+        (a, b)
+    }
+
+    fn run(a: &[f64], b: &[f64], damping: f64) -> (Result<usize, SolveFailure>, Vec<f64>) {
+        let (mut factor, mut x, mut r, mut s) = (vec![0.0; 9], vec![0.0; 3], [0.0; 3], [0.0; 3]);
+        let scratch = SolveScratch {
+            residual: &mut r,
+            step: &mut s,
+        };
+        let result = solve_symmetric(3, a, &mut factor, b, &mut x, damping, scratch);
+        (result, x)
+    }
+
+    #[test]
+    fn a_dependent_row_is_named_and_the_proximal_solve_finds_the_least_norm_solution() {
+        let (a, b) = singular();
+        assert_eq!(run(&a, &b, 0.0).0, Err(SolveFailure::DependentRow(2)));
+        let (result, x) = run(&a, &b, 1e-3);
+        assert!(result.is_ok(), "{result:?}");
+        // least norm: the two equal rows share their part equally
+        assert!((x[0] - x[2]).abs() < 1e-9, "{x:?}");
+        for i in 0..3 {
+            let ax: f64 = (0..3).map(|j| a[i + 3 * j] * x[j]).sum();
+            assert!((ax - b[i]).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn an_inconsistent_system_is_refused() {
+        let (a, _) = singular();
+        let b = [1.0, 0.0, -1.0];
+        assert!(matches!(
+            run(&a, &b, 1e-3).0,
+            Err(SolveFailure::Inconsistent { .. })
+        ));
+    }
+}

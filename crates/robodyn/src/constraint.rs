@@ -1,0 +1,325 @@
+//! Constraints on a robot: what is held, its rows, and the frame its forces are expressed in.
+//!
+//! A constraint is a set of rows `φ(q) = 0` whose velocity form is `J(q) q̇ = 0` and whose
+//! acceleration form is `J q̈ + γ = 0`, with the drift `γ = J̇ q̇`. Its forces λ are what it exerts
+//! on the robot: `M q̈ + h = τ + Jᵀ λ` (Pinocchio's `lambda_c`). The kinds:
+//!
+//! - [`ConstraintKind::Point`]: a point of one frame held to the world or to a point of another
+//!   frame, 3 rows: the velocity of the first point minus that of the second.
+//! - [`ConstraintKind::Frame`]: a frame held to the world or to another frame, 6 rows `[linear;
+//!   angular]` (the velocity of its origin and its angular velocity, minus the second's), or the
+//!   rows its mask keeps.
+//! - [`ConstraintKind::Coupling`]: one joint's coordinate a polynomial of another's (MuJoCo's joint
+//!   equality, a URDF mimic), 1 row.
+//! - [`ConstraintKind::Distance`]: two points at a fixed distance, 1 row.
+//!
+//! Rows of points and frames are in world axes ([`ConstraintReference::World`], Pinocchio's
+//! LOCAL_WORLD_ALIGNED) or in the axes of the first frame ([`ConstraintReference::Local`]); their
+//! forces are expressed in the same axes, applied at the first point. `rows.rs` evaluates them.
+
+mod rows;
+
+pub(crate) use rows::{evaluate, BodyMotion, ConstraintRows};
+
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::spatial::Transform;
+
+/// The axes a point or frame constraint's rows (and forces) are expressed in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum ConstraintReference {
+    /// World axes at the constrained point (Pinocchio's LOCAL_WORLD_ALIGNED).
+    World,
+    /// The axes of the first frame (with its placement), at the constrained point.
+    Local,
+}
+
+/// Where a point or frame constraint attaches: a frame of the model (or the world) and the
+/// constraint frame's placement in it.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Attachment {
+    /// The model frame (`Model::frames` index), or `None` for the world.
+    pub frame: Option<usize>,
+    /// `X_{c←frame}`: the constraint frame in that frame (for a point, only its translation
+    /// counts: the point's offset).
+    pub placement: Transform,
+}
+
+impl Attachment {
+    /// The origin of frame `frame`.
+    pub fn at_frame(frame: usize) -> Self {
+        Attachment {
+            frame: Some(frame),
+            placement: Transform::default(),
+        }
+    }
+}
+
+/// What a constraint holds.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum ConstraintKind {
+    /// The point `first` held to the point `second`, or, with `second` `None`, to the world
+    /// where it is (the position error is then zero). 3 rows.
+    Point {
+        /// The point held.
+        first: Attachment,
+        /// What it is held to.
+        second: Option<Attachment>,
+    },
+    /// The frame `first` held to `second` (or to the world where it is). The rows `[linear x, y,
+    /// z; angular x, y, z]` that `mask` keeps.
+    Frame {
+        /// The frame held.
+        first: Attachment,
+        /// What it is held to.
+        second: Option<Attachment>,
+        /// The rows kept, in the order `[linear; angular]`.
+        mask: [bool; 6],
+    },
+    /// `q_f − q_f,ref = Σ_k c_k (q_l − q_l,ref)^k` between two one-coordinate joints of the
+    /// same kind (bodies `follower` and `leader`). 1 row.
+    Coupling {
+        /// The body whose joint follows.
+        follower: usize,
+        /// The body whose joint leads.
+        leader: usize,
+        /// `c_0 … c_4` (MuJoCo's `polycoef`; a ratio r and offset o are `[o, r, 0, 0, 0]`).
+        polynomial: [f64; 5],
+        /// The coordinates the polynomial is taken about: `(q_f,ref, q_l,ref)`.
+        references: (f64, f64),
+    },
+    /// The points `first` and `second` at distance `length`. 1 row.
+    Distance {
+        /// One point.
+        first: Attachment,
+        /// The other.
+        second: Attachment,
+        /// The distance held (m).
+        length: f64,
+    },
+}
+
+/// One constraint: what it holds and the axes of its rows.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Constraint {
+    /// What is held.
+    pub kind: ConstraintKind,
+    /// The axes of a point or frame constraint's rows (ignored by the others).
+    pub reference: ConstraintReference,
+}
+
+impl Constraint {
+    /// Its number of rows.
+    pub fn rows(&self) -> usize {
+        match &self.kind {
+            ConstraintKind::Point { .. } => 3,
+            ConstraintKind::Frame { mask, .. } => mask.iter().filter(|&&kept| kept).count(),
+            ConstraintKind::Coupling { .. } | ConstraintKind::Distance { .. } => 1,
+        }
+    }
+
+    /// A short description naming its kind and frames or joints, for messages.
+    pub fn describe(&self, model: &Model) -> String {
+        let frame = |a: &Attachment| match a.frame {
+            Some(f) => format!("'{}'", model.frames[f].name),
+            None => "the world".to_string(),
+        };
+        let held_to = |second: &Option<Attachment>| match second {
+            Some(a) => frame(a),
+            None => "the world".to_string(),
+        };
+        match &self.kind {
+            ConstraintKind::Point { first, second } => {
+                format!("PointAnchor({} to {})", frame(first), held_to(second))
+            }
+            ConstraintKind::Frame { first, second, .. } => {
+                format!("FrameAnchor({} to {})", frame(first), held_to(second))
+            }
+            ConstraintKind::Coupling {
+                follower, leader, ..
+            } => format!(
+                "JointCoupling('{}' on '{}')",
+                model.joint_names[*follower], model.joint_names[*leader]
+            ),
+            ConstraintKind::Distance { first, second, .. } => {
+                format!("Distance({} to {})", frame(first), frame(second))
+            }
+        }
+    }
+
+    /// The name of row `k` of this constraint: its axis (`x`, `angular z`, …) for messages.
+    pub fn row_name(&self, k: usize) -> &'static str {
+        const AXES: [&str; 6] = ["x", "y", "z", "angular x", "angular y", "angular z"];
+        match &self.kind {
+            ConstraintKind::Point { .. } => AXES[k],
+            ConstraintKind::Frame { mask, .. } => {
+                let axis = (0..6).filter(|&r| mask[r]).nth(k).unwrap_or(0);
+                AXES[axis]
+            }
+            ConstraintKind::Coupling { .. } | ConstraintKind::Distance { .. } => "the row",
+        }
+    }
+}
+
+/// Constraints checked against a model, with the first row of each.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConstraintSet {
+    constraints: Vec<Constraint>,
+    offsets: Vec<usize>,
+    rows: usize,
+}
+
+impl ConstraintSet {
+    /// Checks each constraint against `model`: its frames and joints exist, a coupling joins two
+    /// one-coordinate joints of the same kind and not a joint to itself, a frame mask keeps a
+    /// row, a distance is positive and finite, placements are finite.
+    pub fn new(model: &Model, constraints: Vec<Constraint>) -> Result<Self> {
+        for (k, constraint) in constraints.iter().enumerate() {
+            check_constraint(model, constraint)
+                .map_err(|message| invalid(format!("constraints[{k}]: {message}")))?;
+        }
+        let mut offsets = Vec::with_capacity(constraints.len());
+        let mut rows = 0;
+        for constraint in &constraints {
+            offsets.push(rows);
+            rows += constraint.rows();
+        }
+        Ok(ConstraintSet {
+            constraints,
+            offsets,
+            rows,
+        })
+    }
+
+    /// The constraints.
+    pub fn constraints(&self) -> &[Constraint] {
+        &self.constraints
+    }
+
+    /// The number of rows of all of them.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// The first row of constraint `k`.
+    pub fn offset(&self, k: usize) -> usize {
+        self.offsets[k]
+    }
+
+    /// The constraint that row `row` belongs to, and the row within it.
+    pub fn row_owner(&self, row: usize) -> (usize, usize) {
+        let k = self.offsets.partition_point(|&start| start <= row) - 1;
+        (k, row - self.offsets[k])
+    }
+
+    /// Names row `row` for a message: `constraints[k] (PointAnchor('foot' to the world)), row y`.
+    pub fn describe_row(&self, model: &Model, row: usize) -> String {
+        let (k, within) = self.row_owner(row);
+        let constraint = &self.constraints[k];
+        format!(
+            "constraints[{k}] ({}), row {}",
+            constraint.describe(model),
+            constraint.row_name(within)
+        )
+    }
+}
+
+/// The error for a constraint argument.
+fn invalid(message: String) -> Error {
+    Error::InvalidValue {
+        argument: "constraints".into(),
+        message,
+    }
+}
+
+/// Why `constraint` does not fit `model`, if it does not.
+fn check_constraint(model: &Model, constraint: &Constraint) -> std::result::Result<(), String> {
+    let attachment = |a: &Attachment| -> std::result::Result<(), String> {
+        if let Some(f) = a.frame {
+            if f >= model.frames.len() {
+                return Err(format!(
+                    "expected a frame index below {}, got {f}",
+                    model.frames.len()
+                ));
+            }
+        }
+        let finite = a.placement.rotation.iter().all(|x| x.is_finite())
+            && a.placement.translation.iter().all(|x| x.is_finite());
+        if !finite {
+            return Err("a placement or offset holds a value that is not finite".into());
+        }
+        Ok(())
+    };
+    match &constraint.kind {
+        ConstraintKind::Point { first, second } => {
+            attachment(first)?;
+            second.iter().try_for_each(attachment)
+        }
+        ConstraintKind::Frame {
+            first,
+            second,
+            mask,
+        } => {
+            attachment(first)?;
+            second.iter().try_for_each(attachment)?;
+            if !mask.iter().any(|&kept| kept) {
+                return Err("the mask keeps no row: expected at least one True of six".into());
+            }
+            Ok(())
+        }
+        ConstraintKind::Distance {
+            first,
+            second,
+            length,
+        } => {
+            attachment(first)?;
+            attachment(second)?;
+            if !(length.is_finite() && *length > 0.0) {
+                return Err(format!(
+                    "expected a positive finite length (m), got {length}"
+                ));
+            }
+            Ok(())
+        }
+        ConstraintKind::Coupling {
+            follower,
+            leader,
+            polynomial,
+            references,
+        } => {
+            let nbodies = model.nbodies();
+            for body in [follower, leader] {
+                if *body == 0 || *body >= nbodies {
+                    return Err(format!(
+                        "expected a joint index from 1 to {}, got {body}",
+                        nbodies - 1
+                    ));
+                }
+            }
+            let (f, l) = (&model.joints[*follower], &model.joints[*leader]);
+            let name = |b: &usize| &model.joint_names[*b];
+            if follower == leader {
+                return Err(format!("joint '{}' is coupled to itself", name(follower)));
+            }
+            if f.nv() != 1 || f.nq() != 1 || l.nv() != 1 || l.nq() != 1 || f.kind() != l.kind() {
+                return Err(format!(
+                    "a coupling joins two revolute or two prismatic joints, got '{}' ({}) and \
+                     '{}' ({})",
+                    name(follower),
+                    f.kind(),
+                    name(leader),
+                    l.kind()
+                ));
+            }
+            let finite = polynomial.iter().all(|c| c.is_finite())
+                && references.0.is_finite()
+                && references.1.is_finite();
+            if !finite {
+                return Err(
+                    "the ratio, offset or polynomial holds a value that is not finite".into(),
+                );
+            }
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,291 @@
+//! The rows of each constraint at a state: its Jacobian J, drift γ = J̇ q̇ and position error φ.
+//!
+//! Reference: Featherstone, *Rigid Body Dynamics Algorithms* (2008), §8.1 (loop constraints as
+//! rows `K q̈ = k`) and §2.11 (classical acceleration); the ECE 470 notes' geometric Jacobian.
+//! A point p fixed in body b, whose spatial velocity in world coordinates is `(ω, v_O)` and
+//! acceleration `(ω̇, a_O)` (here with q̈ = 0, so that they give J̇ q̇), moves with
+//! ```text
+//!   ṗ = v_O + ω × p                  (its velocity: the rows J q̇)
+//!   p̈ = a_O + ω̇ × p + ω × ṗ          (its classical acceleration: the drift γ)
+//! ```
+//! and column k of joint j of J is the joint's subspace column in world coordinates taken at p.
+//! A constraint between two attachments has the first's rows minus the second's; in local axes
+//! each row is turned by the first's rotation `E` (world to constraint frame).
+//! Inputs: the placements `x_world`, velocities `v` and bias accelerations `a` of every body
+//! (body coordinates), q and q̇. Cost: O(depth) per point.
+
+use super::{Attachment, ConstraintKind, ConstraintReference, ConstraintSet};
+use crate::model::Model;
+use crate::spatial::{Motion, Transform, Vec3};
+use nalgebra::{DMatrix, Matrix3, Rotation3};
+
+/// Where the rows of a constraint set are written: J (rows × nv), γ and φ (rows each).
+pub(crate) struct ConstraintRows<'a> {
+    /// J: the rows' velocity is `J q̇`.
+    pub jacobian: &'a mut DMatrix<f64>,
+    /// γ = J̇ q̇: the rows' acceleration is `J q̈ + γ`.
+    pub drift: &'a mut [f64],
+    /// φ: how far each row is from holding (zero where a point is held where it is).
+    pub error: &'a mut [f64],
+}
+
+/// The bodies' motion that the rows are made from: placements `X_{i←0}`, velocities and
+/// accelerations with q̈ = 0, in body coordinates.
+pub(crate) struct BodyMotion<'a> {
+    /// `X_{i←0}` of every body.
+    pub x_world: &'a [Transform],
+    /// Spatial velocity of every body, in its own coordinates.
+    pub v: &'a [Motion],
+    /// Spatial acceleration of every body with q̈ = 0 (no gravity), in its own coordinates.
+    pub a: &'a [Motion],
+}
+
+/// The motion of a constraint frame: its placement, and its origin's velocity and classical
+/// acceleration (with q̈ = 0), all in world coordinates.
+struct FrameMotion {
+    /// `E`: world to constraint-frame axes.
+    rotation: Matrix3<f64>,
+    /// p: the origin.
+    position: Vec3,
+    /// ṗ.
+    velocity: Vec3,
+    /// p̈ with q̈ = 0.
+    acceleration: Vec3,
+    /// ω̇ with q̈ = 0.
+    angular_acceleration: Vec3,
+    /// The body the frame is fixed in (0: the world).
+    body: usize,
+}
+
+/// Writes J, γ and φ of every constraint of `set` (J's rows zeroed first).
+pub(crate) fn evaluate(
+    model: &Model,
+    set: &ConstraintSet,
+    bodies: &BodyMotion,
+    (q, v): (&[f64], &[f64]),
+    mut rows: ConstraintRows,
+) {
+    rows.jacobian.fill(0.0);
+    for (k, constraint) in set.constraints().iter().enumerate() {
+        let row = set.offset(k);
+        let local = constraint.reference == ConstraintReference::Local;
+        match &constraint.kind {
+            ConstraintKind::Point { first, second } => {
+                let mask = [true, true, true, false, false, false];
+                let held = Held::new(model, bodies, first, second.as_ref());
+                held.write(model, bodies, row, &mask, local, &mut rows);
+            }
+            ConstraintKind::Frame {
+                first,
+                second,
+                mask,
+            } => {
+                let held = Held::new(model, bodies, first, second.as_ref());
+                held.write(model, bodies, row, mask, local, &mut rows);
+            }
+            ConstraintKind::Distance {
+                first,
+                second,
+                length,
+            } => {
+                let (one, other) = (
+                    frame_motion(model, bodies, first),
+                    frame_motion(model, bodies, second),
+                );
+                write_distance(model, bodies, (&one, &other), *length, row, &mut rows);
+            }
+            ConstraintKind::Coupling {
+                follower,
+                leader,
+                polynomial,
+                references,
+            } => {
+                let (f, l) = (model.idx_v[*follower], model.idx_v[*leader]);
+                let x = q[model.idx_q[*leader]] - references.1;
+                let (p, dp, ddp) = polynomial_at(polynomial, x);
+                // φ = (q_f − q_f,ref) − p(x);  J = e_f − p'(x) e_l;  γ = −p''(x) q̇_l²
+                rows.error[row] = q[model.idx_q[*follower]] - references.0 - p;
+                rows.jacobian[(row, f)] += 1.0;
+                rows.jacobian[(row, l)] -= dp;
+                rows.drift[row] = -ddp * v[l] * v[l];
+            }
+        }
+    }
+}
+
+/// A point or frame constraint at this state: the first attachment's motion and the second's
+/// (the world where the first is, when there is none).
+struct Held {
+    first: FrameMotion,
+    second: Option<FrameMotion>,
+}
+
+impl Held {
+    fn new(
+        model: &Model,
+        bodies: &BodyMotion,
+        first: &Attachment,
+        second: Option<&Attachment>,
+    ) -> Self {
+        Held {
+            first: frame_motion(model, bodies, first),
+            second: second.map(|s| frame_motion(model, bodies, s)),
+        }
+    }
+
+    /// Writes the `mask`ed rows `[linear; angular]` from row `row` on.
+    fn write(
+        &self,
+        model: &Model,
+        bodies: &BodyMotion,
+        row: usize,
+        mask: &[bool; 6],
+        local: bool,
+        rows: &mut ConstraintRows,
+    ) {
+        let first = &self.first;
+        // the rows' axes: world, or the first frame's (E)
+        let axes = if local {
+            first.rotation
+        } else {
+            Matrix3::identity()
+        };
+        // J: the first point's columns minus the second's
+        for (motion, sign) in [(Some(first), 1.0), (self.second.as_ref(), -1.0)] {
+            let Some(motion) = motion else { continue };
+            point_columns(model, bodies, motion, |column, linear, angular| {
+                let full = six(&(axes * linear), &(axes * angular));
+                for (r, value) in kept(mask, &full) {
+                    rows.jacobian[(row + r, column)] += sign * value;
+                }
+            });
+        }
+
+        // γ = p̈_1 − p̈_2 and ω̇_1 − ω̇_2 with q̈ = 0;  φ = p_1 − p_2 and R_2 log(R_2ᵀ R_1)
+        let (mut acceleration, mut angular_acceleration) =
+            (first.acceleration, first.angular_acceleration);
+        let (mut offset, mut turn) = (Vec3::zeros(), Vec3::zeros());
+        if let Some(second) = &self.second {
+            acceleration -= second.acceleration;
+            angular_acceleration -= second.angular_acceleration;
+            offset = first.position - second.position;
+            // R = Eᵀ, so R_2ᵀ R_1 = E_2 E_1ᵀ
+            let relative = second.rotation * first.rotation.transpose();
+            let log = Rotation3::from_matrix_unchecked(relative).scaled_axis();
+            turn = second.rotation.transpose() * log;
+        }
+        let drift = six(&(axes * acceleration), &(axes * angular_acceleration));
+        let error = six(&(axes * offset), &(axes * turn));
+        for ((r, gamma), (_, phi)) in kept(mask, &drift).zip(kept(mask, &error)) {
+            rows.drift[row + r] = gamma;
+            rows.error[row + r] = phi;
+        }
+    }
+}
+
+/// The distance row: with n = (p_1 − p_2)/d, `J = nᵀ (J_1 − J_2)`,
+/// `γ = nᵀ (p̈_1 − p̈_2) + (|ṗ_1 − ṗ_2|² − (nᵀ (ṗ_1 − ṗ_2))²)/d`, φ = d − length.
+fn write_distance(
+    model: &Model,
+    bodies: &BodyMotion,
+    (one, other): (&FrameMotion, &FrameMotion),
+    length: f64,
+    row: usize,
+    rows: &mut ConstraintRows,
+) {
+    let offset = one.position - other.position;
+    let distance = offset.norm().max(f64::MIN_POSITIVE);
+    let n = offset / distance;
+    for (motion, sign) in [(one, 1.0), (other, -1.0)] {
+        point_columns(model, bodies, motion, |column, linear, _| {
+            rows.jacobian[(row, column)] += sign * n.dot(linear);
+        });
+    }
+    let relative_velocity = one.velocity - other.velocity;
+    let along = n.dot(&relative_velocity);
+    let gamma = n.dot(&(one.acceleration - other.acceleration))
+        + (relative_velocity.norm_squared() - along * along) / distance;
+    rows.drift[row] = gamma;
+    rows.error[row] = distance - length;
+}
+
+/// The motion of an attachment's constraint frame (fixed in the world when it has no frame).
+fn frame_motion(model: &Model, bodies: &BodyMotion, attachment: &Attachment) -> FrameMotion {
+    let Some(frame) = attachment.frame else {
+        return FrameMotion {
+            rotation: attachment.placement.rotation,
+            position: attachment.placement.translation,
+            velocity: Vec3::zeros(),
+            acceleration: Vec3::zeros(),
+            angular_acceleration: Vec3::zeros(),
+            body: 0,
+        };
+    };
+    let body = model.frames[frame].body;
+    // X_{c←0} = X_{c←frame} X_{frame←body} X_{body←0}
+    let placement = attachment.placement * (model.frames[frame].placement * bodies.x_world[body]);
+    let p = placement.translation;
+    // (ω, v_O) and (ω̇, a_O) of the body in world coordinates
+    let velocity = bodies.x_world[body].inverse_apply_motion(&bodies.v[body]);
+    let acceleration = bodies.x_world[body].inverse_apply_motion(&bodies.a[body]);
+    // ṗ = v_O + ω × p;  p̈ = a_O + ω̇ × p + ω × ṗ
+    let point_velocity = velocity.linear + velocity.angular.cross(&p);
+    let point_acceleration = acceleration.linear
+        + acceleration.angular.cross(&p)
+        + velocity.angular.cross(&point_velocity);
+    FrameMotion {
+        rotation: placement.rotation,
+        position: p,
+        velocity: point_velocity,
+        acceleration: point_acceleration,
+        angular_acceleration: acceleration.angular,
+        body,
+    }
+}
+
+/// The columns of the point's Jacobian that are not zero, world axes, each handed to
+/// `column(index, linear, angular)`: the subspace columns of the joints between the point's
+/// body and the world, taken at the point.
+fn point_columns(
+    model: &Model,
+    bodies: &BodyMotion,
+    motion: &FrameMotion,
+    mut column: impl FnMut(usize, &Vec3, &Vec3),
+) {
+    let mut j = motion.body;
+    while j != 0 {
+        let joint = &model.joints[j];
+        for (k, index) in model.v_range(j).enumerate() {
+            let s = joint.subspace_column_at(k, &bodies.x_world[j], &motion.position);
+            column(index, &s.linear, &s.angular);
+        }
+        j = model.parent[j];
+    }
+}
+
+/// `[linear; angular]` as six numbers.
+fn six(linear: &Vec3, angular: &Vec3) -> [f64; 6] {
+    [
+        linear.x, linear.y, linear.z, angular.x, angular.y, angular.z,
+    ]
+}
+
+/// The entries of `full` that `mask` keeps, numbered from 0 in order.
+fn kept<'a>(mask: &'a [bool; 6], full: &'a [f64; 6]) -> impl Iterator<Item = (usize, f64)> + 'a {
+    full.iter()
+        .zip(mask)
+        .filter(|(_, &keep)| keep)
+        .map(|(&value, _)| value)
+        .enumerate()
+}
+
+/// p(x) = Σ c_k x^k and its first two derivatives, by Horner's rule.
+fn polynomial_at(c: &[f64; 5], x: f64) -> (f64, f64, f64) {
+    let (mut p, mut dp, mut ddp) = (0.0, 0.0, 0.0);
+    for &coefficient in c.iter().rev() {
+        ddp = ddp * x + 2.0 * dp;
+        dp = dp * x + p;
+        p = p * x + coefficient;
+    }
+    (p, dp, ddp)
+}

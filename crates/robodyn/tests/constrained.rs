@@ -1,0 +1,482 @@
+//! Constrained dynamics: the constrained equations hold (KKT residuals), the results equal a dense
+//! KKT solve, the rows equal finite differences of the constraint errors, impulses and inverse
+//! dynamics invert as they should, and redundant or malformed constraints are refused by name.
+
+mod common;
+
+use common::*;
+use nalgebra::{DMatrix, DVector};
+use robodyn::algo::{
+    self, constrained_forward_dynamics, constrained_inverse_dynamics, constraint_jacobian,
+    delassus, impulse_dynamics, ConstrainedOptions, ConstraintData,
+};
+use robodyn::constraint::{
+    Attachment, Constraint, ConstraintKind, ConstraintReference, ConstraintSet,
+};
+use robodyn::spatial::{Transform, Vec3};
+use robodyn::{Data, Model};
+
+/// Central differences of the constraint errors with step `h`: first and second derivatives.
+const DIFFERENCE_STEP: f64 = 1e-4;
+/// Their truncation error, O(h²) with h = 1e-4, and rounding, ε/h² ≈ 1e-8.
+const DIFFERENCE_TOLERANCE: f64 = 1e-6;
+
+fn body_of(model: &Model, joint: &str) -> usize {
+    model.joint_names.iter().position(|n| n == joint).unwrap()
+}
+
+fn at(model: &Model, frame: &str, offset: [f64; 3]) -> Attachment {
+    Attachment {
+        frame: Some(model.frame_index(frame).unwrap()),
+        placement: Transform::from_translation(&Vec3::from(offset)),
+    }
+}
+
+fn constraint(kind: ConstraintKind, reference: ConstraintReference) -> Constraint {
+    Constraint { kind, reference }
+}
+
+/// Every kind on the branching floating tree: a point held to the world, a masked frame held in
+/// local axes, a loop between two moving points, a distance and a joint coupling.
+fn tree_constraints(model: &Model) -> Vec<Constraint> {
+    use ConstraintReference::{Local, World};
+    let mut mask = [true; 6];
+    mask[4] = false;
+    let offset_to = Attachment {
+        frame: None,
+        placement: Transform::from_translation(&Vec3::new(0.3, -0.2, 0.1)),
+    };
+    vec![
+        constraint(
+            ConstraintKind::Point {
+                first: at(model, "tip", [0.01, 0.02, 0.0]),
+                second: Some(offset_to),
+            },
+            World,
+        ),
+        constraint(
+            ConstraintKind::Frame {
+                first: at(model, "shin", [0.0, 0.0, -0.3]),
+                second: None,
+                mask,
+            },
+            Local,
+        ),
+        constraint(
+            ConstraintKind::Point {
+                first: at(model, "forearm", [0.1, 0.0, 0.0]),
+                second: Some(at(model, "thigh", [0.0, 0.05, -0.1])),
+            },
+            Local,
+        ),
+        constraint(
+            ConstraintKind::Distance {
+                first: at(model, "finger", [0.0, 0.0, 0.0]),
+                second: at(model, "base", [0.1, 0.0, 0.0]),
+                length: 0.5,
+            },
+            World,
+        ),
+    ]
+}
+
+/// A coupling of the UR5's wrist joints: w3 = 0.5 w1 + 0.2 w1² − 0.1 about references.
+fn coupling(model: &Model) -> Constraint {
+    constraint(
+        ConstraintKind::Coupling {
+            follower: body_of(model, "wrist_3_joint"),
+            leader: body_of(model, "wrist_1_joint"),
+            polynomial: [-0.1, 0.5, 0.2, 0.0, 0.0],
+            references: (0.3, -0.2),
+        },
+        ConstraintReference::World,
+    )
+}
+
+fn cases() -> Vec<(&'static str, Model, Vec<Constraint>)> {
+    let tree = test_model("tree");
+    let tree_set = tree_constraints(&tree);
+    let ur5 = test_model("ur5");
+    let ur5_set = vec![coupling(&ur5)];
+    vec![("tree", tree, tree_set), ("ur5", ur5, ur5_set)]
+}
+
+/// `[M −Jᵀ; J 0] [q̈; λ] = [τ − h; −γ]`, densely.
+fn dense_kkt(
+    model: &Model,
+    data: &mut Data,
+    constraints: &ConstraintData,
+    (q, v, tau): (&[f64], &[f64], &[f64]),
+) -> (DVector<f64>, DVector<f64>) {
+    let (nv, m) = (model.nv, constraints.jacobian.nrows());
+    let mass = algo::crba(model, data, q).unwrap().clone();
+    let h = algo::bias_forces(model, data, q, v).unwrap().clone();
+    let mut kkt = DMatrix::zeros(nv + m, nv + m);
+    kkt.view_mut((0, 0), (nv, nv)).copy_from(&mass);
+    kkt.view_mut((0, nv), (nv, m))
+        .copy_from(&(-constraints.jacobian.transpose()));
+    kkt.view_mut((nv, 0), (m, nv))
+        .copy_from(&constraints.jacobian);
+    let mut rhs = DVector::zeros(nv + m);
+    rhs.rows_mut(0, nv)
+        .copy_from(&(DVector::from_column_slice(tau) - h));
+    rhs.rows_mut(nv, m).copy_from(&(-&constraints.drift));
+    let solution = kkt.lu().solve(&rhs).expect("the KKT matrix is regular");
+    (
+        solution.rows(0, nv).into_owned(),
+        solution.rows(nv, m).into_owned(),
+    )
+}
+
+#[test]
+fn forward_dynamics_solves_the_constrained_equations_and_equals_a_dense_kkt_solve() {
+    let mut rng = rng();
+    for (name, model, constraints) in cases() {
+        let set = ConstraintSet::new(&model, constraints).unwrap();
+        let (mut data, mut c) = (Data::new(&model), ConstraintData::new(&model, &set));
+        for _ in 0..5 {
+            let (q, v, tau) = state(&model, &mut rng);
+            let options = ConstrainedOptions::default();
+            let args = (q.as_slice(), v.as_slice(), tau.as_slice());
+            constrained_forward_dynamics(&model, &mut data, &mut c, &set, args, None, &options)
+                .unwrap();
+            let (qdd, forces) = (c.qdd.clone(), c.forces.clone());
+            // M q̈ + h − τ − Jᵀ λ = 0 and J q̈ + γ = 0
+            let mass = algo::crba(&model, &mut data, q.as_slice()).unwrap().clone();
+            let h = algo::bias_forces(&model, &mut data, q.as_slice(), v.as_slice())
+                .unwrap()
+                .clone();
+            let dynamics = &mass * &qdd + h - &tau - c.jacobian.transpose() * &forces;
+            let scale = 1.0 + tau.amax() + forces.amax();
+            assert!(
+                dynamics.amax() < IDENTITY_TOLERANCE * scale,
+                "{name}: {dynamics}"
+            );
+            let held = &c.jacobian * &qdd + &c.drift;
+            assert!(held.amax() < IDENTITY_TOLERANCE * scale, "{name}: {held}");
+            let (dense_qdd, dense_forces) = dense_kkt(&model, &mut data, &c, args);
+            assert_close(
+                name,
+                qdd.as_slice(),
+                dense_qdd.as_slice(),
+                IDENTITY_TOLERANCE,
+            );
+            assert_close(name, forces.as_slice(), dense_forces.as_slice(), 1e-8);
+        }
+    }
+}
+
+/// The errors φ at q ⊕ t v for t = −h, 0, h.
+fn errors_along(
+    model: &Model,
+    set: &ConstraintSet,
+    q: &DVector<f64>,
+    v: &DVector<f64>,
+) -> [DVector<f64>; 3] {
+    let (mut data, mut c) = (Data::new(model), ConstraintData::new(model, set));
+    [-DIFFERENCE_STEP, 0.0, DIFFERENCE_STEP].map(|t| {
+        let moved = displaced(model, q, &(v * t));
+        constraint_jacobian(model, &mut data, &mut c, set, moved.as_slice()).unwrap();
+        c.error.clone()
+    })
+}
+
+#[test]
+fn rows_and_drift_are_the_derivatives_of_the_constraint_errors() {
+    let mut rng = rng();
+    for (name, model, constraints) in cases() {
+        // the errors of frame rows (angular) and of rows in local axes are differentiated by
+        // the rows only where they hold: those are left to the other tests
+        let set = ConstraintSet::new(&model, constraints).unwrap();
+        let (mut data, mut c) = (Data::new(&model), ConstraintData::new(&model, &set));
+        for _ in 0..3 {
+            let (q, v, _) = state(&model, &mut rng);
+            let zero = DVector::zeros(model.nv);
+            let args = (q.as_slice(), v.as_slice(), zero.as_slice());
+            let options = ConstrainedOptions::default();
+            constrained_forward_dynamics(&model, &mut data, &mut c, &set, args, None, &options)
+                .unwrap();
+            let [before, now, after] = errors_along(&model, &set, &q, &v);
+            let h = DIFFERENCE_STEP;
+            let rate = (&after - &before) / (2.0 * h);
+            let curvature = (&after - 2.0 * &now + &before) / (h * h);
+            for r in 0..set.rows() {
+                let (k, _) = set.row_owner(r);
+                let constraint = &set.constraints()[k];
+                let point = matches!(constraint.kind, ConstraintKind::Point { .. });
+                let frame = matches!(constraint.kind, ConstraintKind::Frame { .. });
+                if frame || (point && constraint.reference == ConstraintReference::Local) {
+                    continue;
+                }
+                let jv = c.jacobian.row(r).dot(&v.transpose());
+                let label = format!("{name} row {r}");
+                assert_close(&label, &[jv], &[rate[r]], DIFFERENCE_TOLERANCE);
+                assert_close(
+                    &label,
+                    &[c.drift[r]],
+                    &[curvature[r]],
+                    1e3 * DIFFERENCE_TOLERANCE,
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn baumgarte_terms_set_the_rows_acceleration() {
+    let model = test_model("tree");
+    let set = ConstraintSet::new(&model, tree_constraints(&model)).unwrap();
+    let (mut data, mut c) = (Data::new(&model), ConstraintData::new(&model, &set));
+    let (q, v, tau) = state(&model, &mut rng());
+    let options = ConstrainedOptions {
+        baumgarte: Some((40.0, 12.0)),
+        damping: 0.0,
+    };
+    let args = (q.as_slice(), v.as_slice(), tau.as_slice());
+    constrained_forward_dynamics(&model, &mut data, &mut c, &set, args, None, &options).unwrap();
+    assert!(c.error.amax() > 1e-3, "the test needs errors to correct");
+    // J q̈ + γ = −K_d J q̇ − K_p φ
+    let target = -12.0 * (&c.jacobian * &v) - 40.0 * &c.error;
+    let reached = &c.jacobian * &c.qdd + &c.drift;
+    assert_close(
+        "baumgarte",
+        reached.as_slice(),
+        target.as_slice(),
+        IDENTITY_TOLERANCE,
+    );
+}
+
+#[test]
+fn delassus_is_j_m_inverse_j_transpose() {
+    let model = test_model("tree");
+    let set = ConstraintSet::new(&model, tree_constraints(&model)).unwrap();
+    let (mut data, mut c) = (Data::new(&model), ConstraintData::new(&model, &set));
+    let q = model.random_configuration(&mut rng());
+    let delassus = delassus(&model, &mut data, &mut c, &set, q.as_slice())
+        .unwrap()
+        .clone();
+    let inverse = algo::inverse_mass_matrix(&model, &mut data, q.as_slice())
+        .unwrap()
+        .clone();
+    let expected = &c.jacobian * inverse * c.jacobian.transpose();
+    assert_close(
+        "delassus",
+        delassus.as_slice(),
+        expected.as_slice(),
+        IDENTITY_TOLERANCE,
+    );
+}
+
+#[test]
+fn impulses_stop_the_constrained_motion_or_reverse_it() {
+    let model = test_model("tree");
+    let set = ConstraintSet::new(&model, tree_constraints(&model)).unwrap();
+    let (mut data, mut c) = (Data::new(&model), ConstraintData::new(&model, &set));
+    let (q, v, _) = state(&model, &mut rng());
+    for restitution in [0.0, 0.4, 1.0] {
+        let args = (q.as_slice(), v.as_slice());
+        impulse_dynamics(&model, &mut data, &mut c, &set, args, restitution, 0.0).unwrap();
+        // J q̇⁺ = −e J q̇;  M (q̇⁺ − q̇) = Jᵀ Λ
+        let after = &c.jacobian * &c.qdd;
+        let expected = -restitution * (&c.jacobian * &v);
+        assert_close(
+            "J v+",
+            after.as_slice(),
+            expected.as_slice(),
+            IDENTITY_TOLERANCE,
+        );
+        let mass = algo::crba(&model, &mut data, q.as_slice()).unwrap().clone();
+        let momentum = mass * (&c.qdd - &v);
+        let applied = c.jacobian.transpose() * &c.forces;
+        assert_close(
+            "M dv",
+            momentum.as_slice(),
+            applied.as_slice(),
+            IDENTITY_TOLERANCE,
+        );
+    }
+}
+
+/// Forward dynamics with the base unactuated (τ zero on its six coordinates) at a random state.
+fn base_unactuated_state(
+    model: &Model,
+    rng: &mut rand::rngs::StdRng,
+) -> (DVector<f64>, DVector<f64>, DVector<f64>) {
+    let (q, v, mut tau) = state(model, rng);
+    tau.rows_mut(0, 6).fill(0.0);
+    (q, v, tau)
+}
+
+#[test]
+fn inverse_dynamics_recovers_the_torques_and_forces_of_forward_dynamics() {
+    let model = test_model("tree");
+    // the shin's frame held: six rows against the six unactuated base coordinates, unique forces
+    let held = constraint(
+        ConstraintKind::Frame {
+            first: at(&model, "shin", [0.0, 0.0, -0.3]),
+            second: None,
+            mask: [true; 6],
+        },
+        ConstraintReference::World,
+    );
+    let set = ConstraintSet::new(&model, vec![held]).unwrap();
+    let (mut data, mut c) = (Data::new(&model), ConstraintData::new(&model, &set));
+    let mut rng = rng();
+    let actuated: Vec<bool> = (0..model.nv).map(|k| k >= 6).collect();
+    for _ in 0..3 {
+        let (q, v, tau) = base_unactuated_state(&model, &mut rng);
+        let options = ConstrainedOptions::default();
+        let args = (q.as_slice(), v.as_slice(), tau.as_slice());
+        constrained_forward_dynamics(&model, &mut data, &mut c, &set, args, None, &options)
+            .unwrap();
+        let (qdd, forces) = (c.qdd.clone(), c.forces.clone());
+        let args = (q.as_slice(), v.as_slice(), qdd.as_slice());
+        constrained_inverse_dynamics(&model, &mut data, &mut c, &set, args, None, &actuated)
+            .unwrap();
+        assert_close("tau", c.tau.as_slice(), tau.as_slice(), 1e-8);
+        assert_close("forces", c.forces.as_slice(), forces.as_slice(), 1e-8);
+        // an acceleration the constraints forbid is refused, naming the row
+        let wrong = &qdd + DVector::from_element(model.nv, 0.1);
+        let args = (q.as_slice(), v.as_slice(), wrong.as_slice());
+        let error =
+            constrained_inverse_dynamics(&model, &mut data, &mut c, &set, args, None, &actuated)
+                .unwrap_err()
+                .to_string();
+        assert!(
+            error.contains("breaks the constraints") && error.contains("constraints[0]"),
+            "{error}"
+        );
+    }
+}
+
+#[test]
+fn inverse_dynamics_gives_the_least_norm_forces_where_they_are_not_unique() {
+    let model = test_model("tree");
+    // two points held: the base may still turn about the line through them, and the forces
+    // along that line are not unique
+    let point = |frame: &str, offset: [f64; 3]| {
+        let kind = ConstraintKind::Point {
+            first: at(&model, frame, offset),
+            second: None,
+        };
+        constraint(kind, ConstraintReference::World)
+    };
+    let constraints = vec![point("tip", [0.0; 3]), point("shin", [0.0, 0.0, -0.3])];
+    let set = ConstraintSet::new(&model, constraints).unwrap();
+    let (mut data, mut c) = (Data::new(&model), ConstraintData::new(&model, &set));
+    let actuated: Vec<bool> = (0..model.nv).map(|k| k >= 6).collect();
+    let (q, v, tau) = base_unactuated_state(&model, &mut rng());
+    let args = (q.as_slice(), v.as_slice(), tau.as_slice());
+    let options = ConstrainedOptions::default();
+    constrained_forward_dynamics(&model, &mut data, &mut c, &set, args, None, &options).unwrap();
+    let qdd = c.qdd.clone();
+    let args = (q.as_slice(), v.as_slice(), qdd.as_slice());
+    constrained_inverse_dynamics(&model, &mut data, &mut c, &set, args, None, &actuated).unwrap();
+    // M q̈ + h = τ + Jᵀ λ with τ zero on the base
+    let mass = algo::crba(&model, &mut data, q.as_slice()).unwrap().clone();
+    let h = algo::bias_forces(&model, &mut data, q.as_slice(), v.as_slice())
+        .unwrap()
+        .clone();
+    let residual = &mass * &qdd + h - &c.tau - c.jacobian.transpose() * &c.forces;
+    assert!(
+        residual.amax() < IDENTITY_TOLERANCE * (1.0 + c.forces.amax()),
+        "{residual}"
+    );
+    assert!(c.tau.rows(0, 6).amax() == 0.0);
+    // least norm: λ = J_u y lies in the column space of J_u (the base's columns of J)
+    let base_columns = c.jacobian.columns(0, 6).into_owned();
+    let svd = base_columns.clone().svd(true, false);
+    let u = svd.u.unwrap();
+    let rank = svd.singular_values.iter().filter(|s| **s > 1e-9).count();
+    assert_eq!(
+        rank, 5,
+        "the line through the points leaves one rotation free"
+    );
+    for k in 0..u.ncols() {
+        if svd.singular_values[k] <= 1e-9 {
+            let along_null = u.column(k).dot(&c.forces);
+            assert!(along_null.abs() < 1e-8 * c.forces.amax(), "{along_null}");
+        }
+    }
+}
+
+#[test]
+fn a_closure_stated_twice_is_named_without_damping_and_shared_with_it() {
+    let model = test_model("tree");
+    let loop_closure = tree_constraints(&model).swap_remove(2);
+    let set = ConstraintSet::new(&model, vec![loop_closure.clone(), loop_closure]).unwrap();
+    let (mut data, mut c) = (Data::new(&model), ConstraintData::new(&model, &set));
+    let (q, v, tau) = state(&model, &mut rng());
+    let args = (q.as_slice(), v.as_slice(), tau.as_slice());
+    let rigid = ConstrainedOptions::default();
+    let error = constrained_forward_dynamics(&model, &mut data, &mut c, &set, args, None, &rigid)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("constraints[1] (PointAnchor('forearm' to 'thigh')), row x")
+            && error.contains("damping"),
+        "{error}"
+    );
+    let damped = ConstrainedOptions {
+        baumgarte: None,
+        damping: 1e-6,
+    };
+    constrained_forward_dynamics(&model, &mut data, &mut c, &set, args, None, &damped).unwrap();
+    assert!(c.iterations > 0);
+    // each statement carries half of the single closure's force
+    let single = ConstraintSet::new(&model, vec![set.constraints()[0].clone()]).unwrap();
+    let mut one = ConstraintData::new(&model, &single);
+    constrained_forward_dynamics(&model, &mut data, &mut one, &single, args, None, &rigid).unwrap();
+    let halves: Vec<f64> = one.forces.iter().map(|f| f / 2.0).collect();
+    assert_close("first", &c.forces.as_slice()[..3], &halves, 1e-8);
+    assert_close("second", &c.forces.as_slice()[3..], &halves, 1e-8);
+    assert_close("qdd", c.qdd.as_slice(), one.qdd.as_slice(), 1e-8);
+}
+
+#[test]
+fn malformed_constraints_are_refused_by_name() {
+    let model = test_model("tree");
+    let coupled = |follower: &str, leader: &str| {
+        let kind = ConstraintKind::Coupling {
+            follower: body_of(&model, follower),
+            leader: body_of(&model, leader),
+            polynomial: [0.0, 1.0, 0.0, 0.0, 0.0],
+            references: (0.0, 0.0),
+        };
+        ConstraintSet::new(&model, vec![constraint(kind, ConstraintReference::World)])
+    };
+    let error = coupled("slide", "elbow").unwrap_err().to_string();
+    assert!(
+        error.contains("'slide' (prismatic)") && error.contains("'elbow' (revolute)"),
+        "{error}"
+    );
+    let error = coupled("ball", "elbow").unwrap_err().to_string();
+    assert!(error.contains("'ball' (spherical)"), "{error}");
+    let error = coupled("knee", "knee").unwrap_err().to_string();
+    assert!(error.contains("coupled to itself"), "{error}");
+    assert!(coupled("knee", "leg").is_ok());
+    let frame = ConstraintKind::Frame {
+        first: at(&model, "tip", [0.0; 3]),
+        second: None,
+        mask: [false; 6],
+    };
+    let error = ConstraintSet::new(&model, vec![constraint(frame, ConstraintReference::World)])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("constraints[0]") && error.contains("mask"),
+        "{error}"
+    );
+    let distance = ConstraintKind::Distance {
+        first: at(&model, "tip", [0.0; 3]),
+        second: at(&model, "base", [0.0; 3]),
+        length: -1.0,
+    };
+    let error = ConstraintSet::new(
+        &model,
+        vec![constraint(distance, ConstraintReference::World)],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(error.contains("positive finite length"), "{error}");
+}
