@@ -20,7 +20,11 @@ import warnings
 from pathlib import Path
 
 from robodyn._core import (
+    Distance,
+    FrameAnchor,
+    JointCoupling,
     Model,
+    PointAnchor,
     SimulationError,
     bundled_names,
     load_bundled,
@@ -80,6 +84,10 @@ __all__ = [
     "AccuracyError",
     "AccuracyWarning",
     "ComputedTorque",
+    "Distance",
+    "FrameAnchor",
+    "JointCoupling",
+    "PointAnchor",
     "dataset",
     "read_dataset",
     "simulate_many",

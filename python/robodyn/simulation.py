@@ -45,7 +45,7 @@ if TYPE_CHECKING:
 from numpy.typing import ArrayLike
 
 from robodyn import _core
-from robodyn._arguments import callback, choice, flag, numbers, real, robot_model
+from robodyn._arguments import bad, callback, choice, flag, numbers, real, robot_model
 from robodyn._joints import coordinate_names
 
 __all__ = [
@@ -324,7 +324,8 @@ def simulate(model: _core.Model, q0: Configuration, v0: ArrayLike | None = None,
              rtol: float | None = None, atol: float = 1e-9, max_step: float | None = None,
              friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
              limit_damping: float = 1e2, progress: Callable[[float], Any] | None = None,
-             accuracy: str = "warn") -> Trajectory: ...
+             accuracy: str = "warn", constraints: Any = None, baumgarte: tuple[float, float] | None = None,
+             damping: float = 0.0) -> Trajectory: ...
 
 
 @overload
@@ -333,7 +334,8 @@ def simulate(model: _core.Model, q0: Configurations, v0: ArrayLike | None = None
              rtol: float | None = None, atol: float = 1e-9, max_step: float | None = None,
              friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
              limit_damping: float = 1e2, progress: Callable[[float], Any] | None = None,
-             accuracy: str = "warn") -> list[Trajectory]: ...
+             accuracy: str = "warn", constraints: Any = None, baumgarte: tuple[float, float] | None = None,
+             damping: float = 0.0) -> list[Trajectory]: ...
 
 
 @overload
@@ -342,7 +344,8 @@ def simulate(model: _core.Model, q0: ArrayLike, v0: ArrayLike | None = None, t_e
              rtol: float | None = None, atol: float = 1e-9, max_step: float | None = None,
              friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
              limit_damping: float = 1e2, progress: Callable[[float], Any] | None = None,
-             accuracy: str = "warn") -> Trajectory | list[Trajectory]: ...
+             accuracy: str = "warn", constraints: Any = None, baumgarte: tuple[float, float] | None = None,
+             damping: float = 0.0) -> Trajectory | list[Trajectory]: ...
 
 
 def simulate(
@@ -364,6 +367,9 @@ def simulate(
     limit_damping: float = 1e2,
     progress: Callable[[float], Any] | None = None,
     accuracy: str = "warn",
+    constraints: Any = None,
+    baumgarte: tuple[float, float] | None = None,
+    damping: float = 0.0,
 ) -> Trajectory | list[Trajectory]:
     """Simulate ``model`` from (``q0``, ``v0``) at t = 0 to ``t_end``, recording every ``dt``.
 
@@ -402,6 +408,12 @@ def simulate(
     ``progress(fraction)`` is called about a hundred times per run (this runs the loop with the GIL
     held; Ctrl-C stops it).
 
+    ``constraints``: one or a list of :class:`robodyn.PointAnchor`, :class:`robodyn.FrameAnchor`,
+    :class:`robodyn.JointCoupling`, :class:`robodyn.Distance` held through the run (closed loops,
+    anchors), with ``baumgarte`` and ``damping`` as in :meth:`Model.constrained_forward_dynamics`;
+    the accelerations are :meth:`Model.constrained_forward_dynamics`'s. Rollouts with constraints run
+    in parallel, each on its own (not in SIMD lanes).
+
     Raises ``ValueError`` naming the argument for bad input, and when the simulation diverges (with
     the time it happened; :class:`robodyn.SimulationError`); an exception raised by a callback
     propagates unchanged.
@@ -412,6 +424,8 @@ def simulate(
     choice("integrator", integrator, INTEGRATORS)
     choice("limits", limits, LIMIT_MODELS)
     choice("accuracy", accuracy, ACCURACY_MODES)
+    if baumgarte is not None and numbers("baumgarte", baumgarte).shape != (2,):
+        raise bad("baumgarte", "None or a pair (kp, kd) of gains (1/s², 1/s)", repr(baumgarte))
     # one rtol: RK45's step control, or the fixed-step schemes' accuracy check
     adaptive = integrator == "rk45"
     rk45_rtol = real("rtol", rtol) if rtol is not None and adaptive else RK45_RTOL
@@ -421,7 +435,7 @@ def simulate(
         float("inf") if max_step is None else real("max_step", max_step), _controller_argument(model, controller),
         _wrenches_argument(wrenches), real("friction_velocity", friction_velocity), limits,
         real("limit_stiffness", limit_stiffness), real("limit_damping", limit_damping), callback("progress", progress),
-        accuracy_rtol,
+        accuracy_rtol, constraints=constraints, baumgarte=baumgarte, damping=damping,
     )
     series = ("q", "v", "a", "tau", "tau_passive")
     statistics = ("steps", "rejected_steps", "evaluations")

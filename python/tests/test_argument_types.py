@@ -66,6 +66,8 @@ VALID: dict[str, Any] = {
     "quaternion": (0.0, 0.0, 0.0, 1.0), "angles": (0.1, 0.2, 0.3), "orientation": "quaternion",
     "initial": None, "inertia_transverse": 1.0, "inertia_axial": 2.0, "omega_axial": 1.0,
     "quantities": ("tau",), "chunk": 4, "per_task": 2, "progress": None, "client": None,
+    "constraints": [robodyn.PointAnchor("tool0")], "joint": "elbow_joint", "leader": "shoulder_lift_joint",
+    "frame1": "tool0", "frame2": "wrist_3_link",
 }
 
 

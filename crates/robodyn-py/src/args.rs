@@ -439,6 +439,10 @@ pub(crate) mod named {
         dt: real -> f64;
         tolerance: real -> f64;
         damping: real -> f64;
+        ratio: real -> f64;
+        offset: real -> f64;
+        length: real -> f64;
+        restitution: real -> f64;
         position_only: flag -> bool;
         floating_base: flag -> bool;
         check_inertia: flag -> bool;

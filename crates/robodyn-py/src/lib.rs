@@ -10,6 +10,8 @@ use pyo3::prelude::*;
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 mod args;
+mod constrained;
+mod constraints;
 mod dynamics;
 mod errors;
 mod kinematics;
@@ -29,6 +31,10 @@ use errors::SimulationError;
 #[pymodule]
 fn _core(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<PyModel>()?;
+    module.add_class::<constraints::PyPointAnchor>()?;
+    module.add_class::<constraints::PyFrameAnchor>()?;
+    module.add_class::<constraints::PyJointCoupling>()?;
+    module.add_class::<constraints::PyDistance>()?;
     module.add("SimulationError", module.py().get_type::<SimulationError>())?;
     module.add_function(wrap_pyfunction!(load_urdf, module)?)?;
     module.add_function(wrap_pyfunction!(load_urdf_string, module)?)?;

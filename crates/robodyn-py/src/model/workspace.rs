@@ -1,7 +1,7 @@
 //! A kernel's workspace, and the pool of them that a batch's threads take from and give back to.
 
 use nalgebra::DMatrix;
-use robodyn::algo::BatchWorkspace;
+use robodyn::algo::{BatchWorkspace, ConstraintData};
 use robodyn::integrate::StepWorkspace;
 use robodyn::spatial::Force;
 use robodyn::{Data, Model};
@@ -17,6 +17,8 @@ pub(crate) struct Workspace {
     pub(crate) step: Option<Box<StepWorkspace>>,
     /// The lane buffers of the batch kernels, made on the first batch that uses them.
     pub(crate) lanes: Option<Box<BatchWorkspace>>,
+    /// The constrained algorithms' workspace, made for the last constraint set's size.
+    pub(crate) constrained: Option<Box<ConstraintData>>,
 }
 
 impl Workspace {
@@ -30,6 +32,7 @@ impl Workspace {
             ),
             step: None,
             lanes: None,
+            constrained: None,
         }
     }
 

@@ -3,6 +3,8 @@
 use super::callbacks::ConstantWrenches;
 use super::rollouts::Rollouts;
 use crate::args::{read_property, read_sample, Argument, SampleShape};
+use crate::constrained::baumgarte_gains;
+use crate::constraints::constraint_set;
 use crate::model::{fill_forces, PyModel};
 use crate::to_py_err;
 use nalgebra::DVector;
@@ -10,9 +12,10 @@ use numpy::PyUntypedArrayMethods;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use robodyn::algo::ConstrainedOptions;
 use robodyn::integrate::{
-    ControlLaw, DesiredMotion, Integrator, LimitModel, NativeController, PassiveForces,
-    SimulationOptions,
+    Constrained, ControlLaw, DesiredMotion, Integrator, LimitModel, NativeController,
+    PassiveForces, SimulationOptions,
 };
 use robodyn::spatial::Force;
 use robodyn::Model;
@@ -32,6 +35,30 @@ pub(super) struct SimulateArguments<'a, 'py> {
     pub(super) passive: PassiveArguments<'a>,
     pub(super) progress: Option<&'a Bound<'py, PyAny>>,
     pub(super) accuracy_rtol: f64,
+    pub(super) constrained: ConstrainedArguments<'a, 'py>,
+}
+
+/// The constraint arguments of `simulate`: the constraints held (None: none) and how.
+pub(super) struct ConstrainedArguments<'a, 'py> {
+    pub(super) constraints: Option<&'a Bound<'py, PyAny>>,
+    pub(super) baumgarte: Option<&'a Bound<'py, PyAny>>,
+    pub(super) damping: f64,
+}
+
+impl ConstrainedArguments<'_, '_> {
+    /// The constrained forward dynamics, or None without constraints.
+    fn read(&self, model: &PyModel) -> PyResult<Option<Constrained>> {
+        let Some(constraints) = self.constraints.filter(|c| !c.is_none()) else {
+            return Ok(None);
+        };
+        let set = constraint_set(model, constraints)?;
+        let options = ConstrainedOptions {
+            baumgarte: baumgarte_gains(self.baumgarte)?,
+            damping: self.damping,
+        };
+        options.check().map_err(to_py_err)?;
+        Ok(Some(Constrained::new(&model.model, set, options)))
+    }
 }
 
 /// The passive-force arguments of `simulate` and `step`.
@@ -155,6 +182,7 @@ impl<'a, 'py> Simulation<'a, 'py> {
                 q0: q0.values().into_owned(),
                 v0: v0.values().into_owned(),
                 batch,
+                constrained: arguments.constrained.read(model)?,
             },
             controller,
             wrenches,

@@ -13,7 +13,7 @@ mod rollouts;
 
 use crate::model::{write_row_major, PyModel};
 use crate::to_py_err;
-use arguments::{PassiveArguments, SimulateArguments, Simulation};
+use arguments::{ConstrainedArguments, PassiveArguments, SimulateArguments, Simulation};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use record::stack;
@@ -26,7 +26,8 @@ use robodyn::integrate::{Integrator, StepWorkspace};
 #[pyfunction]
 #[pyo3(signature = (model, q0, v0, t_end, dt, integrator="rk4", rtol=1e-6, atol=1e-9, max_step=f64::INFINITY,
                     controller=None, wrenches=None, friction_velocity=1e-2, limits="report",
-                    limit_stiffness=1e4, limit_damping=1e2, progress=None, accuracy_rtol=DEFAULT_ACCURACY_RTOL))]
+                    limit_stiffness=1e4, limit_damping=1e2, progress=None, accuracy_rtol=DEFAULT_ACCURACY_RTOL,
+                    constraints=None, baumgarte=None, damping=0.0))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
@@ -47,6 +48,9 @@ pub fn simulate<'py>(
     limit_damping: f64,
     progress: Option<&Bound<'py, PyAny>>,
     accuracy_rtol: f64,
+    constraints: Option<&Bound<'py, PyAny>>,
+    baumgarte: Option<&Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = crate::args::named::damping)] damping: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let arguments = SimulateArguments {
         q0,
@@ -67,6 +71,11 @@ pub fn simulate<'py>(
         },
         progress,
         accuracy_rtol,
+        constrained: ConstrainedArguments {
+            constraints,
+            baumgarte,
+            damping,
+        },
     };
     let simulation = Simulation::read(model, &arguments)?;
     let runs = simulation.run(py)?;

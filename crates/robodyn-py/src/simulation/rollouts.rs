@@ -6,9 +6,10 @@ use super::callbacks::{keep_raised, ConstantWrenches, PythonController, PythonWr
 use crate::to_py_err;
 use pyo3::prelude::*;
 use rayon::prelude::*;
+use robodyn::integrate::simulator::Progress;
 use robodyn::integrate::{
-    simulate as run, simulate_lockstep, Controller, ExternalWrenches, NativeController,
-    SimulationOptions, Trajectory,
+    simulate as run, simulate_lockstep, simulate_with, Constrained, Controller, ExternalWrenches,
+    NativeController, SimulationOptions, Trajectory,
 };
 use robodyn::{Error, Model};
 
@@ -21,6 +22,8 @@ pub(super) struct Rollouts<'a> {
     pub(super) v0: Vec<f64>,
     /// The batch size, `None` for a single state.
     pub(super) batch: Option<usize>,
+    /// The constrained forward dynamics, or `None` for a tree in free space (ABA).
+    pub(super) constrained: Option<Constrained>,
 }
 
 impl Rollouts<'_> {
@@ -35,6 +38,28 @@ impl Rollouts<'_> {
             &self.q0[k * nq..(k + 1) * nq],
             &self.v0[k * nv..(k + 1) * nv],
         )
+    }
+
+    /// Rollout `k` with its forward dynamics: ABA, or the constraints'.
+    fn simulate_one<'a>(
+        &'a self,
+        k: usize,
+        controller: &'a mut dyn Controller,
+        wrenches: Option<&'a mut dyn ExternalWrenches>,
+        progress: Option<Progress<'a>>,
+    ) -> robodyn::Result<Trajectory> {
+        let (model, options) = (self.model, &self.options);
+        let (q, v) = self.start(k);
+        let result = match &self.constrained {
+            None => run(model, q, v, options, controller, wrenches, progress),
+            Some(constrained) => {
+                let forward = constrained.clone();
+                simulate_with(
+                    model, q, v, options, forward, controller, wrenches, progress,
+                )
+            }
+        };
+        result.map_err(|e| self.error(k, e))
     }
 
     /// Names the rollout of a batch that failed.
@@ -82,18 +107,8 @@ impl Rollouts<'_> {
             .map(|k| {
                 let mut controller = native.clone();
                 let mut wrenches = constant.cloned();
-                let (q, v) = self.start(k);
                 let wrenches = wrenches.as_mut().map(|w| w as &mut dyn ExternalWrenches);
-                run(
-                    self.model,
-                    q,
-                    v,
-                    &self.options,
-                    &mut controller,
-                    wrenches,
-                    None,
-                )
-                .map_err(|e| self.error(k, e))
+                self.simulate_one(k, &mut controller, wrenches, None)
             })
             .collect()
     }
@@ -112,7 +127,9 @@ impl<'py> Simulation<'_, 'py> {
             Wrenches::Constant(constant) => {
                 py.detach(|| rollouts.run_native(native, Some(constant)))
             }
-            _ if rollouts.count() > 1 => py.detach(|| rollouts.run_lockstep(native)),
+            _ if rollouts.count() > 1 && rollouts.constrained.is_none() => {
+                py.detach(|| rollouts.run_lockstep(native))
+            }
             _ => py.detach(|| rollouts.run_native(native, None)),
         };
         result.map_err(to_py_err)
@@ -154,9 +171,7 @@ impl<'py> Simulation<'_, 'py> {
                 });
                 keep_raised(&mut progress_raised, result, fraction)
             };
-            let (q, v) = rollouts.start(k);
-            let options = &rollouts.options;
-            let result = run(m, q, v, options, controller, wrenches, Some(&mut report));
+            let result = rollouts.simulate_one(k, controller, wrenches, Some(&mut report));
             let raised = python
                 .and_then(|p| p.raised)
                 .or(callable_wrenches.and_then(|w| w.raised))
@@ -164,7 +179,7 @@ impl<'py> Simulation<'_, 'py> {
             if let Some(error) = raised {
                 return Err(error);
             }
-            runs.push(result.map_err(|e| to_py_err(rollouts.error(k, e)))?);
+            runs.push(result.map_err(to_py_err)?);
         }
         Ok(runs)
     }

@@ -7,11 +7,16 @@
 //!
 //! [`super::simulate`], [`super::simulate_lockstep`] and [`super::StepWorkspace`] call it through
 //! [`ForwardDynamics`] (a generic parameter: static dispatch, nothing allocated per step); their
-//! plain forms use [`Aba`], Featherstone's articulated-body algorithm for a tree in free space.
-//! Dynamics with constraints or contacts implement the same trait (the `_with` forms take them).
+//! plain forms use [`Aba`], Featherstone's articulated-body algorithm for a tree in free space;
+//! [`Constrained`] holds rigid constraints (closed loops, anchors, couplings). Contacts implement
+//! the same trait (the `_with` forms take them).
 
 use crate::algo::lanes::{aba_batch, BatchResult, BatchWorkspace, States};
-use crate::algo::{aba, aba_derivatives, DerivativesInto};
+use crate::algo::{
+    aba, aba_derivatives, constrained_forward_dynamics, ConstrainedOptions, ConstraintData,
+    DerivativesInto,
+};
+use crate::constraint::ConstraintSet;
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::spatial::Force;
@@ -156,6 +161,49 @@ impl ForwardDynamics for Aba {
         qdd: &mut [f64],
     ) -> Option<BatchResult> {
         Some(aba_batch(model, lanes, states, qdd))
+    }
+}
+
+/// A tree under rigid constraints: [`crate::algo::constrained_forward_dynamics`] with the
+/// constraints of a [`ConstraintSet`] and their options (Baumgarte's gains, proximal damping).
+#[derive(Debug, Clone)]
+pub struct Constrained {
+    set: ConstraintSet,
+    options: ConstrainedOptions,
+    constraints: ConstraintData,
+}
+
+impl Constrained {
+    /// The strategy for `set` on `model`.
+    pub fn new(model: &Model, set: ConstraintSet, options: ConstrainedOptions) -> Self {
+        let constraints = ConstraintData::new(model, &set);
+        Constrained {
+            set,
+            options,
+            constraints,
+        }
+    }
+
+    /// The forces λ of the last acceleration evaluated (one per constraint row).
+    pub fn forces(&self) -> &[f64] {
+        self.constraints.forces.as_slice()
+    }
+}
+
+impl ForwardDynamics for Constrained {
+    fn acceleration<'w>(
+        &'w mut self,
+        model: &Model,
+        data: &'w mut Data,
+        q: &[f64],
+        v: &[f64],
+        tau: &[f64],
+        f_ext: Option<&[Force]>,
+    ) -> Result<&'w [f64]> {
+        let c = &mut self.constraints;
+        let state = (q, v, tau);
+        constrained_forward_dynamics(model, data, c, &self.set, state, f_ext, &self.options)?;
+        Ok(self.constraints.qdd.as_slice())
     }
 }
 

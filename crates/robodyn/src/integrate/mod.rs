@@ -33,7 +33,7 @@ pub mod step;
 
 pub use control::{ControlLaw, Controller, DesiredMotion, ExternalWrenches, NativeController};
 pub use forces::{LimitModel, PassiveForces};
-pub use forward_dynamics::{Aba, AccelerationDerivatives, ForwardDynamics};
+pub use forward_dynamics::{Aba, AccelerationDerivatives, Constrained, ForwardDynamics};
 pub use schemes::Integrator;
 pub use simulator::{
     simulate, simulate_lockstep, simulate_lockstep_with, simulate_with, Accuracy, AccuracyIssue,

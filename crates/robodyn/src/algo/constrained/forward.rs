@@ -30,7 +30,7 @@ pub struct ConstrainedOptions {
 
 impl ConstrainedOptions {
     /// Refuses negative or non-finite gains and damping.
-    fn check(&self) -> Result<()> {
+    pub fn check(&self) -> Result<()> {
         let (kp, kd) = self.baumgarte.unwrap_or((0.0, 0.0));
         for (name, value) in [
             ("baumgarte", kp),

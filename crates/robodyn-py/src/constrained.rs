@@ -1,0 +1,287 @@
+//! Dynamics under constraints: the constraint Jacobian, the Delassus matrix, forward dynamics,
+//! impulses and inverse dynamics with the constraints of `constraints.rs`.
+
+use crate::args::*;
+use crate::constraints::constraint_set;
+use crate::model::*;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyEllipsis, PySequence, PySlice, PyString, PyTuple};
+use robodyn::algo::{self, ConstrainedOptions, ConstraintData};
+use robodyn::constraint::ConstraintSet;
+use robodyn::Model;
+
+/// The constrained algorithms' workspace in `slot` for `set`, made again when the set's size
+/// changed.
+fn constraint_data<'w>(
+    slot: &'w mut Option<Box<ConstraintData>>,
+    model: &Model,
+    set: &ConstraintSet,
+) -> &'w mut ConstraintData {
+    if !slot.as_ref().is_some_and(|c| c.fits(model, set)) {
+        *slot = Some(Box::new(ConstraintData::new(model, set)));
+    }
+    slot.as_mut().expect("made above")
+}
+
+impl PyModel {
+    /// `(..., a + b)` results split along their last axis into a dict of `(..., a)` and
+    /// `(..., b)` views named `names`.
+    fn split_last<'py>(
+        py: Python<'py>,
+        whole: &Bound<'py, PyAny>,
+        names: [&str; 2],
+        first: usize,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let out = PyDict::new(py);
+        let ellipsis = PyEllipsis::get(py);
+        let length = whole.getattr("shape")?.get_item(-1)?.extract::<isize>()?;
+        for (name, (start, stop)) in names
+            .iter()
+            .zip([(0, first as isize), (first as isize, length)])
+        {
+            let index = PyTuple::new(
+                py,
+                [ellipsis.as_any(), PySlice::new(py, start, stop, 1).as_any()],
+            )?;
+            out.set_item(PyString::new(py, name), whole.get_item(index)?)?;
+        }
+        Ok(out.into_any())
+    }
+
+    /// The flags of the actuated velocity coordinates: those of the named joints, or (None)
+    /// every coordinate but those of free joints.
+    fn actuated_coordinates(&self, actuated: Option<&Bound<PyAny>>) -> PyResult<Vec<bool>> {
+        let model = &self.model;
+        let mut flags = vec![false; model.nv];
+        let mut set_joint = |body: usize| {
+            for k in model.v_range(body) {
+                flags[k] = true;
+            }
+        };
+        match actuated {
+            None => {
+                for body in 1..model.nbodies() {
+                    if model.joints()[body].kind() != "free" {
+                        set_joint(body);
+                    }
+                }
+            }
+            Some(names) => {
+                let sequence = names.cast::<PySequence>().map_err(|_| {
+                    PyValueError::new_err(format!(
+                        "argument 'actuated': expected a list of joint names, got {}",
+                        describe(names)
+                    ))
+                })?;
+                for item in sequence.try_iter()? {
+                    let item = item?;
+                    let name: String = item.extract().map_err(|_| {
+                        PyValueError::new_err(format!(
+                            "argument 'actuated': expected joint names, got {}",
+                            describe(&item)
+                        ))
+                    })?;
+                    match model.joint_names.iter().skip(1).position(|n| *n == name) {
+                        Some(k) => set_joint(k + 1),
+                        None => {
+                            return Err(PyValueError::new_err(format!(
+                                "argument 'actuated': unknown joint '{name}'; the model's \
+                                 joints are {:?}",
+                                &model.joint_names[1..]
+                            )))
+                        }
+                    }
+                }
+            }
+        }
+        Ok(flags)
+    }
+}
+
+/// Baumgarte's gains from None or a pair (K_p, K_d).
+pub(crate) fn baumgarte_gains(value: Option<&Bound<PyAny>>) -> PyResult<Option<(f64, f64)>> {
+    let Some(value) = value.filter(|v| !v.is_none()) else {
+        return Ok(None);
+    };
+    value.extract::<(f64, f64)>().map(Some).map_err(|_| {
+        PyValueError::new_err(format!(
+            "argument 'baumgarte': expected None or a pair (kp, kd) of gains (1/s², 1/s), got {}",
+            describe(value)
+        ))
+    })
+}
+
+#[pymethods]
+impl PyModel {
+    /// The constraint Jacobian J(q) of `constraints` (one or a list of `PointAnchor`,
+    /// `FrameAnchor`, `JointCoupling`, `Distance`): (rows, nv), the constraints' rows in order;
+    /// the rows' velocity is J v.
+    fn constraint_jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        constraints: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let set = constraint_set(self, constraints)?;
+        let rows = set.rows();
+        let kernel: &Kernel = &|m, w, i, out| {
+            let Workspace {
+                data, constrained, ..
+            } = w;
+            let c = constraint_data(constrained, m, &set);
+            write_row_major(
+                algo::constraint_jacobian(m, data, c, &set, i[0])?,
+                rows,
+                out,
+            );
+            Ok(())
+        };
+        self.evaluate(py, &[self.q_arg("q", q)?], &[rows, self.model.nv], kernel)
+    }
+
+    /// The Delassus matrix J M⁻¹ Jᵀ of `constraints` at q: (rows, rows), the inverse inertia
+    /// the constraints see.
+    fn delassus<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        constraints: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let set = constraint_set(self, constraints)?;
+        let rows = set.rows();
+        let kernel: &Kernel = &|m, w, i, out| {
+            let Workspace {
+                data, constrained, ..
+            } = w;
+            let c = constraint_data(constrained, m, &set);
+            write_row_major(algo::delassus(m, data, c, &set, i[0])?, rows, out);
+            Ok(())
+        };
+        self.evaluate(py, &[self.q_arg("q", q)?], &[rows, rows], kernel)
+    }
+
+    /// Forward dynamics under `constraints`: dict of `qdd` (nv,) and `forces` (rows,) with
+    /// M qdd + h = tau + Jᵀ forces and J qdd + J̇ v = 0 (or −K_d J v − K_p φ with `baumgarte`
+    /// = (K_p, K_d)). Forces are what the constraints exert on the robot, in each constraint's
+    /// axes. `damping` μ > 0 solves redundant constraints (a loop stated twice) by proximal
+    /// iterations, giving their least-norm forces; with 0 a redundant row is a ValueError
+    /// naming it. `f_ext` as in `inverse_dynamics`.
+    #[pyo3(signature = (q, v, tau, constraints, f_ext=None, baumgarte=None, damping=0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn constrained_forward_dynamics<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        tau: &Bound<'py, PyAny>,
+        constraints: &Bound<'py, PyAny>,
+        f_ext: Option<&Bound<'py, PyAny>>,
+        baumgarte: Option<&Bound<'py, PyAny>>,
+        #[pyo3(from_py_with = named::damping)] damping: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let set = constraint_set(self, constraints)?;
+        let options = ConstrainedOptions {
+            baumgarte: baumgarte_gains(baumgarte)?,
+            damping,
+        };
+        let nv = self.model.nv;
+        let kernel: &Kernel = &|m, w, i, out| {
+            let Workspace {
+                data,
+                constrained,
+                forces,
+                ..
+            } = w;
+            let f_ext = i.get(3).map(|flat| {
+                fill_forces(forces, flat);
+                &forces[..]
+            });
+            let c = constraint_data(constrained, m, &set);
+            let state = (i[0], i[1], i[2]);
+            algo::constrained_forward_dynamics(m, data, c, &set, state, f_ext, &options)?;
+            out[..nv].copy_from_slice(c.qdd.as_slice());
+            out[nv..].copy_from_slice(c.forces.as_slice());
+            Ok(())
+        };
+        let whole = self.with_dynamics_arguments((q, v, ("tau", tau)), f_ext, |arguments| {
+            self.evaluate(py, arguments, &[nv + set.rows()], kernel)
+        })?;
+        Self::split_last(py, &whole, ["qdd", "forces"], nv)
+    }
+
+    /// The velocity after an impact that makes `constraints` hold: dict of `v` (nv,), the
+    /// velocity after, and `impulses` (rows,), with M (v⁺ − v) = Jᵀ impulses and J v⁺ =
+    /// −restitution J v (0: the constrained motion stops; 1: it reverses). `damping` as in
+    /// `constrained_forward_dynamics`.
+    #[pyo3(signature = (q, v, constraints, restitution=0.0, damping=0.0))]
+    fn impulse_dynamics<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        constraints: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = named::restitution)] restitution: f64,
+        #[pyo3(from_py_with = named::damping)] damping: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let set = constraint_set(self, constraints)?;
+        let nv = self.model.nv;
+        let kernel: &Kernel = &|m, w, i, out| {
+            let Workspace {
+                data, constrained, ..
+            } = w;
+            let c = constraint_data(constrained, m, &set);
+            algo::impulse_dynamics(m, data, c, &set, (i[0], i[1]), restitution, damping)?;
+            out[..nv].copy_from_slice(c.qdd.as_slice());
+            out[nv..].copy_from_slice(c.forces.as_slice());
+            Ok(())
+        };
+        let arguments = [self.q_arg("q", q)?, self.v_arg("v", v)?];
+        let whole = self.evaluate(py, &arguments, &[nv + set.rows()], kernel)?;
+        Self::split_last(py, &whole, ["v", "impulses"], nv)
+    }
+
+    /// Inverse dynamics under `constraints`: dict of `tau` (nv,; zero on coordinates not
+    /// actuated) and `forces` (rows,) with M a + h = tau + Jᵀ forces. `actuated`: the joints
+    /// with actuators (default: all but free joints, for a floating base). Where the forces are
+    /// not unique they are the least-norm ones. An `a` that breaks the constraints (J a + J̇ v ≠
+    /// 0), or that the forces cannot produce, is a ValueError giving the residual.
+    #[pyo3(signature = (q, v, a, constraints, actuated=None, f_ext=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn constrained_inverse_dynamics<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        a: &Bound<'py, PyAny>,
+        constraints: &Bound<'py, PyAny>,
+        actuated: Option<&Bound<'py, PyAny>>,
+        f_ext: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let set = constraint_set(self, constraints)?;
+        let flags = self.actuated_coordinates(actuated)?;
+        let nv = self.model.nv;
+        let kernel: &Kernel = &|m, w, i, out| {
+            let Workspace {
+                data,
+                constrained,
+                forces,
+                ..
+            } = w;
+            let f_ext = i.get(3).map(|flat| {
+                fill_forces(forces, flat);
+                &forces[..]
+            });
+            let c = constraint_data(constrained, m, &set);
+            let state = (i[0], i[1], i[2]);
+            algo::constrained_inverse_dynamics(m, data, c, &set, state, f_ext, &flags)?;
+            out[..nv].copy_from_slice(c.tau.as_slice());
+            out[nv..].copy_from_slice(c.forces.as_slice());
+            Ok(())
+        };
+        let whole = self.with_dynamics_arguments((q, v, ("a", a)), f_ext, |arguments| {
+            self.evaluate(py, arguments, &[nv + set.rows()], kernel)
+        })?;
+        Self::split_last(py, &whole, ["tau", "forces"], nv)
+    }
+}
