@@ -4,11 +4,13 @@
 use crate::args::*;
 use crate::constraints::constraint_set;
 use crate::model::*;
+use nalgebra::DVector;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyEllipsis, PySequence, PySlice, PyString, PyTuple};
 use robodyn::algo::{self, ConstrainedOptions, ConstraintData};
 use robodyn::constraint::ConstraintSet;
+use robodyn::spatial::Force;
 use robodyn::Model;
 
 /// The constrained algorithms' workspace in `slot` for `set`, made again when the set's size
@@ -24,7 +26,58 @@ fn constraint_data<'w>(
     slot.as_mut().expect("made above")
 }
 
+/// A constrained algorithm on (q, v, τ or q̈) and optional external forces, returning its
+/// vector of nv (q̈ or τ); the forces stay in the [`ConstraintData`].
+type ConstrainedAlgorithm<'a> = dyn for<'c> Fn(
+        &Model,
+        &mut robodyn::Data,
+        &'c mut ConstraintData,
+        (&[f64], &[f64], &[f64]),
+        Option<&[Force]>,
+    ) -> robodyn::Result<&'c DVector<f64>>
+    + Sync
+    + 'a;
+
 impl PyModel {
+    /// `algorithm` on the arguments (q, v, x[, f_ext]) for one state or a batch: a dict of its
+    /// vector and the constraint forces, named `names`.
+    fn constrained_call<'py>(
+        &self,
+        py: Python<'py>,
+        (q, v, x): (
+            &Bound<'py, PyAny>,
+            &Bound<'py, PyAny>,
+            (&'static str, &Bound<'py, PyAny>),
+        ),
+        f_ext: Option<&Bound<'py, PyAny>>,
+        set: &ConstraintSet,
+        names: [&str; 2],
+        algorithm: &ConstrainedAlgorithm,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let nv = self.model.nv;
+        let kernel: &Kernel = &|m, w, i, out| {
+            let Workspace {
+                data,
+                constrained,
+                forces,
+                ..
+            } = w;
+            let f_ext = i.get(3).map(|flat| {
+                fill_forces(forces, flat);
+                &forces[..]
+            });
+            let c = constraint_data(constrained, m, set);
+            let result = algorithm(m, data, c, (i[0], i[1], i[2]), f_ext)?;
+            out[..nv].copy_from_slice(result.as_slice());
+            out[nv..].copy_from_slice(c.forces.as_slice());
+            Ok(())
+        };
+        let whole = self.with_dynamics_arguments((q, v, x), f_ext, |arguments| {
+            self.evaluate(py, arguments, &[nv + set.rows()], kernel)
+        })?;
+        Self::split_last(py, &whole, names, nv)
+    }
+
     /// `(..., a + b)` results split along their last axis into a dict of `(..., a)` and
     /// `(..., b)` views named `names`.
     fn split_last<'py>(
@@ -185,29 +238,12 @@ impl PyModel {
             baumgarte: baumgarte_gains(baumgarte)?,
             damping,
         };
-        let nv = self.model.nv;
-        let kernel: &Kernel = &|m, w, i, out| {
-            let Workspace {
-                data,
-                constrained,
-                forces,
-                ..
-            } = w;
-            let f_ext = i.get(3).map(|flat| {
-                fill_forces(forces, flat);
-                &forces[..]
-            });
-            let c = constraint_data(constrained, m, &set);
-            let state = (i[0], i[1], i[2]);
+        let algorithm: &ConstrainedAlgorithm = &|m, data, c, state, f_ext| {
             algo::constrained_forward_dynamics(m, data, c, &set, state, f_ext, &options)?;
-            out[..nv].copy_from_slice(c.qdd.as_slice());
-            out[nv..].copy_from_slice(c.forces.as_slice());
-            Ok(())
+            Ok(&c.qdd)
         };
-        let whole = self.with_dynamics_arguments((q, v, ("tau", tau)), f_ext, |arguments| {
-            self.evaluate(py, arguments, &[nv + set.rows()], kernel)
-        })?;
-        Self::split_last(py, &whole, ["qdd", "forces"], nv)
+        let arguments = (q, v, ("tau", tau));
+        self.constrained_call(py, arguments, f_ext, &set, ["qdd", "forces"], algorithm)
     }
 
     /// The velocity after an impact that makes `constraints` hold: dict of `v` (nv,), the
@@ -260,28 +296,11 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let set = constraint_set(self, constraints)?;
         let flags = self.actuated_coordinates(actuated)?;
-        let nv = self.model.nv;
-        let kernel: &Kernel = &|m, w, i, out| {
-            let Workspace {
-                data,
-                constrained,
-                forces,
-                ..
-            } = w;
-            let f_ext = i.get(3).map(|flat| {
-                fill_forces(forces, flat);
-                &forces[..]
-            });
-            let c = constraint_data(constrained, m, &set);
-            let state = (i[0], i[1], i[2]);
+        let algorithm: &ConstrainedAlgorithm = &|m, data, c, state, f_ext| {
             algo::constrained_inverse_dynamics(m, data, c, &set, state, f_ext, &flags)?;
-            out[..nv].copy_from_slice(c.tau.as_slice());
-            out[nv..].copy_from_slice(c.forces.as_slice());
-            Ok(())
+            Ok(&c.tau)
         };
-        let whole = self.with_dynamics_arguments((q, v, ("a", a)), f_ext, |arguments| {
-            self.evaluate(py, arguments, &[nv + set.rows()], kernel)
-        })?;
-        Self::split_last(py, &whole, ["tau", "forces"], nv)
+        let arguments = (q, v, ("a", a));
+        self.constrained_call(py, arguments, f_ext, &set, ["tau", "forces"], algorithm)
     }
 }

@@ -12,6 +12,7 @@ use robodyn::constraint::{
     Attachment, Constraint, ConstraintKind, ConstraintReference, ConstraintSet,
 };
 use robodyn::spatial::Transform;
+use robodyn::Model;
 
 /// How far from orthonormal a placement's rotation may be (|RᵀR − 1|∞).
 const ROTATION_TOLERANCE: f64 = 1e-9;
@@ -179,14 +180,15 @@ impl PyFrameAnchor {
 }
 
 /// Joint `joint`'s coordinate held to `ratio · q_leader + offset`, or, with `polycoef` (up to five
-/// numbers c0 … c4), to `c0 + c1 q_leader + … + c4 q_leader⁴`. Both joints revolute or both
+/// numbers c0 … c4), to `c0 + c1 q_leader + … + c4 q_leader⁴`; with `leader` None, held at
+/// `offset` (or c0). Both joints revolute or both
 /// prismatic. 1 row; its force is the torque (or force) on `joint`.
 #[pyclass(name = "JointCoupling", module = "robodyn", frozen)]
 pub(crate) struct PyJointCoupling {
     #[pyo3(get)]
     joint: String,
     #[pyo3(get)]
-    leader: String,
+    leader: Option<String>,
     #[pyo3(get)]
     polycoef: [f64; 5],
 }
@@ -197,7 +199,7 @@ impl PyJointCoupling {
     #[pyo3(signature = (joint, leader, ratio=1.0, offset=0.0, polycoef=None))]
     fn new(
         joint: &Bound<PyAny>,
-        leader: &Bound<PyAny>,
+        leader: Option<&Bound<PyAny>>,
         #[pyo3(from_py_with = named::ratio)] ratio: f64,
         #[pyo3(from_py_with = named::offset)] offset: f64,
         polycoef: Option<&Bound<PyAny>>,
@@ -228,15 +230,17 @@ impl PyJointCoupling {
         }
         Ok(PyJointCoupling {
             joint: name("joint", joint)?,
-            leader: name("leader", leader)?,
+            leader: leader.map(|l| name("leader", l)).transpose()?,
             polycoef,
         })
     }
 
     fn __repr__(&self) -> String {
         format!(
-            "JointCoupling({:?}, {:?}, polycoef={:?})",
-            self.joint, self.leader, self.polycoef
+            "JointCoupling({:?}, {}, polycoef={:?})",
+            self.joint,
+            optional_text(&self.leader),
+            self.polycoef
         )
     }
 
@@ -393,7 +397,11 @@ fn resolve_one(model: &PyModel, value: &Bound<PyAny>) -> PyResult<Option<Constra
         let c = coupling.get();
         let kind = ConstraintKind::Coupling {
             follower: joint_of(model, &c.joint)?,
-            leader: joint_of(model, &c.leader)?,
+            leader: c
+                .leader
+                .as_deref()
+                .map(|l| joint_of(model, l))
+                .transpose()?,
             polynomial: c.polycoef,
             references: (0.0, 0.0),
         };
@@ -409,6 +417,97 @@ fn resolve_one(model: &PyModel, value: &Bound<PyAny>) -> PyResult<Option<Constra
         return Ok(Some(with_reference(kind, "world")));
     }
     Ok(None)
+}
+
+/// A core constraint of `model` as the Python object that states it (frames and joints by name;
+/// a coupling's polynomial about its reference coordinates expanded into one in q_leader).
+pub(crate) fn to_python(py: Python, model: &Model, constraint: &Constraint) -> PyResult<Py<PyAny>> {
+    let frame_name = |a: &Attachment| a.frame.map(|f| model.frames[f].name.clone());
+    let reference = match constraint.reference {
+        ConstraintReference::World => "world",
+        ConstraintReference::Local => "local",
+    }
+    .to_string();
+    let object = match &constraint.kind {
+        ConstraintKind::Point { first, second } => {
+            let offset = |a: &Attachment| <[f64; 3]>::from(a.placement.translation);
+            Py::new(
+                py,
+                PyPointAnchor {
+                    frame: frame_name(first).unwrap_or_default(),
+                    frame2: second.as_ref().and_then(frame_name),
+                    offset: offset(first),
+                    offset2: second.as_ref().map(offset),
+                    reference,
+                },
+            )?
+            .into_any()
+        }
+        ConstraintKind::Frame {
+            first,
+            second,
+            mask,
+        } => Py::new(
+            py,
+            PyFrameAnchor {
+                frame: frame_name(first).unwrap_or_default(),
+                frame2: second.as_ref().and_then(frame_name),
+                placement: first.placement.to_homogeneous(),
+                placement2: second.as_ref().map(|a| a.placement.to_homogeneous()),
+                mask: *mask,
+                reference,
+            },
+        )?
+        .into_any(),
+        ConstraintKind::Coupling {
+            follower,
+            leader,
+            polynomial,
+            references,
+        } => Py::new(
+            py,
+            PyJointCoupling {
+                joint: model.joint_names[*follower].clone(),
+                leader: leader.map(|l| model.joint_names[l].clone()),
+                polycoef: expanded(polynomial, *references, leader.is_some()),
+            },
+        )?
+        .into_any(),
+        ConstraintKind::Distance {
+            first,
+            second,
+            length,
+        } => Py::new(
+            py,
+            PyDistance {
+                frame1: frame_name(first).unwrap_or_default(),
+                frame2: frame_name(second).unwrap_or_default(),
+                length: *length,
+            },
+        )?
+        .into_any(),
+    };
+    Ok(object)
+}
+
+/// `q_f = q_f,ref + Σ_k c_k (q_l − q_l,ref)^k` as `Σ_j d_j q_l^j`: by the binomial theorem,
+/// `d_j = Σ_{k≥j} c_k C(k, j) (−q_l,ref)^(k−j)`, and `d_0` gains q_f,ref. Without a leader only
+/// `c_0` counts.
+fn expanded(c: &[f64; 5], (follower_ref, leader_ref): (f64, f64), has_leader: bool) -> [f64; 5] {
+    let mut d = [0.0; 5];
+    if !has_leader {
+        d[0] = follower_ref + c[0];
+        return d;
+    }
+    let binomial =
+        |k: usize, j: usize| (0..j).fold(1.0, |b, i| b * (k - i) as f64 / (i + 1) as f64);
+    for (j, dj) in d.iter_mut().enumerate() {
+        *dj = (j..5)
+            .map(|k| c[k] * binomial(k, j) * (-leader_ref).powi((k - j) as i32))
+            .sum();
+    }
+    d[0] += follower_ref;
+    d
 }
 
 fn with_reference(kind: ConstraintKind, reference: &str) -> Constraint {

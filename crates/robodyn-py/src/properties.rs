@@ -224,6 +224,18 @@ impl PyModel {
         self.model.warnings.clone()
     }
 
+    /// The constraints the model file declares and holds active (MJCF `<equality>` connect, weld
+    /// and joint, anchors computed at the neutral configuration as MuJoCo's compiler does), as
+    /// the `PointAnchor`, `FrameAnchor` and `JointCoupling` objects that state them; pass them
+    /// to `constrained_forward_dynamics` or `simulate(..., constraints=m.constraints)`.
+    #[getter]
+    fn constraints(&self, py: Python) -> PyResult<Vec<Py<PyAny>>> {
+        let active = self.model.constraints.iter().filter(|c| c.active);
+        active
+            .map(|c| crate::constraints::to_python(py, &self.model, &c.constraint))
+            .collect()
+    }
+
     /// The mass of each moving body (kg), aligned with body_names (fixed links merged in).
     #[getter]
     fn body_masses(&self) -> Vec<f64> {

@@ -77,12 +77,13 @@ pub enum ConstraintKind {
         mask: [bool; 6],
     },
     /// `q_f − q_f,ref = Σ_k c_k (q_l − q_l,ref)^k` between two one-coordinate joints of the
-    /// same kind (bodies `follower` and `leader`). 1 row.
+    /// same kind (bodies `follower` and `leader`), or, without a leader, `q_f − q_f,ref = c_0`
+    /// (the joint held). 1 row.
     Coupling {
         /// The body whose joint follows.
         follower: usize,
-        /// The body whose joint leads.
-        leader: usize,
+        /// The body whose joint leads, or `None`: the follower is held at `q_f,ref + c_0`.
+        leader: Option<usize>,
         /// `c_0 … c_4` (MuJoCo's `polycoef`; a ratio r and offset o are `[o, r, 0, 0, 0]`).
         polynomial: [f64; 5],
         /// The coordinates the polynomial is taken about: `(q_f,ref, q_l,ref)`.
@@ -137,10 +138,13 @@ impl Constraint {
             }
             ConstraintKind::Coupling {
                 follower, leader, ..
-            } => format!(
-                "JointCoupling('{}' on '{}')",
-                model.joint_names[*follower], model.joint_names[*leader]
-            ),
+            } => match leader {
+                Some(leader) => format!(
+                    "JointCoupling('{}' on '{}')",
+                    model.joint_names[*follower], model.joint_names[*leader]
+                ),
+                None => format!("JointCoupling('{}' held)", model.joint_names[*follower]),
+            },
             ConstraintKind::Distance { first, second, .. } => {
                 format!("Distance({} to {})", frame(first), frame(second))
             }
@@ -159,6 +163,24 @@ impl Constraint {
             ConstraintKind::Coupling { .. } | ConstraintKind::Distance { .. } => "the row",
         }
     }
+}
+
+/// A constraint a model file declares (MJCF `<equality>`): the constraint, and what MuJoCo's
+/// soft constraint model reads of it.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ModelConstraint {
+    /// Its name in the file (empty when it has none).
+    pub name: String,
+    /// What it holds (anchors computed at the neutral configuration, MuJoCo's `qpos0`).
+    pub constraint: Constraint,
+    /// Whether it is enforced (`active`); an inactive one is kept but not held.
+    pub active: bool,
+    /// MuJoCo's `solref` (time constant, damping ratio) for its soft form.
+    pub solref: [f64; 2],
+    /// MuJoCo's `solimp` (d₀, d_width, width, midpoint, power) for its soft form.
+    pub solimp: [f64; 5],
+    /// A weld's `torquescale` (the weight of its rotation rows in the soft form; 1 otherwise).
+    pub torquescale: f64,
 }
 
 /// Constraints checked against a model, with the first row of each.
@@ -288,7 +310,7 @@ fn check_constraint(model: &Model, constraint: &Constraint) -> std::result::Resu
             references,
         } => {
             let nbodies = model.nbodies();
-            for body in [follower, leader] {
+            for body in std::iter::once(follower).chain(leader) {
                 if *body == 0 || *body >= nbodies {
                     return Err(format!(
                         "expected a joint index from 1 to {}, got {body}",
@@ -296,20 +318,31 @@ fn check_constraint(model: &Model, constraint: &Constraint) -> std::result::Resu
                     ));
                 }
             }
-            let (f, l) = (&model.joints[*follower], &model.joints[*leader]);
             let name = |b: &usize| &model.joint_names[*b];
-            if follower == leader {
-                return Err(format!("joint '{}' is coupled to itself", name(follower)));
-            }
-            if f.nv() != 1 || f.nq() != 1 || l.nv() != 1 || l.nq() != 1 || f.kind() != l.kind() {
+            let f = &model.joints[*follower];
+            let one_coordinate = |j: &crate::Joint| j.nv() == 1 && j.nq() == 1;
+            if !one_coordinate(f) {
                 return Err(format!(
-                    "a coupling joins two revolute or two prismatic joints, got '{}' ({}) and \
-                     '{}' ({})",
+                    "a coupling holds a revolute or prismatic joint, got '{}' ({})",
                     name(follower),
-                    f.kind(),
-                    name(leader),
-                    l.kind()
+                    f.kind()
                 ));
+            }
+            if let Some(leader) = leader {
+                let l = &model.joints[*leader];
+                if follower == leader {
+                    return Err(format!("joint '{}' is coupled to itself", name(follower)));
+                }
+                if !one_coordinate(l) || f.kind() != l.kind() {
+                    return Err(format!(
+                        "a coupling joins two revolute or two prismatic joints, got '{}' ({}) \
+                         and '{}' ({})",
+                        name(follower),
+                        f.kind(),
+                        name(leader),
+                        l.kind()
+                    ));
+                }
             }
             let finite = polynomial.iter().all(|c| c.is_finite())
                 && references.0.is_finite()

@@ -188,6 +188,9 @@ pub struct Model {
     pub gravity: Vec3,
     /// Mimic relations, reported, not enforced.
     pub mimics: Vec<Mimic>,
+    /// The constraints the model file declares (MJCF `<equality>`), active or not.
+    #[serde(default)]
+    pub constraints: Vec<crate::constraint::ModelConstraint>,
     /// What the loader accepted but the user should know (ignored tags, unchecked inertias).
     pub warnings: Vec<String>,
     /// What the links look like (URDF `<visual>`, MJCF geoms); only the viewer reads it.

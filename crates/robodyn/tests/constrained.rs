@@ -85,7 +85,7 @@ fn coupling(model: &Model) -> Constraint {
     constraint(
         ConstraintKind::Coupling {
             follower: body_of(model, "wrist_3_joint"),
-            leader: body_of(model, "wrist_1_joint"),
+            leader: Some(body_of(model, "wrist_1_joint")),
             polynomial: [-0.1, 0.5, 0.2, 0.0, 0.0],
             references: (0.3, -0.2),
         },
@@ -439,7 +439,7 @@ fn malformed_constraints_are_refused_by_name() {
     let coupled = |follower: &str, leader: &str| {
         let kind = ConstraintKind::Coupling {
             follower: body_of(&model, follower),
-            leader: body_of(&model, leader),
+            leader: Some(body_of(&model, leader)),
             polynomial: [0.0, 1.0, 0.0, 0.0, 0.0],
             references: (0.0, 0.0),
         };

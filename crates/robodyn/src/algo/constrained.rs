@@ -23,7 +23,9 @@ mod solve;
 
 pub use forward::{constrained_forward_dynamics, impulse_dynamics, ConstrainedOptions};
 pub use inverse::{constrained_inverse_dynamics, CONSTRAINT_ACCELERATION_TOLERANCE};
-pub use solve::{DEPENDENT_ROW_TOLERANCE, PROXIMAL_ACCURACY, PROXIMAL_MAX_ITERATIONS};
+pub use solve::{
+    DEPENDENT_ROW_TOLERANCE, PROXIMAL_ACCURACY, PROXIMAL_MAX_ITERATIONS, STALLED_ACCURACY,
+};
 
 use crate::algo::crba::crba;
 use crate::algo::kinematics::update_body_placements;
@@ -208,6 +210,15 @@ fn constraint_rows(
     Ok(())
 }
 
+/// The size of the terms of `Σ_c J_rc x_c` over the rows: `max_r Σ_c |J_rc x_c|`, the scale of
+/// that product's rounding.
+fn product_scale(jacobian: &DMatrix<f64>, x: &[f64]) -> f64 {
+    (0..jacobian.nrows()).fold(0.0, |largest, r| {
+        let row = jacobian.row(r);
+        largest.max(row.iter().zip(x).map(|(j, xi)| (j * xi).abs()).sum())
+    })
+}
+
 /// J M⁻¹ by the factor's sweeps (one right-hand side per row), then `Λ⁻¹ = Σ_c J_:c (J M⁻¹)_:cᵀ`.
 fn delassus_matrix(model: &Model, data: &Data, constraints: &mut ConstraintData) {
     let ConstraintData {
@@ -230,13 +241,15 @@ fn delassus_matrix(model: &Model, data: &Data, constraints: &mut ConstraintData)
     }
 }
 
-/// Solves `Λ⁻¹ λ = rhs` (the right-hand side in `constraints.rhs`) into `constraints.forces`;
-/// a dependent row without damping, or an inconsistent set, is an error naming its rows.
+/// Solves `Λ⁻¹ λ = rhs` (the right-hand side in `constraints.rhs`, computed from terms of size
+/// `scale`) into `constraints.forces`; a dependent row without damping, or an inconsistent set,
+/// is an error naming its rows.
 fn solve_forces(
     model: &Model,
     set: &ConstraintSet,
     constraints: &mut ConstraintData,
     damping: f64,
+    scale: f64,
 ) -> Result<()> {
     let m = set.rows();
     let ConstraintData {
@@ -257,6 +270,7 @@ fn solve_forces(
         rhs,
         forces.as_mut_slice(),
         damping,
+        scale,
         scratch,
     );
     match solved {
@@ -276,8 +290,8 @@ fn solve_forces(
         Err(SolveFailure::Inconsistent { residual }) => Err(Error::InvalidValue {
             argument: "constraints".into(),
             message: format!(
-                "the constraints cannot all hold: after {PROXIMAL_MAX_ITERATIONS} proximal \
-                 iterations their acceleration residual is still {residual:.3e}"
+                "the constraints cannot all hold: the proximal iterations leave an acceleration \
+                 (or velocity) residual of {residual:.3e}"
             ),
         }),
     }

@@ -100,14 +100,19 @@ pub(crate) fn evaluate(
                 polynomial,
                 references,
             } => {
-                let (f, l) = (model.idx_v[*follower], model.idx_v[*leader]);
-                let x = q[model.idx_q[*leader]] - references.1;
-                let (p, dp, ddp) = polynomial_at(polynomial, x);
-                // φ = (q_f − q_f,ref) − p(x);  J = e_f − p'(x) e_l;  γ = −p''(x) q̇_l²
-                rows.error[row] = q[model.idx_q[*follower]] - references.0 - p;
+                let f = model.idx_v[*follower];
                 rows.jacobian[(row, f)] += 1.0;
-                rows.jacobian[(row, l)] -= dp;
-                rows.drift[row] = -ddp * v[l] * v[l];
+                rows.error[row] = q[model.idx_q[*follower]] - references.0 - polynomial[0];
+                rows.drift[row] = 0.0;
+                if let Some(leader) = leader {
+                    let l = model.idx_v[*leader];
+                    let x = q[model.idx_q[*leader]] - references.1;
+                    let (p, dp, ddp) = polynomial_at(polynomial, x);
+                    // φ = (q_f − q_f,ref) − p(x);  J = e_f − p'(x) e_l;  γ = −p''(x) q̇_l²
+                    rows.error[row] = q[model.idx_q[*follower]] - references.0 - p;
+                    rows.jacobian[(row, l)] -= dp;
+                    rows.drift[row] = -ddp * v[l] * v[l];
+                }
             }
         }
     }

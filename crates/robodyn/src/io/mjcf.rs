@@ -13,7 +13,8 @@
 //! q is the body's pose in the world (the XML pose is only MuJoCo's initial qpos).
 //! Every element and attribute is first checked against MuJoCo's schema (`schema_table.rs`): an
 //! unknown name is an error, as in MuJoCo.
-//! Not read (a warning each): actuators, sensors, contacts, equality constraints, tendons,
+//! `<equality>` `connect`, `weld` and `joint` become the model's constraints (`mjcf/equality.rs`).
+//! Not read (a warning each): actuators, sensors, contacts, tendons (and their equalities),
 //! keyframes. Of the assets, the meshes are read, for the inertia of mesh geoms (`mjcf/meshes.rs`).
 
 use crate::error::{Error, Result};
@@ -29,6 +30,7 @@ use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 mod bodies;
+mod equality;
 mod inertia;
 mod mass;
 mod meshes;
@@ -41,11 +43,10 @@ use mass::MassRules;
 use schema_table::MJCF_SCHEMA;
 
 /// Sections of an MJCF file that do not describe the tree.
-const IGNORED_SECTIONS: [&str; 8] = [
+const IGNORED_SECTIONS: [&str; 7] = [
     "actuator",
     "sensor",
     "contact",
-    "equality",
     "tendon",
     "keyframe",
     "visual",
@@ -222,7 +223,9 @@ fn load_sources(sources: &Sources) -> Result<Model> {
     for message in reader.warnings.take() {
         builder.warn(message);
     }
-    Ok(builder.build())
+    let mut model = builder.build();
+    reader.read_equalities(&sections, &mut model)?;
+    Ok(model)
 }
 
 struct Reader<'a> {

@@ -143,6 +143,12 @@ fn check_structure(model: &Model) -> Result<()> {
     if bodies_named.into_iter().any(|body| body >= bodies) || !dof_parents_before {
         return damaged("a frame, visual, mimic or coordinate refers to a missing one".into());
     }
+    let declared = model.constraints.iter().map(|c| c.constraint.clone());
+    if let Err(error) = crate::constraint::ConstraintSet::new(model, declared.collect()) {
+        return damaged(format!(
+            "a declared constraint does not fit the model: {error}"
+        ));
+    }
     Ok(())
 }
 

@@ -69,6 +69,7 @@ impl ModelBuilder {
                 frames: Vec::new(),
                 gravity: Vec3::new(0.0, 0.0, -STANDARD_GRAVITY),
                 mimics: Vec::new(),
+                constraints: Vec::new(),
                 warnings: Vec::new(),
                 visuals: Vec::new(),
                 skybox: None,

@@ -8,7 +8,10 @@
 //! in `data`: RNEA's fields, the mass matrix and its factor, the body placements. Cost: RNEA,
 //! CRBA and M's factor, one tree-sparse solve per row, O(m² nv) for Λ⁻¹ and O(m³) to solve it.
 
-use super::{constraint_rows, delassus_matrix, factor_inertia, solve_forces, ConstraintData};
+use super::solve::largest;
+use super::{
+    constraint_rows, delassus_matrix, factor_inertia, product_scale, solve_forces, ConstraintData,
+};
 use crate::algo::ltdl::solve_rows;
 use crate::algo::rnea::newton_euler;
 use crate::constraint::ConstraintSet;
@@ -96,7 +99,14 @@ pub fn constrained_forward_dynamics(
         );
         *value = -(ja + drift[r] + kd * jv + kp * error[r]);
     }
-    solve_forces(model, set, constraints, options.damping)?;
+    let scale =
+        1.0 + product_scale(
+            &constraints.jacobian,
+            constraints.free_acceleration.as_slice(),
+        ) + largest(constraints.drift.as_slice())
+            + kd * product_scale(&constraints.jacobian, v)
+            + kp * largest(constraints.error.as_slice());
+    solve_forces(model, set, constraints, options.damping, scale)?;
 
     // q̈ = a_f + M⁻¹ Jᵀ λ = a_f + (J M⁻¹)ᵀ λ
     let ConstraintData {
@@ -146,7 +156,8 @@ pub fn impulse_dynamics(
         let jv: f64 = jacobian.row(r).iter().zip(v).map(|(j, vi)| j * vi).sum();
         *value = -(1.0 + restitution) * jv;
     }
-    solve_forces(model, set, constraints, damping)?;
+    let scale = 1.0 + (1.0 + restitution) * product_scale(&constraints.jacobian, v);
+    solve_forces(model, set, constraints, damping, scale)?;
 
     // q̇⁺ = q̇ + M⁻¹ Jᵀ Λ
     let ConstraintData {

@@ -104,7 +104,8 @@ pub fn constrained_inverse_dynamics(
     *iterations = 0;
     if damping > 0.0 {
         let scratch = SolveScratch { residual, step };
-        let solved = solve_symmetric(n, gram, factor, rhs, unknowns, damping, scratch);
+        let scale = 1.0 + largest(&rhs[..n]);
+        let solved = solve_symmetric(n, gram, factor, rhs, unknowns, damping, scale, scratch);
         *iterations = match solved {
             Ok(count) => count,
             Err(SolveFailure::Inconsistent { .. }) | Err(SolveFailure::DependentRow(_)) => 0,

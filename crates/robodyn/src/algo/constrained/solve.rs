@@ -17,8 +17,18 @@
 /// the metric of M⁻¹), so rows closer than 1e-5 rad to dependent are called dependent.
 pub const DEPENDENT_ROW_TOLERANCE: f64 = 1e-10;
 
-/// The proximal iterations stop once `|b − A x|∞ ≤ PROXIMAL_ACCURACY (1 + |b|∞)`.
+/// The proximal iterations stop once `|b − A x|∞ ≤ PROXIMAL_ACCURACY · scale`, the scale being
+/// the size of the terms b was computed from (its rounding floor is about 1e-16 of it).
 pub const PROXIMAL_ACCURACY: f64 = 1e-12;
+
+/// Iterations whose residual no longer falls (by a hundredth over ten of them) have
+/// reached what rounding leaves along the directions A cannot reach: the residual is accepted if
+/// it is below this times the scale (an inconsistency at rounding level, as between the
+/// dependent rows of a planar loop), else the system is refused as inconsistent.
+pub const STALLED_ACCURACY: f64 = 1e-9;
+
+/// How many iterations a stall is judged over.
+const STALL_WINDOW: usize = 10;
 
 /// At most this many proximal iterations; a system still unsolved is refused as inconsistent.
 pub const PROXIMAL_MAX_ITERATIONS: usize = 500;
@@ -44,9 +54,11 @@ pub(crate) struct SolveScratch<'a> {
 }
 
 /// Solves `a x = b` (a: n × n, symmetric positive semi-definite): with `damping` 0 by Cholesky,
-/// refusing a dependent row; with `damping` μ > 0 by proximal iterations on `a + μ 1`.
+/// refusing a dependent row; with `damping` μ > 0 by proximal iterations on `a + μ 1`, to
+/// [`PROXIMAL_ACCURACY`] times `scale` (at least 1: the size of the terms b comes from).
 /// `factor` (n × n) receives the factor. Returns the number of proximal iterations (0 when
 /// direct).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_symmetric(
     n: usize,
     a: &[f64],
@@ -54,6 +66,7 @@ pub(crate) fn solve_symmetric(
     b: &[f64],
     x: &mut [f64],
     damping: f64,
+    scale: f64,
     scratch: SolveScratch,
 ) -> Result<usize, SolveFailure> {
     factor[..n * n].copy_from_slice(&a[..n * n]);
@@ -70,7 +83,8 @@ pub(crate) fn solve_symmetric(
     let SolveScratch { residual, step } = scratch;
     x[..n].fill(0.0);
     residual[..n].copy_from_slice(&b[..n]);
-    let tolerance = PROXIMAL_ACCURACY * (1.0 + largest(&b[..n]));
+    let scale = scale.max(1.0).max(largest(&b[..n]));
+    let mut recent = [f64::INFINITY; STALL_WINDOW];
     for iteration in 1..=PROXIMAL_MAX_ITERATIONS {
         // x ← x + (A + μ 1)⁻¹ (b − A x)
         step[..n].copy_from_slice(&residual[..n]);
@@ -88,8 +102,17 @@ pub(crate) fn solve_symmetric(
                 *r -= aij * xj;
             }
         }
-        if largest(&residual[..n]) <= tolerance {
+        let size = largest(&residual[..n]);
+        if size <= PROXIMAL_ACCURACY * scale {
             return Ok(iteration);
+        }
+        // the residual STALL_WINDOW iterations ago, replaced by this one
+        let before = std::mem::replace(&mut recent[iteration % STALL_WINDOW], size);
+        if size > 0.99 * before {
+            if size <= STALLED_ACCURACY * scale {
+                return Ok(iteration);
+            }
+            return Err(SolveFailure::Inconsistent { residual: size });
         }
     }
     Err(SolveFailure::Inconsistent {
@@ -177,7 +200,7 @@ mod tests {
             residual: &mut r,
             step: &mut s,
         };
-        let result = solve_symmetric(3, a, &mut factor, b, &mut x, damping, scratch);
+        let result = solve_symmetric(3, a, &mut factor, b, &mut x, damping, 1.0, scratch);
         (result, x)
     }
 

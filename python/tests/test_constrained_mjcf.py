@@ -1,0 +1,154 @@
+"""MJCF `<equality>` constraints: read as MuJoCo compiles them (anchors at qpos0, relpose, polycoef,
+classes, active), compared with MuJoCo's compiled `eq_data`; and the loops they close held in
+forward dynamics and in simulation (Cassie)."""
+
+from __future__ import annotations
+
+import warnings
+
+import mujoco
+import numpy as np
+import pytest
+from conftest import REPOSITORY, assert_close
+
+import robodyn
+
+CASSIE = REPOSITORY / "testdata" / "mjcf" / "cassie_nomesh.xml"
+GRIPPER = REPOSITORY / "testdata" / "menagerie" / "robotiq_2f85" / "2f85.xml"
+#: MuJoCo's compiler and robodyn both compute the anchors in double precision from the same poses.
+COMPILER_TOLERANCE = 1e-12
+#: How far a simulated loop may come apart (m).
+LOOP_DRIFT = 1e-8
+
+EQUALITIES = """<mujoco model="equalities">
+  <compiler angle="radian"/>
+  <default><equality solref="0.01 0.8"/><default class="stiff"><equality solimp="0.9 0.99 0.001 0.5 2"/></default></default>
+  <worldbody>
+    <body name="a" pos="0 0 1">
+      <joint name="ja" type="hinge" axis="0 1 0" ref="0.2"/>
+      <inertial pos="0.2 0 0" mass="1" diaginertia="0.01 0.02 0.02"/>
+      <body name="b" pos="0.4 0 0" euler="0.1 0.2 0.3">
+        <joint name="jb" type="hinge" axis="0 1 0"/>
+        <inertial pos="0.2 0 0" mass="1" diaginertia="0.01 0.02 0.02"/>
+        <site name="tip" pos="0.4 0 0"/>
+      </body>
+    </body>
+    <body name="c" pos="0.5 0.3 1.2" euler="0.3 0 0.1">
+      <joint name="jc" type="slide" axis="1 0 0"/>
+      <joint name="jd" type="slide" axis="0 0 1"/>
+      <inertial pos="0 0 0" mass="2" diaginertia="0.1 0.1 0.1"/>
+      <site name="mark" pos="0.1 0 0"/>
+    </body>
+  </worldbody>
+  <equality>
+    <connect name="pin" body1="b" body2="c" anchor="0.4 0.1 0"/>
+    <weld body1="a" body2="c" anchor="0.05 0 0.1" class="stiff"/>
+    <weld body1="b" relpose="0.1 0.2 0.3 0.9 0.1 0.3 0.2" anchor="0.1 0 0" torquescale="2"/>
+    <connect site1="tip" site2="mark"/>
+    <joint joint1="jd" joint2="jc" polycoef="0.1 -0.5 0.3 0 0"/>
+    <joint joint1="jb" polycoef="0.25 0 0 0 0" active="false"/>
+  </equality>
+</mujoco>"""
+
+
+def load(path=None, text=None):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", robodyn.ModelWarning)
+        return robodyn.load(path) if text is None else robodyn.load_mjcf_string(text)
+
+
+def pose(rotation, position):
+    placement = np.eye(4)
+    placement[:3, :3], placement[:3, 3] = rotation, position
+    return placement
+
+
+def mujoco_relpose(data):
+    """A weld's compiled relpose as a 4x4 pose in body1: its position is where body2's anchor
+    is held in body1, its w-first quaternion body2's orientation in body1."""
+    rotation = np.zeros(9)
+    mujoco.mju_quat2Mat(rotation, data[6:10] / np.linalg.norm(data[6:10]))
+    return pose(rotation.reshape(3, 3), data[3:6])
+
+
+def test_connects_and_joint_equalities_are_those_mujoco_compiles():
+    for path in (CASSIE, GRIPPER):
+        model, compiled = load(path), mujoco.MjModel.from_xml_path(str(path))
+        constraints = model.constraints
+        assert len(constraints) == compiled.neq
+        for k, constraint in enumerate(constraints):
+            data = compiled.eq_data[k]
+            if compiled.eq_type[k] == mujoco.mjtEq.mjEQ_CONNECT:
+                assert constraint.frame == mujoco.mj_id2name(compiled, mujoco.mjtObj.mjOBJ_BODY, compiled.eq_obj1id[k])
+                assert_close(constraint.offset, data[0:3], COMPILER_TOLERANCE, f"{path.name} {k} anchor")
+                assert_close(constraint.offset2, data[3:6], COMPILER_TOLERANCE, f"{path.name} {k} anchor2")
+            else:
+                assert compiled.eq_type[k] == mujoco.mjtEq.mjEQ_JOINT
+                # qpos0 of both driver joints is 0: the polynomial is MuJoCo's as written
+                assert_close(constraint.polycoef, data[0:5], COMPILER_TOLERANCE, f"{path.name} {k} polycoef")
+
+
+def test_welds_sites_classes_and_inactive_equalities():
+    model, compiled = load(text=EQUALITIES), mujoco.MjModel.from_xml_string(EQUALITIES)
+    constraints = model.constraints
+    # the inactive joint equality is kept in the file's list but not held
+    assert len(constraints) == compiled.neq - 1
+    q = model.neutral()
+    world = {name: model.frame_pose(q, name) for name in ("a", "b", "c", "tip", "mark")}
+    # the connect's two points coincide at qpos0
+    pin = constraints[0]
+    first = world["b"] @ np.append(pin.offset, 1.0)
+    second = world["c"] @ np.append(pin.offset2, 1.0)
+    assert_close(first, second, COMPILER_TOLERANCE, "connect at qpos0")
+    # the weld frames coincide at qpos0 (relpose from qpos0), and match MuJoCo's compiled relpose
+    weld = constraints[1]
+    assert_close(world["a"] @ np.array(weld.placement), world["c"] @ np.array(weld.placement2), COMPILER_TOLERANCE, "weld")
+    assert_close(weld.placement, mujoco_relpose(compiled.eq_data[1]), COMPILER_TOLERANCE, "weld relpose")
+    assert_close(weld.placement2, pose(np.eye(3), compiled.eq_data[1][0:3]), 0.0, "weld anchor")
+    # a weld to the world with its relpose given
+    given = constraints[2]
+    assert given.frame == "b" and given.frame2 is None
+    assert_close(given.placement, mujoco_relpose(compiled.eq_data[2]), COMPILER_TOLERANCE, "given relpose")
+    assert constraints[3].frame == "tip" and constraints[3].frame2 == "mark"
+    # jd − qpos0 = 0.1 − 0.5 (jc − qpos0) + 0.3 (jc − qpos0)²: both slides' qpos0 are 0
+    assert constraints[4].joint == "jd" and constraints[4].leader == "jc"
+    assert_close(constraints[4].polycoef, [0.1, -0.5, 0.3, 0, 0], 1e-15)
+    # forward dynamics holds them all (the pin and the site connect are redundant with the weld)
+    v = np.zeros(model.nv)
+    result = model.constrained_forward_dynamics(q, v, np.zeros(model.nv), constraints, damping=1e-8)
+    assert np.max(np.abs(model.constraint_jacobian(q, constraints) @ result["qdd"])) < 1e-8
+
+
+def test_an_equality_naming_a_missing_body_or_joint_is_refused_by_line():
+    broken = EQUALITIES.replace('body1="b" body2="c"', 'body1="b" body2="nowhere"')
+    with pytest.raises(ValueError, match=r"line \d+.*'body2': no body or site is called 'nowhere'"):
+        robodyn.load_mjcf_string(broken)
+    broken = EQUALITIES.replace('joint1="jd" joint2="jc"', 'joint1="jd" joint2="ja"')
+    with pytest.raises(ValueError, match=r"'jd' \(prismatic\) and 'ja' \(revolute\)"):
+        robodyn.load_mjcf_string(broken)
+
+
+def test_cassie_keeps_its_loops_closed():
+    model = load(CASSIE)
+    loops = model.constraints
+    assert len(loops) == 4
+    q0 = model.neutral()
+    # the loops close at qpos0; the pelvis falls freely, its legs held together by the rods
+    # Cassie's legs are nearly planar: each rod's out-of-plane row depends on the others, so the
+    # loops are solved in proximal mode
+    with pytest.raises(ValueError, match=r"constraints\[0\] \(PointAnchor\('left-plantar-rod' to 'left-foot'\)\), row y"):
+        model.constrained_forward_dynamics(q0, np.zeros(model.nv), np.zeros(model.nv), loops)
+    # at Cassie's own time step (its <option timestep>): at 1 ms RK4 is unstable on the stiff
+    # knee and heel springs (1500 and 1250 N m/rad on light links), loops or not
+    run = robodyn.simulate(model, q0, t_end=1.0, dt=5e-4, integrator="rk4", constraints=loops, damping=1e-8)
+    worst = 0.0
+    for q in run.q[::10]:
+        for loop in loops:
+            one = model.frame_pose(q, loop.frame) @ np.append(loop.offset, 1.0)
+            other = model.frame_pose(q, loop.frame2) @ np.append(loop.offset2, 1.0)
+            worst = max(worst, float(np.max(np.abs(one - other))))
+    assert worst < LOOP_DRIFT
+    # with the pelvis held, the legs hang from it and the rods carry their weight
+    held = [*loops, robodyn.FrameAnchor("cassie-pelvis")]
+    forces = model.constrained_forward_dynamics(q0, np.zeros(model.nv), np.zeros(model.nv), held, damping=1e-8)["forces"]
+    assert np.max(np.abs(forces[:12])) > 1.0
