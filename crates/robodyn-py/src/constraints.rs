@@ -25,14 +25,19 @@ const ROTATION_TOLERANCE: f64 = 1e-9;
 /// `frame`'s axes).
 #[pyclass(name = "PointAnchor", module = "robodyn", frozen)]
 pub(crate) struct PyPointAnchor {
+    /// The frame whose point is held.
     #[pyo3(get)]
     frame: String,
+    /// The frame it is held to, or None: the world.
     #[pyo3(get)]
     frame2: Option<String>,
+    /// The point in `frame`'s axes, from its origin (m).
     #[pyo3(get)]
     offset: [f64; 3],
+    /// The point it is held to, in `frame2`'s axes or the world's (m); None: where it is.
     #[pyo3(get)]
     offset2: Option<[f64; 3]>,
+    /// The axes of the rows and forces: "world" or "local".
     #[pyo3(get)]
     reference: String,
 }
@@ -94,14 +99,18 @@ impl PyPointAnchor {
 /// the world (default: where it is now). `reference` as for `PointAnchor`.
 #[pyclass(name = "FrameAnchor", module = "robodyn", frozen)]
 pub(crate) struct PyFrameAnchor {
+    /// The frame held.
     #[pyo3(get)]
     frame: String,
+    /// The frame it is held to, or None: the world.
     #[pyo3(get)]
     frame2: Option<String>,
     placement: Matrix4<f64>,
     placement2: Option<Matrix4<f64>>,
+    /// The rows kept, `[linear x, y, z; angular x, y, z]`.
     #[pyo3(get)]
     mask: [bool; 6],
+    /// The axes of the rows and forces: "world" or "local".
     #[pyo3(get)]
     reference: String,
 }
@@ -185,10 +194,13 @@ impl PyFrameAnchor {
 /// prismatic. 1 row; its force is the torque (or force) on `joint`.
 #[pyclass(name = "JointCoupling", module = "robodyn", frozen)]
 pub(crate) struct PyJointCoupling {
+    /// The joint that follows.
     #[pyo3(get)]
     joint: String,
+    /// The joint it follows, or None: it is held at `polycoef[0]`.
     #[pyo3(get)]
     leader: Option<String>,
+    /// c0 … c4: q_joint = c0 + c1 q_leader + … + c4 q_leader⁴.
     #[pyo3(get)]
     polycoef: [f64; 5],
 }
@@ -261,10 +273,13 @@ impl PyJointCoupling {
 /// distance; its force pushes them apart when positive.
 #[pyclass(name = "Distance", module = "robodyn", frozen)]
 pub(crate) struct PyDistance {
+    /// One frame, whose origin is held.
     #[pyo3(get)]
     frame1: String,
+    /// The other.
     #[pyo3(get)]
     frame2: String,
+    /// The distance held between their origins (m).
     #[pyo3(get)]
     length: f64,
 }
