@@ -208,6 +208,18 @@ class Model:
     def impulse_dynamics(
         self, q: ArrayLike, v: ArrayLike, constraints: _Constraints, restitution: float = 0.0, damping: float = 0.0
     ) -> dict[str, _FloatArray]: ...
+    def constrained_forward_dynamics_derivatives(
+        self,
+        q: ArrayLike,
+        v: ArrayLike,
+        tau: ArrayLike,
+        constraints: _Constraints,
+        f_ext: ArrayLike | None = None,
+        damping: float = 0.0,
+    ) -> dict[str, _FloatArray]: ...
+    def impulse_dynamics_derivatives(
+        self, q: ArrayLike, v: ArrayLike, constraints: _Constraints, restitution: float = 0.0, damping: float = 0.0
+    ) -> dict[str, _FloatArray]: ...
     def constrained_inverse_dynamics(
         self,
         q: ArrayLike,
@@ -327,4 +339,7 @@ def step(
     limits: str,
     limit_stiffness: float,
     limit_damping: float,
+    constraints: _Constraints | None = None,
+    baumgarte: tuple[float, float] | None = None,
+    damping: float = 0.0,
 ) -> _FloatArray: ...

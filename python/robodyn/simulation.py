@@ -424,8 +424,7 @@ def simulate(
     choice("integrator", integrator, INTEGRATORS)
     choice("limits", limits, LIMIT_MODELS)
     choice("accuracy", accuracy, ACCURACY_MODES)
-    if baumgarte is not None and numbers("baumgarte", baumgarte).shape != (2,):
-        raise bad("baumgarte", "None or a pair (kp, kd) of gains (1/s², 1/s)", repr(baumgarte))
+    _check_gains(baumgarte)
     # one rtol: RK45's step control, or the fixed-step schemes' accuracy check
     adaptive = integrator == "rk45"
     rk45_rtol = real("rtol", rtol) if rtol is not None and adaptive else RK45_RTOL
@@ -467,6 +466,12 @@ def _report_accuracy(runs: list[Trajectory], accuracy: str, batch: bool) -> None
         warnings.warn(message, AccuracyWarning, stacklevel=3)
 
 
+def _check_gains(baumgarte: Any) -> None:
+    """Baumgarte's gains are None or a pair (kp, kd)."""
+    if baumgarte is not None and numbers("baumgarte", baumgarte).shape != (2,):
+        raise bad("baumgarte", "None or a pair (kp, kd) of gains (1/s², 1/s)", repr(baumgarte))
+
+
 def step(
     model: _core.Model,
     q: ArrayLike,
@@ -480,6 +485,9 @@ def step(
     limits: str = "report",
     limit_stiffness: float = 1e4,
     limit_damping: float = 1e2,
+    constraints: Any = None,
+    baumgarte: tuple[float, float] | None = None,
+    damping: float = 0.0,
 ) -> Any:
     """One step of size ``dt`` from (``q``, ``v``) with the torque ``tau`` held over it: the step
     :func:`simulate` takes (``integrator`` ``"euler"``, ``"semi_implicit_euler"`` or ``"rk4"``, on the
@@ -493,14 +501,21 @@ def step(
     a change δ of q means ``m.integrate(q, δ)``, and x1's change is read as
     ``m.difference(q1, q1')`` (as for every derivative in robodyn). Batched: (N, nq), (N, nv),
     (N, nv) give (N, ...) results computed on all cores.
+
+    ``constraints``, ``baumgarte`` and ``damping`` as in :func:`simulate`: the step integrates
+    :meth:`Model.constrained_forward_dynamics`, and its Jacobians come from
+    :meth:`Model.constrained_forward_dynamics_derivatives` (those of the exact constraint
+    equations, so ``derivatives=True`` takes ``baumgarte=None``).
     """
     robot_model("model", model)
     choice("integrator", integrator, INTEGRATORS[:3], " (a single fixed step)")
+    _check_gains(baumgarte)
     choice("limits", limits, LIMIT_MODELS)
     derivatives = flag("derivatives", derivatives)
     flat = _core.step(
         model, q, v, tau, real("dt", dt), integrator, derivatives, real("friction_velocity", friction_velocity),
         limits, real("limit_stiffness", limit_stiffness), real("limit_damping", limit_damping),
+        constraints=constraints, baumgarte=baumgarte, damping=real("damping", damping),
     )
     nx, nv = model.nq + model.nv, model.nv
     if not derivatives:

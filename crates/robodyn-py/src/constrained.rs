@@ -4,11 +4,11 @@
 use crate::args::*;
 use crate::constraints::constraint_set;
 use crate::model::*;
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyEllipsis, PySequence, PySlice, PyString, PyTuple};
-use robodyn::algo::{self, ConstrainedOptions, ConstraintData};
+use robodyn::algo::{self, ConstrainedDerivatives, ConstrainedOptions, ConstraintData};
 use robodyn::constraint::ConstraintSet;
 use robodyn::spatial::Force;
 use robodyn::Model;
@@ -20,8 +20,21 @@ fn constraint_data<'w>(
     model: &Model,
     set: &ConstraintSet,
 ) -> &'w mut ConstraintData {
-    if !slot.as_ref().is_some_and(|c| c.fits(model, set)) {
-        *slot = Some(Box::new(ConstraintData::new(model, set)));
+    made_for(
+        slot,
+        |c| c.fits(model, set),
+        || ConstraintData::new(model, set),
+    )
+}
+
+/// The workspace in `slot`, made by `make` when there is none or it does not `fit`.
+pub(crate) fn made_for<'w, T>(
+    slot: &'w mut Option<Box<T>>,
+    fits: impl Fn(&T) -> bool,
+    make: impl FnOnce() -> T,
+) -> &'w mut T {
+    if !slot.as_deref().is_some_and(fits) {
+        *slot = Some(Box::new(make()));
     }
     slot.as_mut().expect("made above")
 }
@@ -75,29 +88,35 @@ impl PyModel {
         let whole = self.with_dynamics_arguments((q, v, x), f_ext, |arguments| {
             self.evaluate(py, arguments, &[nv + set.rows()], kernel)
         })?;
-        Self::split_last(py, &whole, names, nv)
+        let parts: [(&str, &[usize]); 2] = [(names[0], &[nv]), (names[1], &[set.rows()])];
+        Self::split_parts(py, &whole, &parts)
     }
 
-    /// `(..., a + b)` results split along their last axis into a dict of `(..., a)` and
-    /// `(..., b)` views named `names`.
-    fn split_last<'py>(
+    /// `(..., n)` results split along their last axis into a dict of views, each part named and
+    /// shaped as `parts` says (`(..., *shape)`), in order.
+    fn split_parts<'py>(
         py: Python<'py>,
         whole: &Bound<'py, PyAny>,
-        names: [&str; 2],
-        first: usize,
+        parts: &[(&str, &[usize])],
     ) -> PyResult<Bound<'py, PyAny>> {
         let out = PyDict::new(py);
         let ellipsis = PyEllipsis::get(py);
-        let length = whole.getattr("shape")?.get_item(-1)?.extract::<isize>()?;
-        for (name, (start, stop)) in names
-            .iter()
-            .zip([(0, first as isize), (first as isize, length)])
-        {
+        let shape: Vec<usize> = whole.getattr("shape")?.extract()?;
+        let batch = &shape[..shape.len() - 1];
+        let mut start = 0;
+        for (name, part) in parts {
+            let stop = start + part.iter().product::<usize>();
             let index = PyTuple::new(
                 py,
-                [ellipsis.as_any(), PySlice::new(py, start, stop, 1).as_any()],
+                [
+                    ellipsis.as_any(),
+                    PySlice::new(py, start as isize, stop as isize, 1).as_any(),
+                ],
             )?;
-            out.set_item(PyString::new(py, name), whole.get_item(index)?)?;
+            let shaped: Vec<usize> = batch.iter().chain(part.iter()).copied().collect();
+            let view = whole.get_item(index)?.call_method1("reshape", (shaped,))?;
+            out.set_item(PyString::new(py, name), view)?;
+            start = stop;
         }
         Ok(out.into_any())
     }
@@ -274,7 +293,7 @@ impl PyModel {
         };
         let arguments = [self.q_arg("q", q)?, self.v_arg("v", v)?];
         let whole = self.evaluate(py, &arguments, &[nv + set.rows()], kernel)?;
-        Self::split_last(py, &whole, ["v", "impulses"], nv)
+        Self::split_parts(py, &whole, &[("v", &[nv]), ("impulses", &[set.rows()])])
     }
 
     /// Inverse dynamics under `constraints`: dict of `tau` (nv,; zero on coordinates not
@@ -302,5 +321,143 @@ impl PyModel {
         };
         let arguments = (q, v, ("a", a));
         self.constrained_call(py, arguments, f_ext, &set, ["tau", "forces"], algorithm)
+    }
+
+    /// Derivatives of `constrained_forward_dynamics` (of the exact equations: no Baumgarte
+    /// terms): dict of `qdd` and `forces` as there, `dqdd_dq`, `dqdd_dv`, `dqdd_dtau` (nv, nv)
+    /// and `dforces_dq`, `dforces_dv`, `dforces_dtau` (rows, nv). ∂/∂q as in
+    /// `inverse_dynamics_derivatives` (tangent space, right perturbations). With `damping` and
+    /// redundant rows, qdd's derivatives are exact and the forces' are the least-norm solution
+    /// of the differentiated equations (Jᵀ dforces, what reaches the robot, is exact).
+    #[pyo3(signature = (q, v, tau, constraints, f_ext=None, damping=0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn constrained_forward_dynamics_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        tau: &Bound<'py, PyAny>,
+        constraints: &Bound<'py, PyAny>,
+        f_ext: Option<&Bound<'py, PyAny>>,
+        #[pyo3(from_py_with = named::damping)] damping: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let set = constraint_set(self, constraints)?;
+        let kernel: &Kernel = &|m, w, i, out| {
+            let Workspace {
+                data,
+                constrained,
+                constrained_derivatives,
+                forces,
+                ..
+            } = w;
+            let f_ext = i.get(3).map(|flat| {
+                fill_forces(forces, flat);
+                &forces[..]
+            });
+            let c = constraint_data(constrained, m, &set);
+            let d = derivatives_workspace(constrained_derivatives, m, &set);
+            let state = (i[0], i[1], i[2]);
+            algo::constrained_forward_dynamics_derivatives(
+                m, data, c, d, &set, state, f_ext, damping,
+            )?;
+            let matrices = [
+                &d.dqdd_dq,
+                &d.dqdd_dv,
+                &d.dqdd_dtau,
+                &d.dforces_dq,
+                &d.dforces_dv,
+                &d.dforces_dtau,
+            ];
+            write_derivatives(c, &matrices, out);
+            Ok(())
+        };
+        let (nv, rows) = (self.model.nv, set.rows());
+        let size = nv + rows + 3 * nv * nv + 3 * rows * nv;
+        let whole = self.with_dynamics_arguments((q, v, ("tau", tau)), f_ext, |arguments| {
+            self.evaluate(py, arguments, &[size], kernel)
+        })?;
+        let (square, tall): (&[usize], &[usize]) = (&[nv, nv], &[rows, nv]);
+        let parts = [
+            ("qdd", &[nv][..]),
+            ("forces", &[rows][..]),
+            ("dqdd_dq", square),
+            ("dqdd_dv", square),
+            ("dqdd_dtau", square),
+            ("dforces_dq", tall),
+            ("dforces_dv", tall),
+            ("dforces_dtau", tall),
+        ];
+        Self::split_parts(py, &whole, &parts)
+    }
+
+    /// Derivatives of `impulse_dynamics`: dict of `v` and `impulses` as there, `dv_dq`, `dv_dv`
+    /// (nv, nv; of the velocity after) and `dimpulses_dq`, `dimpulses_dv` (rows, nv). ∂/∂q and
+    /// `damping` as in `constrained_forward_dynamics_derivatives`.
+    #[pyo3(signature = (q, v, constraints, restitution=0.0, damping=0.0))]
+    fn impulse_dynamics_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        constraints: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = named::restitution)] restitution: f64,
+        #[pyo3(from_py_with = named::damping)] damping: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let set = constraint_set(self, constraints)?;
+        let kernel: &Kernel = &|m, w, i, out| {
+            let Workspace {
+                data,
+                constrained,
+                constrained_derivatives,
+                ..
+            } = w;
+            let c = constraint_data(constrained, m, &set);
+            let d = derivatives_workspace(constrained_derivatives, m, &set);
+            let state = (i[0], i[1]);
+            algo::impulse_dynamics_derivatives(m, data, c, d, &set, state, restitution, damping)?;
+            let matrices = [&d.dqdd_dq, &d.dqdd_dv, &d.dforces_dq, &d.dforces_dv];
+            write_derivatives(c, &matrices, out);
+            Ok(())
+        };
+        let (nv, rows) = (self.model.nv, set.rows());
+        let size = nv + rows + 2 * nv * nv + 2 * rows * nv;
+        let arguments = [self.q_arg("q", q)?, self.v_arg("v", v)?];
+        let whole = self.evaluate(py, &arguments, &[size], kernel)?;
+        let (square, tall): (&[usize], &[usize]) = (&[nv, nv], &[rows, nv]);
+        let parts = [
+            ("v", &[nv][..]),
+            ("impulses", &[rows][..]),
+            ("dv_dq", square),
+            ("dv_dv", square),
+            ("dimpulses_dq", tall),
+            ("dimpulses_dv", tall),
+        ];
+        Self::split_parts(py, &whole, &parts)
+    }
+}
+
+/// The derivatives' workspace in `slot` for `set`, made again when the set's size changed.
+fn derivatives_workspace<'w>(
+    slot: &'w mut Option<Box<ConstrainedDerivatives>>,
+    model: &Model,
+    set: &ConstraintSet,
+) -> &'w mut ConstrainedDerivatives {
+    made_for(
+        slot,
+        |d| d.fits(model, set),
+        || ConstrainedDerivatives::new(model, set),
+    )
+}
+
+/// q̈ (or q̇⁺) and the forces of `c`, then each of `matrices` row by row, one after the other.
+fn write_derivatives(c: &ConstraintData, matrices: &[&DMatrix<f64>], out: &mut [f64]) {
+    let (nv, rows) = (c.qdd.len(), c.forces.len());
+    out[..nv].copy_from_slice(c.qdd.as_slice());
+    out[nv..nv + rows].copy_from_slice(c.forces.as_slice());
+    let mut rest = &mut out[nv + rows..];
+    for matrix in matrices {
+        let (part, after) = rest.split_at_mut(matrix.len());
+        write_row_major(matrix, matrix.nrows(), part);
+        rest = after;
     }
 }

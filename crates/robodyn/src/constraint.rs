@@ -17,8 +17,12 @@
 //! LOCAL_WORLD_ALIGNED) or in the axes of the first frame ([`ConstraintReference::Local`]); their
 //! forces are expressed in the same axes, applied at the first point. `rows.rs` evaluates them.
 
+mod derivatives;
 mod rows;
 
+pub(crate) use derivatives::{
+    add_body_forces, differentiate_rows, RowDerivatives, RowLevel, RowScratch,
+};
 pub(crate) use rows::{evaluate, BodyMotion, ConstraintRows};
 
 use crate::error::{Error, Result};

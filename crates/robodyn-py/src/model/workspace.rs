@@ -1,8 +1,8 @@
 //! A kernel's workspace, and the pool of them that a batch's threads take from and give back to.
 
 use nalgebra::DMatrix;
-use robodyn::algo::{BatchWorkspace, ConstraintData};
-use robodyn::integrate::StepWorkspace;
+use robodyn::algo::{BatchWorkspace, ConstrainedDerivatives, ConstraintData};
+use robodyn::integrate::{Constrained, StepWorkspace};
 use robodyn::spatial::Force;
 use robodyn::{Data, Model};
 use std::sync::Mutex;
@@ -15,10 +15,14 @@ pub(crate) struct Workspace {
     pub(crate) jacobians: (DMatrix<f64>, DMatrix<f64>),
     /// The stages of a simulation step, made on the first `step` call.
     pub(crate) step: Option<Box<StepWorkspace>>,
+    /// The stages of a constrained step, made for the last call's constraints.
+    pub(crate) constrained_step: Option<Box<StepWorkspace<Constrained>>>,
     /// The lane buffers of the batch kernels, made on the first batch that uses them.
     pub(crate) lanes: Option<Box<BatchWorkspace>>,
     /// The constrained algorithms' workspace, made for the last constraint set's size.
     pub(crate) constrained: Option<Box<ConstraintData>>,
+    /// The constrained derivatives' workspace, made for the last constraint set's size.
+    pub(crate) constrained_derivatives: Option<Box<ConstrainedDerivatives>>,
 }
 
 impl Workspace {
@@ -31,8 +35,10 @@ impl Workspace {
                 DMatrix::zeros(model.nv, model.nv),
             ),
             step: None,
+            constrained_step: None,
             lanes: None,
             constrained: None,
+            constrained_derivatives: None,
         }
     }
 

@@ -47,7 +47,7 @@ pub(super) struct ConstrainedArguments<'a, 'py> {
 
 impl ConstrainedArguments<'_, '_> {
     /// The constrained forward dynamics, or None without constraints.
-    fn read(&self, model: &PyModel) -> PyResult<Option<Constrained>> {
+    pub(super) fn read(&self, model: &PyModel) -> PyResult<Option<Constrained>> {
         let Some(constraints) = self.constraints.filter(|c| !c.is_none()) else {
             return Ok(None);
         };

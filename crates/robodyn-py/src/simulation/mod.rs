@@ -11,6 +11,7 @@ mod callbacks;
 mod record;
 mod rollouts;
 
+use crate::constrained::made_for;
 use crate::model::{write_row_major, PyModel};
 use crate::to_py_err;
 use arguments::{ConstrainedArguments, PassiveArguments, SimulateArguments, Simulation};
@@ -18,7 +19,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use record::stack;
 use robodyn::integrate::simulator::DEFAULT_ACCURACY_RTOL;
-use robodyn::integrate::{Integrator, StepWorkspace};
+use robodyn::integrate::{ForwardDynamics, Integrator, PassiveForces, StepWorkspace};
+use robodyn::Model;
 
 /// Simulates `model` from `q0`, `v0` (one state, or N of them: shape (N, nq), (N, nv)) over
 /// [0, t_end], recording every `dt`. See `robodyn.simulate` for the arguments; `controller` is
@@ -83,8 +85,11 @@ pub fn simulate<'py>(
 }
 
 /// One step of each state: per sample the flat [q₁, v₁] and, with `derivatives`, A (2nv × 2nv)
-/// and B (2nv × nv) row-major after it. The Python `robodyn.step` splits them.
+/// and B (2nv × nv) row-major after it. The Python `robodyn.step` splits them. With
+/// `constraints`, the step integrates their constrained forward dynamics.
 #[pyfunction]
+#[pyo3(signature = (model, q, v, tau, dt, integrator, derivatives, friction_velocity, limits,
+                    limit_stiffness, limit_damping, constraints=None, baumgarte=None, damping=0.0))]
 #[allow(clippy::too_many_arguments)]
 pub fn step<'py>(
     py: Python<'py>,
@@ -99,6 +104,9 @@ pub fn step<'py>(
     limits: &str,
     limit_stiffness: f64,
     limit_damping: f64,
+    constraints: Option<&Bound<'py, PyAny>>,
+    baumgarte: Option<&Bound<'py, PyAny>>,
+    damping: f64,
 ) -> PyResult<Bound<'py, PyAny>> {
     let m = &model.model;
     let passive = PassiveArguments {
@@ -108,6 +116,12 @@ pub fn step<'py>(
         limit_damping,
     }
     .read()?;
+    let constrained = ConstrainedArguments {
+        constraints,
+        baumgarte,
+        damping,
+    }
+    .read(model)?;
     let integrator = Integrator::from_name(integrator, 0.0, 0.0).map_err(to_py_err)?;
     let arguments = [
         model.q_arg("q", q)?,
@@ -116,11 +130,55 @@ pub fn step<'py>(
     ];
     let (nq, nv) = (m.nq, m.nv);
     let size = nq + nv + if derivatives { 6 * nv * nv } else { 0 };
-    model.evaluate(py, &arguments, &[size], &|m, w, i, out| {
-        let stepper = w
-            .step
-            .get_or_insert_with(|| Box::new(StepWorkspace::new(m)));
-        stepper.step(m, i[0], i[1], i[2], dt, integrator, &passive, derivatives)?;
+    let one_step = OneStep {
+        dt,
+        integrator,
+        passive: &passive,
+        derivatives,
+    };
+    model.evaluate(
+        py,
+        &arguments,
+        &[size],
+        &|m, w, i, out| match &constrained {
+            None => {
+                let stepper = w
+                    .step
+                    .get_or_insert_with(|| Box::new(StepWorkspace::new(m)));
+                one_step.run(m, stepper, (i[0], i[1], i[2]), out)
+            }
+            Some(held) => {
+                let stepper = made_for(
+                    &mut w.constrained_step,
+                    |s| s.forward_dynamics.is_for(held),
+                    || StepWorkspace::with_forward_dynamics(m, held.clone()),
+                );
+                one_step.run(m, stepper, (i[0], i[1], i[2]), out)
+            }
+        },
+    )
+}
+
+/// The options of one `step` call.
+struct OneStep<'a> {
+    dt: f64,
+    integrator: Integrator,
+    passive: &'a PassiveForces,
+    derivatives: bool,
+}
+
+impl OneStep<'_> {
+    /// The step from (q, v) under τ with `stepper`, written as [q₁, v₁, A, B] into `out`.
+    fn run<F: ForwardDynamics>(
+        &self,
+        m: &Model,
+        stepper: &mut StepWorkspace<F>,
+        (q, v, tau): (&[f64], &[f64], &[f64]),
+        out: &mut [f64],
+    ) -> robodyn::Result<()> {
+        let (nq, nv) = (m.nq, m.nv);
+        let (dt, integrator, derivatives) = (self.dt, self.integrator, self.derivatives);
+        stepper.step(m, q, v, tau, dt, integrator, self.passive, derivatives)?;
         let (state, jacobians) = out.split_at_mut(nq + nv);
         state[..nq].copy_from_slice(&stepper.q_end);
         state[nq..].copy_from_slice(&stepper.v_end);
@@ -130,5 +188,5 @@ pub fn step<'py>(
             write_row_major(&stepper.b, 2 * nv, b);
         }
         Ok(())
-    })
+    }
 }

@@ -17,10 +17,14 @@
 //! the least-norm forces of a redundant set (a loop closure stated twice).
 //! The results live in a [`ConstraintData`] made for the set.
 
+mod derivatives;
 mod forward;
 mod inverse;
 mod solve;
 
+pub use derivatives::{
+    constrained_forward_dynamics_derivatives, impulse_dynamics_derivatives, ConstrainedDerivatives,
+};
 pub use forward::{constrained_forward_dynamics, impulse_dynamics, ConstrainedOptions};
 pub use inverse::{constrained_inverse_dynamics, CONSTRAINT_ACCELERATION_TOLERANCE};
 pub use solve::{
@@ -251,15 +255,36 @@ fn solve_forces(
     damping: f64,
     scale: f64,
 ) -> Result<()> {
+    let mut forces = std::mem::take(&mut constraints.forces);
+    let solved = solve_delassus(
+        model,
+        set,
+        constraints,
+        damping,
+        scale,
+        forces.as_mut_slice(),
+    );
+    constraints.forces = forces;
+    constraints.iterations = solved?;
+    Ok(())
+}
+
+/// [`solve_forces`] into `x` (m) instead; returns the proximal iterations it took.
+fn solve_delassus(
+    model: &Model,
+    set: &ConstraintSet,
+    constraints: &mut ConstraintData,
+    damping: f64,
+    scale: f64,
+    x: &mut [f64],
+) -> Result<usize> {
     let m = set.rows();
     let ConstraintData {
         delassus,
-        forces,
         rhs,
         factor,
         residual,
         step,
-        iterations,
         ..
     } = constraints;
     let scratch = SolveScratch { residual, step };
@@ -268,16 +293,13 @@ fn solve_forces(
         delassus.as_slice(),
         factor,
         rhs,
-        forces.as_mut_slice(),
+        x,
         damping,
         scale,
         scratch,
     );
     match solved {
-        Ok(n) => {
-            *iterations = n;
-            Ok(())
-        }
+        Ok(n) => Ok(n),
         Err(SolveFailure::DependentRow(row)) => Err(Error::InvalidValue {
             argument: "constraints".into(),
             message: format!(

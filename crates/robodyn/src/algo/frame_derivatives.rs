@@ -22,11 +22,10 @@
 
 use crate::algo::crba::{add_composite_inertias, world_inertias_and_subspaces};
 use crate::algo::frame_motion::place_frame_support;
-use crate::algo::kinematics::frame_placement;
 use crate::algo::Reference;
 use crate::error::{check_vector, Result};
 use crate::model::Model;
-use crate::spatial::{Motion, Vec3};
+use crate::spatial::{Motion, Transform, Vec3};
 use crate::Data;
 
 /// Linear and angular parts of one column, before they are written.
@@ -44,7 +43,21 @@ pub fn frame_motion_derivatives(
 ) -> Result<()> {
     let body = place_frame_support(model, data, q, v, frame)?;
     check_vector("a", a, model.nv)?;
+    let placement = model.frames[frame].placement;
+    attached_motion_derivatives(model, data, (v, a), body, &placement, reference);
+    Ok(())
+}
 
+/// [`frame_motion_derivatives`] of the frame `placement` = `X_{c←body}` fixed in `body`, once
+/// `data.support`, `data.x_up` and `data.x_world` hold the placements from `body` to the world.
+pub(crate) fn attached_motion_derivatives(
+    model: &Model,
+    data: &mut Data,
+    (v, a): (&[f64], &[f64]),
+    body: usize,
+    placement: &Transform,
+    reference: Reference,
+) {
     // outward along the support, world coordinates: ν_i = ν_λ + S q̇, α_i = α_λ + S q̈ + ν_i × S q̇
     data.v_world[0] = Motion::ZERO;
     data.a_world[0] = Motion::ZERO;
@@ -64,7 +77,7 @@ pub fn frame_motion_derivatives(
     }
 
     // the frame: origin p, axes R (`pose.rotation` = Rᵀ), ω, ṗ, ω̇, p̈ in world axes
-    let pose = frame_placement(model, data, frame);
+    let pose = *placement * data.x_world[body];
     let origin = pose.translation;
     let (nu, alpha) = (data.v_world[body], data.a_world[body]);
     let velocity = (nu.linear + nu.angular.cross(&origin), nu.angular);
@@ -140,7 +153,6 @@ pub fn frame_motion_derivatives(
             }
         }
     }
-    Ok(())
 }
 
 /// The change of a frame quantity, as a spatial vector in world coordinates and as the classical

@@ -107,7 +107,7 @@ pub(crate) fn evaluate(
                 if let Some(leader) = leader {
                     let l = model.idx_v[*leader];
                     let x = q[model.idx_q[*leader]] - references.1;
-                    let (p, dp, ddp) = polynomial_at(polynomial, x);
+                    let [p, dp, ddp, _] = polynomial_at(polynomial, x);
                     // φ = (q_f − q_f,ref) − p(x);  J = e_f − p'(x) e_l;  γ = −p''(x) q̇_l²
                     rows.error[row] = q[model.idx_q[*follower]] - references.0 - p;
                     rows.jacobian[(row, l)] -= dp;
@@ -269,14 +269,17 @@ fn point_columns(
 }
 
 /// `[linear; angular]` as six numbers.
-fn six(linear: &Vec3, angular: &Vec3) -> [f64; 6] {
+pub(super) fn six(linear: &Vec3, angular: &Vec3) -> [f64; 6] {
     [
         linear.x, linear.y, linear.z, angular.x, angular.y, angular.z,
     ]
 }
 
 /// The entries of `full` that `mask` keeps, numbered from 0 in order.
-fn kept<'a>(mask: &'a [bool; 6], full: &'a [f64; 6]) -> impl Iterator<Item = (usize, f64)> + 'a {
+pub(super) fn kept<'a>(
+    mask: &'a [bool; 6],
+    full: &'a [f64; 6],
+) -> impl Iterator<Item = (usize, f64)> + 'a {
     full.iter()
         .zip(mask)
         .filter(|(_, &keep)| keep)
@@ -284,13 +287,14 @@ fn kept<'a>(mask: &'a [bool; 6], full: &'a [f64; 6]) -> impl Iterator<Item = (us
         .enumerate()
 }
 
-/// p(x) = Σ c_k x^k and its first two derivatives, by Horner's rule.
-fn polynomial_at(c: &[f64; 5], x: f64) -> (f64, f64, f64) {
-    let (mut p, mut dp, mut ddp) = (0.0, 0.0, 0.0);
+/// p(x) = Σ c_k x^k and its first three derivatives, by Horner's rule.
+pub(super) fn polynomial_at(c: &[f64; 5], x: f64) -> [f64; 4] {
+    let [mut p, mut dp, mut ddp, mut dddp] = [0.0; 4];
     for &coefficient in c.iter().rev() {
+        dddp = dddp * x + 3.0 * ddp;
         ddp = ddp * x + 2.0 * dp;
         dp = dp * x + p;
         p = p * x + coefficient;
     }
-    (p, dp, ddp)
+    [p, dp, ddp, dddp]
 }

@@ -13,8 +13,8 @@
 
 use crate::algo::lanes::{aba_batch, BatchResult, BatchWorkspace, States};
 use crate::algo::{
-    aba, aba_derivatives, constrained_forward_dynamics, ConstrainedOptions, ConstraintData,
-    DerivativesInto,
+    aba, aba_derivatives, constrained_forward_dynamics, constrained_forward_dynamics_derivatives,
+    ConstrainedDerivatives, ConstrainedOptions, ConstraintData, DerivativesInto,
 };
 use crate::constraint::ConstraintSet;
 use crate::error::{Error, Result};
@@ -171,6 +171,8 @@ pub struct Constrained {
     set: ConstraintSet,
     options: ConstrainedOptions,
     constraints: ConstraintData,
+    /// The derivatives' workspace, made on the first step that asks for them.
+    derivatives: Option<Box<ConstrainedDerivatives>>,
 }
 
 impl Constrained {
@@ -181,12 +183,18 @@ impl Constrained {
             set,
             options,
             constraints,
+            derivatives: None,
         }
     }
 
     /// The forces λ of the last acceleration evaluated (one per constraint row).
     pub fn forces(&self) -> &[f64] {
         self.constraints.forces.as_slice()
+    }
+
+    /// Whether this strategy holds the same constraints with the same options as `other`.
+    pub fn is_for(&self, other: &Constrained) -> bool {
+        self.set == other.set && self.options == other.options
     }
 }
 
@@ -204,6 +212,47 @@ impl ForwardDynamics for Constrained {
         let state = (q, v, tau);
         constrained_forward_dynamics(model, data, c, &self.set, state, f_ext, &self.options)?;
         Ok(self.constraints.qdd.as_slice())
+    }
+
+    /// [`constrained_forward_dynamics_derivatives`]: the derivatives of the exact equations, so
+    /// refused with Baumgarte's gains (whose terms they do not hold).
+    fn acceleration_derivatives(
+        &mut self,
+        model: &Model,
+        data: &mut Data,
+        q: &[f64],
+        v: &[f64],
+        tau: &[f64],
+        out: &mut AccelerationDerivatives,
+    ) -> Result<()> {
+        if self.options.baumgarte.is_some() {
+            return Err(Error::InvalidValue {
+                argument: "derivatives".into(),
+                message: "constrained derivatives are those of the exact constraint equations; \
+                          a step with derivatives takes baumgarte=None"
+                    .into(),
+            });
+        }
+        let set = &self.set;
+        let d = self
+            .derivatives
+            .get_or_insert_with(|| Box::new(ConstrainedDerivatives::new(model, set)));
+        let (c, damping) = (&mut self.constraints, self.options.damping);
+        constrained_forward_dynamics_derivatives(
+            model,
+            data,
+            c,
+            d,
+            set,
+            (q, v, tau),
+            None,
+            damping,
+        )?;
+        out.qdd.copy_from_slice(c.qdd.as_slice());
+        out.by_q.copy_from(&d.dqdd_dq);
+        out.by_v.copy_from(&d.dqdd_dv);
+        out.by_tau.copy_from(&d.dqdd_dtau);
+        Ok(())
     }
 }
 

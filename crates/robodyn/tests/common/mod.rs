@@ -1,6 +1,8 @@
 //! Shared helpers of the integration tests: the models they run on and the tolerances.
 #![allow(dead_code)]
 
+pub mod constraints;
+
 use nalgebra::{DMatrix, DVector};
 use rand::{rngs::StdRng, Rng, SeedableRng};
 use robodyn::algo::{jacobian, Reference};
