@@ -65,6 +65,8 @@ for posture in postures:
     for _ in range(20):
         miss = np.concatenate([solo.frame_pose(posture, foot)[:3, 3] - sole for foot, sole in zip(FEET, soles)])
         posture[7:] -= np.linalg.solve(solo.constraint_jacobian(posture, targets)[:, 6:], miss)
+misses = [solo.frame_pose(posture, foot)[:3, 3] - sole for posture in postures for foot, sole in zip(FEET, soles)]
+show("every lean: the feet where they stood, largest miss along x, y, z (m)", np.zeros(3), np.abs(misses).max(axis=0), 1e-12)
 still = np.zeros((len(leans), solo.nv))
 leaning = solo.constrained_inverse_dynamics(postures, still, still, feet)["forces"].reshape(len(leans), 4, 3)
 totals = leaning[:, :, 2].sum(axis=1)
