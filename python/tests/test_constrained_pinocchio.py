@@ -288,14 +288,19 @@ def pinocchio_impulse(robot, anchors, reference, pq, pv, restitution):
     return after, data.impulse_c.copy()
 
 
+def impact_states(request, case, seed, count=3):
+    """The case's anchors at random states, for impulses (which have no drift): (robot, anchors, q, v, k)."""
+    robot_name, build = CASES[case]
+    robot = request.getfixturevalue(robot_name)
+    for k, (q, v, _) in enumerate(random_states(robot, count, seed)):
+        yield robot, build(robot, q), q, v, k
+
+
 @pytest.mark.parametrize("restitution", [0.0, 0.5])
 @pytest.mark.parametrize("reference", sorted(REFERENCES))
 @pytest.mark.parametrize("case", WORLD_ANCHORED)
 def test_impulse_dynamics_agrees_with_pinocchio(request, case, reference, restitution):
-    robot_name, build = CASES[case]
-    robot = request.getfixturevalue(robot_name)
-    for k, (q, v, _) in enumerate(random_states(robot, 3, seed=300)):
-        anchors = build(robot, q)
+    for robot, anchors, q, v, k in impact_states(request, case, seed=300):
         after, impulses = pinocchio_impulse(robot, anchors, reference, robot.layout.q_to_pinocchio(q), robot.layout.v_to_pinocchio(v), restitution)
         result = robot.model.impulse_dynamics(q, v, [anchor.robodyn(reference) for anchor in anchors], restitution=restitution)
         label = f"{case} {reference} e={restitution} state {k}"
