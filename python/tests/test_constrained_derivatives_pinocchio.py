@@ -142,7 +142,7 @@ def assert_derivatives_are_differences(model, q, v, tau, constraints, label, dam
 
 
 @pytest.mark.parametrize("reference", sorted(REFERENCES))
-@pytest.mark.parametrize("case", ["talos_masked_sole"])
+@pytest.mark.parametrize("case", ["talos_hands_loop", "talos_masked_sole"])
 def test_derivatives_pinocchio_does_not_state_equal_central_differences(request, case, reference):
     for robot, anchors, q, v, tau, label in case_states(request, case, reference, seed=1000, count=1):
         assert_derivatives_are_differences(robot.model, q, v, tau, [anchor.robodyn(reference) for anchor in anchors], label)
@@ -165,3 +165,69 @@ def test_derivatives_on_cassies_loops_equal_central_differences(cassie, damping)
         # τ = M u: accelerations of order one on every coordinate (a rod's spin has an inertia of 4e-6)
         v, tau = rng.uniform(-1, 1, cassie.nv), cassie.mass_matrix(q) @ rng.uniform(-1, 1, cassie.nv)
         assert_derivatives_are_differences(cassie, q, v, tau, cassie.constraints, f"Cassie state {seed} damping {damping}", damping)
+
+
+#: Singular values of J below this (relative to the largest) count as dependent rows.
+RANK_CUTOFF = 1e-10
+#: The loops count as closed when their points are this close (m); qpos0's are 2e-17 apart.
+CLOSURE_TOLERANCE = 1e-14
+CLOSING_STEPS = 20
+#: The step of the extrapolated differences along Cassie's closed configurations: their error
+#: falls as h⁴ to 1e-8 of the values at 1e-4, below which the proximal solves' rounding grows.
+CLOSED_STEP = 1e-4
+
+
+def loop_gaps(model, q):
+    """Each rod's attachment point minus the point it is held to, in world axes."""
+    gaps = [model.frame_pose(q, c.frame) @ np.append(c.offset, 1.0) - model.frame_pose(q, c.frame2) @ np.append(c.offset2, 1.0) for c in model.constraints]
+    return np.concatenate([gap[:3] for gap in gaps])
+
+
+def closed(model, q):
+    """q moved back onto the closed configurations by Newton's least-norm steps."""
+    for _ in range(CLOSING_STEPS):
+        gaps = loop_gaps(model, q)
+        if np.max(np.abs(gaps)) <= CLOSURE_TOLERANCE:
+            return q
+        q = model.integrate(q, -np.linalg.lstsq(model.constraint_jacobian(q, model.constraints), gaps, rcond=RANK_CUTOFF)[0])
+    raise AssertionError(f"the loops did not close: {np.max(np.abs(loop_gaps(model, q))):.1e} m")
+
+
+def test_derivatives_on_cassies_closed_loops_equal_central_differences_along_them(cassie):
+    """At qpos0, where the loops close and two of their rows depend on the others: q̈'s derivatives
+    along the closed configurations (q moved in J's null space, then closed again) and along the
+    velocities the loops allow; the forces through Jᵀ (what reaches the robot; λ is not unique)."""
+    model, loops = cassie, cassie.constraints
+    q = model.neutral()
+    jacobian = model.constraint_jacobian(q, loops)
+    _, singular, rows = np.linalg.svd(jacobian)
+    tangent = rows[int(np.sum(singular > RANK_CUTOFF * singular[0])) :].T
+    assert tangent.shape[1] == model.nv - 10, "two of the twelve rows depend on the others at qpos0"
+    rng = np.random.default_rng(13)
+    v, tau = tangent @ rng.uniform(-1, 1, tangent.shape[1]), model.mass_matrix(q) @ rng.uniform(-1, 1, model.nv)
+    ours = model.constrained_forward_dynamics_derivatives(q, v, tau, loops, damping=1e-8)
+
+    def solve(q, v, tau):
+        result = model.constrained_forward_dynamics(q, v, tau, loops, damping=1e-8)
+        return {"qdd": result["qdd"], "forces": jacobian.T @ result["forces"]}
+
+    value = solve(q, v, tau)
+
+    def central(moved, d, h, field):
+        return (solve(*moved(h * d))[field] - solve(*moved(-h * d))[field]) / (2 * h)
+
+    for name, moved, directions in [
+        ("q", lambda step: (closed(model, model.integrate(q, step)), v, tau), tangent),
+        ("v", lambda step: (q, v + step, tau), tangent),
+        ("tau", lambda step: (q, v, tau + step), np.eye(model.nv)),
+    ]:
+        for field, analytic in [("qdd", ours[f"dqdd_d{name}"]), ("forces", jacobian.T @ ours[f"dforces_d{name}"])]:
+            # Richardson's extrapolation (4 D(h/2) − D(h)) / 3 removes the h² term: along some
+            # closed directions q̈'s third derivative is large (central differences at h = 1e-5
+            # miss by 2.6e-4, falling as h²), and rounding forbids a smaller step
+            numeric = np.column_stack([
+                (4 * central(moved, d, CLOSED_STEP / 2, field) - central(moved, d, CLOSED_STEP, field)) / 3 for d in directions.T
+            ])
+            error = float(np.max(np.abs(analytic @ directions - numeric)))
+            bound = DIFFERENCE_TOLERANCE * max(1.0, float(np.max(np.abs(value[field]))))
+            assert error <= bound, f"Cassie at qpos0 d{field}/d{name}: max error {error:.3e} > {bound:.3e}"

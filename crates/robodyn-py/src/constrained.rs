@@ -28,11 +28,11 @@ fn constraint_data<'w>(
 }
 
 /// The workspace in `slot`, made by `make` when there is none or it does not `fit`.
-pub(crate) fn made_for<'w, T>(
-    slot: &'w mut Option<Box<T>>,
+pub(crate) fn made_for<T>(
+    slot: &mut Option<Box<T>>,
     fits: impl Fn(&T) -> bool,
     make: impl FnOnce() -> T,
-) -> &'w mut T {
+) -> &mut T {
     if !slot.as_deref().is_some_and(fits) {
         *slot = Some(Box::new(make()));
     }

@@ -11,7 +11,7 @@ use robodyn::algo::{
     self, constrained_forward_dynamics, constrained_inverse_dynamics, constraint_jacobian,
     delassus, impulse_dynamics, ConstrainedOptions, ConstraintData,
 };
-use robodyn::constraint::{ConstraintKind, ConstraintReference, ConstraintSet};
+use robodyn::constraint::{Attachment, ConstraintKind, ConstraintReference, ConstraintSet};
 use robodyn::{Data, Model};
 
 /// Central differences of the constraint errors with step `h`: first and second derivatives.
@@ -449,4 +449,30 @@ fn a_simulated_four_bar_stays_closed_and_keeps_its_energy() {
         energy_change < 1e-7,
         "energy changed by {energy_change:e} J"
     );
+}
+
+#[test]
+fn a_closed_weld_has_a_finite_zero_error() {
+    // rounding can put the trace of R₂ᵀR₁ of coinciding frames above 3: the error stays finite
+    let model = test_model("ur5");
+    let tool = model.frame_index("tool0").unwrap();
+    let mut data = Data::new(&model);
+    let mut rng = rng();
+    for _ in 0..200 {
+        let q = model.random_configuration(&mut rng);
+        algo::forward_kinematics(&model, &mut data, q.as_slice()).unwrap();
+        let weld = ConstraintKind::Frame {
+            first: Attachment::at_frame(tool),
+            second: Some(Attachment {
+                frame: None,
+                placement: algo::frame_placement(&model, &data, tool),
+            }),
+            mask: [true; 6],
+        };
+        let set =
+            ConstraintSet::new(&model, vec![constraint(weld, ConstraintReference::World)]).unwrap();
+        let mut c = ConstraintData::new(&model, &set);
+        constraint_jacobian(&model, &mut data, &mut c, &set, q.as_slice()).unwrap();
+        assert!(c.error.amax() < IDENTITY_TOLERANCE, "{}", c.error);
+    }
 }

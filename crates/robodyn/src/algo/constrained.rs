@@ -309,11 +309,12 @@ fn solve_delassus(
                 set.describe_row(model, row)
             ),
         }),
-        Err(SolveFailure::Inconsistent { residual }) => Err(Error::InvalidValue {
+        Err(SolveFailure::Inconsistent { residual, scale }) => Err(Error::InvalidValue {
             argument: "constraints".into(),
             message: format!(
                 "the constraints cannot all hold: the proximal iterations leave an acceleration \
-                 (or velocity) residual of {residual:.3e}"
+                 (or velocity) residual of {residual:.3e}, {:.1e} of the terms' size {scale:.3e}",
+                residual / scale
             ),
         }),
     }

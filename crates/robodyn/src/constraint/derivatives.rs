@@ -249,6 +249,7 @@ fn held_mask(kind: &ConstraintKind) -> [bool; 6] {
 
 /// Writes the derivatives of every row of `set` at `level` into `out` (zeroed first), and the
 /// part of ∂(Jᵀ λ)/∂q that RNEA misses for the forces `forces`.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn differentiate_rows(
     model: &Model,
     data: &mut Data,

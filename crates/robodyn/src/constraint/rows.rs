@@ -16,8 +16,8 @@
 
 use super::{Attachment, ConstraintKind, ConstraintReference, ConstraintSet};
 use crate::model::Model;
-use crate::spatial::{Motion, Transform, Vec3};
-use nalgebra::{DMatrix, Matrix3, Rotation3};
+use crate::spatial::{log_rotation, Motion, Transform, Vec3};
+use nalgebra::{DMatrix, Matrix3, Rotation3, UnitQuaternion};
 
 /// Where the rows of a constraint set are written: J (rows × nv), γ and φ (rows each).
 pub(crate) struct ConstraintRows<'a> {
@@ -176,7 +176,10 @@ impl Held {
             offset = first.position - second.position;
             // R = Eᵀ, so R_2ᵀ R_1 = E_2 E_1ᵀ
             let relative = second.rotation * first.rotation.transpose();
-            let log = Rotation3::from_matrix_unchecked(relative).scaled_axis();
+            // through a unit quaternion: the angle from the trace alone is NaN when rounding
+            // puts the trace of a closed weld above 3
+            let turned = Rotation3::from_matrix_unchecked(relative);
+            let log = log_rotation(&UnitQuaternion::from_rotation_matrix(&turned));
             turn = second.rotation.transpose() * log;
         }
         let drift = six(&(axes * acceleration), &(axes * angular_acceleration));

@@ -20,11 +20,15 @@
 //! matrix: `dλ = (J M⁻¹ Jᵀ)⁻¹ (r₂ − J M⁻¹ r₁)`, `dq̈ = M⁻¹ (r₁ + Jᵀ dλ)`, column by column.
 //! Impulses solve `M (q̇⁺ − q̇) − Jᵀ Λ = 0`, `J q̇⁺ + e J q̇ = 0`, differentiated the same way,
 //! with `∂(M Δq̇)/∂q = ∂ID(q, 0, Δq̇)/∂q − ∂g/∂q`.
-//! With damping, the forces of a redundant set are its least-norm ones; dq̈ is then exact and dλ
-//! is the least-norm solution of the differentiated equations (the change of the forces that
-//! reach the robot: Jᵀ dλ is exact).
+//! With damping (a redundant set, whose forces are the least-norm ones) the Delassus matrix is
+//! singular: dλ is its pseudo-inverse's, the least-squares change of least norm. Along the
+//! configurations where the dependent rows stay dependent (a planar loop moving in its plane), and
+//! along q̇ and τ, dq̈ and Jᵀ dλ (what reaches the robot) are then exact; a change of q that makes
+//! those rows independent (a planar loop leaving its plane) has no derivative, and gets the
+//! least-squares one.
 //! Baumgarte's terms are not differentiated: these are the derivatives of the exact equations.
 
+use super::solve::PseudoInverse;
 use super::{constrained_forward_dynamics, impulse_dynamics, product_scale};
 use super::{solve_delassus, ConstrainedOptions, ConstraintData};
 use crate::algo::derivatives::{rnea_derivatives, DerivativesInto};
@@ -178,6 +182,7 @@ pub fn constrained_forward_dynamics_derivatives(
     d.dforces_dv.copy_from(&d.rows.by_v);
     d.dforces_dv.neg_mut();
     d.dforces_dtau.fill(0.0);
+    let solver = Solver::new(constraints, damping);
     for (x, y) in [
         (&mut d.dqdd_dq, &mut d.dforces_dq),
         (&mut d.dqdd_dv, &mut d.dforces_dv),
@@ -190,7 +195,7 @@ pub fn constrained_forward_dynamics_derivatives(
             set,
             (x, y),
             &mut d.column,
-            damping,
+            &solver,
         )?;
     }
     Ok(())
@@ -257,6 +262,7 @@ pub fn impulse_dynamics_derivatives(
     d.dforces_dq.neg_mut();
     d.dforces_dv.copy_from(&constraints.jacobian);
     d.dforces_dv *= -restitution;
+    let solver = Solver::new(constraints, damping);
     for (x, y) in [
         (&mut d.dqdd_dq, &mut d.dforces_dq),
         (&mut d.dqdd_dv, &mut d.dforces_dv),
@@ -268,10 +274,27 @@ pub fn impulse_dynamics_derivatives(
             set,
             (x, y),
             &mut d.column,
-            damping,
+            &solver,
         )?;
     }
     Ok(())
+}
+
+/// How the Delassus systems of the derivatives are solved: by Cholesky (independent rows), or by
+/// its pseudo-inverse (with damping: rows that may depend on each other).
+enum Solver {
+    Cholesky,
+    PseudoInverse(PseudoInverse),
+}
+
+impl Solver {
+    fn new(constraints: &ConstraintData, damping: f64) -> Self {
+        if damping > 0.0 {
+            Solver::PseudoInverse(PseudoInverse::new(&constraints.delassus))
+        } else {
+            Solver::Cholesky
+        }
+    }
 }
 
 /// Solves `[M −Jᵀ; J 0] [X; Y] = [R₁; R₂]` in place (R₁ in `x`, nv × k; R₂ in `y`, m × k) with
@@ -284,20 +307,25 @@ fn solve_saddle_point(
     set: &ConstraintSet,
     (x, y): (&mut DMatrix<f64>, &mut DMatrix<f64>),
     column: &mut [f64],
-    damping: f64,
+    solver: &Solver,
 ) -> Result<()> {
     let m = set.rows();
     for c in 0..x.ncols() {
         // X₀ = M⁻¹ R₁, one column (contiguous, a right-hand side of width 1) at a time
         solve_rows(model, data, x.column_mut(c).as_mut_slice());
         let x0 = x.column(c);
-        let scale = 1.0 + product_scale(&constraints.jacobian, x0.as_slice());
         for r in 0..m {
-            let rhs = y[(r, c)] - constraints.jacobian.row(r).dot(&x0.transpose());
-            constraints.rhs[r] = rhs;
+            constraints.rhs[r] = y[(r, c)] - constraints.jacobian.row(r).dot(&x0.transpose());
         }
-        let scale = scale + super::solve::largest(&constraints.rhs[..m]);
-        solve_delassus(model, set, constraints, damping, scale, column)?;
+        match solver {
+            Solver::Cholesky => {
+                let scale = 1.0
+                    + product_scale(&constraints.jacobian, x0.as_slice())
+                    + super::solve::largest(&constraints.rhs[..m]);
+                solve_delassus(model, set, constraints, 0.0, scale, column)?;
+            }
+            Solver::PseudoInverse(inverse) => inverse.solve(&constraints.rhs[..m], column),
+        }
         y.column_mut(c).copy_from_slice(column);
     }
     x.gemm_tr(1.0, &constraints.jacobian_inverse_inertia, y, 1.0);

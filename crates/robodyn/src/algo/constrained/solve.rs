@@ -21,11 +21,14 @@ pub const DEPENDENT_ROW_TOLERANCE: f64 = 1e-10;
 /// the size of the terms b was computed from (its rounding floor is about 1e-16 of it).
 pub const PROXIMAL_ACCURACY: f64 = 1e-12;
 
-/// Iterations whose residual no longer falls (by a hundredth over ten of them) have
-/// reached what rounding leaves along the directions A cannot reach: the residual is accepted if
-/// it is below this times the scale (an inconsistency at rounding level, as between the
-/// dependent rows of a planar loop), else the system is refused as inconsistent.
-pub const STALLED_ACCURACY: f64 = 1e-9;
+/// Iterations whose residual no longer falls (by a hundredth over ten of them) have reached what
+/// is left along the directions A cannot reach, or reaches only through eigenvalues far below the
+/// damping: the residual is accepted if it is below this times the scale, else the system is
+/// refused as inconsistent. Rows that depend on each other only nearly leave such a residual: the
+/// out-of-plane rows of a planar loop that integration has opened by 1e-11 m (Cassie's legs
+/// swinging at 2 rad/s leave 1e-8 to 1e-7 m/s², about 1e-8 of the scale). A set that cannot hold
+/// (one point held at two places) leaves one of the order of the scale itself.
+pub const STALLED_ACCURACY: f64 = 1e-6;
 
 /// How many iterations a stall is judged over.
 const STALL_WINDOW: usize = 10;
@@ -42,6 +45,8 @@ pub(crate) enum SolveFailure {
     Inconsistent {
         /// `|b − A x|∞` at the last iteration.
         residual: f64,
+        /// The size of the terms b was computed from.
+        scale: f64,
     },
 }
 
@@ -112,11 +117,15 @@ pub(crate) fn solve_symmetric(
             if size <= STALLED_ACCURACY * scale {
                 return Ok(iteration);
             }
-            return Err(SolveFailure::Inconsistent { residual: size });
+            return Err(SolveFailure::Inconsistent {
+                residual: size,
+                scale,
+            });
         }
     }
     Err(SolveFailure::Inconsistent {
         residual: largest(&residual[..n]),
+        scale,
     })
 }
 
@@ -171,6 +180,40 @@ fn cholesky_solve(n: usize, l: &[f64], x: &mut [f64]) {
             sum -= l[j + k * n] * x[j];
         }
         x[k] = sum / l[k + k * n];
+    }
+}
+
+/// The least-squares solution of least norm of `A x = b` for a symmetric positive semi-definite A,
+/// `x = A⁺ b = Σ u_i (u_iᵀ b) / σ_i` over the eigen-directions A reaches: those with σ_i above
+/// [`DEPENDENT_ROW_TOLERANCE`] times the largest (the others are rows depending on the rest).
+/// Golub and Van Loan, §5.5 (the pseudo-inverse); §8.3 (the symmetric eigen-decomposition).
+pub(crate) struct PseudoInverse {
+    eigen: nalgebra::SymmetricEigen<f64, nalgebra::Dyn>,
+    cutoff: f64,
+}
+
+impl PseudoInverse {
+    /// The decomposition of `a` (allocates its m × m eigenvectors).
+    pub(crate) fn new(a: &nalgebra::DMatrix<f64>) -> Self {
+        let eigen = a.clone().symmetric_eigen();
+        let cutoff = DEPENDENT_ROW_TOLERANCE * eigen.eigenvalues.amax();
+        PseudoInverse { eigen, cutoff }
+    }
+
+    /// `x = A⁺ b`.
+    pub(crate) fn solve(&self, b: &[f64], x: &mut [f64]) {
+        x.fill(0.0);
+        let (values, vectors) = (&self.eigen.eigenvalues, &self.eigen.eigenvectors);
+        for (i, &sigma) in values.iter().enumerate() {
+            if sigma <= self.cutoff {
+                continue;
+            }
+            let u = vectors.column(i);
+            let along: f64 = u.iter().zip(b).map(|(ui, bi)| ui * bi).sum::<f64>() / sigma;
+            for (xk, uk) in x.iter_mut().zip(u.iter()) {
+                *xk += along * uk;
+            }
+        }
     }
 }
 
