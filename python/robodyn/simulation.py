@@ -324,7 +324,7 @@ def simulate(model: _core.Model, q0: Configuration, v0: ArrayLike | None = None,
              rtol: float | None = None, atol: float = 1e-9, max_step: float | None = None,
              friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
              limit_damping: float = 1e2, progress: Callable[[float], Any] | None = None,
-             accuracy: str = "warn", constraints: Any = None, baumgarte: tuple[float, float] | None = None,
+             accuracy: str = "warn", constraints: Any | None = "model", baumgarte: tuple[float, float] | None = None,
              damping: float = 0.0) -> Trajectory: ...
 
 
@@ -334,7 +334,7 @@ def simulate(model: _core.Model, q0: Configurations, v0: ArrayLike | None = None
              rtol: float | None = None, atol: float = 1e-9, max_step: float | None = None,
              friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
              limit_damping: float = 1e2, progress: Callable[[float], Any] | None = None,
-             accuracy: str = "warn", constraints: Any = None, baumgarte: tuple[float, float] | None = None,
+             accuracy: str = "warn", constraints: Any | None = "model", baumgarte: tuple[float, float] | None = None,
              damping: float = 0.0) -> list[Trajectory]: ...
 
 
@@ -344,7 +344,7 @@ def simulate(model: _core.Model, q0: ArrayLike, v0: ArrayLike | None = None, t_e
              rtol: float | None = None, atol: float = 1e-9, max_step: float | None = None,
              friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
              limit_damping: float = 1e2, progress: Callable[[float], Any] | None = None,
-             accuracy: str = "warn", constraints: Any = None, baumgarte: tuple[float, float] | None = None,
+             accuracy: str = "warn", constraints: Any | None = "model", baumgarte: tuple[float, float] | None = None,
              damping: float = 0.0) -> Trajectory | list[Trajectory]: ...
 
 
@@ -367,7 +367,7 @@ def simulate(
     limit_damping: float = 1e2,
     progress: Callable[[float], Any] | None = None,
     accuracy: str = "warn",
-    constraints: Any = None,
+    constraints: Any | None = "model",
     baumgarte: tuple[float, float] | None = None,
     damping: float = 0.0,
 ) -> Trajectory | list[Trajectory]:
@@ -408,10 +408,14 @@ def simulate(
     ``progress(fraction)`` is called about a hundred times per run (this runs the loop with the GIL
     held; Ctrl-C stops it).
 
-    ``constraints``: one or a list of :class:`robodyn.PointAnchor`, :class:`robodyn.FrameAnchor`,
+    ``constraints``: ``"model"`` (the default) holds the model's own, :attr:`Model.constraints`
+    (an MJCF file's ``<equality>``; none for a model without); ``None`` or ``[]`` holds none; or one
+    or a list of :class:`robodyn.PointAnchor`, :class:`robodyn.FrameAnchor`,
     :class:`robodyn.JointCoupling`, :class:`robodyn.Distance` held through the run (closed loops,
     anchors), with ``baumgarte`` and ``damping`` as in :meth:`Model.constrained_forward_dynamics`;
-    the accelerations are :meth:`Model.constrained_forward_dynamics`'s. Rollouts with constraints run
+    the accelerations are :meth:`Model.constrained_forward_dynamics`'s. Loops whose rows depend on
+    each other (a planar linkage closed by 3-D connects, as Cassie's legs) need ``damping > 0``:
+    without it the run stops at once with an error naming the row. Rollouts with constraints run
     in parallel, each on its own (not in SIMD lanes).
 
     Raises ``ValueError`` naming the argument for bad input, and when the simulation diverges (with
@@ -434,7 +438,7 @@ def simulate(
         float("inf") if max_step is None else real("max_step", max_step), _controller_argument(model, controller),
         _wrenches_argument(wrenches), real("friction_velocity", friction_velocity), limits,
         real("limit_stiffness", limit_stiffness), real("limit_damping", limit_damping), callback("progress", progress),
-        accuracy_rtol, constraints=constraints, baumgarte=baumgarte, damping=damping,
+        accuracy_rtol, constraints=_held(model, constraints), baumgarte=baumgarte, damping=damping,
     )
     series = ("q", "v", "a", "tau", "tau_passive")
     statistics = ("steps", "rejected_steps", "evaluations")
@@ -466,6 +470,14 @@ def _report_accuracy(runs: list[Trajectory], accuracy: str, batch: bool) -> None
         warnings.warn(message, AccuracyWarning, stacklevel=3)
 
 
+def _held(model: _core.Model, constraints: Any) -> Any:
+    """The constraints a run holds: the model's own for ``"model"``, else those given."""
+    if isinstance(constraints, str):
+        choice("constraints", constraints, ("model",), " or constraint objects")
+        return model.constraints or None
+    return constraints
+
+
 def _check_gains(baumgarte: Any) -> None:
     """Baumgarte's gains are None or a pair (kp, kd)."""
     if baumgarte is not None and numbers("baumgarte", baumgarte).shape != (2,):
@@ -485,7 +497,7 @@ def step(
     limits: str = "report",
     limit_stiffness: float = 1e4,
     limit_damping: float = 1e2,
-    constraints: Any = None,
+    constraints: Any | None = "model",
     baumgarte: tuple[float, float] | None = None,
     damping: float = 0.0,
 ) -> Any:
@@ -515,7 +527,7 @@ def step(
     flat = _core.step(
         model, q, v, tau, real("dt", dt), integrator, derivatives, real("friction_velocity", friction_velocity),
         limits, real("limit_stiffness", limit_stiffness), real("limit_damping", limit_damping),
-        constraints=constraints, baumgarte=baumgarte, damping=real("damping", damping),
+        constraints=_held(model, constraints), baumgarte=baumgarte, damping=real("damping", damping),
     )
     nx, nv = model.nq + model.nv, model.nv
     if not derivatives:

@@ -17,6 +17,8 @@ CASSIE = REPOSITORY / "testdata" / "mjcf" / "cassie_nomesh.xml"
 GRIPPER = REPOSITORY / "testdata" / "menagerie" / "robotiq_2f85" / "2f85.xml"
 #: MuJoCo's compiler and robodyn both compute the anchors in double precision from the same poses.
 COMPILER_TOLERANCE = 1e-12
+#: Identities between exact computations (the constrained equations), relative.
+IDENTITY_TOLERANCE = 1e-9
 #: How far a simulated loop may come apart (m).
 LOOP_DRIFT = 1e-8
 
@@ -139,6 +141,14 @@ def loop_gap(model, loops, configurations):
     return worst
 
 
+def swinging(model):
+    """Cassie's hips swinging its legs apart at 2 rad/s (a velocity its loops allow)."""
+    swing = np.zeros(model.nv)
+    velocity_index = dict(zip(model.joint_names, model.joint_idx_v))
+    swing[velocity_index["left-hip-pitch"]], swing[velocity_index["right-hip-pitch"]] = 2.0, -2.0
+    return swing
+
+
 def test_cassie_keeps_its_loops_closed():
     model = load(CASSIE)
     loops = model.constraints
@@ -155,12 +165,44 @@ def test_cassie_keeps_its_loops_closed():
     assert loop_gap(model, loops, run.q[::10]) < LOOP_DRIFT
     # the legs swinging apart at 2 rad/s: the loops open by rounding, so their out-of-plane rows
     # depend on the others only nearly, and the proximal iterations accept what that leaves
-    swing = np.zeros(model.nv)
-    velocity_index = dict(zip(model.joint_names, model.joint_idx_v))
-    swing[velocity_index["left-hip-pitch"]], swing[velocity_index["right-hip-pitch"]] = 2.0, -2.0
-    run = robodyn.simulate(model, q0, swing, t_end=0.5, dt=5e-4, integrator="rk4", constraints=loops, damping=1e-8)
+    run = robodyn.simulate(model, q0, swinging(model), t_end=0.5, dt=5e-4, integrator="rk4", constraints=loops, damping=1e-8)
     assert run.t[-1] == pytest.approx(0.5) and loop_gap(model, loops, run.q[::10]) < LOOP_DRIFT
     # with the pelvis held, the legs hang from it and the rods carry their weight
     held = [*loops, robodyn.FrameAnchor("cassie-pelvis")]
     forces = model.constrained_forward_dynamics(q0, np.zeros(model.nv), np.zeros(model.nv), held, damping=1e-8)["forces"]
     assert np.max(np.abs(forces[:12])) > 1.0
+
+
+def test_cassie_standing_with_its_loops_and_both_feet_held():
+    """Both loops of each leg and both feet welded to the ground: 24 rows, of which the feet's and
+    the loops' overlap (the legs cannot move at all), solved in proximal mode; the constrained
+    equations hold and the rows' accelerations vanish."""
+    model = load(CASSIE)
+    q, v = model.neutral(), np.zeros(model.nv)
+    held = [*model.constraints, robodyn.FrameAnchor("left-foot"), robodyn.FrameAnchor("right-foot")]
+    tau = np.random.default_rng(2).uniform(-10, 10, model.nv)
+    with pytest.raises(ValueError, match="redundant"):
+        model.constrained_forward_dynamics(q, v, tau, held)
+    result = model.constrained_forward_dynamics(q, v, tau, held, damping=1e-8)
+    jacobian = model.constraint_jacobian(q, held)
+    residual = model.mass_matrix(q) @ result["qdd"] + model.bias_forces(q, v) - tau - jacobian.T @ result["forces"]
+    assert np.max(np.abs(residual)) < IDENTITY_TOLERANCE * (1 + np.max(np.abs(tau)))
+    assert np.max(np.abs(jacobian @ result["qdd"])) < IDENTITY_TOLERANCE * (1 + np.max(np.abs(result["qdd"])))
+
+
+def test_simulate_holds_the_models_own_constraints_by_default():
+    model = load(CASSIE)
+    q0 = model.neutral()
+    # Cassie's loops have dependent rows: without damping the run says so, naming the row
+    with pytest.raises(ValueError, match=r"row y.*damping > 0"):
+        robodyn.simulate(model, q0, t_end=0.01, dt=5e-4, integrator="rk4")
+    options = {"t_end": 0.05, "dt": 5e-4, "integrator": "rk4", "damping": 1e-8}
+    held = robodyn.simulate(model, q0, swinging(model), **options)
+    explicit = robodyn.simulate(model, q0, swinging(model), constraints=model.constraints, **options)
+    np.testing.assert_array_equal(held.q, explicit.q)
+    assert loop_gap(model, model.constraints, held.q) < LOOP_DRIFT
+    # None holds nothing: the open tree's rods come apart
+    loose = robodyn.simulate(model, q0, swinging(model), constraints=None, **options)
+    assert loop_gap(model, model.constraints, loose.q) > 1e3 * LOOP_DRIFT
+    with pytest.raises(ValueError, match="constraints"):
+        robodyn.simulate(model, q0, constraints="models", **options)
