@@ -1,9 +1,14 @@
 """robodyn against Pinocchio and MuJoCo from Python, in one run: per-call time of each algorithm,
-a 10 000-state batch against a Python loop, a 10 s UR5 rollout (RK4, PD) against mj_step and 64
-rollouts of 1 s against mujoco.rollout, printed as ratios (< 1 means robodyn is faster).
+a 10 000-state batch against a Python loop, forward dynamics under contacts (Solo12 on its feet,
+Talos on its soles) and impacts against Pinocchio's constraintDynamics and impulseDynamics, a 10 s
+UR5 rollout (RK4, PD) against mj_step and 64 rollouts of 1 s against mujoco.rollout, printed as
+ratios (< 1 means robodyn is faster).
 
-Run: .venv/bin/python benchmarks/compare.py [--batch 10000] [--robots ur5 panda talos] [--json out.json]
-(--json also writes the tables as JSON, which scripts/benchmarks_page.py turns into docs/benchmarks.md).
+Run: .venv/bin/python benchmarks/compare.py [--batch 10000] [--robots ur5 panda talos]
+[--sections pinocchio constrained mujoco simulation] [--criterion target/criterion] [--json out.json]
+(--json also writes the tables as JSON, which scripts/benchmarks_page.py turns into docs/benchmarks.md;
+--criterion sets the Rust core's times of the constrained cases, from a `cargo bench -p robodyn
+--bench constrained` run before, beside the same calls from Python).
 Needs the bench extras (pip install '.[bench]'). Times are the best of several repeats; a batch
 round repeats the batch for at least BATCH_ROUND_S (a Python loop takes that long once).
 
@@ -154,6 +159,150 @@ def compare_robot(name: str, batch: int) -> list[tuple[str, float, float]]:
         "jacobian": (lambda: m.jacobian(states, frame), pin_jacobian_loop),
     }
     rows += [(f"{name} {algorithm} ({batch} states)", *batch_times(ours, theirs)) for algorithm, (ours, theirs) in batches.items()]
+    return rows
+
+
+#: The constrained section's robots: name -> (file, rows per contact, the frames held). Each frame
+#: is held to the world where it is, in world axes (Pinocchio's LOCAL_WORLD_ALIGNED): Solo12 on its
+#: four feet (a point each), Talos (the file of ROBOTS) on its two soles (the whole frame each).
+CONTACTS = {
+    "solo12": ("solo_description/robots/solo12.urdf", 3, ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")),
+    "talos": (ROBOTS["talos"][0], 6, ("left_sole_link", "right_sole_link")),
+}
+#: What the contacts are called in the rows.
+CONTACT_NAMES = {3: "feet", 6: "soles"}
+#: The constrained algorithms timed, as the rows name them -> their criterion benchmark in
+#: `cargo bench -p robodyn --bench constrained` (group `constrained/ROBOT`, which criterion keeps in
+#: its folder `constrained_ROBOT`).
+CONSTRAINED_ALGORITHMS = {"forward dynamics": "forward_dynamics", "impulse dynamics": "impulse_dynamics"}
+#: Before any timing, robodyn's results equal Pinocchio's to this, relative to each state's largest
+#: entry (Pinocchio's tests agree to 1e-9): a benchmark never times a wrong answer.
+AGREEMENT = 1e-8
+
+
+def assert_agree(label: str, ours, theirs) -> None:
+    """|ours - theirs| <= AGREEMENT * max(1, the largest |theirs| of the state), state by state
+    (the last axis holds one state's entries)."""
+    ours, theirs = np.asarray(ours), np.asarray(theirs)
+    scale = np.maximum(1.0, np.max(np.abs(theirs), axis=-1))
+    error = np.max(np.abs(ours - theirs), axis=-1)
+    worst = np.unravel_index(np.argmax(error / scale), np.shape(scale))
+    assert np.all(error <= AGREEMENT * scale), f"{label}: robodyn and Pinocchio differ by {error[worst]:.1e} (scale {scale[worst]:.1e})"
+
+
+def pinocchio_contacts(pm, pd, size: int, frames):
+    """Pinocchio's constraint models and datas of the contacts, prepared once as a user would
+    before a loop: `initConstraintDynamics` sizes the contact Cholesky factor in `pd`. `size`: 3 (a
+    point) or 6 (a frame) rows per contact."""
+    kind = pin.ContactType.CONTACT_3D if size == 3 else pin.ContactType.CONTACT_6D
+    models, datas = pin.StdVec_RigidConstraintModel(), pin.StdVec_RigidConstraintData()
+    for name in frames:
+        frame = pm.frames[pm.getFrameId(name)]
+        models.append(pin.RigidConstraintModel(kind, pm, frame.parentJoint, frame.placement, pin.LOCAL_WORLD_ALIGNED))
+        datas.append(models[-1].createData())
+    pin.initConstraintDynamics(pm, pd, models, datas)
+    return models, datas
+
+
+def contact_states(m, contacts, count: int, seed: int):
+    """`count` states at the contacts (each (count, n)): random configurations q, velocities v the
+    contacts allow, random torques and the random velocities u that v comes from, moving the
+    contacts (an impact's). v = u - J⁺ J u: there Pinocchio's drift of 6-D world rows (the
+    contact's spatial acceleration) equals robodyn's J̇ v."""
+    rng = np.random.default_rng(seed)
+    q = m.random_configuration(n=count, seed=seed)
+    jacobians = m.constraint_jacobian(q, contacts)
+    u = rng.uniform(-1, 1, (count, m.nv))
+    v = u - np.einsum("nij,nj->ni", np.linalg.pinv(jacobians), np.einsum("nij,nj->ni", jacobians, u))
+    return q, v, rng.uniform(-5, 5, (count, m.nv)), u
+
+
+def constrained_case(name: str, algorithm: str, states: int | None = None) -> str:
+    """A constrained row's case: robot, contacts, algorithm, one call or `states` states."""
+    count = "one call" if states is None else f"{states} states"
+    return f"{name} {CONTACT_NAMES[CONTACTS[name][1]]}: {algorithm} ({count})"
+
+
+def compare_constrained(name: str, batch: int) -> list[tuple[str, float, float]]:
+    """Forward dynamics with the contacts of CONTACTS (and, for Solo12, an impact on them): one call
+    and a batch against `pin.constraintDynamics` (`pin.impulseDynamics`) with its default settings
+    (one exact solve), after checking that both give the same answers."""
+    path, size, frames = CONTACTS[name]
+    urdf = robodyn._example_robot_data_dir() / path
+    m = robodyn.load(urdf, floating_base=True)
+    pm = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
+    pd = pm.createData()
+    models, datas = pinocchio_contacts(pm, pd, size, frames)
+    contacts = [robodyn.PointAnchor(frame) if size == 3 else robodyn.FrameAnchor(frame) for frame in frames]
+    mapping = PinocchioLayout(m, pm)
+
+    q, v, tau, impact = (x[0] for x in contact_states(m, contacts, 1, seed=4))
+    states, velocities, torques, impacts = contact_states(m, contacts, batch, seed=5)
+    pq, pv, ptau, pimpact = mapping.q_to_pinocchio(q), mapping.v_to_pinocchio(v), mapping.v_to_pinocchio(tau), mapping.v_to_pinocchio(impact)
+    pin_states = [mapping.q_to_pinocchio(x) for x in states]
+    pin_velocities = [mapping.v_to_pinocchio(x) for x in velocities]
+    pin_torques = [mapping.v_to_pinocchio(x) for x in torques]
+    pin_impacts = [mapping.v_to_pinocchio(x) for x in impacts]
+
+    def pin_forward(x, w, t):
+        return pin.constraintDynamics(pm, pd, x, w, t, models, datas)
+
+    def pin_impulse(x, w):
+        return pin.impulseDynamics(pm, pd, x, w, models, datas)
+
+    def pin_forward_loop():
+        for x, w, t in zip(pin_states, pin_velocities, pin_torques):
+            pin_forward(x, w, t)
+
+    def pin_impulse_loop():
+        for x, w in zip(pin_states, pin_impacts):
+            pin_impulse(x, w)
+
+    def check(ours, keys, solve, arguments, forces: str) -> None:
+        """robodyn's result (one state or a batch), its entries `keys`, against Pinocchio's `solve`
+        at the same states: its return value (in robodyn's order) and `pd`'s field `forces`."""
+        expected = [(mapping.v_from_pinocchio(solve(*state)), getattr(pd, forces).copy()) for state in arguments]
+        for key, column in zip(keys, zip(*expected)):
+            assert_agree(f"{name} {key}", np.reshape(ours[key], np.shape(column)), np.array(column))
+
+    forward_keys = ("qdd", "forces")
+    check(m.constrained_forward_dynamics(q, v, tau, contacts), forward_keys, pin_forward, [(pq, pv, ptau)], "lambda_c")
+    check(m.constrained_forward_dynamics(states, velocities, torques, contacts), forward_keys, pin_forward,
+          zip(pin_states, pin_velocities, pin_torques), "lambda_c")
+    rows = [
+        (constrained_case(name, "forward dynamics"),
+         *best_times(lambda: m.constrained_forward_dynamics(q, v, tau, contacts), lambda: pin_forward(pq, pv, ptau), 2000)),
+        (constrained_case(name, "forward dynamics", batch),
+         *batch_times(lambda: m.constrained_forward_dynamics(states, velocities, torques, contacts), pin_forward_loop)),
+    ]
+    if name == "solo12":
+        impulse_keys = ("v", "impulses")
+        check(m.impulse_dynamics(q, impact, contacts), impulse_keys, pin_impulse, [(pq, pimpact)], "impulse_c")
+        check(m.impulse_dynamics(states, impacts, contacts), impulse_keys, pin_impulse, zip(pin_states, pin_impacts), "impulse_c")
+        rows += [
+            (constrained_case(name, "impulse dynamics"),
+             *best_times(lambda: m.impulse_dynamics(q, impact, contacts), lambda: pin_impulse(pq, pimpact), 2000)),
+            (constrained_case(name, "impulse dynamics", batch),
+             *batch_times(lambda: m.impulse_dynamics(states, impacts, contacts), pin_impulse_loop)),
+        ]
+    return rows
+
+
+def native_constrained(criterion: Path, timed) -> list[tuple[str, float, float]]:
+    """The Rust core's time of each constrained one-call row (criterion's estimate from the last
+    `cargo bench -p robodyn --bench constrained` whose results are in `criterion`), beside that
+    row's time from Python in `timed` (the rows of `compare_constrained`)."""
+    from_python = {case: ours for case, ours, _ in timed}
+    rows = []
+    for name in CONTACTS:
+        for algorithm, bench in CONSTRAINED_ALGORITHMS.items():
+            case = constrained_case(name, algorithm)
+            estimates = criterion / f"constrained_{name}" / bench / "new" / "estimates.json"
+            if case in from_python and estimates.is_file():
+                estimate = json.loads(estimates.read_text(encoding="utf-8"))
+                # the slope of time against iterations (criterion's headline figure), in ns
+                nanoseconds = (estimate.get("slope") or estimate["mean"])["point_estimate"]
+                rows.append((case, nanoseconds * 1e-9, from_python[case]))
     return rows
 
 
@@ -319,17 +468,28 @@ def compare_batched_rollouts(name: str) -> list[tuple[str, float, float]]:
 
 
 def print_table(title: str, other: str, rows) -> None:
+    width = max(40, 2 + max((len(case) for case, _, _ in rows), default=0))
     print(f"\n{title}")
-    print(f"{'case':<40}{'robodyn':>14}{other:>14}{'ratio':>9}")
+    print(f"{'case':<{width}}{'robodyn':>14}{other:>14}{'ratio':>9}")
     for case, ours, theirs in rows:
         unit, scale = ("us", 1e6) if theirs < 1e-3 else ("ms", 1e3)
-        print(f"{case:<40}{ours * scale:>11.2f} {unit}{theirs * scale:>11.2f} {unit}{ours / theirs:>9.3f}")
+        print(f"{case:<{width}}{ours * scale:>11.2f} {unit}{theirs * scale:>11.2f} {unit}{ours / theirs:>9.3f}")
+
+
+#: The sections of a run, in order: robodyn against Pinocchio, the constrained cases, against
+#: MuJoCo, the rollouts.
+SECTIONS = ("pinocchio", "constrained", "mujoco", "simulation")
+#: The table of the Rust core's constrained times (`--criterion`), after the constrained section.
+NATIVE_TITLE = "Constrained dynamics, one call: the Rust core (criterion) beside the call from Python"
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--batch", type=int, default=10_000)
     parser.add_argument("--robots", nargs="+", default=list(ROBOTS), choices=list(ROBOTS))
+    parser.add_argument("--sections", nargs="+", default=list(SECTIONS), choices=list(SECTIONS), help="the sections run (default: all)")
+    parser.add_argument("--criterion", type=Path, help="criterion's results (target/criterion) of `cargo bench -p robodyn --bench "
+                        "constrained`, set beside the constrained one-call rows in a table of their own")
     parser.add_argument("--json", type=Path, help="also write the tables to this file (times in seconds)")
     args = parser.parse_args()
     versions = {"robodyn": robodyn.__version__, "pinocchio": pin.__version__, "mujoco": mujoco.__version__,
@@ -338,17 +498,24 @@ def main() -> None:
                "load_average": [os.getloadavg()[0]]}
     print(f"robodyn {versions['robodyn']}, Pinocchio {versions['pinocchio']}, MuJoCo {versions['mujoco']}; "
           f"Python {versions['python']}, {machine['machine']}, {machine['cores']} cores")
-    sections = [
-        ("robodyn vs Pinocchio", "pinocchio", lambda: [row for name in args.robots for row in compare_robot(name, args.batch)]),
-        ("robodyn vs MuJoCo (fixed base)", "mujoco", lambda: [row for name in args.robots for row in compare_mujoco(name, args.batch)]),
-        ("Simulation: robodyn.simulate vs mj_step and mujoco.rollout", "mujoco",
-         lambda: compare_rollout("ur5") + compare_batched_rollouts("ur5")),
-    ]
+    sections = {
+        "pinocchio": ("robodyn vs Pinocchio", "pinocchio", lambda: [row for name in args.robots for row in compare_robot(name, args.batch)]),
+        "constrained": ("Constrained dynamics: robodyn vs Pinocchio (Solo12 on 4 feet, Talos on 2 soles)", "pinocchio",
+                        lambda: [row for name in CONTACTS for row in compare_constrained(name, args.batch)]),
+        "mujoco": ("robodyn vs MuJoCo (fixed base)", "mujoco", lambda: [row for name in args.robots for row in compare_mujoco(name, args.batch)]),
+        "simulation": ("Simulation: robodyn.simulate vs mj_step and mujoco.rollout", "mujoco",
+                       lambda: compare_rollout("ur5") + compare_batched_rollouts("ur5")),
+    }
     tables = []
-    for title, other, run in sections:
+    for key in args.sections:
+        title, other, run = sections[key]
         rows = run()
         print_table(title, other, rows)
         tables.append({"title": title, "other": other, "rows": [list(row) for row in rows]})
+        if key == "constrained" and args.criterion:
+            native = native_constrained(args.criterion, rows)
+            print_table(NATIVE_TITLE, "from Python", native)
+            tables.append({"title": NATIVE_TITLE, "other": "from Python", "rows": [list(row) for row in native]})
     if args.json:
         # the one-minute load average at the start and at the end: other jobs sharing the machine
         machine["load_average"].append(os.getloadavg()[0])

@@ -14,7 +14,7 @@ use std::hint::black_box;
 use std::path::PathBuf;
 
 /// The example-robot-data robots directory, if present.
-fn robots_dir() -> Option<PathBuf> {
+pub fn robots_dir() -> Option<PathBuf> {
     let dir = std::env::var("ROBODYN_ROBOTS_DIR").map(PathBuf::from).unwrap_or_else(|_| {
         PathBuf::from(env!("CARGO_MANIFEST_DIR"))
             .join("../../.venv/lib/python3.11/site-packages/cmeel.prefix/share/example-robot-data/robots")
