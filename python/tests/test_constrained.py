@@ -224,3 +224,27 @@ def test_a_simulated_four_bar_stays_closed_and_keeps_its_energy():
     np.testing.assert_array_equal(runs[0].q, runs[1].q)
     with pytest.raises(ValueError, match="argument 'baumgarte'"):
         robodyn.simulate(model, q0, t_end=0.1, constraints=closure, baumgarte="stiff")
+
+
+def test_weighted_inverse_dynamics_moves_the_load_off_heavy_rows():
+    """Solo12 standing: four feet leave one vertical mode free (one diagonal pair of feet against
+    the other). With the FL-HR diagonal's rows weighted ten times, the other diagonal carries more
+    (W/11 against W/2 on a symmetric stance); the weight is still carried, and W·forces lies in
+    the base rows' column space."""
+    solo = robodyn.load("solo12.urdf", floating_base=True)
+    feet = [robodyn.PointAnchor(foot) for foot in ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")]
+    q = solo.neutral()
+    q[7:] = [0.0, 0.8, -1.6, 0.0, 0.8, -1.6, 0.0, -0.8, 1.6, 0.0, -0.8, 1.6]
+    rest = np.zeros(solo.nv)
+    plain = solo.constrained_inverse_dynamics(q, rest, rest, feet)["forces"].reshape(4, 3)
+    weights = np.repeat([10.0, 1.0, 1.0, 10.0], 3)
+    weighted = solo.constrained_inverse_dynamics(q, rest, rest, feet, weights=weights)["forces"]
+    assert_close(weighted.reshape(4, 3).sum(axis=0), plain.sum(axis=0), IDENTITY_TOLERANCE)
+    assert weighted.reshape(4, 3)[[0, 3], 2].sum() < 0.5 * plain[[0, 3], 2].sum()
+    base = solo.constraint_jacobian(q, feet)[:, :6]
+    null = np.linalg.svd(base.T)[2][6:]
+    assert np.max(np.abs(null @ (weights * weighted))) < IDENTITY_TOLERANCE * np.max(np.abs(weights * weighted))
+    with pytest.raises(ValueError, match="weights.*row 3"):
+        solo.constrained_inverse_dynamics(q, rest, rest, feet, weights=np.array([1.0, 1, 1, -1, 1, 1, 1, 1, 1, 1, 1, 1]))
+    with pytest.raises(ValueError, match="weights"):
+        solo.constrained_inverse_dynamics(q, rest, rest, feet, weights=np.ones(5))

@@ -299,9 +299,11 @@ impl PyModel {
     /// Inverse dynamics under `constraints`: dict of `tau` (nv,; zero on coordinates not
     /// actuated) and `forces` (rows,) with M a + h = tau + Jᵀ forces. `actuated`: the joints
     /// with actuators (default: all but free joints, for a floating base). Where the forces are
-    /// not unique they are the least-norm ones. An `a` that breaks the constraints (J a + J̇ v ≠
-    /// 0), or that the forces cannot produce, is a ValueError giving the residual.
-    #[pyo3(signature = (q, v, a, constraints, actuated=None, f_ext=None))]
+    /// not unique they are the least-norm ones, or with `weights` (rows,; each > 0) those of
+    /// least Σ weights·forces² (a heavier weight, less force on that row). An `a` that breaks
+    /// the constraints (J a + J̇ v ≠ 0), or that the forces cannot produce, is a ValueError
+    /// giving the residual.
+    #[pyo3(signature = (q, v, a, constraints, actuated=None, f_ext=None, weights=None))]
     #[allow(clippy::too_many_arguments)]
     fn constrained_inverse_dynamics<'py>(
         &self,
@@ -312,11 +314,17 @@ impl PyModel {
         constraints: &Bound<'py, PyAny>,
         actuated: Option<&Bound<'py, PyAny>>,
         f_ext: Option<&Bound<'py, PyAny>>,
+        weights: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let set = constraint_set(self, constraints)?;
         let flags = self.actuated_coordinates(actuated)?;
+        let weights = weights
+            .filter(|w| !w.is_none())
+            .map(|w| read_sample("weights", w, SampleShape::vector(set.rows())))
+            .transpose()?;
         let algorithm: &ConstrainedAlgorithm = &|m, data, c, state, f_ext| {
-            algo::constrained_inverse_dynamics(m, data, c, &set, state, f_ext, &flags)?;
+            let weights = weights.as_deref();
+            algo::constrained_inverse_dynamics(m, data, c, &set, state, f_ext, &flags, weights)?;
             Ok(&c.tau)
         };
         let arguments = (q, v, ("a", a));

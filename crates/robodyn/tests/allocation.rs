@@ -250,6 +250,9 @@ fn algorithms_allocate_nothing_after_data_new() {
         for (algorithm, count) in counts {
             assert_eq!(count, 0, "{name}: {algorithm} allocated {count} times");
         }
+        if model.nv >= 6 {
+            constrained_allocations(name, &model, &mut data, (q, v, a));
+        }
         // a simulation allocates its buffers up front: ten times the steps, the same count
         for integrator in [
             Integrator::ExplicitEuler,
@@ -290,5 +293,59 @@ fn algorithms_allocate_nothing_after_data_new() {
             let (short, long) = (run(0.01), run(0.1));
             assert_eq!(short, long, "{name}: {integrator:?} allocated per step");
         }
+    }
+}
+
+/// Constrained forward dynamics and its derivatives allocate nothing after their workspaces are
+/// made (a point of the last body held: three independent rows on six or more coordinates).
+fn constrained_allocations(
+    name: &str,
+    model: &robodyn::Model,
+    data: &mut Data,
+    (q, v, tau): (&[f64], &[f64], &[f64]),
+) {
+    use robodyn::constraint::{Attachment, Constraint, ConstraintKind, ConstraintReference};
+    let last = model.nbodies() - 1;
+    let frame = model.frames.iter().position(|f| f.body == last).unwrap();
+    let point = Constraint {
+        kind: ConstraintKind::Point {
+            first: Attachment::at_frame(frame),
+            second: None,
+        },
+        reference: ConstraintReference::World,
+    };
+    let set = robodyn::constraint::ConstraintSet::new(model, vec![point]).unwrap();
+    let mut c = ConstraintData::new(model, &set);
+    let mut d = ConstrainedDerivatives::new(model, &set);
+    let options = ConstrainedOptions::default();
+    let counts = [
+        (
+            "constrained_forward_dynamics",
+            allocations(|| {
+                constrained_forward_dynamics(
+                    model,
+                    data,
+                    &mut c,
+                    &set,
+                    (q, v, tau),
+                    None,
+                    &options,
+                )
+                .unwrap();
+            }),
+        ),
+        (
+            "constrained_forward_dynamics_derivatives",
+            allocations(|| {
+                let state = (q, v, tau);
+                constrained_forward_dynamics_derivatives(
+                    model, data, &mut c, &mut d, &set, state, None, 0.0,
+                )
+                .unwrap();
+            }),
+        ),
+    ];
+    for (algorithm, count) in counts {
+        assert_eq!(count, 0, "{name}: {algorithm} allocated {count} times");
     }
 }

@@ -249,17 +249,18 @@ fn inverse_dynamics_recovers_the_torques_and_forces_of_forward_dynamics() {
             .unwrap();
         let (qdd, forces) = (c.qdd.clone(), c.forces.clone());
         let args = (q.as_slice(), v.as_slice(), qdd.as_slice());
-        constrained_inverse_dynamics(&model, &mut data, &mut c, &set, args, None, &actuated)
+        constrained_inverse_dynamics(&model, &mut data, &mut c, &set, args, None, &actuated, None)
             .unwrap();
         assert_close("tau", c.tau.as_slice(), tau.as_slice(), 1e-8);
         assert_close("forces", c.forces.as_slice(), forces.as_slice(), 1e-8);
         // an acceleration the constraints forbid is refused, naming the row
         let wrong = &qdd + DVector::from_element(model.nv, 0.1);
         let args = (q.as_slice(), v.as_slice(), wrong.as_slice());
-        let error =
-            constrained_inverse_dynamics(&model, &mut data, &mut c, &set, args, None, &actuated)
-                .unwrap_err()
-                .to_string();
+        let error = constrained_inverse_dynamics(
+            &model, &mut data, &mut c, &set, args, None, &actuated, None,
+        )
+        .unwrap_err()
+        .to_string();
         assert!(
             error.contains("breaks the constraints") && error.contains("constraints[0]"),
             "{error}"
@@ -289,7 +290,8 @@ fn inverse_dynamics_gives_the_least_norm_forces_where_they_are_not_unique() {
     constrained_forward_dynamics(&model, &mut data, &mut c, &set, args, None, &options).unwrap();
     let qdd = c.qdd.clone();
     let args = (q.as_slice(), v.as_slice(), qdd.as_slice());
-    constrained_inverse_dynamics(&model, &mut data, &mut c, &set, args, None, &actuated).unwrap();
+    constrained_inverse_dynamics(&model, &mut data, &mut c, &set, args, None, &actuated, None)
+        .unwrap();
     // M q̈ + h = τ + Jᵀ λ with τ zero on the base
     let mass = algo::crba(&model, &mut data, q.as_slice()).unwrap().clone();
     let h = algo::bias_forces(&model, &mut data, q.as_slice(), v.as_slice())
@@ -316,6 +318,73 @@ fn inverse_dynamics_gives_the_least_norm_forces_where_they_are_not_unique() {
             assert!(along_null.abs() < 1e-8 * c.forces.amax(), "{along_null}");
         }
     }
+}
+
+#[test]
+fn weighted_inverse_dynamics_gives_the_forces_of_least_weighted_norm() {
+    let model = test_model("tree");
+    // the two points of the test above, their rows weighted unequally
+    let point = |frame: &str, offset: [f64; 3]| {
+        let kind = ConstraintKind::Point {
+            first: at(&model, frame, offset),
+            second: None,
+        };
+        constraint(kind, ConstraintReference::World)
+    };
+    let constraints = vec![point("tip", [0.0; 3]), point("shin", [0.0, 0.0, -0.3])];
+    let set = ConstraintSet::new(&model, constraints).unwrap();
+    let (mut data, mut c) = (Data::new(&model), ConstraintData::new(&model, &set));
+    let actuated: Vec<bool> = (0..model.nv).map(|k| k >= 6).collect();
+    let (q, v, tau) = base_unactuated_state(&model, &mut rng());
+    let args = (q.as_slice(), v.as_slice(), tau.as_slice());
+    let options = ConstrainedOptions::default();
+    constrained_forward_dynamics(&model, &mut data, &mut c, &set, args, None, &options).unwrap();
+    let qdd = c.qdd.clone();
+    let args = (q.as_slice(), v.as_slice(), qdd.as_slice());
+    constrained_inverse_dynamics(&model, &mut data, &mut c, &set, args, None, &actuated, None)
+        .unwrap();
+    let plain = c.forces.clone();
+    let weights = [1.0, 2.0, 3.0, 10.0, 0.5, 4.0];
+    let weighted = Some(&weights[..]);
+    constrained_inverse_dynamics(
+        &model, &mut data, &mut c, &set, args, None, &actuated, weighted,
+    )
+    .unwrap();
+    // the base's rows hold with either, and W λ lies in the column space of J_u
+    let base_columns = c.jacobian.columns(0, 6).into_owned();
+    let balance = base_columns.transpose() * (&c.forces - &plain);
+    assert!(
+        balance.amax() < IDENTITY_TOLERANCE * (1.0 + plain.amax()),
+        "{balance}"
+    );
+    let scaled = DVector::from_iterator(6, c.forces.iter().zip(weights).map(|(f, w)| f * w));
+    let svd = base_columns.svd(true, false);
+    let u = svd.u.unwrap();
+    for k in 0..u.ncols() {
+        if svd.singular_values[k] <= 1e-9 {
+            let along_null = u.column(k).dot(&scaled);
+            assert!(along_null.abs() < 1e-8 * scaled.amax(), "{along_null}");
+        }
+    }
+    assert!((&c.forces - &plain).amax() > 1e-3 * plain.amax());
+    // a weight that is not positive is named
+    let bad = [1.0, 2.0, 0.0, 1.0, 1.0, 1.0];
+    let error = constrained_inverse_dynamics(
+        &model,
+        &mut data,
+        &mut c,
+        &set,
+        args,
+        None,
+        &actuated,
+        Some(&bad),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        error.contains("weights") && error.contains("row 2"),
+        "{error}"
+    );
 }
 
 #[test]

@@ -315,7 +315,9 @@ fn solve_saddle_point(
         solve_rows(model, data, x.column_mut(c).as_mut_slice());
         let x0 = x.column(c);
         for r in 0..m {
-            constraints.rhs[r] = y[(r, c)] - constraints.jacobian.row(r).dot(&x0.transpose());
+            let row = constraints.jacobian.row(r);
+            let product: f64 = row.iter().zip(x0.iter()).map(|(j, x)| j * x).sum();
+            constraints.rhs[r] = y[(r, c)] - product;
         }
         match solver {
             Solver::Cholesky => {

@@ -94,7 +94,10 @@ pub fn constrained_forward_dynamics(
     for (r, value) in rhs.iter_mut().take(set.rows()).enumerate() {
         let row = jacobian.row(r);
         let (ja, jv) = (
-            row.dot(&free_acceleration.transpose()),
+            row.iter()
+                .zip(free_acceleration.iter())
+                .map(|(j, a)| j * a)
+                .sum::<f64>(),
             row.iter().zip(v).map(|(j, vi)| j * vi).sum::<f64>(),
         );
         *value = -(ja + drift[r] + kd * jv + kp * error[r]);

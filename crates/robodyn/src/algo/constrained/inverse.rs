@@ -8,8 +8,9 @@
 //! ```text
 //!   M q̈ + h = Sᵀ τ_a + Jᵀ λ       rows u:  J_uᵀ λ = (M q̈ + h)_u      rows a:  τ_a = (M q̈ + h − Jᵀ λ)_a
 //! ```
-//! λ is the least-norm solution of the u rows: λ = J_u y with (J_uᵀ J_u) y = (M q̈ + h)_u, solved
-//! by proximal iterations (it is singular when the forces are not unique). q̈ must satisfy the
+//! λ is the least-norm solution of the u rows, or with weights W (diagonal, > 0) the one of least
+//! λᵀ W λ: λ = W⁻¹ J_u y with (J_uᵀ W⁻¹ J_u) y = (M q̈ + h)_u, solved by proximal iterations (it
+//! is singular when the forces are not unique). q̈ must satisfy the
 //! constraints, `J q̈ + γ = 0`; a q̈ that does not, or that the forces cannot produce, is refused
 //! with its residual. Writes `constraints.tau` (zero on coordinates not actuated),
 //! `constraints.forces`, J, γ, φ, and RNEA's fields of `data`.
@@ -33,7 +34,9 @@ pub const CONSTRAINT_ACCELERATION_TOLERANCE: f64 = 1e-9;
 const LEAST_NORM_DAMPING: f64 = 1e-8;
 
 /// τ (on the `actuated` coordinates) and λ that produce `a` under the constraints of `set`, with
-/// `f_ext` as in [`crate::algo::rnea()`]. `actuated` has one flag per velocity coordinate.
+/// `f_ext` as in [`crate::algo::rnea()`]. `actuated` has one flag per velocity coordinate;
+/// `weights` one per row (> 0; `None`: all 1): where the forces are not unique, those of least
+/// `Σ w_r λ_r²` (a heavier weight, less force on that row).
 #[allow(clippy::too_many_arguments)]
 pub fn constrained_inverse_dynamics(
     model: &Model,
@@ -43,12 +46,16 @@ pub fn constrained_inverse_dynamics(
     (q, v, a): (&[f64], &[f64], &[f64]),
     f_ext: Option<&[Force]>,
     actuated: &[bool],
+    weights: Option<&[f64]>,
 ) -> Result<()> {
     super::check_fits(model, constraints, set)?;
     check_vector("v", v, model.nv)?;
     check_vector("a", a, model.nv)?;
     check_length("actuated", actuated.len(), model.nv)?;
     let m = set.rows();
+    check_weights(weights, m)?;
+    // W⁻¹ of row r
+    let inverse_weight = |r: usize| weights.map_or(1.0, |w| 1.0 / w[r]);
 
     // J q̈ + γ = 0 must hold
     constraint_rows(model, data, constraints, set, q, v)?;
@@ -90,13 +97,15 @@ pub fn constrained_inverse_dynamics(
     } = constraints;
     tau.copy_from(tau_full);
 
-    // the rows u: (J_uᵀ J_u) y = τ_full,u
+    // the rows u: (J_uᵀ W⁻¹ J_u) y = τ_full,u
     let unactuated = || (0..model.nv).filter(|&c| !actuated[c]);
     let n = unactuated().count();
     for (i, ci) in unactuated().enumerate() {
         rhs[i] = tau[ci];
         for (j, cj) in unactuated().enumerate() {
-            gram[i + j * n] = jacobian.column(ci).dot(&jacobian.column(cj));
+            gram[i + j * n] = (0..m)
+                .map(|r| jacobian[(r, ci)] * inverse_weight(r) * jacobian[(r, cj)])
+                .sum();
         }
     }
     let damping = LEAST_NORM_DAMPING * (0..n).fold(0.0f64, |d, i| d.max(gram[i + i * n]));
@@ -110,9 +119,12 @@ pub fn constrained_inverse_dynamics(
             Ok(count) => count,
             Err(SolveFailure::Inconsistent { .. }) | Err(SolveFailure::DependentRow(_)) => 0,
         };
-        // λ = J_u y
+        // λ = W⁻¹ J_u y
         for (i, ci) in unactuated().enumerate() {
             forces.axpy(unknowns[i], &jacobian.column(ci), 1.0);
+        }
+        for (r, force) in forces.iter_mut().enumerate() {
+            *force *= inverse_weight(r);
         }
     }
 
@@ -138,4 +150,22 @@ pub fn constrained_inverse_dynamics(
         tau[c] = 0.0;
     }
     Ok(())
+}
+
+/// Refuses weights that are not one finite positive number per row.
+fn check_weights(weights: Option<&[f64]>, rows: usize) -> Result<()> {
+    let Some(weights) = weights else {
+        return Ok(());
+    };
+    check_length("weights", weights.len(), rows)?;
+    match weights.iter().position(|w| !(w.is_finite() && *w > 0.0)) {
+        None => Ok(()),
+        Some(r) => Err(Error::InvalidValue {
+            argument: "weights".into(),
+            message: format!(
+                "expected one finite weight > 0 per constraint row, got {} for row {r}",
+                weights[r]
+            ),
+        }),
+    }
 }
