@@ -209,7 +209,7 @@ swing[velocity_index["left-hip-pitch"]], swing[velocity_index["right-hip-pitch"]
 show("J q̇ of the hips' swing (m/s)", np.zeros(12), cassie.constraint_jacobian(cassie.neutral(), loops) @ swing)
 # half the time step of Cassie's file: at this speed its stiff springs on light links need it
 fall = robodyn.simulate(cassie, cassie.neutral(), swing, t_end=0.5, dt=2.5e-4, integrator="rk4", constraints=loops, damping=1e-8)
-loose = robodyn.simulate(cassie, cassie.neutral(), swing, t_end=0.5, dt=1e-4, integrator="rk4")
+loose = robodyn.simulate(cassie, cassie.neutral(), swing, t_end=0.5, dt=1e-4, integrator="rk4", constraints=None)
 
 
 def rod_ends(q: np.ndarray, loop: robodyn.PointAnchor) -> np.ndarray:

@@ -346,7 +346,7 @@ def test_gravity_and_armature_are_settable():
     assert m.kinetic_energy([0.0], [2.0]) == pytest.approx(0.5 * 1.5 * 4)
 
 
-def test_mimic_joints_are_reported():
+def test_mimic_joints_are_reported_and_held():
     urdf = """<robot name="gripper"><link name="base"/><link name="left"/><link name="right"/>
       <joint name="l" type="prismatic"><parent link="base"/><child link="left"/><limit lower="0" upper="0.04" effort="1" velocity="1"/></joint>
       <joint name="r" type="prismatic"><parent link="base"/><child link="right"/><limit lower="-0.04" upper="0" effort="1" velocity="1"/>
@@ -354,6 +354,20 @@ def test_mimic_joints_are_reported():
     m = robodyn.load_urdf_string(urdf)
     assert m.nv == 2
     assert m.mimic_joints == [("r", "l", -1.0, 0.0)]
+    # held as a coupling, which simulation holds by default
+    (coupling,) = m.constraints
+    assert (coupling.joint, coupling.leader, coupling.polycoef[:2]) == ("r", "l", [0.0, -1.0])
+    inertial = '<inertial><mass value="0.1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial>'
+    massive = urdf.replace('<link name="left"/>', f'<link name="left">{inertial}</link>')
+    m = robodyn.load_urdf_string(massive.replace('<link name="right"/>', f'<link name="right">{inertial}</link>'))
+    run = robodyn.simulate(m, [0.01, -0.01], [0.2, -0.2], t_end=0.1, dt=1e-3)
+    assert np.max(np.abs(run.q[:, 1] + run.q[:, 0])) < 1e-12
+    # a prismatic joint mimicking a revolute one cannot be coupled: reported, not held, warned
+    mixed = urdf.replace('<joint name="l" type="prismatic">', '<joint name="l" type="revolute"><axis xyz="0 0 1"/>')
+    m = robodyn.load_urdf_string(mixed)
+    (warning,) = m.warnings
+    assert "1 <mimic> relation(s) reported" in warning and "'r' (prismatic) and 'l' (revolute)" in warning
+    assert m.constraints == [] and m.mimic_joints == [("r", "l", -1.0, 0.0)]
 
 
 @pytest.mark.parametrize("n", [1, 7, 37, 1001])

@@ -201,7 +201,8 @@ impl PyModel {
     }
 
     /// URDF mimic relations as (joint, mimicked joint, multiplier, offset):
-    /// q[joint] = multiplier * q[mimicked] + offset. Reported, not enforced.
+    /// q[joint] = multiplier * q[mimicked] + offset. Those between two revolute or two prismatic
+    /// joints are also in `constraints` (as `JointCoupling`s), which `simulate` holds.
     #[getter]
     fn mimic_joints(&self) -> Vec<(String, String, f64, f64)> {
         self.model

@@ -123,6 +123,12 @@ impl Constraint {
         }
     }
 
+    /// Why it does not fit `model` (an unknown frame or joint, joints of different kinds, ...), if
+    /// it does not; [`ConstraintSet::new`] refuses it with this reason.
+    pub fn check(&self, model: &Model) -> std::result::Result<(), String> {
+        check_constraint(model, self)
+    }
+
     /// A short description naming its kind and frames or joints, for messages.
     pub fn describe(&self, model: &Model) -> String {
         let frame = |a: &Attachment| match a.frame {
@@ -185,6 +191,25 @@ pub struct ModelConstraint {
     pub solimp: [f64; 5],
     /// A weld's `torquescale` (the weight of its rotation rows in the soft form; 1 otherwise).
     pub torquescale: f64,
+}
+
+/// MuJoCo's defaults of an equality's `solref` (time constant, damping ratio).
+pub const DEFAULT_SOLREF: [f64; 2] = [0.02, 1.0];
+/// MuJoCo's defaults of an equality's `solimp`.
+pub const DEFAULT_SOLIMP: [f64; 5] = [0.9, 0.95, 0.001, 0.5, 2.0];
+
+impl ModelConstraint {
+    /// An active constraint named `name` with MuJoCo's default `solref` and `solimp`.
+    pub fn active(name: String, constraint: Constraint) -> Self {
+        ModelConstraint {
+            name,
+            constraint,
+            active: true,
+            solref: DEFAULT_SOLREF,
+            solimp: DEFAULT_SOLIMP,
+            torquescale: 1.0,
+        }
+    }
 }
 
 /// Constraints checked against a model, with the first row of each.

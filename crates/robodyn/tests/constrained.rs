@@ -268,27 +268,53 @@ fn inverse_dynamics_recovers_the_torques_and_forces_of_forward_dynamics() {
     }
 }
 
-#[test]
-fn inverse_dynamics_gives_the_least_norm_forces_where_they_are_not_unique() {
-    let model = test_model("tree");
-    // two points held: the base may still turn about the line through them, and the forces
-    // along that line are not unique
+/// Two points of the tree held, with the base unactuated, and the state (q, q̇, q̈) of forward
+/// dynamics there: the base may still turn about the line through the points, and the forces
+/// along that line are not unique.
+struct TwoPoints {
+    set: ConstraintSet,
+    data: Data,
+    c: ConstraintData,
+    actuated: Vec<bool>,
+    state: (DVector<f64>, DVector<f64>, DVector<f64>),
+}
+
+fn two_points(model: &Model) -> TwoPoints {
     let point = |frame: &str, offset: [f64; 3]| {
         let kind = ConstraintKind::Point {
-            first: at(&model, frame, offset),
+            first: at(model, frame, offset),
             second: None,
         };
         constraint(kind, ConstraintReference::World)
     };
     let constraints = vec![point("tip", [0.0; 3]), point("shin", [0.0, 0.0, -0.3])];
-    let set = ConstraintSet::new(&model, constraints).unwrap();
-    let (mut data, mut c) = (Data::new(&model), ConstraintData::new(&model, &set));
+    let set = ConstraintSet::new(model, constraints).unwrap();
+    let (mut data, mut c) = (Data::new(model), ConstraintData::new(model, &set));
     let actuated: Vec<bool> = (0..model.nv).map(|k| k >= 6).collect();
-    let (q, v, tau) = base_unactuated_state(&model, &mut rng());
+    let (q, v, tau) = base_unactuated_state(model, &mut rng());
     let args = (q.as_slice(), v.as_slice(), tau.as_slice());
     let options = ConstrainedOptions::default();
-    constrained_forward_dynamics(&model, &mut data, &mut c, &set, args, None, &options).unwrap();
+    constrained_forward_dynamics(model, &mut data, &mut c, &set, args, None, &options).unwrap();
     let qdd = c.qdd.clone();
+    TwoPoints {
+        set,
+        data,
+        c,
+        actuated,
+        state: (q, v, qdd),
+    }
+}
+
+#[test]
+fn inverse_dynamics_gives_the_least_norm_forces_where_they_are_not_unique() {
+    let model = test_model("tree");
+    let TwoPoints {
+        set,
+        mut data,
+        mut c,
+        actuated,
+        state: (q, v, qdd),
+    } = two_points(&model);
     let args = (q.as_slice(), v.as_slice(), qdd.as_slice());
     constrained_inverse_dynamics(&model, &mut data, &mut c, &set, args, None, &actuated, None)
         .unwrap();
@@ -324,22 +350,13 @@ fn inverse_dynamics_gives_the_least_norm_forces_where_they_are_not_unique() {
 fn weighted_inverse_dynamics_gives_the_forces_of_least_weighted_norm() {
     let model = test_model("tree");
     // the two points of the test above, their rows weighted unequally
-    let point = |frame: &str, offset: [f64; 3]| {
-        let kind = ConstraintKind::Point {
-            first: at(&model, frame, offset),
-            second: None,
-        };
-        constraint(kind, ConstraintReference::World)
-    };
-    let constraints = vec![point("tip", [0.0; 3]), point("shin", [0.0, 0.0, -0.3])];
-    let set = ConstraintSet::new(&model, constraints).unwrap();
-    let (mut data, mut c) = (Data::new(&model), ConstraintData::new(&model, &set));
-    let actuated: Vec<bool> = (0..model.nv).map(|k| k >= 6).collect();
-    let (q, v, tau) = base_unactuated_state(&model, &mut rng());
-    let args = (q.as_slice(), v.as_slice(), tau.as_slice());
-    let options = ConstrainedOptions::default();
-    constrained_forward_dynamics(&model, &mut data, &mut c, &set, args, None, &options).unwrap();
-    let qdd = c.qdd.clone();
+    let TwoPoints {
+        set,
+        mut data,
+        mut c,
+        actuated,
+        state: (q, v, qdd),
+    } = two_points(&model);
     let args = (q.as_slice(), v.as_slice(), qdd.as_slice());
     constrained_inverse_dynamics(&model, &mut data, &mut c, &set, args, None, &actuated, None)
         .unwrap();

@@ -59,14 +59,19 @@ fn check_columns(
     }
 }
 
-/// The forward-dynamics derivatives at (q, q̇, τ) against differences in q, q̇ and τ.
-fn check_forward(
-    label: &str,
+/// The derivatives at (q, q̇, τ) with their workspaces, and the options of the dynamics they
+/// differentiate.
+fn derivatives_at(
     model: &Model,
     set: &ConstraintSet,
     (q, v, tau): (&DVector<f64>, &DVector<f64>, &DVector<f64>),
     f_ext: Option<&[Force]>,
-    (damping, h, tolerance): (f64, f64, f64),
+    damping: f64,
+) -> (
+    Data,
+    ConstraintData,
+    ConstrainedDerivatives,
+    ConstrainedOptions,
 ) {
     let mut data = Data::new(model);
     let (mut c, mut d) = (
@@ -82,6 +87,19 @@ fn check_forward(
         baumgarte: None,
         damping,
     };
+    (data, c, d, options)
+}
+
+/// The forward-dynamics derivatives at (q, q̇, τ) against differences in q, q̇ and τ.
+fn check_forward(
+    label: &str,
+    model: &Model,
+    set: &ConstraintSet,
+    (q, v, tau): (&DVector<f64>, &DVector<f64>, &DVector<f64>),
+    f_ext: Option<&[Force]>,
+    (damping, h, tolerance): (f64, f64, f64),
+) {
+    let (mut data, _, d, options) = derivatives_at(model, set, (q, v, tau), f_ext, damping);
     let mut dynamics = |q: &DVector<f64>, v: &DVector<f64>, tau: &DVector<f64>| {
         let mut other = ConstraintData::new(model, set);
         let args = (q.as_slice(), v.as_slice(), tau.as_slice());
@@ -170,20 +188,7 @@ fn check_forward_accelerations(
     (q, v, tau): (&DVector<f64>, &DVector<f64>, &DVector<f64>),
     (damping, h, tolerance): (f64, f64, f64),
 ) {
-    let mut data = Data::new(model);
-    let (mut c, mut d) = (
-        ConstraintData::new(model, set),
-        ConstrainedDerivatives::new(model, set),
-    );
-    let args = (q.as_slice(), v.as_slice(), tau.as_slice());
-    constrained_forward_dynamics_derivatives(
-        model, &mut data, &mut c, &mut d, set, args, None, damping,
-    )
-    .unwrap();
-    let options = ConstrainedOptions {
-        baumgarte: None,
-        damping,
-    };
+    let (mut data, c, d, options) = derivatives_at(model, set, (q, v, tau), None, damping);
     let jacobian = c.jacobian.clone();
     let mut generalized = |q: &DVector<f64>, v: &DVector<f64>| {
         let mut other = ConstraintData::new(model, set);

@@ -12,6 +12,7 @@
 //! Visuals are read for the viewer (`urdf/visuals.rs`); collision, transmission and gazebo
 //! elements are ignored.
 
+use crate::constraint::{Constraint, ConstraintKind, ConstraintReference, ModelConstraint};
 use crate::error::{Error, Result};
 use crate::io::schema;
 use crate::io::urdf_schema::URDF_SCHEMA;
@@ -518,6 +519,43 @@ impl<'a> Parser<'a> {
             ));
         }
         self.add_visuals(&mut builder, robot, links, &placement)?;
-        Ok(builder.build())
+        let mut model = builder.build();
+        hold_mimics(&mut model, self.source);
+        Ok(model)
+    }
+}
+
+/// Each mimic relation between two revolute or two prismatic joints as a held
+/// [`ConstraintKind::Coupling`] in `model.constraints` (q_f = multiplier q_l + offset), so that
+/// simulation holds it; the others (continuous joints, mixed kinds) are reported in one warning.
+fn hold_mimics(model: &mut Model, source: &str) {
+    let mut reported = Vec::new();
+    for mimic in model.mimics.clone() {
+        let constraint = Constraint {
+            kind: ConstraintKind::Coupling {
+                follower: mimic.joint,
+                leader: Some(mimic.mimicked),
+                polynomial: [mimic.offset, mimic.multiplier, 0.0, 0.0, 0.0],
+                references: (0.0, 0.0),
+            },
+            reference: ConstraintReference::World,
+        };
+        match constraint.check(model) {
+            Ok(()) => {
+                let name = format!("mimic {}", model.joint_names[mimic.joint]);
+                model
+                    .constraints
+                    .push(ModelConstraint::active(name, constraint));
+            }
+            Err(reason) => reported.push(reason),
+        }
+    }
+    if !reported.is_empty() {
+        model.warnings.push(format!(
+            "{source}: {} <mimic> relation(s) reported (m.mimic_joints) but not held as \
+             constraints: {}",
+            reported.len(),
+            reported.join("; ")
+        ));
     }
 }

@@ -182,23 +182,19 @@ pub fn constrained_forward_dynamics_derivatives(
     d.dforces_dv.copy_from(&d.rows.by_v);
     d.dforces_dv.neg_mut();
     d.dforces_dtau.fill(0.0);
-    let solver = Solver::new(constraints, damping);
-    for (x, y) in [
+    let pairs = [
         (&mut d.dqdd_dq, &mut d.dforces_dq),
         (&mut d.dqdd_dv, &mut d.dforces_dv),
         (&mut d.dqdd_dtau, &mut d.dforces_dtau),
-    ] {
-        solve_saddle_point(
-            model,
-            data,
-            constraints,
-            set,
-            (x, y),
-            &mut d.column,
-            &solver,
-        )?;
-    }
-    Ok(())
+    ];
+    solve_saddle_points(
+        model,
+        data,
+        (constraints, set),
+        pairs,
+        &mut d.column,
+        damping,
+    )
 }
 
 /// The derivatives of q̇⁺ and Λ of [`impulse_dynamics`] at (q, q̇), into `derivatives`
@@ -262,22 +258,18 @@ pub fn impulse_dynamics_derivatives(
     d.dforces_dq.neg_mut();
     d.dforces_dv.copy_from(&constraints.jacobian);
     d.dforces_dv *= -restitution;
-    let solver = Solver::new(constraints, damping);
-    for (x, y) in [
+    let pairs = [
         (&mut d.dqdd_dq, &mut d.dforces_dq),
         (&mut d.dqdd_dv, &mut d.dforces_dv),
-    ] {
-        solve_saddle_point(
-            model,
-            data,
-            constraints,
-            set,
-            (x, y),
-            &mut d.column,
-            &solver,
-        )?;
-    }
-    Ok(())
+    ];
+    solve_saddle_points(
+        model,
+        data,
+        (constraints, set),
+        pairs,
+        &mut d.column,
+        damping,
+    )
 }
 
 /// How the Delassus systems of the derivatives are solved: by Cholesky (independent rows), or by
@@ -295,6 +287,22 @@ impl Solver {
             Solver::Cholesky
         }
     }
+}
+
+/// [`solve_saddle_point`] for each pair of right-hand sides, with one [`Solver`].
+fn solve_saddle_points<'p>(
+    model: &Model,
+    data: &Data,
+    (constraints, set): (&mut ConstraintData, &ConstraintSet),
+    pairs: impl IntoIterator<Item = (&'p mut DMatrix<f64>, &'p mut DMatrix<f64>)>,
+    column: &mut [f64],
+    damping: f64,
+) -> Result<()> {
+    let solver = Solver::new(constraints, damping);
+    for (x, y) in pairs {
+        solve_saddle_point(model, data, constraints, set, (x, y), column, &solver)?;
+    }
+    Ok(())
 }
 
 /// Solves `[M −Jᵀ; J 0] [X; Y] = [R₁; R₂]` in place (R₁ in `x`, nv × k; R₂ in `y`, m × k) with

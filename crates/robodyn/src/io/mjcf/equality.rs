@@ -21,6 +21,7 @@ use super::Reader;
 use crate::algo::frame_pose;
 use crate::constraint::{
     Attachment, Constraint, ConstraintKind, ConstraintReference, ConstraintSet, ModelConstraint,
+    DEFAULT_SOLIMP, DEFAULT_SOLREF,
 };
 use crate::error::Result;
 use crate::io::xml::parse_numbers;
@@ -29,10 +30,6 @@ use crate::spatial::{Transform, Vec3};
 use crate::Data;
 use nalgebra::{Quaternion, UnitQuaternion};
 use roxmltree::Node;
-
-/// MuJoCo's defaults of an equality's `solref` and `solimp`.
-const SOLREF: [f64; 2] = [0.02, 1.0];
-const SOLIMP: [f64; 5] = [0.9, 0.95, 0.001, 0.5, 2.0];
 
 impl<'a> Reader<'a> {
     /// The constraints of the `<equality>` sections among `sections`, into `model.constraints`
@@ -86,8 +83,8 @@ impl<'a> Reader<'a> {
             name: element.attribute("name").unwrap_or_default().to_string(),
             constraint,
             active,
-            solref: self.leading_numbers(element, "solref", SOLREF)?,
-            solimp: self.leading_numbers(element, "solimp", SOLIMP)?,
+            solref: self.leading_numbers(element, "solref", DEFAULT_SOLREF)?,
+            solimp: self.leading_numbers(element, "solimp", DEFAULT_SOLIMP)?,
             torquescale: self
                 .equality_numbers::<1>(element, "torquescale")?
                 .map_or(1.0, |[t]| t),
