@@ -331,7 +331,13 @@ fn inverse_dynamics_gives_the_least_norm_forces_where_they_are_not_unique() {
     assert!(c.tau.rows(0, 6).amax() == 0.0);
     // least norm: λ = J_u y lies in the column space of J_u (the base's columns of J)
     let base_columns = c.jacobian.columns(0, 6).into_owned();
-    let svd = base_columns.clone().svd(true, false);
+    assert_in_column_space(&base_columns, &c.forces);
+}
+
+/// `vector` has no part along the left null space of `matrix` (rank 5: the line through the two
+/// points leaves one rotation of the base free).
+fn assert_in_column_space(matrix: &DMatrix<f64>, vector: &DVector<f64>) {
+    let svd = matrix.clone().svd(true, false);
     let u = svd.u.unwrap();
     let rank = svd.singular_values.iter().filter(|s| **s > 1e-9).count();
     assert_eq!(
@@ -340,8 +346,8 @@ fn inverse_dynamics_gives_the_least_norm_forces_where_they_are_not_unique() {
     );
     for k in 0..u.ncols() {
         if svd.singular_values[k] <= 1e-9 {
-            let along_null = u.column(k).dot(&c.forces);
-            assert!(along_null.abs() < 1e-8 * c.forces.amax(), "{along_null}");
+            let along_null = u.column(k).dot(vector);
+            assert!(along_null.abs() < 1e-8 * vector.amax(), "{along_null}");
         }
     }
 }
@@ -375,14 +381,7 @@ fn weighted_inverse_dynamics_gives_the_forces_of_least_weighted_norm() {
         "{balance}"
     );
     let scaled = DVector::from_iterator(6, c.forces.iter().zip(weights).map(|(f, w)| f * w));
-    let svd = base_columns.svd(true, false);
-    let u = svd.u.unwrap();
-    for k in 0..u.ncols() {
-        if svd.singular_values[k] <= 1e-9 {
-            let along_null = u.column(k).dot(&scaled);
-            assert!(along_null.abs() < 1e-8 * scaled.amax(), "{along_null}");
-        }
-    }
+    assert_in_column_space(&base_columns, &scaled);
     assert!((&c.forces - &plain).amax() > 1e-3 * plain.amax());
     // a weight that is not positive is named
     let bad = [1.0, 2.0, 0.0, 1.0, 1.0, 1.0];
