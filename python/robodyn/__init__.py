@@ -18,6 +18,7 @@ import os
 import sys
 import warnings
 from pathlib import Path
+from typing import Literal, overload
 
 from robodyn._core import (
     Distance,
@@ -48,6 +49,7 @@ from robodyn.simulation import (
     step,
 )
 from robodyn.datasets import dataset, read_dataset, simulate_many
+from robodyn.mimic import MimicModel
 
 
 def _operational_space_method(self, q, v, frame, task="full", damping=None, reference="world"):
@@ -87,6 +89,7 @@ __all__ = [
     "Distance",
     "FrameAnchor",
     "JointCoupling",
+    "MimicModel",
     "PointAnchor",
     "dataset",
     "read_dataset",
@@ -156,9 +159,20 @@ def _find_file(name: str) -> Path:
     )
 
 
+@overload
 def load(
-    name_or_path: str | os.PathLike[str], floating_base: bool = False, check_inertia: bool = True, strict: bool = False
-) -> Model:
+    name_or_path: str | os.PathLike[str], floating_base: bool = False, check_inertia: bool = True,
+    strict: bool = False, mimic: Literal[False] = False,
+) -> Model: ...
+@overload
+def load(
+    name_or_path: str | os.PathLike[str], floating_base: bool = False, check_inertia: bool = True,
+    strict: bool = False, *, mimic: Literal[True],
+) -> MimicModel: ...
+def load(
+    name_or_path: str | os.PathLike[str], floating_base: bool = False, check_inertia: bool = True,
+    strict: bool = False, mimic: bool = False,
+) -> Model | MimicModel:
     """Load a robot model.
 
     ``name_or_path`` is a bundled model's name (see :func:`models`), a path to a URDF file, an MJCF
@@ -176,6 +190,14 @@ def load(
     :class:`ModelWarning` naming the file, line and the nearest known name; in MJCF it is an error,
     as in MuJoCo. ``strict=True`` turns every warning into a ``ValueError``.
 
+    URDF mimic joints (``<mimic>``: q_f = multiplier q_l + offset) are joints of their own by default,
+    held as :class:`JointCoupling` constraints in ``m.constraints`` (which :func:`simulate` holds);
+    a :class:`ModelWarning` says so. ``mimic=True`` enforces them in reduced coordinates: a
+    :class:`MimicModel`, whose q and v leave the followers out and whose every method (dynamics,
+    kinematics, derivatives, constraints, simulation) takes and returns them. The leader may come
+    anywhere in the tree; a cycle of relations, or a relation between joints of different kinds,
+    is a ``ValueError``.
+
     Raises ``FileNotFoundError`` for a missing file (saying where robodyn looked) and ``ValueError``
     for an invalid model, naming the file, element and line, or for a wrong argument.
     """
@@ -183,11 +205,24 @@ def load(
     floating_base = _arguments.flag("floating_base", floating_base)
     check_inertia = _arguments.flag("check_inertia", check_inertia)
     strict = _arguments.flag("strict", strict)
+    mimic = _arguments.flag("mimic", mimic)
     model = _load_model(text, floating_base, check_inertia)
+    if mimic:
+        model = MimicModel(model)
     if strict and model.warnings:
         raise ValueError("strict=True: " + " | ".join(model.warnings))
     for message in model.warnings:
         warnings.warn(message, ModelWarning, stacklevel=2)
+    if mimic:
+        return model
+    held = [c.joint for c in model.constraints if isinstance(c, JointCoupling) and c.joint in
+            {follower for follower, _, _, _ in model.mimic_joints}]
+    if held:
+        warnings.warn(
+            f"{text}: {len(held)} mimic joint(s) ({', '.join(repr(name) for name in held[:3])}"
+            f"{', …' if len(held) > 3 else ''}) are joints of their own, "
+            "held as robodyn.JointCoupling constraints in m.constraints (simulate holds them); "
+            "robodyn.load(..., mimic=True) enforces them in reduced coordinates", ModelWarning, stacklevel=2)
     return model
 
 

@@ -109,10 +109,11 @@ def writable_folder(name: str, value: Any) -> Path:
 
 
 def robot_model(name: str, value: Any) -> Any:
-    """A ``robodyn.Model``."""
+    """A ``robodyn.Model``, or one in reduced coordinates (``robodyn.MimicModel``)."""
     from robodyn._core import Model
+    from robodyn.mimic import MimicModel
 
-    if not isinstance(value, Model):
+    if not isinstance(value, (Model, MimicModel)):
         raise bad(name, "a robodyn.Model", repr(value))
     return value
 

@@ -194,7 +194,7 @@ def info(model: str) -> int:
     for name, body in zip(m.frame_names, m.frame_bodies):
         print(f"  {name}  ({'world' if body < 0 else m.body_names[body]})")
     for relation in m.mimic_joints:
-        print(f"mimic: q[{relation[0]}] = {relation[2]:g} q[{relation[1]}] + {relation[3]:g} (a JointCoupling in m.constraints where both joints are revolute or prismatic)")
+        print(f"mimic: q[{relation[0]}] = {relation[2]:g} q[{relation[1]}] + {relation[3]:g} (a JointCoupling in m.constraints where both joints are revolute or prismatic; load(..., mimic=True) enforces it in reduced coordinates)")
     print(f"\nWarnings: {len(m.warnings)}")
     for message in m.warnings:
         print(f"  {message}")

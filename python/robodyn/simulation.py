@@ -47,6 +47,8 @@ from numpy.typing import ArrayLike
 from robodyn import _core
 from robodyn._arguments import bad, callback, choice, flag, numbers, real, robot_model
 from robodyn._joints import coordinate_names
+from robodyn._mimic_motion import simulate_reduced, step_reduced
+from robodyn.mimic import MimicModel
 
 __all__ = [
     "AccuracyError",
@@ -319,7 +321,7 @@ Configurations = Union["np.ndarray[tuple[int, int], np.dtype[Any]]", Sequence[Se
 
 
 @overload
-def simulate(model: _core.Model, q0: Configuration, v0: ArrayLike | None = None, t_end: float = 1.0,
+def simulate(model: _core.Model | MimicModel, q0: Configuration, v0: ArrayLike | None = None, t_end: float = 1.0,
              dt: float = 1e-3, integrator: str = "rk4", controller: Any = None, wrenches: Any = None, *,
              rtol: float | None = None, atol: float = 1e-9, max_step: float | None = None,
              friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
@@ -329,7 +331,7 @@ def simulate(model: _core.Model, q0: Configuration, v0: ArrayLike | None = None,
 
 
 @overload
-def simulate(model: _core.Model, q0: Configurations, v0: ArrayLike | None = None, t_end: float = 1.0,
+def simulate(model: _core.Model | MimicModel, q0: Configurations, v0: ArrayLike | None = None, t_end: float = 1.0,
              dt: float = 1e-3, integrator: str = "rk4", controller: Any = None, wrenches: Any = None, *,
              rtol: float | None = None, atol: float = 1e-9, max_step: float | None = None,
              friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
@@ -339,7 +341,7 @@ def simulate(model: _core.Model, q0: Configurations, v0: ArrayLike | None = None
 
 
 @overload
-def simulate(model: _core.Model, q0: ArrayLike, v0: ArrayLike | None = None, t_end: float = 1.0,
+def simulate(model: _core.Model | MimicModel, q0: ArrayLike, v0: ArrayLike | None = None, t_end: float = 1.0,
              dt: float = 1e-3, integrator: str = "rk4", controller: Any = None, wrenches: Any = None, *,
              rtol: float | None = None, atol: float = 1e-9, max_step: float | None = None,
              friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
@@ -349,7 +351,7 @@ def simulate(model: _core.Model, q0: ArrayLike, v0: ArrayLike | None = None, t_e
 
 
 def simulate(
-    model: _core.Model,
+    model: _core.Model | MimicModel,
     q0: ArrayLike,
     v0: ArrayLike | None = None,
     t_end: float = 1.0,
@@ -422,6 +424,8 @@ def simulate(
     the time it happened; :class:`robodyn.SimulationError`); an exception raised by a callback
     propagates unchanged.
     """
+    if isinstance(model, MimicModel):
+        return simulate_reduced(dict(locals()))
     robot_model("model", model)
     q0 = numbers("q0", q0)
     v0 = np.zeros(q0.shape[:-1] + (model.nv,)) if v0 is None else numbers("v0", v0)
@@ -485,7 +489,7 @@ def _check_gains(baumgarte: Any) -> None:
 
 
 def step(
-    model: _core.Model,
+    model: _core.Model | MimicModel,
     q: ArrayLike,
     v: ArrayLike,
     tau: ArrayLike,
@@ -519,6 +523,8 @@ def step(
     :meth:`Model.constrained_forward_dynamics_derivatives` (those of the exact constraint
     equations, so ``derivatives=True`` takes ``baumgarte=None``).
     """
+    if isinstance(model, MimicModel):
+        return step_reduced(dict(locals()))
     robot_model("model", model)
     choice("integrator", integrator, INTEGRATORS[:3], " (a single fixed step)")
     _check_gains(baumgarte)

@@ -33,6 +33,13 @@ URDF = """<robot name="arm"><link name="base"/><link name="link">
   <joint name="j" type="revolute"><parent link="base"/><child link="link"/><axis xyz="0 0 1"/>
   <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>"""
 MJCF = REPOSITORY / "testdata" / "mjcf" / "iiwa14.xml"
+#: UR5 with a finger on its tool that mimics the last wrist joint: in reduced coordinates, UR5's q.
+MIMIC = robodyn.MimicModel(robodyn.load_urdf_string((REPOSITORY / "models" / "ur5.urdf").read_text().replace(
+    "</robot>",
+    '<link name="finger"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" '
+    'iyz="0"/></inertial></link><joint name="finger_joint" type="revolute"><parent link="tool0"/>'
+    '<child link="finger"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/>'
+    '<mimic joint="wrist_3_joint" multiplier="0.5"/></joint></robot>')))
 DH_ROWS = [{"a": 0, "alpha": 0, "d": 0, "theta": 0, "type": "revolute"}]
 
 #: A value no parameter of robodyn takes.
@@ -67,7 +74,7 @@ VALID: dict[str, Any] = {
     "initial": None, "inertia_transverse": 1.0, "inertia_axial": 2.0, "omega_axial": 1.0,
     "quantities": ("tau",), "chunk": 4, "per_task": 2, "progress": None, "client": None,
     "constraints": [robodyn.PointAnchor("tool0")], "joint": "elbow_joint", "leader": "shoulder_lift_joint",
-    "frame1": "tool0", "frame2": "wrist_3_link",
+    "frame1": "tool0", "frame2": "wrist_3_link", "q_full": MIMIC.full.neutral(),
 }
 
 
@@ -98,6 +105,7 @@ SPECIFIC: dict[str, dict[str, Callable[[Path], Any]]] = {
     "robodyn.dataset": {"out": lambda folder: str(folder / "states.zarr")},
     "robodyn.read_dataset": {"path": lambda folder: _dataset_file(folder)},
     "robodyn.Model.to_html": {"path": lambda folder: str(folder / "model.html")},
+    "robodyn.MimicModel.to_html": {"path": lambda folder: str(folder / "model.html")},
     "robodyn.plot.animate_trajectory": {"path": lambda folder: str(folder / "motion.gif")},
     "robodyn.plot.check_animation_path": {"path": lambda folder: str(folder / "motion.gif")},
     "robodyn.plot.check_figure_path": {"path": lambda folder: str(folder / "figure.png")},
@@ -135,6 +143,10 @@ def public_api() -> dict[str, Callable[..., Any]]:
             add(f"robodyn.Model.{name}", getattr(robodyn.Model, name))
         elif _settable(name):
             add(f"robodyn.Model.{name} =", _setter(name))
+    for name in dir(robodyn.MimicModel):
+        attribute = inspect.getattr_static(robodyn.MimicModel, name)
+        if not name.startswith("_") and inspect.isroutine(attribute):
+            add(f"robodyn.MimicModel.{name}", getattr(robodyn.MimicModel, name))
     for module in _submodules():
         names = getattr(module, "__all__", [n for n in vars(module) if not n.startswith("_")])
         for name in names:
@@ -195,9 +207,9 @@ def _call(qualified: str, wrong_parameter: str, wrong_value: Any, folder: Path) 
     made = {**MADE, **SPECIFIC.get(qualified, {})}
     positional, keywords = [], {}
     parameters = list(inspect.signature(function).parameters.values())
-    if qualified.startswith("robodyn.Model."):
+    if qualified.startswith(("robodyn.Model.", "robodyn.MimicModel.")):
         # bound to a copy: a setter must not change the model the other cases use
-        positional.append(pickle.loads(pickle.dumps(UR5)))
+        positional.append(pickle.loads(pickle.dumps(MIMIC if qualified.startswith("robodyn.MimicModel.") else UR5)))
         parameters = parameters[1:]
     for parameter in parameters:
         if parameter.kind in (parameter.VAR_POSITIONAL, parameter.VAR_KEYWORD):
@@ -224,7 +236,7 @@ def test_the_walk_finds_the_api():
     """It reaches the top level, Model's methods and setters and the submodules' functions."""
     for name in ("robodyn.load", "robodyn.step", "robodyn.simulate_many", "robodyn.Model.inverse_dynamics",
                  "robodyn.Model.operational_space", "robodyn.Model.gravity =", "robodyn.inertia.solid_box",
-                 "robodyn.viewer.model_html"):
+                 "robodyn.viewer.model_html", "robodyn.MimicModel.inverse_kinematics"):
         assert name in API, name
     assert ("robodyn.step", "derivatives", WRONG) in WALK
 

@@ -114,7 +114,11 @@ class Chain:
     ``gravity`` the gravity acceleration in the base frame; ``values`` the numbers of the symbolic
     parameters a file gave (used by ``lambdify`` and ``codegen`` unless overridden); ``frames``
     extra frames (tool, base) as ``name -> (link index or -1, 4×4 pose in that link)``;
-    ``decimals`` whether its numbers are decimals (from a file), which the results then print as.
+    ``decimals`` whether its numbers are decimals (from a file), which the results then print as;
+    ``mimics`` the mimic relations ``{follower: (leader, ratio, offset)}`` (link indices; q_follower
+    = ratio q_leader + offset), with which :func:`robodyn.symbolic.lagrange` and
+    :func:`robodyn.symbolic.newton_euler` give the equations in the other coordinates
+    (:mod:`robodyn.symbolic.mimic`).
     """
 
     name: str
@@ -127,6 +131,7 @@ class Chain:
     springs: tuple[PointSpring, ...] = ()
     frames: dict = field(default_factory=dict)
     decimals: bool = False
+    mimics: dict = field(default_factory=dict)
 
     def __post_init__(self):
         if not self.links:
@@ -152,6 +157,16 @@ class Chain:
                         f"link '{link.name}': {attribute} expected a {shape} matrix, "
                         f"got {getattr(value, 'shape', type(value).__name__)}"
                     )
+        for follower, relation in self.mimics.items():
+            leader = relation[0] if isinstance(relation, tuple) and len(relation) == 3 else None
+            if not (isinstance(follower, int) and isinstance(leader, int) and 0 <= follower < n and 0 <= leader < n):
+                raise ValueError(f"chain '{self.name}': mimics expected {{follower: (leader, ratio, offset)}} "
+                                 f"with link indices in [0, {n - 1}], got {follower!r}: {relation!r}")
+            kinds = (self.links[follower].joint, self.links[leader].joint)
+            if follower == leader or kinds[0] != kinds[1]:
+                raise ValueError(
+                    f"chain '{self.name}': joint '{self.links[follower].name}' ({kinds[0]}) mimics "
+                    f"'{self.links[leader].name}' ({kinds[1]}): expected another joint of the same kind")
         if getattr(self.gravity, "shape", None) != (3, 1):
             raise ValueError(f"chain '{self.name}': gravity expected a 3-vector")
 

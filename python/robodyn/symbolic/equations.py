@@ -73,6 +73,11 @@ class EquationsOfMotion:
         return self.chain.n
 
     @property
+    def coordinates(self) -> tuple[tuple, tuple, tuple]:
+        """The coordinate, velocity and acceleration symbols the equations are written in."""
+        return self.chain.q, self.chain.qd, self.chain.qdd
+
+    @property
     def q(self):
         return sp.Matrix(self.chain.q)
 

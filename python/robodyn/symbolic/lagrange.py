@@ -21,6 +21,7 @@ import sympy as sp
 from robodyn.symbolic.chain import Chain
 from robodyn.symbolic.equations import EquationsOfMotion
 from robodyn.symbolic.kinematics import ChainKinematics, dot, matvec, transpose
+from robodyn.symbolic.mimic import ReducedEquations
 
 __all__ = ["lagrange", "mass_matrix_by_jacobians", "passive_joint_forces"]
 
@@ -71,7 +72,8 @@ def passive_joint_forces(chain: Chain, kinematics: ChainKinematics) -> tuple[sp.
 def lagrange(chain: Chain, forces=None) -> EquationsOfMotion:
     """The Euler–Lagrange equations of ``chain`` (see the module docstring). ``forces``: n more
     generalized forces Qⱼ acting on the joints besides the actuators (expressions in q and q̇),
-    which enter F as −Q."""
+    which enter F as −Q. A chain with mimic joints gives :class:`ReducedEquations`, in the
+    coordinates the followers' relations leave (``forces`` still one per joint)."""
     if forces is not None:
         forces = [sp.sympify(f) for f in forces]
         if len(forces) != chain.n:
@@ -106,7 +108,7 @@ def lagrange(chain: Chain, forces=None) -> EquationsOfMotion:
 
     springs, spring_forces, dissipation = passive_joint_forces(chain, kinematics)
     dissipation = [d - force for d, force in zip(dissipation, forces)]
-    return EquationsOfMotion(
+    equations = EquationsOfMotion(
         chain=chain,
         kinematics=kinematics,
         rigid_tau=tau,
@@ -116,3 +118,5 @@ def lagrange(chain: Chain, forces=None) -> EquationsOfMotion:
         spring_forces=spring_forces,
         dissipation=dissipation,
     )
+    # a chain with mimic joints: the same equations, in the kept coordinates
+    return ReducedEquations(equations) if chain.mimics else equations

@@ -267,10 +267,14 @@ def from_dh(table, convention: str | None = None, *, symbolic_params=False, grav
 
 
 def from_urdf(path, *, symbolic_params=False, gravity=None, angle_tolerance: float = ANGLE_TOLERANCE,
-              coordinate: str = "q") -> Chain:
+              coordinate: str = "q", mimic: bool = False) -> Chain:
     """A chain (or tree) from a URDF file: revolute, continuous and prismatic joints move links,
     fixed joints merge their child into its parent (mass, centre of mass and inertia combined),
     links in depth-first file order as the core numbers them. Gravity −9.81 along z unless given.
+
+    A file with ``<mimic>`` joints needs ``mimic=True``: the chain then keeps the relations
+    (``chain.mimics``), and its equations come in the coordinates they leave, as
+    ``robodyn.load(path, mimic=True)``'s (see :mod:`robodyn.symbolic.mimic`).
     """
     path = Path(path)
     if not path.is_file():
@@ -285,14 +289,21 @@ def from_urdf(path, *, symbolic_params=False, gravity=None, angle_tolerance: flo
     joints = robot.findall("joint")
     children: dict = {}
     child_names = set()
+    mimic_tags: dict = {}
     for joint in joints:
         parent, child = joint.find("parent"), joint.find("child")
         if parent is None or child is None:
             raise ValueError(f"{path}: joint '{joint.get('name')}': expected <parent> and <child>")
         children.setdefault(parent.get("link"), []).append(joint)
         child_names.add(child.get("link"))
-        if joint.find("mimic") is not None:
-            raise ValueError(f"{path}: joint '{joint.get('name')}': <mimic> joints are not supported")
+        tag = joint.find("mimic")
+        if tag is not None:
+            where = f"{path}: joint '{joint.get('name')}' <mimic>"
+            if not mimic:
+                raise ValueError(f"{where}: a mimic joint follows another; pass mimic=True for the equations "
+                                 "in the coordinates its relation leaves")
+            mimic_tags[joint.get("name")] = (tag.get("joint"), _exact(tag.get("multiplier", "1"), f"{where} 'multiplier'"),
+                                             _exact(tag.get("offset", "0"), f"{where} 'offset'"))
     roots = [name for name in links if name not in child_names]
     if len(roots) != 1:
         raise ValueError(f"{path}: expected one root link, got {roots}")
@@ -392,5 +403,12 @@ def from_urdf(path, *, symbolic_params=False, gravity=None, angle_tolerance: flo
         chain_links.append(Link(body["joint"], body["kind"], body["parent"], body["origin"], body["axis"],
                                 mass, com, inertia))
     gravity_vector = sp.Matrix(gravity) if gravity is not None else sp.Matrix([0, 0, -STANDARD_GRAVITY])
+    moving = {body["joint"]: k for k, body in enumerate(bodies)}
+    mimics = {}
+    for follower, (leader, ratio, offset) in mimic_tags.items():
+        for role, name in (("joint", follower), ("the joint it mimics", leader)):
+            if name not in moving:
+                raise ValueError(f"{path}: joint '{follower}' <mimic>: {role} '{name}' is not a moving joint")
+        mimics[moving[follower]] = (moving[leader], ratio, offset)
     return Chain(robot.get("name", path.stem), tuple(chain_links), parameters.gravity(gravity_vector),
-                 q, qd, qdd, values=parameters.values, decimals=True)
+                 q, qd, qdd, values=parameters.values, decimals=True, mimics=mimics)

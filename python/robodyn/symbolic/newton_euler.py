@@ -33,6 +33,7 @@ from robodyn.symbolic.chain import Chain
 from robodyn.symbolic.equations import as_given
 from robodyn.symbolic.kinematics import ChainKinematics, cross, dot, matvec, transpose
 from robodyn.symbolic.lagrange import passive_joint_forces
+from robodyn.symbolic.mimic import MimicMap
 from robodyn.symbolic.trig import trig_canonical
 
 __all__ = ["newton_euler", "NewtonEuler"]
@@ -57,18 +58,23 @@ class NewtonEuler:
         self._rigid_tau = rigid_tau
         self._passive = passive
         self.ring = kinematics.ring
+        # with mimic joints: every result at the relations, τ in the kept coordinates
+        self._mimics = MimicMap(chain) if chain.mimics else None
 
     def _column(self, vector) -> sp.Matrix:
-        return as_given(sp.Matrix([x.as_expr() for x in vector]), self.chain.decimals)
+        column = sp.Matrix([x.as_expr() for x in vector])
+        if self._mimics is not None:
+            column = column.applyfunc(self._mimics.reduce)
+        return as_given(column, self.chain.decimals)
 
     def _per_link(self, name: str) -> list[sp.Matrix]:
         return [self._column(v) for v in self._vectors[name]]
 
     @cached_property
     def tau(self) -> sp.Matrix:
-        """Joint torques (forces for prismatic joints), n × 1."""
-        return as_given(sp.Matrix([t.as_expr() + p for t, p in zip(self._rigid_tau, self._passive)]),
-                        self.chain.decimals)
+        """Joint torques (forces for prismatic joints), n × 1; with mimic joints, Gᵀ τ at the
+        relations (one per kept coordinate)."""
+        return as_given(sp.Matrix(self._exact_tau()), self.chain.decimals)
 
     omega = cached_property(lambda self: self._per_link("omega"))
     omega_dot = cached_property(lambda self: self._per_link("omega_dot"))
@@ -82,11 +88,12 @@ class NewtonEuler:
     def difference(self, equations) -> sp.Matrix:
         """τ_Newton–Euler − τ_Lagrange of the same chain, exactly, in canonical form: the zero
         vector when the two agree."""
-        angles = self.ring.joint_angles
+        angles = self._mimics.angles if self._mimics is not None else self.ring.joint_angles
         return sp.Matrix([trig_canonical(a - b, angles) for a, b in zip(self._exact_tau(), equations._exact_tau())])
 
     def _exact_tau(self) -> list:
-        return [t.as_expr() + p for t, p in zip(self._rigid_tau, self._passive)]
+        tau = [t.as_expr() + p for t, p in zip(self._rigid_tau, self._passive)]
+        return tau if self._mimics is None else self._mimics.forces(tau)
 
     def __repr__(self) -> str:
         return f"<NewtonEuler of '{self.chain.name}': {self.chain.n} joints>"

@@ -27,11 +27,11 @@ def known_values(chain, params: dict | None) -> dict:
     return values
 
 
-def parameter_values(chain, params: dict | None, expressions) -> dict:
+def parameter_values(chain, params: dict | None, expressions, coordinates) -> dict:
     """:func:`known_values`, raising ``ValueError`` that names any parameter of ``expressions``
-    left without a value."""
+    left without a value (``coordinates``: the symbols that are not parameters)."""
     values = known_values(chain, params)
-    coordinates = set(chain.q) | set(chain.qd) | set(chain.qdd)
+    coordinates = set(coordinates)
     free = set().union(*(sp.sympify(e).free_symbols for e in expressions)) - coordinates
     missing = sorted(s.name for s in free if s not in values)
     if missing:
@@ -45,12 +45,12 @@ class NumericEquations:
 
     def __init__(self, equations, params: dict | None = None):
         chain = equations.chain
-        self.n = chain.n
+        self.n = equations.n
         self.name = chain.name
         parts = {"M": equations.M, "C": equations.C, "V": equations.V, "G": equations.G,
                  "F": equations.F, "tau": equations.tau}
-        values = parameter_values(chain, params, parts.values())
-        arguments = list(chain.q) + list(chain.qd) + list(chain.qdd)
+        arguments = [symbol for symbols in equations.coordinates for symbol in symbols]
+        values = parameter_values(chain, params, parts.values(), arguments)
         self._functions = {
             name: sp.lambdify(arguments, expr.xreplace(values), modules="numpy", cse=True)
             for name, expr in parts.items()

@@ -53,7 +53,7 @@ def _matrix_latex(matrix: sp.Matrix) -> str:
 def latex(equations, form: str = "matrices") -> str:
     """LaTeX of ``τ = M(q) q̈ + V(q, q̇) + G(q) [+ F(q̇)]``: ``form="matrices"`` gives M, V, G (and
     F) as matrices, ``form="torques"`` the equation of every joint."""
-    q = equations.chain.q
+    q = equations.coordinates[0]
     name = sp.latex(q[0]).split("_")[0]
     lines = []
     if form == "torques":
@@ -75,7 +75,7 @@ def latex(equations, form: str = "matrices") -> str:
 
 def text(equations) -> str:
     """Plain text of M, V, G (and F), entry by entry, with the abbreviations."""
-    q = equations.chain.q
+    q = equations.coordinates[0]
     n = equations.n
     out = [f"{equations.chain.name}: tau = M(q) qdd + V(q, qd) + G(q) + F(qd)",
            "c_{12} = cos(q_1 + q_2), s_{1} = sin(q_1), qdot_i = dq_i/dt", ""]
