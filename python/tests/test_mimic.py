@@ -15,13 +15,28 @@ from conftest import CROSS_CHECK_TOLERANCE, IDENTITY_TOLERANCE, assert_close
 
 import robodyn
 
-#: Files with mimic joints that Pinocchio 4.1 builds with mimic=True (path under robots/).
-PINOCCHIO_MIMIC_FILES = [
-    "panda_description/urdf/panda.urdf",
-    "baxter_description/urdf/baxter.urdf",
-    "pr2_description/urdf/pr2.urdf",
-    "tiago_pro_description/robots/tiago_pro.urdf",
-]
+
+
+def pinocchio_mimic_files() -> list[str]:
+    """Every example-robot-data URDF with mimic joints that Pinocchio 4.1 builds with mimic=True
+    (path under robots/): Panda's two, Baxter, PR2 and TIAGo Pro at the time of writing."""
+    import pinocchio as pin
+
+    robots = robodyn._example_robot_data_dir()
+    found = []
+    for path in sorted(robots.rglob("*.urdf")) if robots else []:
+        if "<mimic" not in path.read_text(errors="replace"):
+            continue
+        try:
+            model = pin.buildModelFromUrdf(str(path), mimic=True)
+        except Exception:  # Pinocchio refuses a leader that comes after its follower
+            continue
+        if model.nvExtended > model.nv:
+            found.append(path.relative_to(robots).as_posix())
+    return found
+
+
+PINOCCHIO_MIMIC_FILES = pinocchio_mimic_files()
 #: Files where a leader's joint comes after its follower's (Pinocchio refuses them).
 LEADER_LATER_FILES = ["talos_data/robots/talos_full_v2.urdf", "romeo_description/urdf/romeo.urdf"]
 #: Central differences with this step are exact to about its square times the third derivative.
@@ -65,6 +80,11 @@ class PinocchioMimicLayout:
 def random_state(model, seed):
     rng = np.random.default_rng(seed)
     return model.random_configuration(seed=seed), rng.standard_normal(model.nv), rng.standard_normal(model.nv)
+
+
+def test_pinocchio_builds_the_expected_files():
+    assert {"panda_description/urdf/panda.urdf", "pr2_description/urdf/pr2.urdf",
+            "tiago_pro_description/robots/tiago_pro.urdf"} <= set(PINOCCHIO_MIMIC_FILES)
 
 
 @pytest.mark.parametrize("path", PINOCCHIO_MIMIC_FILES)
