@@ -12,8 +12,10 @@
 //! ```text
 //!   Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ),      q̈ = a_f + M⁻¹ Jᵀ λ
 //! ```
-//! M⁻¹ Jᵀ comes from M's tree-sparse factor, one solve per row; no matrix of size nv + rows is
-//! formed. Λ⁻¹ is solved by Cholesky, or, with damping μ > 0, by proximal iterations that give
+//! With M's tree-sparse factor M = Lᵀ D L and Y = L⁻ᵀ Jᵀ (the factor's first sweep, which keeps
+//! each row's zeros outside its bodies' ancestors), `Λ⁻¹ = Yᵀ D⁻¹ Y`, `J a_f = Yᵀ D⁻¹ z` with
+//! z = L⁻ᵀ (τ − h), and `q̈ = L⁻¹ D⁻¹ (z + Y λ)`: one sweep per row, one more each way for
+//! the forces, no matrix of size nv + rows formed (Featherstone §6.5 and §8.3). Λ⁻¹ is solved by Cholesky, or, with damping μ > 0, by proximal iterations that give
 //! the least-norm forces of a redundant set (a loop closure stated twice).
 //! The results live in a [`ConstraintData`] made for the set.
 
@@ -33,7 +35,7 @@ pub use solve::{
 
 use crate::algo::crba::crba;
 use crate::algo::kinematics::update_body_placements;
-use crate::algo::ltdl::{factor_mass_matrix, solve_rows};
+use crate::algo::ltdl::{factor_mass_matrix, solve_lower_rows, solve_transposed_rows};
 use crate::constraint::{evaluate, BodyMotion, ConstraintRows, ConstraintSet};
 use crate::error::{check_vector, Error, Result};
 use crate::model::Model;
@@ -52,7 +54,10 @@ pub struct ConstraintData {
     pub drift: DVector<f64>,
     /// φ (m): how far each row is from holding (zero for a point held where it is).
     pub error: DVector<f64>,
-    /// J M⁻¹ (m × nv).
+    /// Yᵀ = (L⁻ᵀ Jᵀ)ᵀ (m × nv), J half solved by M's factor: `Λ⁻¹ = Yᵀ D⁻¹ Y`. Written with
+    /// the Delassus matrix.
+    pub factored_rows: DMatrix<f64>,
+    /// J M⁻¹ (m × nv). Written by the derivatives (from [`ConstraintData::factored_rows`]).
     pub jacobian_inverse_inertia: DMatrix<f64>,
     /// The Delassus matrix J M⁻¹ Jᵀ (m × m).
     pub delassus: DMatrix<f64>,
@@ -64,8 +69,10 @@ pub struct ConstraintData {
     pub tau: DVector<f64>,
     /// The proximal iterations the last solve took (0: solved directly).
     pub iterations: usize,
-    /// The free acceleration `M⁻¹ (τ − h)` (nv).
-    free_acceleration: DVector<f64>,
+    /// z = L⁻ᵀ (τ − h) (nv), the free acceleration `a_f = M⁻¹ (τ − h)` half solved.
+    swept_force: DVector<f64>,
+    /// D⁻¹ z (nv).
+    scaled_force: DVector<f64>,
     /// The right-hand side of the last solve.
     rhs: Vec<f64>,
     /// Cholesky factor and scratch of the last solve (room for max(m, nv)).
@@ -85,13 +92,15 @@ impl ConstraintData {
             jacobian: DMatrix::zeros(m, nv),
             drift: DVector::zeros(m),
             error: DVector::zeros(m),
+            factored_rows: DMatrix::zeros(m, nv),
             jacobian_inverse_inertia: DMatrix::zeros(m, nv),
             delassus: DMatrix::zeros(m, m),
             forces: DVector::zeros(m),
             qdd: DVector::zeros(nv),
             tau: DVector::zeros(nv),
             iterations: 0,
-            free_acceleration: DVector::zeros(nv),
+            swept_force: DVector::zeros(nv),
+            scaled_force: DVector::zeros(nv),
             rhs: vec![0.0; n],
             factor: vec![0.0; n * n],
             gram: vec![0.0; n * n],
@@ -143,10 +152,10 @@ fn rows_at_rest(
     set: &ConstraintSet,
     q: &[f64],
 ) -> Result<()> {
-    let mut rest = std::mem::take(&mut constraints.free_acceleration);
+    let mut rest = std::mem::take(&mut constraints.swept_force);
     rest.fill(0.0);
     let result = constraint_rows(model, data, constraints, set, q, rest.as_slice());
-    constraints.free_acceleration = rest;
+    constraints.swept_force = rest;
     result
 }
 
@@ -214,35 +223,50 @@ fn constraint_rows(
     Ok(())
 }
 
-/// The size of the terms of `Σ_c J_rc x_c` over the rows: `max_r Σ_c |J_rc x_c|`, the scale of
-/// that product's rounding.
-fn product_scale(jacobian: &DMatrix<f64>, x: &[f64]) -> f64 {
-    (0..jacobian.nrows()).fold(0.0, |largest, r| {
-        let row = jacobian.row(r);
-        largest.max(row.iter().zip(x).map(|(j, xi)| (j * xi).abs()).sum())
-    })
+/// The size of the terms of `Σ_c A_rc x_c` over the rows of the column-major `a`:
+/// `max_r Σ_c |A_rc x_c|`, the scale of that product's rounding (`sums`: room for a's rows).
+fn product_scale(a: &DMatrix<f64>, x: &[f64], sums: &mut [f64]) -> f64 {
+    let sums = &mut sums[..a.nrows()];
+    sums.fill(0.0);
+    for (column, x_c) in a.column_iter().zip(x) {
+        for (sum, a_rc) in sums.iter_mut().zip(column.iter()) {
+            *sum += (a_rc * x_c).abs();
+        }
+    }
+    solve::largest(sums)
 }
 
-/// J M⁻¹ by the factor's sweeps (one right-hand side per row), then `Λ⁻¹ = Σ_c J_:c (J M⁻¹)_:cᵀ`.
+/// Y = L⁻ᵀ Jᵀ by the factor's first sweep (one column per row), then
+/// `Λ⁻¹ = J M⁻¹ Jᵀ = Yᵀ D⁻¹ Y = Σ_k y_k y_kᵀ / D_k` over the coordinates k some row reaches
+/// (y_k: row k of Y; zero outside the rows' bodies' ancestors).
 fn delassus_matrix(model: &Model, data: &Data, constraints: &mut ConstraintData) {
     let ConstraintData {
         jacobian,
-        jacobian_inverse_inertia,
+        factored_rows,
         delassus,
         ..
     } = constraints;
-    // column-major J (m × nv) is Jᵀ row by row: M X = Jᵀ gives X = M⁻¹ Jᵀ, that is J M⁻¹
-    jacobian_inverse_inertia.copy_from(jacobian);
-    solve_rows(model, data, jacobian_inverse_inertia.as_mut_slice());
+    // column-major J (m × nv) is Jᵀ row by row: the sweep leaves Yᵀ
+    factored_rows.copy_from(jacobian);
+    solve_transposed_rows(model, data, factored_rows.as_mut_slice());
     delassus.fill(0.0);
-    for c in 0..model.nv {
-        delassus.ger(
-            1.0,
-            &jacobian.column(c),
-            &jacobian_inverse_inertia.column(c),
-            1.0,
-        );
+    for (k, y_k) in factored_rows.column_iter().enumerate() {
+        if y_k.iter().any(|y| *y != 0.0) {
+            delassus.ger(1.0 / data.mass_matrix_factor[(k, k)], &y_k, &y_k, 1.0);
+        }
     }
+}
+
+/// J M⁻¹ = (L⁻¹ D⁻¹ Y)ᵀ in `constraints.jacobian_inverse_inertia`, from the Y of
+/// [`delassus_matrix`]: the factor's second sweep.
+fn finish_jacobian_inverse_inertia(model: &Model, data: &Data, constraints: &mut ConstraintData) {
+    let ConstraintData {
+        factored_rows,
+        jacobian_inverse_inertia,
+        ..
+    } = constraints;
+    jacobian_inverse_inertia.copy_from(factored_rows);
+    solve_lower_rows(model, data, jacobian_inverse_inertia.as_mut_slice());
 }
 
 /// Solves `Λ⁻¹ λ = rhs` (the right-hand side in `constraints.rhs`, computed from terms of size

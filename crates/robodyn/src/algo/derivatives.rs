@@ -36,7 +36,9 @@
 use crate::algo::crba::{
     add_composites, mass_matrix_of_composites, world_inertias_of, CompositeBuffers,
 };
-use crate::algo::ltdl::{factor_into, singular_mass_matrix, solve_rows_in, solve_rows_with};
+use crate::algo::ltdl::{
+    factor_into, singular_mass_matrix, solve_rows_in, solve_rows_with, Sweeps,
+};
 use crate::algo::rnea::check_external_forces;
 use crate::dispatch::multiversion;
 use crate::error::{check_vector, Result};
@@ -191,7 +193,7 @@ pub fn aba_derivatives(
     let (mut b, mut solve) = DerivativeBuffers::with_solve(data);
     one_state_aba_right_sides(model, &mut b, &mut solve, (q, v, tau, f_ext))
         .map_err(|()| singular_mass_matrix())?;
-    solve_rows_in(model, solve.factor, solve.rows);
+    solve_rows_in(model, solve.factor, solve.rows, Sweeps::Both);
     into.copy_rows(data);
     Ok(())
 }
@@ -247,7 +249,7 @@ pub(crate) fn aba_derivative_passes<S: Real>(
     state: DynamicsState<S>,
 ) -> std::result::Result<(), ()> {
     aba_derivative_right_sides(model, b, &mut solve, state)?;
-    solve_rows_with(model, solve.factor, solve.rows);
+    solve_rows_with(model, solve.factor, solve.rows, Sweeps::Both);
     Ok(())
 }
 
@@ -270,7 +272,7 @@ fn aba_derivative_right_sides<S: Real>(
     for (qdd, (applied, bias)) in solve.qdd.iter_mut().zip(tau.iter().zip(b.tau.iter())) {
         *qdd = *applied - *bias;
     }
-    solve_rows_with(model, solve.factor, solve.qdd);
+    solve_rows_with(model, solve.factor, solve.qdd, Sweeps::Both);
     // [∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂τ] = M⁻¹ [−∂τ/∂q, −∂τ/∂q̇, 1] at q̈: the right-hand sides
     let nv = model.nv;
     solve.rows.fill(S::splat(0.0));

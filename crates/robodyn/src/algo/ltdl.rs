@@ -80,40 +80,85 @@ pub(crate) fn factor_into<S: Real>(
     Ok(())
 }
 
+/// Which sweeps of the solve with M = Lᵀ D L a call makes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Sweeps {
+    /// Both: X = M⁻¹ B.
+    Both,
+    /// The first alone, from the leaves: Y = L⁻ᵀ B.
+    Transposed,
+    /// The second alone, from the root: X = L⁻¹ D⁻¹ Y.
+    Lower,
+}
+
 multiversion! {
-    /// [`solve_rows`] with the column-major `factor` of [`factor_into`]. Each elimination step is one row update over all columns at once, vectorised: with AVX-512 or
+    /// [`solve_rows`]' `sweeps` with the column-major `factor` of [`factor_into`]. Each
+    /// elimination step is one row update over all columns at once, vectorised: with AVX-512 or
     /// AVX2 where the processor has it ([`crate::dispatch`]), else with the baseline's SSE2.
-    pub(crate) fn solve_rows_in(model: &Model, factor: &[f64], rows: &mut [f64]) {
-        solve_rows_avx512 for ["avx512f"] => { solve_rows_with(model, factor, rows) }
-        solve_rows_avx2 for ["avx2"] => { solve_rows_with(model, factor, rows) }
-        baseline => { solve_rows_with(model, factor, rows) }
+    pub(crate) fn solve_rows_in(model: &Model, factor: &[f64], rows: &mut [f64], sweeps: Sweeps) {
+        solve_rows_avx512 for ["avx512f"] => { solve_rows_with(model, factor, rows, sweeps) }
+        solve_rows_avx2 for ["avx2"] => { solve_rows_with(model, factor, rows, sweeps) }
+        baseline => { solve_rows_with(model, factor, rows, sweeps) }
     }
 }
 
 /// Solves M X = B in place for B stored row by row in `rows` (row i at `i * width..(i + 1) *
 /// width`, width = rows.len() / nv), with the factor of [`factor_mass_matrix`] in `data`.
 pub fn solve_rows(model: &Model, data: &Data, rows: &mut [f64]) {
-    solve_rows_in(model, data.mass_matrix_factor.as_slice(), rows);
+    solve_rows_in(
+        model,
+        data.mass_matrix_factor.as_slice(),
+        rows,
+        Sweeps::Both,
+    );
 }
 
-/// [`solve_rows`] with the column-major `factor` of [`factor_into`], in `f64` or lanes. The
-/// columns are solved a block at a time (256 bytes of each row, the block of one row held in
-/// registers while it is updated or used), so a block's rows stay in the L1 cache through the
-/// sweeps; each column is solved by the same operations in the same order in any block.
+/// The first half of [`solve_rows`]: Y = L⁻ᵀ B in place (rows as there). A column of B that is
+/// zero outside a body's ancestors stays so: `Yᵀ D⁻¹ Y = Bᵀ M⁻¹ B` can be summed over them.
+pub fn solve_transposed_rows(model: &Model, data: &Data, rows: &mut [f64]) {
+    solve_rows_in(
+        model,
+        data.mass_matrix_factor.as_slice(),
+        rows,
+        Sweeps::Transposed,
+    );
+}
+
+/// The second half of [`solve_rows`]: X = L⁻¹ D⁻¹ Y in place (rows as there), so that
+/// [`solve_transposed_rows`] then this is M⁻¹.
+pub fn solve_lower_rows(model: &Model, data: &Data, rows: &mut [f64]) {
+    solve_rows_in(
+        model,
+        data.mass_matrix_factor.as_slice(),
+        rows,
+        Sweeps::Lower,
+    );
+}
+
+/// [`solve_rows`]' `sweeps` with the column-major `factor` of [`factor_into`], in `f64` or
+/// lanes. The columns are solved a block at a time (256 bytes of each row, the block of one row
+/// held in registers while it is updated or used), so a block's rows stay in the L1 cache
+/// through the sweeps; each column is solved by the same operations in the same order in any
+/// block.
 #[inline(always)]
-pub(crate) fn solve_rows_with<S: Real>(model: &Model, factor: &[S], rows: &mut [S]) {
+pub(crate) fn solve_rows_with<S: Real>(
+    model: &Model,
+    factor: &[S],
+    rows: &mut [S],
+    sweeps: Sweeps,
+) {
     let width = rows.len() / model.nv.max(1);
     let mut start = 0;
     if std::mem::size_of::<S>() == 8 {
-        start = solve_blocks::<S, 32>(model, factor, rows, width, start);
-        start = solve_blocks::<S, 16>(model, factor, rows, width, start);
+        start = solve_blocks::<S, 32>(model, factor, rows, width, start, sweeps);
+        start = solve_blocks::<S, 16>(model, factor, rows, width, start, sweeps);
     }
     if std::mem::size_of::<S>() <= 32 {
-        start = solve_blocks::<S, 8>(model, factor, rows, width, start);
+        start = solve_blocks::<S, 8>(model, factor, rows, width, start, sweeps);
     }
-    start = solve_blocks::<S, 4>(model, factor, rows, width, start);
-    start = solve_blocks::<S, 2>(model, factor, rows, width, start);
-    solve_blocks::<S, 1>(model, factor, rows, width, start);
+    start = solve_blocks::<S, 4>(model, factor, rows, width, start, sweeps);
+    start = solve_blocks::<S, 2>(model, factor, rows, width, start, sweeps);
+    solve_blocks::<S, 1>(model, factor, rows, width, start, sweeps);
 }
 
 /// Solves the blocks of `W` columns from column `start` on while whole ones fit in the rows'
@@ -125,11 +170,16 @@ fn solve_blocks<S: Real, const W: usize>(
     rows: &mut [S],
     width: usize,
     mut start: usize,
+    sweeps: Sweeps,
 ) -> usize {
     while start + W <= width {
         let block = Block::<W> { width, start };
-        solve_transposed::<S, W>(model, factor, rows, block);
-        solve_lower::<S, W>(model, factor, rows, block);
+        if sweeps != Sweeps::Lower {
+            solve_transposed::<S, W>(model, factor, rows, block);
+        }
+        if sweeps != Sweeps::Transposed {
+            solve_lower::<S, W>(model, factor, rows, block);
+        }
         start += W;
     }
     start
@@ -279,7 +329,12 @@ mod tests {
                 .map(|k| ((k * 7919) % 1000) as f64 / 997.0 - 0.5)
                 .collect();
             let mut generic = rows.clone();
-            solve_rows_with(&model, data.mass_matrix_factor.as_slice(), &mut generic);
+            solve_rows_with(
+                &model,
+                data.mass_matrix_factor.as_slice(),
+                &mut generic,
+                Sweeps::Both,
+            );
             let mut dispatched = rows.clone();
             solve_rows(&model, &data, &mut dispatched);
             assert_eq!(generic, dispatched, "width {width}");
@@ -287,7 +342,14 @@ mod tests {
             if std::arch::is_x86_feature_detected!("avx2") {
                 let mut avx2 = rows.clone();
                 // SAFETY: the processor has AVX2, just checked.
-                unsafe { solve_rows_avx2(&model, data.mass_matrix_factor.as_slice(), &mut avx2) };
+                unsafe {
+                    solve_rows_avx2(
+                        &model,
+                        data.mass_matrix_factor.as_slice(),
+                        &mut avx2,
+                        Sweeps::Both,
+                    )
+                };
                 assert_eq!(generic, avx2, "width {width}");
             }
             #[cfg(target_arch = "x86_64")]
@@ -295,7 +357,12 @@ mod tests {
                 let mut avx512 = rows.clone();
                 // SAFETY: the processor has AVX-512F, just checked.
                 unsafe {
-                    solve_rows_avx512(&model, data.mass_matrix_factor.as_slice(), &mut avx512)
+                    solve_rows_avx512(
+                        &model,
+                        data.mass_matrix_factor.as_slice(),
+                        &mut avx512,
+                        Sweeps::Both,
+                    )
                 };
                 assert_eq!(generic, avx512, "width {width}");
             }

@@ -29,7 +29,9 @@
 //! Baumgarte's terms are not differentiated: these are the derivatives of the exact equations.
 
 use super::solve::PseudoInverse;
-use super::{constrained_forward_dynamics, impulse_dynamics, product_scale};
+use super::{
+    constrained_forward_dynamics, finish_jacobian_inverse_inertia, impulse_dynamics, product_scale,
+};
 use super::{solve_delassus, ConstrainedOptions, ConstraintData};
 use crate::algo::derivatives::{rnea_derivatives, DerivativesInto};
 use crate::algo::ltdl::solve_rows;
@@ -149,6 +151,7 @@ pub fn constrained_forward_dynamics_derivatives(
         damping,
     };
     constrained_forward_dynamics(model, data, constraints, set, (q, v, tau), f_ext, &options)?;
+    finish_jacobian_inverse_inertia(model, data, constraints);
 
     // ∂ID/∂q, ∂ID/∂q̇ at q̈ with λ (and f_ext) on the bodies: ID − Jᵀλ as RNEA has it
     let d = &mut *derivatives;
@@ -212,6 +215,7 @@ pub fn impulse_dynamics_derivatives(
 ) -> Result<()> {
     check_derivatives_fit(model, derivatives, set)?;
     impulse_dynamics(model, data, constraints, set, (q, v), restitution, damping)?;
+    finish_jacobian_inverse_inertia(model, data, constraints);
     let d = &mut *derivatives;
 
     // ∂(M Δq̇ − JᵀΛ)/∂q = ∂ID(q, 0, Δq̇; Λ)/∂q − ∂g/∂q, Δq̇ = q̇⁺ − q̇
@@ -330,7 +334,7 @@ fn solve_saddle_point(
         match solver {
             Solver::Cholesky => {
                 let scale = 1.0
-                    + product_scale(&constraints.jacobian, x0.as_slice())
+                    + product_scale(&constraints.jacobian, x0.as_slice(), &mut constraints.step)
                     + super::solve::largest(&constraints.rhs[..m]);
                 solve_delassus(model, set, constraints, 0.0, scale, column)?;
             }

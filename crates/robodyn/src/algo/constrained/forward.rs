@@ -4,21 +4,23 @@
 //! from the constraint-space inverse inertia) and §11.6 (impulses); Pinocchio's
 //! `constraintDynamics` and `impulseDynamics` compute the same quantities. See the module's
 //! header for the equations. Inputs: q, q̇, τ (or only q, q̇), the constraint set. Writes
-//! `constraints.qdd`, `constraints.forces` and everything on the way (J, γ, φ, J M⁻¹, Λ⁻¹), and
+//! `constraints.qdd`, `constraints.forces` and everything on the way (J, γ, φ, Y, Λ⁻¹), and
 //! in `data`: RNEA's fields, the mass matrix and its factor, the body placements. Cost: RNEA,
-//! CRBA and M's factor, one tree-sparse solve per row, O(m² nv) for Λ⁻¹ and O(m³) to solve it.
+//! CRBA and M's factor, one sweep of the factor per row and two for the forces, O(m² d) for Λ⁻¹
+//! (d: the coordinates the rows reach) and O(m³) to solve it.
 
 use super::solve::largest;
 use super::{
     constraint_rows, delassus_matrix, factor_inertia, product_scale, solve_forces, ConstraintData,
 };
-use crate::algo::ltdl::solve_rows;
+use crate::algo::ltdl::{solve_lower_rows, solve_transposed_rows};
 use crate::algo::rnea::newton_euler;
 use crate::constraint::ConstraintSet;
 use crate::error::{check_vector, Error, Result};
 use crate::model::Model;
 use crate::spatial::Force;
 use crate::Data;
+use nalgebra::{DVectorView, DVectorViewMut};
 
 /// How the constraint equations are solved.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -68,59 +70,62 @@ pub fn constrained_forward_dynamics(
     check_vector("tau", tau, model.nv)?;
     options.check()?;
 
-    // a_f = M⁻¹ (τ − h), h = C q̇ + g − Σ Jᵀ f_ext (RNEA with q̈ = 0), M = Lᵀ D L
+    // z = L⁻ᵀ (τ − h), h = C q̇ + g − Σ Jᵀ f_ext (RNEA with q̈ = 0), M = Lᵀ D L; a_f = L⁻¹ D⁻¹ z
     let h = newton_euler(model, data, q, Some(v), None, f_ext)?;
-    let free = &mut constraints.free_acceleration;
-    for ((a, t), b) in free.iter_mut().zip(tau).zip(h.iter()) {
-        *a = t - b;
+    for ((z, t), b) in constraints.swept_force.iter_mut().zip(tau).zip(h.iter()) {
+        *z = t - b;
     }
     factor_inertia(model, data, q)?;
-    solve_rows(model, data, constraints.free_acceleration.as_mut_slice());
+    solve_transposed_rows(model, data, constraints.swept_force.as_mut_slice());
 
-    // J, γ, φ; then J M⁻¹ and Λ⁻¹ = J M⁻¹ Jᵀ
+    // J, γ, φ; then Y = L⁻ᵀ Jᵀ and Λ⁻¹ = Yᵀ D⁻¹ Y
     constraint_rows(model, data, constraints, set, q, v)?;
     delassus_matrix(model, data, constraints);
 
-    // Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ)
-    let (kp, kd) = options.baumgarte.unwrap_or((0.0, 0.0));
+    // Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ), J a_f = Yᵀ D⁻¹ z
+    let m = set.rows();
     let ConstraintData {
         jacobian,
+        factored_rows,
         drift,
         error,
-        free_acceleration,
+        swept_force,
+        scaled_force,
         rhs,
+        step,
         ..
     } = constraints;
-    for (r, value) in rhs.iter_mut().take(set.rows()).enumerate() {
-        let row = jacobian.row(r);
-        let (ja, jv) = (
-            row.iter()
-                .zip(free_acceleration.iter())
-                .map(|(j, a)| j * a)
-                .sum::<f64>(),
-            row.iter().zip(v).map(|(j, vi)| j * vi).sum::<f64>(),
-        );
-        *value = -(ja + drift[r] + kd * jv + kp * error[r]);
+    for (k, (scaled, z)) in scaled_force.iter_mut().zip(swept_force.iter()).enumerate() {
+        *scaled = z / data.mass_matrix_factor[(k, k)];
     }
-    let scale =
-        1.0 + product_scale(
-            &constraints.jacobian,
-            constraints.free_acceleration.as_slice(),
-        ) + largest(constraints.drift.as_slice())
-            + kd * product_scale(&constraints.jacobian, v)
-            + kp * largest(constraints.error.as_slice());
+    let mut right = DVectorViewMut::from_slice(&mut rhs[..m], m);
+    right.gemv(-1.0, factored_rows, scaled_force, 0.0);
+    right.axpy(-1.0, drift, 1.0);
+    let (kp, kd) = options.baumgarte.unwrap_or((0.0, 0.0));
+    let mut scale = 1.0
+        + product_scale(factored_rows, scaled_force.as_slice(), step)
+        + largest(drift.as_slice());
+    if kd != 0.0 {
+        right.gemv(-kd, jacobian, &DVectorView::from_slice(v, v.len()), 1.0);
+        scale += kd * product_scale(jacobian, v, step);
+    }
+    if kp != 0.0 {
+        right.axpy(-kp, error, 1.0);
+        scale += kp * largest(error.as_slice());
+    }
     solve_forces(model, set, constraints, options.damping, scale)?;
 
-    // q̈ = a_f + M⁻¹ Jᵀ λ = a_f + (J M⁻¹)ᵀ λ
+    // q̈ = a_f + M⁻¹ Jᵀ λ = L⁻¹ D⁻¹ (z + Y λ)
     let ConstraintData {
-        jacobian_inverse_inertia,
+        factored_rows,
         forces,
-        free_acceleration,
+        swept_force,
         qdd,
         ..
     } = constraints;
-    qdd.copy_from(free_acceleration);
-    qdd.gemv_tr(1.0, jacobian_inverse_inertia, forces, 1.0);
+    qdd.copy_from(swept_force);
+    qdd.gemv_tr(1.0, factored_rows, forces, 1.0);
+    solve_lower_rows(model, data, qdd.as_mut_slice());
     Ok(())
 }
 
@@ -154,22 +159,32 @@ pub fn impulse_dynamics(
     delassus_matrix(model, data, constraints);
 
     // Λ⁻¹ Λ = −(1 + e) J q̇
-    let ConstraintData { jacobian, rhs, .. } = constraints;
-    for (r, value) in rhs.iter_mut().take(set.rows()).enumerate() {
-        let jv: f64 = jacobian.row(r).iter().zip(v).map(|(j, vi)| j * vi).sum();
-        *value = -(1.0 + restitution) * jv;
-    }
-    let scale = 1.0 + (1.0 + restitution) * product_scale(&constraints.jacobian, v);
+    let m = set.rows();
+    let ConstraintData {
+        jacobian,
+        rhs,
+        step,
+        ..
+    } = constraints;
+    let velocity = DVectorView::from_slice(v, v.len());
+    DVectorViewMut::from_slice(&mut rhs[..m], m).gemv(
+        -(1.0 + restitution),
+        jacobian,
+        &velocity,
+        0.0,
+    );
+    let scale = 1.0 + (1.0 + restitution) * product_scale(jacobian, v, step);
     solve_forces(model, set, constraints, damping, scale)?;
 
-    // q̇⁺ = q̇ + M⁻¹ Jᵀ Λ
+    // q̇⁺ = q̇ + M⁻¹ Jᵀ Λ = q̇ + L⁻¹ D⁻¹ (Y Λ)
     let ConstraintData {
-        jacobian_inverse_inertia,
+        factored_rows,
         forces,
         qdd,
         ..
     } = constraints;
-    qdd.copy_from_slice(v);
-    qdd.gemv_tr(1.0, jacobian_inverse_inertia, forces, 1.0);
+    qdd.gemv_tr(1.0, factored_rows, forces, 0.0);
+    solve_lower_rows(model, data, qdd.as_mut_slice());
+    *qdd += velocity;
     Ok(())
 }
