@@ -10,6 +10,10 @@ from typing import Any
 import numpy as np
 
 
+#: Below this quaternion vector norm (half the angle, rad) log(R) takes its first-order form 2 xyz.
+SMALL_ROTATION = 1e-12
+
+
 def _rotation_log(rotation: np.ndarray) -> np.ndarray:
     """log(R) as a rotation vector, through the unit quaternion (accurate near 0 and π)."""
     trace = np.trace(rotation)
@@ -29,7 +33,7 @@ def _rotation_log(rotation: np.ndarray) -> np.ndarray:
     if w < 0:
         w, xyz = -w, -xyz
     norm = np.linalg.norm(xyz)
-    return xyz * (2.0 * np.arctan2(norm, w) / norm) if norm > 1e-12 else 2.0 * xyz
+    return xyz * (2.0 * np.arctan2(norm, w) / norm) if norm > SMALL_ROTATION else 2.0 * xyz
 
 
 def _pose_error(model, q: np.ndarray, frame: Any, target: np.ndarray, position_only: bool) -> np.ndarray:

@@ -41,6 +41,8 @@ from robodyn.operational_space import task_rows
 
 __all__ = ["MimicModel"]
 
+#: Rounding slack (rad or m) when checking that a group's reduced limits keep each follower in its own.
+LIMIT_ROUNDING = 1e-12
 #: The joint kinds a mimic relation may join (one coordinate each, of the same kind).
 ONE_COORDINATE_JOINTS = ("revolute", "prismatic")
 
@@ -290,7 +292,7 @@ class MimicModel(ConstrainedMethods):
             full_lower = np.asarray(self.full.lower_position_limit)
             full_upper = np.asarray(self.full.upper_position_limit)
             outside = [k for k, r in group if k != self.independent_q[j] and not all(
-                full_lower[k] - 1e-12 <= r * x + self._q_offset[k] <= full_upper[k] + 1e-12 for x in (lower[j], upper[j])
+                full_lower[k] - LIMIT_ROUNDING <= r * x + self._q_offset[k] <= full_upper[k] + LIMIT_ROUNDING for x in (lower[j], upper[j])
                 if np.isfinite(x))]
             if outside:
                 names = [self._joint_of_q(k) for k in outside]
