@@ -2,9 +2,9 @@
 //! `benchmarks/compare.py`'s constrained section: example-robot-data's Solo12 on its four feet
 //! (a point each, 12 rows) and Talos on its two soles (a frame each, 12 rows), held to the world
 //! where they are, in world axes (Pinocchio's LOCAL_WORLD_ALIGNED), at a velocity the contacts
-//! allow, and an impact there. Besides the whole calls, their parts: RNEA for the bias forces,
-//! CRBA with M's factor, the constraint Jacobian, M⁻¹ Jᵀ by the factor's sweeps (one per row),
-//! and the Delassus matrix J M⁻¹ Jᵀ (CRBA, factor, Jacobian, sweeps and the product). Skipped when
+//! allow, and an impact there. Besides the whole calls, their parts: ABA (the free acceleration
+//! and the articulated inertias the constrained algorithms build on), the constraint Jacobian,
+//! and `delassus` on its own (CRBA, M's factor, the Jacobian and one sweep per row). Skipped when
 //! the URDFs are not found (see `cases`).
 
 #[allow(dead_code)]
@@ -14,9 +14,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::DVector;
 use rand::{rngs::StdRng, SeedableRng};
 use robodyn::algo::{
-    bias_forces, constrained_forward_dynamics, constraint_jacobian, crba, delassus,
-    impulse_dynamics,
-    ltdl::{factor_mass_matrix, solve_rows},
+    aba, constrained_forward_dynamics, constraint_jacobian, delassus, impulse_dynamics,
     ConstrainedOptions, ConstraintData,
 };
 use robodyn::constraint::{
@@ -134,32 +132,14 @@ fn benchmarks(c: &mut Criterion) {
                     .map(|()| constraints.qdd[0])
             })
         });
-        // the parts: RNEA (h), CRBA and M = Lᵀ D L, then J and γ
-        group.bench_function("part_rnea", |b| {
-            b.iter(|| bias_forces(&model, &mut data, black_box(&q), &v).map(|h| h[0]))
-        });
-        group.bench_function("part_crba_factor", |b| {
-            b.iter(|| {
-                crba(&model, &mut data, black_box(&q)).expect("crba");
-                factor_mass_matrix(&model, &mut data)
-            })
+        // the parts: ABA (a_f and the articulated inertias), then J and γ
+        group.bench_function("part_aba", |b| {
+            b.iter(|| aba(&model, &mut data, black_box(&q), &v, &tau, None).map(|a| a[0]))
         });
         group.bench_function("part_constraint_jacobian", |b| {
             b.iter(|| {
                 constraint_jacobian(&model, &mut data, &mut constraints, &set, black_box(&q))
                     .map(|j| j[0])
-            })
-        });
-        let mut rows_inverse_inertia = constraints.jacobian.clone();
-        group.bench_function("part_solve_rows", |b| {
-            b.iter(|| {
-                rows_inverse_inertia.copy_from(&constraints.jacobian);
-                solve_rows(
-                    &model,
-                    &data,
-                    black_box(rows_inverse_inertia.as_mut_slice()),
-                );
-                rows_inverse_inertia[0]
             })
         });
         group.bench_function("part_delassus", |b| {

@@ -28,6 +28,7 @@ pub(crate) use rows::{evaluate, BodyMotion, ConstraintRows};
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::spatial::Transform;
+use std::ops::Range;
 
 /// The axes a point or frame constraint's rows (and forces) are expressed in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -120,6 +121,23 @@ impl Constraint {
             ConstraintKind::Point { .. } => 3,
             ConstraintKind::Frame { mask, .. } => mask.iter().filter(|&&kept| kept).count(),
             ConstraintKind::Coupling { .. } | ConstraintKind::Distance { .. } => 1,
+        }
+    }
+
+    /// The bodies it attaches to or whose joints it couples (the world as 0), up to two.
+    pub fn bodies(&self, model: &Model) -> [Option<usize>; 2] {
+        let body = |a: &Attachment| a.frame.map_or(0, |f| model.frames[f].body);
+        match &self.kind {
+            ConstraintKind::Point { first, second }
+            | ConstraintKind::Frame { first, second, .. } => {
+                [Some(body(first)), second.as_ref().map(body)]
+            }
+            ConstraintKind::Distance { first, second, .. } => {
+                [Some(body(first)), Some(body(second))]
+            }
+            ConstraintKind::Coupling {
+                follower, leader, ..
+            } => [Some(*follower), *leader],
         }
     }
 
@@ -218,6 +236,14 @@ pub struct ConstraintSet {
     constraints: Vec<Constraint>,
     offsets: Vec<usize>,
     rows: usize,
+    /// Per constraint, the bodies whose joints its rows reach (the ancestors of its bodies, the
+    /// world left out), the deepest first.
+    supports: Vec<Vec<usize>>,
+    /// The bodies some row reaches, in increasing order (each after its parent).
+    support: Vec<usize>,
+    /// For each body of `support`, the rows from the first to the last of the constraints that
+    /// reach it.
+    row_spans: Vec<Range<usize>>,
 }
 
 impl ConstraintSet {
@@ -235,11 +261,58 @@ impl ConstraintSet {
             offsets.push(rows);
             rows += constraint.rows();
         }
+        let mut reached = vec![false; model.nbodies()];
+        let mut supports = Vec::with_capacity(constraints.len());
+        for constraint in &constraints {
+            let mut own = vec![false; model.nbodies()];
+            for mut body in constraint.bodies(model).into_iter().flatten() {
+                while body != 0 && !own[body] {
+                    own[body] = true;
+                    body = model.parent[body];
+                }
+            }
+            let deepest_first: Vec<usize> =
+                (1..model.nbodies()).rev().filter(|&i| own[i]).collect();
+            for &i in &deepest_first {
+                reached[i] = true;
+            }
+            supports.push(deepest_first);
+        }
+        let support: Vec<usize> = (1..model.nbodies()).filter(|&i| reached[i]).collect();
+        let mut spans = vec![rows..0; model.nbodies()];
+        for ((constraint, own), &offset) in constraints.iter().zip(&supports).zip(&offsets) {
+            for &i in own {
+                spans[i].start = spans[i].start.min(offset);
+                spans[i].end = spans[i].end.max(offset + constraint.rows());
+            }
+        }
+        let row_spans = support.iter().map(|&i| spans[i].clone()).collect();
         Ok(ConstraintSet {
             constraints,
             offsets,
             rows,
+            supports,
+            support,
+            row_spans,
         })
+    }
+
+    /// The bodies whose joints the rows of constraint `k` reach (the ancestors of its bodies),
+    /// the deepest first: J's columns of any other joint are zero in its rows.
+    pub fn support_of(&self, k: usize) -> &[usize] {
+        &self.supports[k]
+    }
+
+    /// The bodies whose joints some row reaches, in increasing order (each after its parent).
+    pub fn support(&self) -> &[usize] {
+        &self.support
+    }
+
+    /// The rows, from the first to the last, of the constraints that reach each body of
+    /// [`ConstraintSet::support`] (in its order): J's columns of that body's joint are zero in
+    /// the other rows.
+    pub fn row_spans(&self) -> &[Range<usize>] {
+        &self.row_spans
     }
 
     /// The constraints.

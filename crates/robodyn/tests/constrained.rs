@@ -72,6 +72,12 @@ fn forward_dynamics_solves_the_constrained_equations_and_equals_a_dense_kkt_solv
             );
             let held = &c.jacobian * &qdd + &c.drift;
             assert!(held.amax() < IDENTITY_TOLERANCE * scale, "{name}: {held}");
+            // its Delassus matrix, from ABA's terms, is J M⁻¹ Jᵀ
+            let inverse = mass.clone().try_inverse().expect("M is regular");
+            let expected = &c.jacobian * inverse * c.jacobian.transpose();
+            let label = format!("{name}: Delassus");
+            let (ours, expected) = (c.delassus.as_slice(), expected.as_slice());
+            assert_close(&label, ours, expected, IDENTITY_TOLERANCE);
             let (dense_qdd, dense_forces) = dense_kkt(&model, &mut data, &c, args);
             assert_close(
                 name,

@@ -2,9 +2,9 @@
 //! constraints of a [`ConstraintSet`], and the constraint Jacobian and Delassus matrix.
 //!
 //! Reference: Featherstone, *Rigid Body Dynamics Algorithms* (2008), §8.1-8.3 (the constrained
-//! equations of motion, solved through the constraint-space inverse inertia) and §6.5 (the
-//! tree-sparse factorisation M = Lᵀ D L); Carpentier, Budhiraja and Mansard, RSS 2021 (the
-//! proximal solve). The equations, with J the constraint rows and γ = J̇ q̇ their drift:
+//! equations of motion, solved through the constraint-space inverse inertia), Table 7.1 (the
+//! articulated-body algorithm) and §6.5 (the tree-sparse factorisation M = Lᵀ D L); Carpentier,
+//! Budhiraja and Mansard, RSS 2021 (the proximal solve). The equations, with J the constraint rows and γ = J̇ q̇ their drift:
 //! ```text
 //!   M q̈ + h = τ + Jᵀ λ,      J q̈ + γ = −K_d J q̇ − K_p φ   (Baumgarte's terms optional)
 //! ```
@@ -12,13 +12,16 @@
 //! ```text
 //!   Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ),      q̈ = a_f + M⁻¹ Jᵀ λ
 //! ```
-//! With M's tree-sparse factor M = Lᵀ D L and Y = L⁻ᵀ Jᵀ (the factor's first sweep, which keeps
-//! each row's zeros outside its bodies' ancestors), `Λ⁻¹ = Yᵀ D⁻¹ Y`, `J a_f = Yᵀ D⁻¹ z` with
-//! z = L⁻ᵀ (τ − h), and `q̈ = L⁻¹ D⁻¹ (z + Y λ)`: one sweep per row, one more each way for
-//! the forces, no matrix of size nv + rows formed (Featherstone §6.5 and §8.3). Λ⁻¹ is solved by Cholesky, or, with damping μ > 0, by proximal iterations that give
-//! the least-norm forces of a redundant set (a loop closure stated twice).
+//! Forward dynamics and impulses never form M: the articulated-body algorithm gives a_f, and its
+//! inward pass run on each row of J gives Λ⁻¹ and M⁻¹ Jᵀ λ (`articulated`: O(n + m d + m² d +
+//! m³), d the bodies the rows reach). The Delassus matrix on its own and the derivatives take
+//! M's tree-sparse factor M = Lᵀ D L and Y = L⁻ᵀ Jᵀ (the factor's first sweep, which keeps each
+//! row's zeros outside its bodies' ancestors): `Λ⁻¹ = Yᵀ D⁻¹ Y` (Featherstone §6.5 and §8.3).
+//! Λ⁻¹ is solved by Cholesky, or, with damping μ > 0, by proximal iterations that give the
+//! least-norm forces of a redundant set (a loop closure stated twice).
 //! The results live in a [`ConstraintData`] made for the set.
 
+mod articulated;
 mod derivatives;
 mod forward;
 mod inverse;
@@ -39,9 +42,9 @@ use crate::algo::ltdl::{factor_mass_matrix, solve_lower_rows, solve_transposed_r
 use crate::constraint::{evaluate, BodyMotion, ConstraintRows, ConstraintSet};
 use crate::error::{check_vector, Error, Result};
 use crate::model::Model;
-use crate::spatial::Motion;
+use crate::spatial::{Force, Motion};
 use crate::Data;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, Vector6};
 use solve::{solve_symmetric, SolveFailure, SolveScratch};
 
 /// The workspace and results of the constrained algorithms for one [`ConstraintSet`] (m rows)
@@ -69,10 +72,20 @@ pub struct ConstraintData {
     pub tau: DVector<f64>,
     /// The proximal iterations the last solve took (0: solved directly).
     pub iterations: usize,
-    /// z = L⁻ᵀ (τ − h) (nv), the free acceleration `a_f = M⁻¹ (τ − h)` half solved.
-    swept_force: DVector<f64>,
-    /// D⁻¹ z (nv).
-    scaled_force: DVector<f64>,
+    /// Y = K Jᵀ as rows (m × nv): each row of J taken as a generalised force through ABA's
+    /// inward pass, its u_i (see `articulated`): `Λ⁻¹ = Σ_i Y_iᵀ D_i⁻¹ Y_i`. Written by forward
+    /// dynamics and impulses.
+    transmitted_rows: DMatrix<f64>,
+    /// The forces the inward passes of a constraint's rows (at most 6) carry to each body
+    /// (nbodies; zero between uses).
+    body_forces: Vec<[Force; 6]>,
+    /// The bodies' accelerations: under the free acceleration, then those the forces add
+    /// (nbodies).
+    body_accelerations: Vec<Motion>,
+    /// Yᵀ λ (nv), or zero where an algorithm needs a zero velocity or torque.
+    joint_forces: DVector<f64>,
+    /// One body's columns of Y, row by row, and D_i⁻¹ times them (m pairs of 6-vectors).
+    body_rows: Vec<(Vector6<f64>, Vector6<f64>)>,
     /// The right-hand side of the last solve.
     rhs: Vec<f64>,
     /// Cholesky factor and scratch of the last solve (room for max(m, nv)).
@@ -99,8 +112,11 @@ impl ConstraintData {
             qdd: DVector::zeros(nv),
             tau: DVector::zeros(nv),
             iterations: 0,
-            swept_force: DVector::zeros(nv),
-            scaled_force: DVector::zeros(nv),
+            transmitted_rows: DMatrix::zeros(m, nv),
+            body_forces: vec![[Force::ZERO; 6]; model.nbodies()],
+            body_accelerations: vec![Motion::ZERO; model.nbodies()],
+            joint_forces: DVector::zeros(nv),
+            body_rows: vec![(Vector6::zeros(), Vector6::zeros()); m],
             rhs: vec![0.0; n],
             factor: vec![0.0; n * n],
             gram: vec![0.0; n * n],
@@ -112,7 +128,9 @@ impl ConstraintData {
 
     /// Whether this workspace was made for a set of `set`'s size on `model`.
     pub fn fits(&self, model: &Model, set: &ConstraintSet) -> bool {
-        self.jacobian.nrows() == set.rows() && self.jacobian.ncols() == model.nv
+        self.jacobian.nrows() == set.rows()
+            && self.jacobian.ncols() == model.nv
+            && self.body_forces.len() == model.nbodies()
     }
 }
 
@@ -152,10 +170,10 @@ fn rows_at_rest(
     set: &ConstraintSet,
     q: &[f64],
 ) -> Result<()> {
-    let mut rest = std::mem::take(&mut constraints.swept_force);
+    let mut rest = std::mem::take(&mut constraints.joint_forces);
     rest.fill(0.0);
     let result = constraint_rows(model, data, constraints, set, q, rest.as_slice());
-    constraints.swept_force = rest;
+    constraints.joint_forces = rest;
     result
 }
 
@@ -257,9 +275,17 @@ fn delassus_matrix(model: &Model, data: &Data, constraints: &mut ConstraintData)
     }
 }
 
-/// J M⁻¹ = (L⁻¹ D⁻¹ Y)ᵀ in `constraints.jacobian_inverse_inertia`, from the Y of
-/// [`delassus_matrix`]: the factor's second sweep.
-fn finish_jacobian_inverse_inertia(model: &Model, data: &Data, constraints: &mut ConstraintData) {
+/// M by CRBA and its factor, `Λ⁻¹` by [`delassus_matrix`] and
+/// `J M⁻¹ = (L⁻¹ D⁻¹ Y)ᵀ` in `constraints.jacobian_inverse_inertia` (the factor's second sweep),
+/// with J already in `constraints`: what the derivatives' saddle-point solves take.
+fn factor_with_rows(
+    model: &Model,
+    data: &mut Data,
+    constraints: &mut ConstraintData,
+    q: &[f64],
+) -> Result<()> {
+    factor_inertia(model, data, q)?;
+    delassus_matrix(model, data, constraints);
     let ConstraintData {
         factored_rows,
         jacobian_inverse_inertia,
@@ -267,6 +293,7 @@ fn finish_jacobian_inverse_inertia(model: &Model, data: &Data, constraints: &mut
     } = constraints;
     jacobian_inverse_inertia.copy_from(factored_rows);
     solve_lower_rows(model, data, jacobian_inverse_inertia.as_mut_slice());
+    Ok(())
 }
 
 /// Solves `Λ⁻¹ λ = rhs` (the right-hand side in `constraints.rhs`, computed from terms of size

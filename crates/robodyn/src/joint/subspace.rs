@@ -193,24 +193,53 @@ impl MotionSubspace<'_> {
             MotionSubspace::Axis { .. } => {
                 let d_inv = d[(0, 0)];
                 subtract_outer_upper(i_a, &u[0], &(u[0] * d_inv));
-                *p_a += u[0] * (d_inv * terms.u_tau[0]);
             }
             MotionSubspace::Columns { .. } => {
                 let nv_i = self.dofs().len();
                 for r in 0..nv_i {
                     // W_r = Σ_c D⁻¹_rc U_c, so that U D⁻¹ Uᵀ = Σ_r U_r W_rᵀ
                     let mut w_r = u[0] * d[(r, 0)];
-                    let mut d_inv_u = S::splat(0.0);
-                    for c in 0..nv_i {
-                        if c > 0 {
-                            w_r += u[c] * d[(r, c)];
-                        }
-                        d_inv_u += d[(r, c)] * terms.u_tau[c];
+                    for c in 1..nv_i {
+                        w_r += u[c] * d[(r, c)];
                     }
                     subtract_outer_upper(i_a, &u[r], &w_r);
-                    *p_a += u[r] * d_inv_u;
                 }
             }
+        }
+        self.add_bias_response(p_a, terms.u, terms.d_inv, terms.u_tau);
+    }
+
+    /// `u −= S_iᵀ p` on the joint's coordinates (`u[k]` for coordinate k): ABA's
+    /// `u_i = τ_i − S_iᵀ p_i` with τ_i in `u`.
+    #[inline(always)]
+    pub(crate) fn subtract_projection<S: Real>(&self, p: &Force<S>, u: &mut [S; 6]) {
+        match *self {
+            MotionSubspace::Axis { c, negative, .. } => u[0] -= signed(p.component(c), negative),
+            MotionSubspace::Columns { joint, .. } => {
+                for (k, u_k) in u.iter_mut().enumerate().take(joint.nv()) {
+                    *u_k -= joint.project_force(k, p);
+                }
+            }
+        }
+    }
+
+    /// `p += U D⁻¹ u` (`u_forces`: U's columns; `d_inv`: D⁻¹ in its leading block): ABA's bias
+    /// force passed on to the parent, before the transform.
+    #[inline(always)]
+    pub(crate) fn add_bias_response<S: Real>(
+        &self,
+        p: &mut Force<S>,
+        u_forces: &[Force<S>; 6],
+        d_inv: &Matrix6<S>,
+        u: &[S; 6],
+    ) {
+        let nv_i = self.dofs().len();
+        for r in 0..nv_i {
+            let mut d_inv_u = S::splat(0.0);
+            for c in 0..nv_i {
+                d_inv_u += d_inv[(r, c)] * u[c];
+            }
+            *p += u_forces[r] * d_inv_u;
         }
     }
 

@@ -16,8 +16,8 @@
 //! ```
 //! ∂ID/∂x with λ as forces on the bodies is RNEA's derivative; what RNEA misses of ∂(Jᵀλ)/∂q
 //! (forces that keep their direction while the bodies turn) and the rows' partials come from
-//! `constraint::derivatives`. The solve reuses forward dynamics' factor of M and its Delassus
-//! matrix: `dλ = (J M⁻¹ Jᵀ)⁻¹ (r₂ − J M⁻¹ r₁)`, `dq̈ = M⁻¹ (r₁ + Jᵀ dλ)`, column by column.
+//! `constraint::derivatives`. The solve factors M (CRBA, M = Lᵀ D L) and takes the Delassus
+//! matrix from that factor: `dλ = (J M⁻¹ Jᵀ)⁻¹ (r₂ − J M⁻¹ r₁)`, `dq̈ = M⁻¹ (r₁ + Jᵀ dλ)`, column by column.
 //! Impulses solve `M (q̇⁺ − q̇) − Jᵀ Λ = 0`, `J q̇⁺ + e J q̇ = 0`, differentiated the same way,
 //! with `∂(M Δq̇)/∂q = ∂ID(q, 0, Δq̇)/∂q − ∂g/∂q`.
 //! With damping (a redundant set, whose forces are the least-norm ones) the Delassus matrix is
@@ -29,9 +29,7 @@
 //! Baumgarte's terms are not differentiated: these are the derivatives of the exact equations.
 
 use super::solve::PseudoInverse;
-use super::{
-    constrained_forward_dynamics, finish_jacobian_inverse_inertia, impulse_dynamics, product_scale,
-};
+use super::{constrained_forward_dynamics, factor_with_rows, impulse_dynamics, product_scale};
 use super::{solve_delassus, ConstrainedOptions, ConstraintData};
 use crate::algo::derivatives::{rnea_derivatives, DerivativesInto};
 use crate::algo::ltdl::solve_rows;
@@ -151,7 +149,7 @@ pub fn constrained_forward_dynamics_derivatives(
         damping,
     };
     constrained_forward_dynamics(model, data, constraints, set, (q, v, tau), f_ext, &options)?;
-    finish_jacobian_inverse_inertia(model, data, constraints);
+    factor_with_rows(model, data, constraints, q)?;
 
     // ∂ID/∂q, ∂ID/∂q̇ at q̈ with λ (and f_ext) on the bodies: ID − Jᵀλ as RNEA has it
     let d = &mut *derivatives;
@@ -215,7 +213,7 @@ pub fn impulse_dynamics_derivatives(
 ) -> Result<()> {
     check_derivatives_fit(model, derivatives, set)?;
     impulse_dynamics(model, data, constraints, set, (q, v), restitution, damping)?;
-    finish_jacobian_inverse_inertia(model, data, constraints);
+    factor_with_rows(model, data, constraints, q)?;
     let d = &mut *derivatives;
 
     // ∂(M Δq̇ − JᵀΛ)/∂q = ∂ID(q, 0, Δq̇; Λ)/∂q − ∂g/∂q, Δq̇ = q̇⁺ − q̇

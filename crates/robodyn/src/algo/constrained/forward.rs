@@ -3,20 +3,18 @@
 //! Reference: Featherstone, *Rigid Body Dynamics Algorithms* (2008), §8.3 (the constraint forces
 //! from the constraint-space inverse inertia) and §11.6 (impulses); Pinocchio's
 //! `constraintDynamics` and `impulseDynamics` compute the same quantities. See the module's
-//! header for the equations. Inputs: q, q̇, τ (or only q, q̇), the constraint set. Writes
-//! `constraints.qdd`, `constraints.forces` and everything on the way (J, γ, φ, Y, Λ⁻¹), and
-//! in `data`: RNEA's fields, the mass matrix and its factor, the body placements. Cost: RNEA,
-//! CRBA and M's factor, one sweep of the factor per row and two for the forces, O(m² d) for Λ⁻¹
-//! (d: the coordinates the rows reach) and O(m³) to solve it.
+//! header for the equations; both run on the articulated-body algorithm's terms, M is never
+//! formed (`articulated`). Inputs: q, q̇, τ (or only q, q̇), the constraint set. Writes
+//! `constraints.qdd`, `constraints.forces` and everything on the way (J, γ, φ, Y, Λ⁻¹), and in
+//! `data`: ABA's fields (`data.qdd` the free acceleration) and the placements of the bodies the
+//! rows reach. Cost: ABA, O(d) per row (d: the bodies its constraint reaches), O(m² d) for Λ⁻¹,
+//! O(m³) to solve it and one outward pass for the forces' effect.
 
+use super::articulated::{articulated_delassus, constraint_response, free_motion_rows};
 use super::solve::largest;
-use super::{
-    constraint_rows, delassus_matrix, factor_inertia, product_scale, solve_forces, ConstraintData,
-};
-use crate::algo::ltdl::{solve_lower_rows, solve_transposed_rows};
-use crate::algo::rnea::newton_euler;
+use super::{product_scale, solve_forces, ConstraintData};
 use crate::constraint::ConstraintSet;
-use crate::error::{check_vector, Error, Result};
+use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::spatial::Force;
 use crate::Data;
@@ -66,45 +64,28 @@ pub fn constrained_forward_dynamics(
     options: &ConstrainedOptions,
 ) -> Result<()> {
     super::check_fits(model, constraints, set)?;
-    check_vector("v", v, model.nv)?;
-    check_vector("tau", tau, model.nv)?;
     options.check()?;
 
-    // z = L⁻ᵀ (τ − h), h = C q̇ + g − Σ Jᵀ f_ext (RNEA with q̈ = 0), M = Lᵀ D L; a_f = L⁻¹ D⁻¹ z
-    let h = newton_euler(model, data, q, Some(v), None, f_ext)?;
-    for ((z, t), b) in constraints.swept_force.iter_mut().zip(tau).zip(h.iter()) {
-        *z = t - b;
-    }
-    factor_inertia(model, data, q)?;
-    solve_transposed_rows(model, data, constraints.swept_force.as_mut_slice());
+    // a_f = ABA(q, q̇, τ, f_ext); J, φ, γ and the rows' acceleration J a_f + γ under it
+    free_motion_rows(model, data, constraints, set, (q, v, tau), f_ext)?;
+    // Y = K Jᵀ by each row's inward pass;  Λ⁻¹ = Σ_i Y_iᵀ D_i⁻¹ Y_i
+    articulated_delassus(model, data, constraints, set);
 
-    // J, γ, φ; then Y = L⁻ᵀ Jᵀ and Λ⁻¹ = Yᵀ D⁻¹ Y
-    constraint_rows(model, data, constraints, set, q, v)?;
-    delassus_matrix(model, data, constraints);
-
-    // Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ), J a_f = Yᵀ D⁻¹ z
+    // Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ)
     let m = set.rows();
     let ConstraintData {
         jacobian,
-        factored_rows,
         drift,
         error,
-        swept_force,
-        scaled_force,
         rhs,
         step,
         ..
     } = constraints;
-    for (k, (scaled, z)) in scaled_force.iter_mut().zip(swept_force.iter()).enumerate() {
-        *scaled = z / data.mass_matrix_factor[(k, k)];
-    }
     let mut right = DVectorViewMut::from_slice(&mut rhs[..m], m);
-    right.gemv(-1.0, factored_rows, scaled_force, 0.0);
-    right.axpy(-1.0, drift, 1.0);
+    right.neg_mut();
     let (kp, kd) = options.baumgarte.unwrap_or((0.0, 0.0));
-    let mut scale = 1.0
-        + product_scale(factored_rows, scaled_force.as_slice(), step)
-        + largest(drift.as_slice());
+    let mut scale =
+        1.0 + product_scale(jacobian, data.qdd.as_slice(), step) + largest(drift.as_slice());
     if kd != 0.0 {
         right.gemv(-kd, jacobian, &DVectorView::from_slice(v, v.len()), 1.0);
         scale += kd * product_scale(jacobian, v, step);
@@ -115,17 +96,11 @@ pub fn constrained_forward_dynamics(
     }
     solve_forces(model, set, constraints, options.damping, scale)?;
 
-    // q̈ = a_f + M⁻¹ Jᵀ λ = L⁻¹ D⁻¹ (z + Y λ)
-    let ConstraintData {
-        factored_rows,
-        forces,
-        swept_force,
-        qdd,
-        ..
-    } = constraints;
-    qdd.copy_from(swept_force);
-    qdd.gemv_tr(1.0, factored_rows, forces, 1.0);
-    solve_lower_rows(model, data, qdd.as_mut_slice());
+    // q̈ = a_f + M⁻¹ Jᵀ λ
+    let mut qdd = std::mem::take(&mut constraints.qdd);
+    constraint_response(model, data, constraints, qdd.as_mut_slice());
+    qdd += &data.qdd;
+    constraints.qdd = qdd;
     Ok(())
 }
 
@@ -142,7 +117,6 @@ pub fn impulse_dynamics(
     damping: f64,
 ) -> Result<()> {
     super::check_fits(model, constraints, set)?;
-    check_vector("v", v, model.nv)?;
     if !(0.0..=1.0).contains(&restitution) {
         return Err(Error::InvalidValue {
             argument: "restitution".into(),
@@ -154,9 +128,20 @@ pub fn impulse_dynamics(
         damping,
     };
     options.check()?;
-    factor_inertia(model, data, q)?;
-    constraint_rows(model, data, constraints, set, q, v)?;
-    delassus_matrix(model, data, constraints);
+    // ABA's terms at (q, q̇, τ = 0) and J
+    let mut zeros = std::mem::take(&mut constraints.joint_forces);
+    zeros.fill(0.0);
+    let rows = free_motion_rows(
+        model,
+        data,
+        constraints,
+        set,
+        (q, v, zeros.as_slice()),
+        None,
+    );
+    constraints.joint_forces = zeros;
+    rows?;
+    articulated_delassus(model, data, constraints, set);
 
     // Λ⁻¹ Λ = −(1 + e) J q̇
     let m = set.rows();
@@ -176,15 +161,10 @@ pub fn impulse_dynamics(
     let scale = 1.0 + (1.0 + restitution) * product_scale(jacobian, v, step);
     solve_forces(model, set, constraints, damping, scale)?;
 
-    // q̇⁺ = q̇ + M⁻¹ Jᵀ Λ = q̇ + L⁻¹ D⁻¹ (Y Λ)
-    let ConstraintData {
-        factored_rows,
-        forces,
-        qdd,
-        ..
-    } = constraints;
-    qdd.gemv_tr(1.0, factored_rows, forces, 0.0);
-    solve_lower_rows(model, data, qdd.as_mut_slice());
-    *qdd += velocity;
+    // q̇⁺ = q̇ + M⁻¹ Jᵀ Λ
+    let mut after = std::mem::take(&mut constraints.qdd);
+    constraint_response(model, data, constraints, after.as_mut_slice());
+    after += velocity;
+    constraints.qdd = after;
     Ok(())
 }
