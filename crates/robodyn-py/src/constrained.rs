@@ -5,6 +5,7 @@ use crate::args::*;
 use crate::constraints::constraint_set;
 use crate::model::*;
 use nalgebra::{DMatrix, DVector};
+use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyEllipsis, PySequence, PySlice, PyString, PyTuple};
@@ -92,14 +93,32 @@ impl PyModel {
         Self::split_parts(py, &whole, &parts)
     }
 
-    /// `(..., n)` results split along their last axis into a dict of views, each part named and
-    /// shaped as `parts` says (`(..., *shape)`), in order.
+    /// `(..., n)` results split along their last axis into a dict, each part named and shaped as
+    /// `parts` says (`(..., *shape)`), in order: views of a batch's array, copies of one state's.
     fn split_parts<'py>(
         py: Python<'py>,
         whole: &Bound<'py, PyAny>,
         parts: &[(&str, &[usize])],
     ) -> PyResult<Bound<'py, PyAny>> {
         let out = PyDict::new(py);
+        if let Ok(flat) = whole.cast::<PyArray1<f64>>() {
+            // one state: copies of its parts (a few numbers), far cheaper than views made by
+            // Python's indexing
+            let values = flat.readonly();
+            let values = values.as_slice()?;
+            let mut start = 0;
+            for (name, part) in parts {
+                let stop = start + part.iter().product::<usize>();
+                let array = PyArray1::from_slice(py, &values[start..stop]);
+                let shaped = match part.len() {
+                    1 => array.into_any(),
+                    _ => array.reshape(part.to_vec())?.into_any(),
+                };
+                out.set_item(PyString::new(py, name), shaped)?;
+                start = stop;
+            }
+            return Ok(out.into_any());
+        }
         let ellipsis = PyEllipsis::get(py);
         let shape: Vec<usize> = whole.getattr("shape")?.extract()?;
         let batch = &shape[..shape.len() - 1];
