@@ -155,11 +155,12 @@ impl Held {
         } else {
             Matrix3::identity()
         };
-        // J: the first point's columns minus the second's
+        // J: the first point's columns minus the second's (world axes: no turn)
+        let turned = |x: &Vec3| if local { axes * x } else { *x };
         for (motion, sign) in [(Some(first), 1.0), (self.second.as_ref(), -1.0)] {
             let Some(motion) = motion else { continue };
             point_columns(model, bodies, motion, |column, linear, angular| {
-                let full = six(&(axes * linear), &(axes * angular));
+                let full = six(&turned(linear), &turned(angular));
                 for (r, value) in kept(mask, &full) {
                     rows.jacobian[(row + r, column)] += sign * value;
                 }
