@@ -57,8 +57,8 @@ pub struct ConstraintData {
     pub drift: DVector<f64>,
     /// φ (m): how far each row is from holding (zero for a point held where it is).
     pub error: DVector<f64>,
-    /// Yᵀ = (L⁻ᵀ Jᵀ)ᵀ (m × nv), J half solved by M's factor: `Λ⁻¹ = Yᵀ D⁻¹ Y`. Written with
-    /// the Delassus matrix.
+    /// Yᵀ = (L⁻ᵀ Jᵀ)ᵀ (m × nv), J half solved by M's factor: `Λ⁻¹ = Yᵀ D⁻¹ Y`. Written by
+    /// [`delassus`] and the derivatives (forward dynamics and impulses do not factor M).
     pub factored_rows: DMatrix<f64>,
     /// J M⁻¹ (m × nv). Written by the derivatives (from [`ConstraintData::factored_rows`]).
     pub jacobian_inverse_inertia: DMatrix<f64>,
