@@ -14,8 +14,9 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::DVector;
 use rand::{rngs::StdRng, SeedableRng};
 use robodyn::algo::{
-    aba, constrained_forward_dynamics, constraint_jacobian, delassus, impulse_dynamics,
-    ConstrainedOptions, ConstraintData,
+    aba, constrained_forward_dynamics, constrained_forward_dynamics_derivatives,
+    constraint_jacobian, delassus, impulse_dynamics, ConstrainedDerivatives, ConstrainedOptions,
+    ConstraintData,
 };
 use robodyn::constraint::{
     Attachment, Constraint, ConstraintKind, ConstraintReference, ConstraintSet,
@@ -130,6 +131,23 @@ fn benchmarks(c: &mut Criterion) {
                 let state = (black_box(&q[..]), &impact[..]);
                 impulse_dynamics(&model, &mut data, &mut constraints, &set, state, 0.0, 0.0)
                     .map(|()| constraints.qdd[0])
+            })
+        });
+        let mut derivatives = ConstrainedDerivatives::new(&model, &set);
+        group.bench_function("forward_dynamics_derivatives", |b| {
+            b.iter(|| {
+                let state = (black_box(&q[..]), &v[..], &tau[..]);
+                constrained_forward_dynamics_derivatives(
+                    &model,
+                    &mut data,
+                    &mut constraints,
+                    &mut derivatives,
+                    &set,
+                    state,
+                    None,
+                    0.0,
+                )
+                .map(|()| derivatives.dqdd_dq[0])
             })
         });
         // the parts: ABA (a_f and the articulated inertias), then J and γ

@@ -45,7 +45,7 @@ use crate::model::Model;
 use crate::spatial::{Force, Motion};
 use crate::Data;
 use nalgebra::{DMatrix, DVector, Vector6};
-use solve::{solve_symmetric, SolveFailure, SolveScratch};
+use solve::{factor_symmetric, solve_symmetric, SolveFailure, SolveScratch};
 
 /// The workspace and results of the constrained algorithms for one [`ConstraintSet`] (m rows)
 /// on one model (nv coordinates). Made once by [`ConstraintData::new`].
@@ -306,52 +306,49 @@ fn solve_forces(
     damping: f64,
     scale: f64,
 ) -> Result<()> {
-    let mut forces = std::mem::take(&mut constraints.forces);
-    let solved = solve_delassus(
-        model,
-        set,
-        constraints,
-        damping,
-        scale,
-        forces.as_mut_slice(),
-    );
-    constraints.forces = forces;
-    constraints.iterations = solved?;
-    Ok(())
-}
-
-/// [`solve_forces`] into `x` (m) instead; returns the proximal iterations it took.
-fn solve_delassus(
-    model: &Model,
-    set: &ConstraintSet,
-    constraints: &mut ConstraintData,
-    damping: f64,
-    scale: f64,
-    x: &mut [f64],
-) -> Result<usize> {
-    let m = set.rows();
     let ConstraintData {
         delassus,
         rhs,
         factor,
         residual,
         step,
+        forces,
+        iterations,
         ..
     } = constraints;
     let scratch = SolveScratch { residual, step };
     let solved = solve_symmetric(
-        m,
+        set.rows(),
         delassus.as_slice(),
         factor,
         rhs,
-        x,
+        forces.as_mut_slice(),
         damping,
         scale,
         scratch,
     );
-    match solved {
-        Ok(n) => Ok(n),
-        Err(SolveFailure::DependentRow(row)) => Err(Error::InvalidValue {
+    *iterations = solved.map_err(|failure| refused(model, set, failure))?;
+    Ok(())
+}
+
+/// The Cholesky factor of the Delassus matrix in `constraints.factor` (for the derivatives'
+/// many right-hand sides); a dependent row is an error naming it, as for [`solve_forces`].
+fn factor_delassus(
+    model: &Model,
+    set: &ConstraintSet,
+    constraints: &mut ConstraintData,
+) -> Result<()> {
+    let ConstraintData {
+        delassus, factor, ..
+    } = constraints;
+    factor_symmetric(set.rows(), delassus.as_slice(), factor)
+        .map_err(|failure| refused(model, set, failure))
+}
+
+/// The error of a Delassus solve that failed, naming the row or the residual.
+fn refused(model: &Model, set: &ConstraintSet, failure: SolveFailure) -> Error {
+    match failure {
+        SolveFailure::DependentRow(row) => Error::InvalidValue {
             argument: "constraints".into(),
             message: format!(
                 "the constraints are redundant or singular at this configuration: {} is zero or \
@@ -359,14 +356,14 @@ fn solve_delassus(
                  forces",
                 set.describe_row(model, row)
             ),
-        }),
-        Err(SolveFailure::Inconsistent { residual, scale }) => Err(Error::InvalidValue {
+        },
+        SolveFailure::Inconsistent { residual, scale } => Error::InvalidValue {
             argument: "constraints".into(),
             message: format!(
                 "the constraints cannot all hold: the proximal iterations leave an acceleration \
                  (or velocity) residual of {residual:.3e}, {:.1e} of the terms' size {scale:.3e}",
                 residual / scale
             ),
-        }),
+        },
     }
 }

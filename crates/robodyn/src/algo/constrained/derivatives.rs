@@ -17,7 +17,8 @@
 //! ∂ID/∂x with λ as forces on the bodies is RNEA's derivative; what RNEA misses of ∂(Jᵀλ)/∂q
 //! (forces that keep their direction while the bodies turn) and the rows' partials come from
 //! `constraint::derivatives`. The solve factors M (CRBA, M = Lᵀ D L) and takes the Delassus
-//! matrix from that factor: `dλ = (J M⁻¹ Jᵀ)⁻¹ (r₂ − J M⁻¹ r₁)`, `dq̈ = M⁻¹ (r₁ + Jᵀ dλ)`, column by column.
+//! matrix from that factor, inverted once: `dλ = (J M⁻¹ Jᵀ)⁻¹ (r₂ − J M⁻¹ r₁)`,
+//! `dq̈ = M⁻¹ (r₁ + Jᵀ dλ)`, all columns of r₁ and r₂ at once.
 //! Impulses solve `M (q̇⁺ − q̇) − Jᵀ Λ = 0`, `J q̇⁺ + e J q̇ = 0`, differentiated the same way,
 //! with `∂(M Δq̇)/∂q = ∂ID(q, 0, Δq̇)/∂q − ∂g/∂q`.
 //! With damping (a redundant set, whose forces are the least-norm ones) the Delassus matrix is
@@ -28,9 +29,9 @@
 //! least-squares one.
 //! Baumgarte's terms are not differentiated: these are the derivatives of the exact equations.
 
-use super::solve::PseudoInverse;
-use super::{constrained_forward_dynamics, factor_with_rows, impulse_dynamics, product_scale};
-use super::{solve_delassus, ConstrainedOptions, ConstraintData};
+use super::solve::{cholesky_solve, pseudo_inverse};
+use super::{constrained_forward_dynamics, factor_delassus, factor_with_rows, impulse_dynamics};
+use super::{ConstrainedOptions, ConstraintData};
 use crate::algo::derivatives::{rnea_derivatives, DerivativesInto};
 use crate::algo::ltdl::solve_rows;
 use crate::constraint::{
@@ -66,8 +67,8 @@ pub struct ConstrainedDerivatives {
     /// q̇⁺ − q̇ or q̇⁺ + e q̇, and zeros (nv each).
     velocity: DVector<f64>,
     zeros: DVector<f64>,
-    /// One column of dλ.
-    column: Vec<f64>,
+    /// The saddle-point solves' scratch.
+    saddle: SaddleScratch,
 }
 
 /// ∂(rows)/∂q and ∂(rows)/∂q̇ with q̈ (or q̇⁺) held, what RNEA misses of ∂(Jᵀλ)/∂q, and the
@@ -120,7 +121,12 @@ impl ConstrainedDerivatives {
             body_forces: vec![Force::ZERO; model.nbodies().saturating_sub(1)],
             velocity: DVector::zeros(nv),
             zeros: DVector::zeros(nv),
-            column: vec![0.0; m],
+            saddle: SaddleScratch {
+                inverse: DMatrix::zeros(m, m),
+                transposed: DMatrix::zeros(nv, nv),
+                forces: DMatrix::zeros(m, nv),
+                response: DMatrix::zeros(nv, m),
+            },
         }
     }
 
@@ -193,7 +199,7 @@ pub fn constrained_forward_dynamics_derivatives(
         data,
         (constraints, set),
         pairs,
-        &mut d.column,
+        &mut d.saddle,
         damping,
     )
 }
@@ -269,78 +275,81 @@ pub fn impulse_dynamics_derivatives(
         data,
         (constraints, set),
         pairs,
-        &mut d.column,
+        &mut d.saddle,
         damping,
     )
 }
 
-/// How the Delassus systems of the derivatives are solved: by Cholesky (independent rows), or by
-/// its pseudo-inverse (with damping: rows that may depend on each other).
-enum Solver {
-    Cholesky,
-    PseudoInverse(PseudoInverse),
-}
-
-impl Solver {
-    fn new(constraints: &ConstraintData, damping: f64) -> Self {
-        if damping > 0.0 {
-            Solver::PseudoInverse(PseudoInverse::new(&constraints.delassus))
-        } else {
-            Solver::Cholesky
-        }
+/// `Λ = (J M⁻¹ Jᵀ)⁻¹` into `inverse` (m × m), for the derivatives' many right-hand sides: by
+/// Cholesky (independent rows; a dependent one is an error naming it), or with damping (rows
+/// that may depend on each other) the pseudo-inverse.
+fn invert_delassus(
+    model: &Model,
+    set: &ConstraintSet,
+    constraints: &mut ConstraintData,
+    damping: f64,
+    inverse: &mut DMatrix<f64>,
+) -> Result<()> {
+    if damping > 0.0 {
+        pseudo_inverse(&constraints.delassus, inverse);
+        return Ok(());
     }
+    factor_delassus(model, set, constraints)?;
+    inverse.fill_with_identity();
+    for mut column in inverse.column_iter_mut() {
+        cholesky_solve(
+            set.rows(),
+            constraints.factor.as_slice(),
+            column.as_mut_slice(),
+        );
+    }
+    Ok(())
 }
 
-/// [`solve_saddle_point`] for each pair of right-hand sides, with one [`Solver`].
+/// The scratch of [`solve_saddle_points`].
+#[derive(Debug, Clone)]
+struct SaddleScratch {
+    /// Λ (m × m).
+    inverse: DMatrix<f64>,
+    /// A right-hand side R₁ transposed (k × nv, k = nv), for the solve with M.
+    transposed: DMatrix<f64>,
+    /// Λ (R₂ − J X₀) (m × k).
+    forces: DMatrix<f64>,
+    /// (J M⁻¹)ᵀ = M⁻¹ Jᵀ (nv × m): a product with it goes to the blocked matrix product, one
+    /// with its transpose would not.
+    response: DMatrix<f64>,
+}
+
+/// Solves `[M −Jᵀ; J 0] [X; Y] = [R₁; R₂]` in place for each pair (R₁ in the first, nv × k; R₂ in
+/// the second, m × k) with forward dynamics' factor of M, J, J M⁻¹ and the Delassus matrix,
+/// inverted once: `X₀ = M⁻¹ R₁`, `Y = Λ (R₂ − J X₀)`, `X = X₀ + (J M⁻¹)ᵀ Y`.
 fn solve_saddle_points<'p>(
     model: &Model,
     data: &Data,
     (constraints, set): (&mut ConstraintData, &ConstraintSet),
     pairs: impl IntoIterator<Item = (&'p mut DMatrix<f64>, &'p mut DMatrix<f64>)>,
-    column: &mut [f64],
+    scratch: &mut SaddleScratch,
     damping: f64,
 ) -> Result<()> {
-    let solver = Solver::new(constraints, damping);
+    let SaddleScratch {
+        inverse,
+        transposed,
+        forces,
+        response,
+    } = scratch;
+    invert_delassus(model, set, constraints, damping, inverse)?;
+    constraints.jacobian_inverse_inertia.transpose_to(response);
     for (x, y) in pairs {
-        solve_saddle_point(model, data, constraints, set, (x, y), column, &solver)?;
+        // X₀ = M⁻¹ R₁: R₁ᵀ (column-major) holds R₁ row by row, all its columns solved at once
+        x.transpose_to(transposed);
+        solve_rows(model, data, transposed.as_mut_slice());
+        transposed.transpose_to(x);
+        // Y = Λ (R₂ − J X₀), X = X₀ + (J M⁻¹)ᵀ Y
+        y.gemm(-1.0, &constraints.jacobian, x, 1.0);
+        forces.gemm(1.0, inverse, y, 0.0);
+        y.copy_from(forces);
+        x.gemm(1.0, response, y, 1.0);
     }
-    Ok(())
-}
-
-/// Solves `[M −Jᵀ; J 0] [X; Y] = [R₁; R₂]` in place (R₁ in `x`, nv × k; R₂ in `y`, m × k) with
-/// forward dynamics' factor of M, J, J M⁻¹ and Delassus matrix:
-/// `X₀ = M⁻¹ R₁`, `Λ⁻¹ Y = R₂ − J X₀`, `X = X₀ + (J M⁻¹)ᵀ Y`.
-fn solve_saddle_point(
-    model: &Model,
-    data: &Data,
-    constraints: &mut ConstraintData,
-    set: &ConstraintSet,
-    (x, y): (&mut DMatrix<f64>, &mut DMatrix<f64>),
-    column: &mut [f64],
-    solver: &Solver,
-) -> Result<()> {
-    let m = set.rows();
-    for c in 0..x.ncols() {
-        // X₀ = M⁻¹ R₁, one column (contiguous, a right-hand side of width 1) at a time
-        solve_rows(model, data, x.column_mut(c).as_mut_slice());
-        let x0 = x.column(c);
-        for r in 0..m {
-            let row = constraints.jacobian.row(r);
-            let product: f64 = row.iter().zip(x0.iter()).map(|(j, x)| j * x).sum();
-            constraints.rhs[r] = y[(r, c)] - product;
-        }
-        match solver {
-            Solver::Cholesky => {
-                let scale = 1.0
-                    + product_scale(&constraints.jacobian, x0.as_slice(), &mut constraints.step)
-                    + super::solve::largest(&constraints.rhs[..m]);
-                solve_delassus(model, set, constraints, 0.0, scale, column)?;
-            }
-            Solver::PseudoInverse(inverse) => inverse.solve(&constraints.rhs[..m], column),
-        }
-        y.column_mut(c).copy_from_slice(column);
-    }
-    x.gemm_tr(1.0, &constraints.jacobian_inverse_inertia, y, 1.0);
     Ok(())
 }
 

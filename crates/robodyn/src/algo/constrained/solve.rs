@@ -74,13 +74,13 @@ pub(crate) fn solve_symmetric(
     scale: f64,
     scratch: SolveScratch,
 ) -> Result<usize, SolveFailure> {
-    factor[..n * n].copy_from_slice(&a[..n * n]);
     if damping == 0.0 {
-        cholesky(n, factor)?;
+        factor_symmetric(n, a, factor)?;
         x[..n].copy_from_slice(&b[..n]);
         cholesky_solve(n, factor, x);
         return Ok(0);
     }
+    factor[..n * n].copy_from_slice(&a[..n * n]);
     for k in 0..n {
         factor[k + k * n] += damping;
     }
@@ -129,6 +129,17 @@ pub(crate) fn solve_symmetric(
     })
 }
 
+/// The Cholesky factor of `a` (n × n, symmetric positive definite) into `factor`, for
+/// [`cholesky_solve`]; a dependent row is refused as by [`solve_symmetric`].
+pub(crate) fn factor_symmetric(
+    n: usize,
+    a: &[f64],
+    factor: &mut [f64],
+) -> Result<(), SolveFailure> {
+    factor[..n * n].copy_from_slice(&a[..n * n]);
+    cholesky(n, factor)
+}
+
 /// The largest magnitude of `values` (0 when empty).
 pub(crate) fn largest(values: &[f64]) -> f64 {
     values.iter().fold(0.0, |m, x| m.max(x.abs()))
@@ -164,7 +175,7 @@ fn cholesky(n: usize, a: &mut [f64]) -> Result<(), SolveFailure> {
 }
 
 /// Solves `L Lᵀ x = b` in place (b in `x`) with the factor of [`cholesky`].
-fn cholesky_solve(n: usize, l: &[f64], x: &mut [f64]) {
+pub(crate) fn cholesky_solve(n: usize, l: &[f64], x: &mut [f64]) {
     // L y = b
     for k in 0..n {
         let mut sum = x[k];
@@ -183,36 +194,20 @@ fn cholesky_solve(n: usize, l: &[f64], x: &mut [f64]) {
     }
 }
 
-/// The least-squares solution of least norm of `A x = b` for a symmetric positive semi-definite A,
-/// `x = A⁺ b = Σ u_i (u_iᵀ b) / σ_i` over the eigen-directions A reaches: those with σ_i above
+/// The pseudo-inverse `A⁺ = Σ u_i u_iᵀ / σ_i` of a symmetric positive semi-definite A into `out`
+/// (both m × m), over the eigen-directions A reaches: those with σ_i above
 /// [`DEPENDENT_ROW_TOLERANCE`] times the largest (the others are rows depending on the rest).
-/// Golub and Van Loan, §5.5 (the pseudo-inverse); §8.3 (the symmetric eigen-decomposition).
-pub(crate) struct PseudoInverse {
-    eigen: nalgebra::SymmetricEigen<f64, nalgebra::Dyn>,
-    cutoff: f64,
-}
-
-impl PseudoInverse {
-    /// The decomposition of `a` (allocates its m × m eigenvectors).
-    pub(crate) fn new(a: &nalgebra::DMatrix<f64>) -> Self {
-        let eigen = a.clone().symmetric_eigen();
-        let cutoff = DEPENDENT_ROW_TOLERANCE * eigen.eigenvalues.amax();
-        PseudoInverse { eigen, cutoff }
-    }
-
-    /// `x = A⁺ b`.
-    pub(crate) fn solve(&self, b: &[f64], x: &mut [f64]) {
-        x.fill(0.0);
-        let (values, vectors) = (&self.eigen.eigenvalues, &self.eigen.eigenvectors);
-        for (i, &sigma) in values.iter().enumerate() {
-            if sigma <= self.cutoff {
-                continue;
-            }
-            let u = vectors.column(i);
-            let along: f64 = u.iter().zip(b).map(|(ui, bi)| ui * bi).sum::<f64>() / sigma;
-            for (xk, uk) in x.iter_mut().zip(u.iter()) {
-                *xk += along * uk;
-            }
+/// `A⁺ b` is the least-squares solution of least norm of `A x = b`. Allocates the
+/// eigen-decomposition. Golub and Van Loan, §5.5 (the pseudo-inverse); §8.3 (the symmetric
+/// eigen-decomposition).
+pub(crate) fn pseudo_inverse(a: &nalgebra::DMatrix<f64>, out: &mut nalgebra::DMatrix<f64>) {
+    let eigen = a.clone().symmetric_eigen();
+    let cutoff = DEPENDENT_ROW_TOLERANCE * eigen.eigenvalues.amax();
+    out.fill(0.0);
+    for (i, &sigma) in eigen.eigenvalues.iter().enumerate() {
+        if sigma > cutoff {
+            let u = eigen.eigenvectors.column(i);
+            out.ger(1.0 / sigma, &u, &u, 1.0);
         }
     }
 }
