@@ -174,7 +174,11 @@ CONTACT_NAMES = {3: "feet", 6: "soles"}
 #: The constrained algorithms timed, as the rows name them -> their criterion benchmark in
 #: `cargo bench -p robodyn --bench constrained` (group `constrained/ROBOT`, which criterion keeps in
 #: its folder `constrained_ROBOT`).
-CONSTRAINED_ALGORITHMS = {"forward dynamics": "forward_dynamics", "impulse dynamics": "impulse_dynamics"}
+CONSTRAINED_ALGORITHMS = {"forward dynamics": "forward_dynamics", "impulse dynamics": "impulse_dynamics",
+                          "derivatives": "forward_dynamics_derivatives"}
+#: The derivatives of constrained forward dynamics, in the order of Pinocchio's
+#: `computeConstraintDynamicsDerivatives`.
+DERIVATIVE_KEYS = ("dqdd_dq", "dqdd_dv", "dqdd_dtau", "dforces_dq", "dforces_dv", "dforces_dtau")
 #: Before any timing, robodyn's results equal Pinocchio's to this, relative to each state's largest
 #: entry (Pinocchio's tests agree to 1e-9): a benchmark never times a wrong answer.
 AGREEMENT = 1e-8
@@ -274,6 +278,31 @@ def compare_constrained(name: str, batch: int) -> list[tuple[str, float, float]]
          *best_times(lambda: m.constrained_forward_dynamics(q, v, tau, contacts), lambda: pin_forward(pq, pv, ptau), 2000)),
         (constrained_case(name, "forward dynamics", batch),
          *batch_times(lambda: m.constrained_forward_dynamics(states, velocities, torques, contacts), pin_forward_loop)),
+    ]
+    # the derivatives: one call, and a batch of a tenth of the states (each state's result is
+    # six matrices)
+    derivative_batch = batch // 10
+
+    def pin_derivatives(x, w, t):
+        pin_forward(x, w, t)
+        return pin.computeConstraintDynamicsDerivatives(pm, pd, models, datas)
+
+    def pin_derivatives_loop():
+        for x, w, t in zip(pin_states[:derivative_batch], pin_velocities, pin_torques):
+            pin_derivatives(x, w, t)
+
+    ours = m.constrained_forward_dynamics_derivatives(q, v, tau, contacts)
+    for key, theirs in zip(DERIVATIVE_KEYS, pin_derivatives(pq, pv, ptau)):
+        expected = mapping.matrix_from_pinocchio(theirs) if key.startswith("dqdd") else mapping.jacobian_from_pinocchio(theirs)
+        assert_agree(f"{name} {key}", ours[key].ravel(), expected.ravel())
+    few = slice(0, derivative_batch)
+    rows += [
+        (constrained_case(name, "derivatives"),
+         *best_times(lambda: m.constrained_forward_dynamics_derivatives(q, v, tau, contacts),
+                     lambda: pin_derivatives(pq, pv, ptau), 200)),
+        (constrained_case(name, "derivatives", derivative_batch),
+         *batch_times(lambda: m.constrained_forward_dynamics_derivatives(states[few], velocities[few], torques[few], contacts),
+                      pin_derivatives_loop)),
     ]
     if name == "solo12":
         impulse_keys = ("v", "impulses")

@@ -97,7 +97,7 @@ impl AttachedColumns {
     ) {
         let Some(frame) = attachment.frame else {
             for matrix in self.matrices() {
-                matrix.fill(0.0);
+                matrix.as_mut_slice().fill(0.0);
             }
             self.rotation = attachment.placement.rotation;
             self.position = attachment.placement.translation;
@@ -111,10 +111,15 @@ impl AttachedColumns {
         let placement: Transform = attachment.placement * model.frames[frame].placement;
         update_support_placements(model, data, q, body);
         attached_motion_derivatives(model, data, (v, a), body, &placement, Reference::World);
-        self.jacobian.copy_from(&data.jacobian);
-        self.velocity_dq.copy_from(&data.frame_velocity_dq);
-        self.acceleration_dq.copy_from(&data.frame_acceleration_dq);
-        self.acceleration_dv.copy_from(&data.frame_acceleration_dv);
+        let computed = [
+            &data.jacobian,
+            &data.frame_velocity_dq,
+            &data.frame_acceleration_dq,
+            &data.frame_acceleration_dv,
+        ];
+        for (matrix, from) in self.matrices().into_iter().zip(computed) {
+            matrix.as_mut_slice().copy_from_slice(from.as_slice());
+        }
         let pose = placement * data.x_world[body];
         let p = pose.translation;
         // ṗ = ν_lin + ω × p;  p̈ = α_lin + ω̇ × p + ω × ṗ
@@ -260,9 +265,9 @@ pub(crate) fn differentiate_rows(
     scratch: &mut RowScratch,
     mut out: RowDerivatives,
 ) {
-    out.by_q.fill(0.0);
-    out.by_v.fill(0.0);
-    out.forces_by_q.fill(0.0);
+    for matrix in [&mut out.by_q, &mut out.by_v, &mut out.forces_by_q] {
+        matrix.as_mut_slice().fill(0.0);
+    }
     let RowScratch {
         first: one,
         second: other,

@@ -29,7 +29,7 @@
 //! least-squares one.
 //! Baumgarte's terms are not differentiated: these are the derivatives of the exact equations.
 
-use super::solve::{cholesky_solve, pseudo_inverse};
+use super::solve::{cholesky_solve_rows, pseudo_inverse};
 use super::{constrained_forward_dynamics, factor_delassus, factor_with_rows, impulse_dynamics};
 use super::{ConstrainedOptions, ConstraintData};
 use crate::algo::derivatives::{rnea_derivatives, DerivativesInto};
@@ -179,16 +179,12 @@ pub fn constrained_forward_dynamics_derivatives(
     d.rows.differentiate(model, data, set, q, level, lambda);
 
     // r₁ = ∂τ/∂x − ∂(ID − Jᵀλ)/∂x,  r₂ = −∂(J q̈ + γ)/∂x
-    d.dqdd_dq.copy_from(&d.rows.forces_by_q);
-    d.dqdd_dq -= &data.dtau_dq;
-    d.dqdd_dv.copy_from(&data.dtau_dv);
-    d.dqdd_dv.neg_mut();
+    difference_into(&mut d.dqdd_dq, &d.rows.forces_by_q, &data.dtau_dq);
+    negated_into(&mut d.dqdd_dv, &data.dtau_dv);
     d.dqdd_dtau.fill_with_identity();
-    d.dforces_dq.copy_from(&d.rows.by_q);
-    d.dforces_dq.neg_mut();
-    d.dforces_dv.copy_from(&d.rows.by_v);
-    d.dforces_dv.neg_mut();
-    d.dforces_dtau.fill(0.0);
+    negated_into(&mut d.dforces_dq, &d.rows.by_q);
+    negated_into(&mut d.dforces_dv, &d.rows.by_v);
+    d.dforces_dtau.as_mut_slice().fill(0.0);
     let pairs = [
         (&mut d.dqdd_dq, &mut d.dforces_dq),
         (&mut d.dqdd_dv, &mut d.dforces_dv),
@@ -244,8 +240,7 @@ pub fn impulse_dynamics_derivatives(
         Some(&d.body_forces),
         DerivativesInto::Data,
     )?;
-    d.dqdd_dq.copy_from(&data.dtau_dq);
-    d.dqdd_dq.neg_mut();
+    negated_into(&mut d.dqdd_dq, &data.dtau_dq);
     rnea_derivatives(model, data, q, zeros, zeros, None, DerivativesInto::Data)?;
     d.dqdd_dq += &data.dtau_dq;
 
@@ -262,8 +257,7 @@ pub fn impulse_dynamics_derivatives(
     // r₁ = (∂(JᵀΛ)/∂q missed) − ∂(MΔq̇ − JᵀΛ)/∂q and M;  r₂ = −∂(J w)/∂q and −e J
     d.dqdd_dq += &d.rows.forces_by_q;
     d.dqdd_dv.copy_from(&data.mass_matrix);
-    d.dforces_dq.copy_from(&d.rows.by_q);
-    d.dforces_dq.neg_mut();
+    negated_into(&mut d.dforces_dq, &d.rows.by_q);
     d.dforces_dv.copy_from(&constraints.jacobian);
     d.dforces_dv *= -restitution;
     let pairs = [
@@ -295,14 +289,13 @@ fn invert_delassus(
         return Ok(());
     }
     factor_delassus(model, set, constraints)?;
+    // Λ is symmetric: solving for the identity row by row gives it as well as column by column
     inverse.fill_with_identity();
-    for mut column in inverse.column_iter_mut() {
-        cholesky_solve(
-            set.rows(),
-            constraints.factor.as_slice(),
-            column.as_mut_slice(),
-        );
-    }
+    cholesky_solve_rows(
+        set.rows(),
+        constraints.factor.as_slice(),
+        inverse.as_mut_slice(),
+    );
     Ok(())
 }
 
@@ -347,10 +340,29 @@ fn solve_saddle_points<'p>(
         // Y = Λ (R₂ − J X₀), X = X₀ + (J M⁻¹)ᵀ Y
         y.gemm(-1.0, &constraints.jacobian, x, 1.0);
         forces.gemm(1.0, inverse, y, 0.0);
-        y.copy_from(forces);
+        y.as_mut_slice().copy_from_slice(forces.as_slice());
         x.gemm(1.0, response, y, 1.0);
     }
     Ok(())
+}
+
+/// `out = a − b` (matrices of one shape), element by element over their storage.
+fn difference_into(out: &mut DMatrix<f64>, a: &DMatrix<f64>, b: &DMatrix<f64>) {
+    for ((o, a), b) in out
+        .as_mut_slice()
+        .iter_mut()
+        .zip(a.as_slice())
+        .zip(b.as_slice())
+    {
+        *o = a - b;
+    }
+}
+
+/// `out = −a` (matrices of one shape).
+fn negated_into(out: &mut DMatrix<f64>, a: &DMatrix<f64>) {
+    for (o, a) in out.as_mut_slice().iter_mut().zip(a.as_slice()) {
+        *o = -a;
+    }
 }
 
 /// Refuses a derivatives workspace made for another set or model.

@@ -174,23 +174,43 @@ fn cholesky(n: usize, a: &mut [f64]) -> Result<(), SolveFailure> {
     Ok(())
 }
 
-/// Solves `L Lᵀ x = b` in place (b in `x`) with the factor of [`cholesky`].
+/// Solves `L Lᵀ x = b` in place (b in `x[..n]`) with the factor of [`cholesky`].
 pub(crate) fn cholesky_solve(n: usize, l: &[f64], x: &mut [f64]) {
-    // L y = b
-    for k in 0..n {
-        let mut sum = x[k];
-        for j in 0..k {
-            sum -= l[k + j * n] * x[j];
-        }
-        x[k] = sum / l[k + k * n];
+    cholesky_solve_rows(n, l, &mut x[..n]);
+}
+
+/// Solves `L Lᵀ X = B` in place for B stored row by row in `rows` (row i at `i * w..(i + 1) *
+/// w`, w = rows.len() / n): each step updates a whole row, all columns at once.
+pub(crate) fn cholesky_solve_rows(n: usize, l: &[f64], rows: &mut [f64]) {
+    if n == 0 {
+        return;
     }
-    // Lᵀ x = y
-    for k in (0..n).rev() {
-        let mut sum = x[k];
-        for j in k + 1..n {
-            sum -= l[j + k * n] * x[j];
+    let w = rows.len() / n;
+    // L Y = B: y_k = (b_k − Σ_{j<k} L_kj y_j) / L_kk
+    for k in 0..n {
+        let (done, rest) = rows.split_at_mut(k * w);
+        let row = &mut rest[..w];
+        for (j, y_j) in done.chunks_exact(w).enumerate() {
+            let l_kj = l[k + j * n];
+            for (x, y) in row.iter_mut().zip(y_j) {
+                *x -= l_kj * y;
+            }
         }
-        x[k] = sum / l[k + k * n];
+        let inverse = 1.0 / l[k + k * n];
+        row.iter_mut().for_each(|x| *x *= inverse);
+    }
+    // Lᵀ X = Y: x_k = (y_k − Σ_{j>k} L_jk x_j) / L_kk
+    for k in (0..n).rev() {
+        let (before, done) = rows.split_at_mut((k + 1) * w);
+        let row = &mut before[k * w..];
+        for (j, x_j) in done.chunks_exact(w).enumerate() {
+            let l_jk = l[(k + 1 + j) + k * n];
+            for (x, y) in row.iter_mut().zip(x_j) {
+                *x -= l_jk * y;
+            }
+        }
+        let inverse = 1.0 / l[k + k * n];
+        row.iter_mut().for_each(|x| *x *= inverse);
     }
 }
 
@@ -253,6 +273,30 @@ mod tests {
         for i in 0..3 {
             let ax: f64 = (0..3).map(|j| a[i + 3 * j] * x[j]).sum();
             assert!((ax - b[i]).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn many_right_hand_sides_solve_as_each_alone() {
+        // A = B Bᵀ + 1, positive definite; X = A⁻¹ (rows of B as right-hand sides)
+        let (a, _) = singular();
+        let a: Vec<f64> = (0..9)
+            .map(|k| a[k] + if k % 4 == 0 { 1.0 } else { 0.0 })
+            .collect();
+        let mut factor = vec![0.0; 9];
+        factor_symmetric(3, &a, &mut factor).unwrap();
+        let mut rows = vec![1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+        cholesky_solve_rows(3, &factor, &mut rows);
+        for c in 0..3 {
+            let mut x = [0.0; 3];
+            x[c] = 1.0;
+            cholesky_solve(3, &factor, &mut x);
+            for r in 0..3 {
+                assert!((rows[r * 3 + c] - x[r]).abs() < 1e-15);
+                // A x = e_c
+                let ax: f64 = (0..3).map(|j| a[r + 3 * j] * x[j]).sum();
+                assert!((ax - if r == c { 1.0 } else { 0.0 }).abs() < 1e-12);
+            }
         }
     }
 
