@@ -67,6 +67,24 @@ def test_batches_equal_one_state_at_a_time(ur5):
         np.testing.assert_array_equal(impulses["v"][k], ur5.impulse_dynamics(q[k], v[k], constraints, restitution=0.5)["v"])
 
 
+def test_a_list_passed_again_or_changed_gives_its_own_answer(ur5):
+    # a call resolves the constraint objects it is given; the same objects again reuse that
+    # set, other objects (a changed list, equal new objects) are resolved anew
+    q = ur5.random_configuration(seed=6)
+    tool, wrist = robodyn.PointAnchor("tool0"), robodyn.PointAnchor("wrist_1_link")
+    constraints = [tool]
+    first = ur5.constraint_jacobian(q, constraints)
+    assert_close(ur5.constraint_jacobian(q, constraints), first, 0.0)
+    constraints[0] = wrist
+    assert_close(ur5.constraint_jacobian(q, constraints), ur5.jacobian(q, "wrist_1_link")[:3], IDENTITY_TOLERANCE)
+    constraints.append(tool)
+    assert ur5.constraint_jacobian(q, constraints).shape == (6, ur5.nv)
+    assert_close(ur5.constraint_jacobian(q, [robodyn.PointAnchor("tool0")]), first, 0.0)
+    with pytest.raises(ValueError, match="unknown"):
+        ur5.constraint_jacobian(q, [tool, robodyn.PointAnchor("no_such_frame")])
+    assert_close(ur5.constraint_jacobian(q, tool), first, 0.0)
+
+
 def test_delassus_and_impulses(ur5):
     q, v = ur5.random_configuration(seed=6), np.linspace(-1, 1, ur5.nv)
     constraints = loop(ur5)

@@ -13,6 +13,7 @@ use robodyn::constraint::{
 };
 use robodyn::spatial::Transform;
 use robodyn::Model;
+use std::sync::Arc;
 
 /// How far from orthonormal a placement's rotation may be (|RᵀR − 1|∞).
 const ROTATION_TOLERANCE: f64 = 1e-9;
@@ -319,28 +320,70 @@ impl PyDistance {
 }
 
 /// The constraints of argument `constraints` (one constraint or a sequence of them) resolved
-/// against `model`.
-pub(crate) fn constraint_set(model: &PyModel, value: &Bound<PyAny>) -> PyResult<ConstraintSet> {
-    let mut constraints = Vec::new();
-    if is_constraint(value) {
-        constraints.push(resolve(model, value, 0)?);
-    } else {
-        let sequence = value
-            .cast::<PySequence>()
-            .ok()
-            .filter(|_| !value.is_instance_of::<PyString>());
-        let sequence = sequence.ok_or_else(|| {
-            PyValueError::new_err(format!(
-                "argument 'constraints': expected a constraint (PointAnchor, FrameAnchor, \
-                 JointCoupling, Distance) or a list of them, got {}",
-                describe(value)
-            ))
-        })?;
-        for (k, item) in sequence.try_iter()?.enumerate() {
-            constraints.push(resolve(model, &item?, k)?);
-        }
+/// against `model`, or the set of the last call where it passed the same objects.
+pub(crate) fn constraint_set(
+    model: &PyModel,
+    value: &Bound<PyAny>,
+) -> PyResult<Arc<ConstraintSet>> {
+    let items = constraint_items(value)?;
+    let mut last = model
+        .last_constraints
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    if let Some(resolved) = last.as_ref().filter(|r| r.made_from(&items)) {
+        return Ok(resolved.set.clone());
     }
-    ConstraintSet::new(&model.model, constraints).map_err(crate::to_py_err)
+    let constraints = items
+        .iter()
+        .enumerate()
+        .map(|(k, item)| resolve(model, item, k))
+        .collect::<PyResult<Vec<_>>>()?;
+    let set = Arc::new(ConstraintSet::new(&model.model, constraints).map_err(crate::to_py_err)?);
+    *last = Some(ResolvedConstraints {
+        objects: items.into_iter().map(Bound::unbind).collect(),
+        set: set.clone(),
+    });
+    Ok(set)
+}
+
+/// The constraint objects of the argument `constraints`: one, or a sequence of them.
+fn constraint_items<'py>(value: &Bound<'py, PyAny>) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    if is_constraint(value) {
+        return Ok(vec![value.clone()]);
+    }
+    let sequence = value
+        .cast::<PySequence>()
+        .ok()
+        .filter(|_| !value.is_instance_of::<PyString>());
+    let sequence = sequence.ok_or_else(|| {
+        PyValueError::new_err(format!(
+            "argument 'constraints': expected a constraint (PointAnchor, FrameAnchor, \
+             JointCoupling, Distance) or a list of them, got {}",
+            describe(value)
+        ))
+    })?;
+    sequence.try_iter()?.collect()
+}
+
+/// The set the last call resolved, with the objects it came from. The constraint classes are
+/// frozen and final, so the same objects in the same order resolve to the same set: a loop
+/// that passes one list again and again resolves it once. The objects are held, so their
+/// identities stay theirs.
+pub(crate) struct ResolvedConstraints {
+    objects: Vec<Py<PyAny>>,
+    set: Arc<ConstraintSet>,
+}
+
+impl ResolvedConstraints {
+    /// Whether `items` are the very objects this set came from, in order.
+    fn made_from(&self, items: &[Bound<PyAny>]) -> bool {
+        self.objects.len() == items.len()
+            && self
+                .objects
+                .iter()
+                .zip(items)
+                .all(|(o, i)| o.as_ptr() == i.as_ptr())
+    }
 }
 
 fn is_constraint(value: &Bound<PyAny>) -> bool {

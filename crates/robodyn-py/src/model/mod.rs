@@ -18,6 +18,7 @@ pub(crate) use schedule::Kernel;
 pub(crate) use workspace::{fill_forces, Workspace, WorkspacePool};
 
 use crate::args::*;
+use crate::constraints::ResolvedConstraints;
 use crate::to_py_err;
 use nalgebra::DMatrix;
 use pyo3::exceptions::PyValueError;
@@ -53,6 +54,8 @@ pub(crate) struct PyModel {
     /// Frame name to index, for the calls that take a frame by name (a fast hash: the names are
     /// the model's own, and SipHash had cost a tenth of a Talos Jacobian call's fixed cost).
     pub(crate) frame_indices: FxHashMap<String, usize>,
+    /// The constraint set the last constrained call resolved (see `ResolvedConstraints`).
+    pub(crate) last_constraints: Mutex<Option<ResolvedConstraints>>,
 }
 
 impl PyModel {
@@ -68,6 +71,7 @@ impl PyModel {
             workspace,
             batch_workspaces: WorkspacePool::default(),
             frame_indices,
+            last_constraints: Mutex::new(None),
         }
     }
 

@@ -57,7 +57,11 @@ impl ConstrainedArguments<'_, '_> {
             damping: self.damping,
         };
         options.check().map_err(to_py_err)?;
-        Ok(Some(Constrained::new(&model.model, set, options)))
+        Ok(Some(Constrained::new(
+            &model.model,
+            std::sync::Arc::unwrap_or_clone(set),
+            options,
+        )))
     }
 }
 
