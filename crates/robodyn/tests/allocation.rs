@@ -297,7 +297,8 @@ fn algorithms_allocate_nothing_after_data_new() {
 }
 
 /// Constrained forward dynamics and its derivatives allocate nothing after their workspaces are
-/// made (a point of the last body held: three independent rows on six or more coordinates).
+/// made (the frame of the last body held: six independent rows on six or more coordinates, more
+/// than the five below which nalgebra's products stay unblocked).
 fn constrained_allocations(
     name: &str,
     model: &robodyn::Model,
@@ -307,14 +308,15 @@ fn constrained_allocations(
     use robodyn::constraint::{Attachment, Constraint, ConstraintKind, ConstraintReference};
     let last = model.nbodies() - 1;
     let frame = model.frames.iter().position(|f| f.body == last).unwrap();
-    let point = Constraint {
-        kind: ConstraintKind::Point {
+    let held = Constraint {
+        kind: ConstraintKind::Frame {
             first: Attachment::at_frame(frame),
             second: None,
+            mask: [true; 6],
         },
         reference: ConstraintReference::World,
     };
-    let set = robodyn::constraint::ConstraintSet::new(model, vec![point]).unwrap();
+    let set = robodyn::constraint::ConstraintSet::new(model, vec![held]).unwrap();
     let mut c = ConstraintData::new(model, &set);
     let mut d = ConstrainedDerivatives::new(model, &set);
     let options = ConstrainedOptions::default();

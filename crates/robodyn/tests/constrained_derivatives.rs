@@ -59,6 +59,19 @@ fn check_columns(
     }
 }
 
+/// q̈ and λ (or q̇⁺ and Λ) of two routes to them agree to this, relative to the largest of them.
+const SAME_DYNAMICS: f64 = 1e-9;
+
+fn assert_same_dynamics(label: &str, ours: &DVector<f64>, other: &DVector<f64>) {
+    let scale = other.amax().max(1.0);
+    let difference = (ours - other).amax();
+    assert!(
+        difference <= SAME_DYNAMICS * scale,
+        "{label}: the derivatives' dynamics differ from the dynamics' own by {difference:e} \
+         (scale {scale:e})"
+    );
+}
+
 /// The derivatives at (q, q̇, τ) with their workspaces, and the options of the dynamics they
 /// differentiate.
 fn derivatives_at(
@@ -99,7 +112,7 @@ fn check_forward(
     f_ext: Option<&[Force]>,
     (damping, h, tolerance): (f64, f64, f64),
 ) {
-    let (mut data, _, d, options) = derivatives_at(model, set, (q, v, tau), f_ext, damping);
+    let (mut data, c, d, options) = derivatives_at(model, set, (q, v, tau), f_ext, damping);
     let mut dynamics = |q: &DVector<f64>, v: &DVector<f64>, tau: &DVector<f64>| {
         let mut other = ConstraintData::new(model, set);
         let args = (q.as_slice(), v.as_slice(), tau.as_slice());
@@ -107,6 +120,8 @@ fn check_forward(
             .unwrap();
         stacked(&other)
     };
+    // the derivatives solve q̈ and λ with M's factor, forward dynamics with ABA's terms
+    assert_same_dynamics(label, &stacked(&c), &dynamics(q, v, tau));
     let nv = model.nv;
     let size = (nv, h, tolerance);
     check_columns(
@@ -253,6 +268,7 @@ fn impulse_derivatives_equal_finite_differences() {
                 stacked(&other)
             };
             let label = format!("{name} impulses, e = {restitution}");
+            assert_same_dynamics(&label, &stacked(&c), &impulses(&q, &v));
             let size = (model.nv, FD_STEP, FD_TOLERANCE);
             check_columns(
                 &format!("{label}: d/dq"),

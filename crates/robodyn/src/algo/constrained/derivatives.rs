@@ -16,8 +16,8 @@
 //! ```
 //! ∂ID/∂x with λ as forces on the bodies is RNEA's derivative; what RNEA misses of ∂(Jᵀλ)/∂q
 //! (forces that keep their direction while the bodies turn) and the rows' partials come from
-//! `constraint::derivatives`. The solve factors M (CRBA, M = Lᵀ D L) and takes the Delassus
-//! matrix from that factor, inverted once: `dλ = (J M⁻¹ Jᵀ)⁻¹ (r₂ − J M⁻¹ r₁)`,
+//! `constraint::derivatives`. M is factored (CRBA, M = Lᵀ D L), q̈ and λ themselves are solved
+//! with that factor, and so is the saddle point, with the Delassus matrix inverted once: `dλ = (J M⁻¹ Jᵀ)⁻¹ (r₂ − J M⁻¹ r₁)`,
 //! `dq̈ = M⁻¹ (r₁ + Jᵀ dλ)`, all columns of r₁ and r₂ at once.
 //! Impulses solve `M (q̇⁺ − q̇) − Jᵀ Λ = 0`, `J q̇⁺ + e J q̇ = 0`, differentiated the same way,
 //! with `∂(M Δq̇)/∂q = ∂ID(q, 0, Δq̇)/∂q − ∂g/∂q`.
@@ -29,19 +29,23 @@
 //! least-squares one.
 //! Baumgarte's terms are not differentiated: these are the derivatives of the exact equations.
 
-use super::solve::{cholesky_solve_rows, pseudo_inverse};
-use super::{constrained_forward_dynamics, factor_delassus, factor_with_rows, impulse_dynamics};
+use super::forward::{solve_accelerated_forces, solve_impulses};
+use super::solve::{cholesky_solve_rows, multiply_add, pseudo_inverse};
+use super::{check_fits, constraint_rows, factor_delassus, factor_with_rows};
+#[cfg(doc)]
+use super::{constrained_forward_dynamics, impulse_dynamics};
 use super::{ConstrainedOptions, ConstraintData};
 use crate::algo::derivatives::{rnea_derivatives, DerivativesInto};
 use crate::algo::ltdl::solve_rows;
+use crate::algo::rnea::rnea;
 use crate::constraint::{
     add_body_forces, differentiate_rows, ConstraintSet, RowDerivatives, RowLevel, RowScratch,
 };
-use crate::error::{Error, Result};
+use crate::error::{check_vector, Error, Result};
 use crate::model::Model;
 use crate::spatial::Force;
 use crate::Data;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, DVectorViewMut};
 
 /// The derivatives of [`constrained_forward_dynamics`] (or of [`impulse_dynamics`]) for one
 /// [`ConstraintSet`] (m rows) on one model (nv coordinates), with their workspace. Made once by
@@ -154,8 +158,7 @@ pub fn constrained_forward_dynamics_derivatives(
         baumgarte: None,
         damping,
     };
-    constrained_forward_dynamics(model, data, constraints, set, (q, v, tau), f_ext, &options)?;
-    factor_with_rows(model, data, constraints, q)?;
+    factored_forward_dynamics(model, data, constraints, set, (q, v, tau), f_ext, &options)?;
 
     // ∂ID/∂q, ∂ID/∂q̇ at q̈ with λ (and f_ext) on the bodies: ID − Jᵀλ as RNEA has it
     let d = &mut *derivatives;
@@ -214,8 +217,7 @@ pub fn impulse_dynamics_derivatives(
     damping: f64,
 ) -> Result<()> {
     check_derivatives_fit(model, derivatives, set)?;
-    impulse_dynamics(model, data, constraints, set, (q, v), restitution, damping)?;
-    factor_with_rows(model, data, constraints, q)?;
+    factored_impulse_dynamics(model, data, constraints, set, (q, v), restitution, damping)?;
     let d = &mut *derivatives;
 
     // ∂(M Δq̇ − JᵀΛ)/∂q = ∂ID(q, 0, Δq̇; Λ)/∂q − ∂g/∂q, Δq̇ = q̇⁺ − q̇
@@ -274,6 +276,76 @@ pub fn impulse_dynamics_derivatives(
     )
 }
 
+/// [`constrained_forward_dynamics`] from M's factor instead of ABA's terms: the derivatives need
+/// M, its factor, J M⁻¹ and Λ⁻¹ (left in `data` and `constraints`), and with them q̈ and λ are a
+/// few solves away. `a_f = M⁻¹ (τ − h)` (h: RNEA at q̈ = 0, with f_ext), λ as there, then
+/// `q̈ = a_f + (J M⁻¹)ᵀ λ`; the free acceleration stays in `data.qdd`.
+fn factored_forward_dynamics(
+    model: &Model,
+    data: &mut Data,
+    constraints: &mut ConstraintData,
+    set: &ConstraintSet,
+    (q, v, tau): (&[f64], &[f64], &[f64]),
+    f_ext: Option<&[Force]>,
+    options: &ConstrainedOptions,
+) -> Result<()> {
+    check_fits(model, constraints, set)?;
+    options.check()?;
+    check_vector("tau", tau, model.nv)?;
+    // J, γ, φ; M, its factor, Λ⁻¹ and J M⁻¹
+    constraint_rows(model, data, constraints, set, q, v)?;
+    factor_with_rows(model, data, constraints, q)?;
+
+    // a_f = M⁻¹ (τ − h);  J a_f + γ
+    let mut zeros = std::mem::take(&mut constraints.joint_forces);
+    zeros.fill(0.0);
+    let bias = rnea(model, data, q, v, zeros.as_slice(), f_ext).map(|_| ());
+    constraints.joint_forces = zeros;
+    bias?;
+    let mut free = std::mem::take(&mut data.qdd);
+    for ((a, t), h) in free.iter_mut().zip(tau).zip(data.tau.iter()) {
+        *a = t - h;
+    }
+    solve_rows(model, data, free.as_mut_slice());
+    data.qdd = free;
+    let m = set.rows();
+    let mut rows = DVectorViewMut::from_slice(&mut constraints.rhs[..m], m);
+    rows.copy_from(&constraints.drift);
+    rows.gemv(1.0, &constraints.jacobian, &data.qdd, 1.0);
+
+    // Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ);  q̈ = a_f + (J M⁻¹)ᵀ λ
+    solve_accelerated_forces(model, set, constraints, (v, data.qdd.as_slice()), options)?;
+    constraints.qdd.copy_from(&data.qdd);
+    let response = &constraints.jacobian_inverse_inertia;
+    constraints
+        .qdd
+        .gemv_tr(1.0, response, &constraints.forces, 1.0);
+    Ok(())
+}
+
+/// [`impulse_dynamics`] from M's factor, as [`factored_forward_dynamics`]:
+/// `q̇⁺ = q̇ + (J M⁻¹)ᵀ Λ`.
+fn factored_impulse_dynamics(
+    model: &Model,
+    data: &mut Data,
+    constraints: &mut ConstraintData,
+    set: &ConstraintSet,
+    (q, v): (&[f64], &[f64]),
+    restitution: f64,
+    damping: f64,
+) -> Result<()> {
+    check_fits(model, constraints, set)?;
+    constraint_rows(model, data, constraints, set, q, v)?;
+    factor_with_rows(model, data, constraints, q)?;
+    solve_impulses(model, set, constraints, v, restitution, damping)?;
+    constraints.qdd.copy_from_slice(v);
+    let response = &constraints.jacobian_inverse_inertia;
+    constraints
+        .qdd
+        .gemv_tr(1.0, response, &constraints.forces, 1.0);
+    Ok(())
+}
+
 /// `Λ = (J M⁻¹ Jᵀ)⁻¹` into `inverse` (m × m), for the derivatives' many right-hand sides: by
 /// Cholesky (independent rows; a dependent one is an error naming it), or with damping (rows
 /// that may depend on each other) the pseudo-inverse.
@@ -308,8 +380,7 @@ struct SaddleScratch {
     transposed: DMatrix<f64>,
     /// Λ (R₂ − J X₀) (m × k).
     forces: DMatrix<f64>,
-    /// (J M⁻¹)ᵀ = M⁻¹ Jᵀ (nv × m): a product with it goes to the blocked matrix product, one
-    /// with its transpose would not.
+    /// (J M⁻¹)ᵀ = M⁻¹ Jᵀ (nv × m): a product with it runs down contiguous columns.
     response: DMatrix<f64>,
 }
 
@@ -338,10 +409,10 @@ fn solve_saddle_points<'p>(
         solve_rows(model, data, transposed.as_mut_slice());
         transposed.transpose_to(x);
         // Y = Λ (R₂ − J X₀), X = X₀ + (J M⁻¹)ᵀ Y
-        y.gemm(-1.0, &constraints.jacobian, x, 1.0);
-        forces.gemm(1.0, inverse, y, 0.0);
+        multiply_add(y, -1.0, &constraints.jacobian, x, 1.0);
+        multiply_add(forces, 1.0, inverse, y, 0.0);
         y.as_mut_slice().copy_from_slice(forces.as_slice());
-        x.gemm(1.0, response, y, 1.0);
+        multiply_add(x, 1.0, response, y, 1.0);
     }
     Ok(())
 }

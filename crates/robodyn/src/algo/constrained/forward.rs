@@ -72,29 +72,7 @@ pub fn constrained_forward_dynamics(
     articulated_delassus(model, data, constraints, set);
 
     // Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ)
-    let m = set.rows();
-    let ConstraintData {
-        jacobian,
-        drift,
-        error,
-        rhs,
-        step,
-        ..
-    } = constraints;
-    let mut right = DVectorViewMut::from_slice(&mut rhs[..m], m);
-    right.neg_mut();
-    let (kp, kd) = options.baumgarte.unwrap_or((0.0, 0.0));
-    let mut scale =
-        1.0 + product_scale(jacobian, data.qdd.as_slice(), step) + largest(drift.as_slice());
-    if kd != 0.0 {
-        right.gemv(-kd, jacobian, &DVectorView::from_slice(v, v.len()), 1.0);
-        scale += kd * product_scale(jacobian, v, step);
-    }
-    if kp != 0.0 {
-        right.axpy(-kp, error, 1.0);
-        scale += kp * largest(error.as_slice());
-    }
-    solve_forces(model, set, constraints, options.damping, scale)?;
+    solve_accelerated_forces(model, set, constraints, (v, data.qdd.as_slice()), options)?;
 
     // q̈ = a_f + M⁻¹ Jᵀ λ
     let mut qdd = std::mem::take(&mut constraints.qdd);
@@ -117,17 +95,6 @@ pub fn impulse_dynamics(
     damping: f64,
 ) -> Result<()> {
     super::check_fits(model, constraints, set)?;
-    if !(0.0..=1.0).contains(&restitution) {
-        return Err(Error::InvalidValue {
-            argument: "restitution".into(),
-            message: format!("expected a value from 0 to 1, got {restitution}"),
-        });
-    }
-    let options = ConstrainedOptions {
-        baumgarte: None,
-        damping,
-    };
-    options.check()?;
     // ABA's terms at (q, q̇, τ = 0) and J
     let mut zeros = std::mem::take(&mut constraints.joint_forces);
     zeros.fill(0.0);
@@ -144,6 +111,70 @@ pub fn impulse_dynamics(
     articulated_delassus(model, data, constraints, set);
 
     // Λ⁻¹ Λ = −(1 + e) J q̇
+    solve_impulses(model, set, constraints, v, restitution, damping)?;
+
+    // q̇⁺ = q̇ + M⁻¹ Jᵀ Λ
+    let mut after = std::mem::take(&mut constraints.qdd);
+    constraint_response(model, data, constraints, after.as_mut_slice());
+    after += DVectorView::from_slice(v, v.len());
+    constraints.qdd = after;
+    Ok(())
+}
+
+/// λ from `Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ)`, with `J a_f + γ` (a_f: the free
+/// acceleration `free`) in `constraints.rhs` and J, φ and Λ⁻¹ in `constraints`.
+pub(super) fn solve_accelerated_forces(
+    model: &Model,
+    set: &ConstraintSet,
+    constraints: &mut ConstraintData,
+    (v, free): (&[f64], &[f64]),
+    options: &ConstrainedOptions,
+) -> Result<()> {
+    let m = set.rows();
+    let ConstraintData {
+        jacobian,
+        drift,
+        error,
+        rhs,
+        step,
+        ..
+    } = constraints;
+    let mut right = DVectorViewMut::from_slice(&mut rhs[..m], m);
+    right.neg_mut();
+    let (kp, kd) = options.baumgarte.unwrap_or((0.0, 0.0));
+    let mut scale = 1.0 + product_scale(jacobian, free, step) + largest(drift.as_slice());
+    if kd != 0.0 {
+        right.gemv(-kd, jacobian, &DVectorView::from_slice(v, v.len()), 1.0);
+        scale += kd * product_scale(jacobian, v, step);
+    }
+    if kp != 0.0 {
+        right.axpy(-kp, error, 1.0);
+        scale += kp * largest(error.as_slice());
+    }
+    solve_forces(model, set, constraints, options.damping, scale)
+}
+
+/// The impulses Λ from `Λ⁻¹ Λ = −(1 + e) J q̇`, with J and Λ⁻¹ in `constraints`; a restitution
+/// outside [0, 1] or a negative damping is refused.
+pub(super) fn solve_impulses(
+    model: &Model,
+    set: &ConstraintSet,
+    constraints: &mut ConstraintData,
+    v: &[f64],
+    restitution: f64,
+    damping: f64,
+) -> Result<()> {
+    if !(0.0..=1.0).contains(&restitution) {
+        return Err(Error::InvalidValue {
+            argument: "restitution".into(),
+            message: format!("expected a value from 0 to 1, got {restitution}"),
+        });
+    }
+    let options = ConstrainedOptions {
+        baumgarte: None,
+        damping,
+    };
+    options.check()?;
     let m = set.rows();
     let ConstraintData {
         jacobian,
@@ -159,12 +190,5 @@ pub fn impulse_dynamics(
         0.0,
     );
     let scale = 1.0 + (1.0 + restitution) * product_scale(jacobian, v, step);
-    solve_forces(model, set, constraints, damping, scale)?;
-
-    // q̇⁺ = q̇ + M⁻¹ Jᵀ Λ
-    let mut after = std::mem::take(&mut constraints.qdd);
-    constraint_response(model, data, constraints, after.as_mut_slice());
-    after += velocity;
-    constraints.qdd = after;
-    Ok(())
+    solve_forces(model, set, constraints, damping, scale)
 }
