@@ -28,6 +28,10 @@ import re
 import timeit
 from pathlib import Path
 
+# numpy's OpenBLAS keeps a thread of its own spinning after each call, which on a 2-core machine
+# takes a core from a batch's threads: set before numpy is imported (a user's setting stays)
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 import mujoco
 import numpy as np
 import pinocchio as pin
