@@ -326,20 +326,24 @@ pub(crate) fn constraint_set(
     value: &Bound<PyAny>,
 ) -> PyResult<Arc<ConstraintSet>> {
     let items = constraint_items(value)?;
-    let mut last = model
-        .last_constraints
-        .lock()
-        .unwrap_or_else(|e| e.into_inner());
-    if let Some(resolved) = last.as_ref().filter(|r| r.made_from(&items)) {
+    let last = || {
+        model
+            .last_constraints
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+    };
+    if let Some(resolved) = last().as_ref().filter(|r| r.made_from(&items)) {
         return Ok(resolved.set.clone());
     }
+    // resolved without the lock held: describing a bad item may run Python code, which may let
+    // another thread take the GIL and then wait for the lock
     let constraints = items
         .iter()
         .enumerate()
         .map(|(k, item)| resolve(model, item, k))
         .collect::<PyResult<Vec<_>>>()?;
     let set = Arc::new(ConstraintSet::new(&model.model, constraints).map_err(crate::to_py_err)?);
-    *last = Some(ResolvedConstraints {
+    *last() = Some(ResolvedConstraints {
         objects: items.into_iter().map(Bound::unbind).collect(),
         set: set.clone(),
     });
