@@ -142,14 +142,18 @@ pub(super) fn solve_accelerated_forces(
     let mut right = DVectorViewMut::from_slice(&mut rhs[..m], m);
     right.neg_mut();
     let (kp, kd) = options.baumgarte.unwrap_or((0.0, 0.0));
-    let mut scale = 1.0 + product_scale(jacobian, free, step) + largest(drift.as_slice());
     if kd != 0.0 {
         right.gemv(-kd, jacobian, &DVectorView::from_slice(v, v.len()), 1.0);
-        scale += kd * product_scale(jacobian, v, step);
     }
     if kp != 0.0 {
         right.axpy(-kp, error, 1.0);
-        scale += kp * largest(error.as_slice());
+    }
+    // the size of the terms the right side is made of, for the proximal iterations' accuracy
+    // (a direct solve needs none)
+    let mut scale = 1.0;
+    if options.damping > 0.0 {
+        scale += product_scale(jacobian, free, step) + largest(drift.as_slice());
+        scale += kd * product_scale(jacobian, v, step) + kp * largest(error.as_slice());
     }
     solve_forces(model, set, constraints, options.damping, scale)
 }
@@ -189,6 +193,9 @@ pub(super) fn solve_impulses(
         &velocity,
         0.0,
     );
-    let scale = 1.0 + (1.0 + restitution) * product_scale(jacobian, v, step);
+    let scale = match damping > 0.0 {
+        true => 1.0 + (1.0 + restitution) * product_scale(jacobian, v, step),
+        false => 1.0,
+    };
     solve_forces(model, set, constraints, damping, scale)
 }

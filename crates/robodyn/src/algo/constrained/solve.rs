@@ -179,7 +179,24 @@ fn cholesky(n: usize, a: &mut [f64]) -> Result<(), SolveFailure> {
 
 /// Solves `L Lᵀ x = b` in place (b in `x[..n]`) with the factor of [`cholesky`].
 pub(crate) fn cholesky_solve(n: usize, l: &[f64], x: &mut [f64]) {
-    cholesky_solve_rows(n, l, &mut x[..n]);
+    // the operations of `cholesky_solve_rows` on one column, without its row slicing
+    // L y = b: y_k = (b_k − Σ_{j<k} L_kj y_j) / L_kk
+    for k in 0..n {
+        let mut y_k = x[k];
+        for (j, y_j) in x[..k].iter().enumerate() {
+            y_k -= l[k + j * n] * y_j;
+        }
+        x[k] = y_k * (1.0 / l[k + k * n]);
+    }
+    // Lᵀ x = y: x_k = (y_k − Σ_{j>k} L_jk x_j) / L_kk
+    for k in (0..n).rev() {
+        let column = &l[k * n..(k + 1) * n];
+        let mut x_k = x[k];
+        for (l_jk, x_j) in column[k + 1..].iter().zip(&x[k + 1..n]) {
+            x_k -= l_jk * x_j;
+        }
+        x[k] = x_k * (1.0 / column[k]);
+    }
 }
 
 /// Solves `L Lᵀ X = B` in place for B stored row by row in `rows` (row i at `i * w..(i + 1) *
