@@ -16,56 +16,57 @@
 
 use super::{Attachment, ConstraintKind, ConstraintReference, ConstraintSet};
 use crate::model::Model;
-use crate::spatial::{log_rotation, Motion, Transform, Vec3};
-use nalgebra::{DMatrix, Matrix3, Rotation3, UnitQuaternion};
+use crate::spatial::{log_rotation, Motion, Real, Transform};
+use nalgebra::{DMatrix, Matrix3, Rotation3, UnitQuaternion, Vector3};
 
-/// Where the rows of a constraint set are written: J (rows × nv), γ and φ (rows each).
-pub(crate) struct ConstraintRows<'a> {
+/// Where the rows of a constraint set are written: J (rows × nv), γ and φ (rows each); in `f64`
+/// or in lanes ([`crate::algo::lanes`]).
+pub(crate) struct ConstraintRows<'a, S = f64> {
     /// J: the rows' velocity is `J q̇`.
-    pub jacobian: &'a mut DMatrix<f64>,
+    pub jacobian: &'a mut DMatrix<S>,
     /// γ = J̇ q̇: the rows' acceleration is `J q̈ + γ`.
-    pub drift: &'a mut [f64],
+    pub drift: &'a mut [S],
     /// φ: how far each row is from holding (zero where a point is held where it is).
-    pub error: &'a mut [f64],
+    pub error: &'a mut [S],
 }
 
 /// The bodies' motion that the rows are made from: placements `X_{i←0}`, velocities and
 /// accelerations with q̈ = 0, in body coordinates.
-pub(crate) struct BodyMotion<'a> {
+pub(crate) struct BodyMotion<'a, S = f64> {
     /// `X_{i←0}` of every body.
-    pub x_world: &'a [Transform],
+    pub x_world: &'a [Transform<S>],
     /// Spatial velocity of every body, in its own coordinates.
-    pub v: &'a [Motion],
+    pub v: &'a [Motion<S>],
     /// Spatial acceleration of every body with q̈ = 0 (no gravity), in its own coordinates.
-    pub a: &'a [Motion],
+    pub a: &'a [Motion<S>],
 }
 
 /// The motion of a constraint frame: its placement, and its origin's velocity and classical
 /// acceleration (with q̈ = 0), all in world coordinates.
-struct FrameMotion {
+struct FrameMotion<S> {
     /// `E`: world to constraint-frame axes.
-    rotation: Matrix3<f64>,
+    rotation: Matrix3<S>,
     /// p: the origin.
-    position: Vec3,
+    position: Vector3<S>,
     /// ṗ.
-    velocity: Vec3,
+    velocity: Vector3<S>,
     /// p̈ with q̈ = 0.
-    acceleration: Vec3,
+    acceleration: Vector3<S>,
     /// ω̇ with q̈ = 0.
-    angular_acceleration: Vec3,
+    angular_acceleration: Vector3<S>,
     /// The body the frame is fixed in (0: the world).
     body: usize,
 }
 
 /// Writes J, γ and φ of every constraint of `set` (J's rows zeroed first).
-pub(crate) fn evaluate(
+pub(crate) fn evaluate<S: Real>(
     model: &Model,
     set: &ConstraintSet,
-    bodies: &BodyMotion,
-    (q, v): (&[f64], &[f64]),
-    mut rows: ConstraintRows,
+    bodies: &BodyMotion<S>,
+    (q, v): (&[S], &[S]),
+    mut rows: ConstraintRows<S>,
 ) {
-    rows.jacobian.fill(0.0);
+    rows.jacobian.fill(S::zero());
     for (k, constraint) in set.constraints().iter().enumerate() {
         let row = set.offset(k);
         let local = constraint.reference == ConstraintReference::Local;
@@ -101,15 +102,16 @@ pub(crate) fn evaluate(
                 references,
             } => {
                 let f = model.idx_v[*follower];
-                rows.jacobian[(row, f)] += 1.0;
-                rows.error[row] = q[model.idx_q[*follower]] - references.0 - polynomial[0];
-                rows.drift[row] = 0.0;
+                let follower_q = q[model.idx_q[*follower]] - S::splat(references.0);
+                rows.jacobian[(row, f)] += S::one();
+                rows.error[row] = follower_q - S::splat(polynomial[0]);
+                rows.drift[row] = S::zero();
                 if let Some(leader) = leader {
                     let l = model.idx_v[*leader];
-                    let x = q[model.idx_q[*leader]] - references.1;
+                    let x = q[model.idx_q[*leader]] - S::splat(references.1);
                     let [p, dp, ddp, _] = polynomial_at(polynomial, x);
                     // φ = (q_f − q_f,ref) − p(x);  J = e_f − p'(x) e_l;  γ = −p''(x) q̇_l²
-                    rows.error[row] = q[model.idx_q[*follower]] - references.0 - p;
+                    rows.error[row] = follower_q - p;
                     rows.jacobian[(row, l)] -= dp;
                     rows.drift[row] = -ddp * v[l] * v[l];
                 }
@@ -120,15 +122,15 @@ pub(crate) fn evaluate(
 
 /// A point or frame constraint at this state: the first attachment's motion and the second's
 /// (the world where the first is, when there is none).
-struct Held {
-    first: FrameMotion,
-    second: Option<FrameMotion>,
+struct Held<S> {
+    first: FrameMotion<S>,
+    second: Option<FrameMotion<S>>,
 }
 
-impl Held {
+impl<S: Real> Held<S> {
     fn new(
         model: &Model,
-        bodies: &BodyMotion,
+        bodies: &BodyMotion<S>,
         first: &Attachment,
         second: Option<&Attachment>,
     ) -> Self {
@@ -142,11 +144,11 @@ impl Held {
     fn write(
         &self,
         model: &Model,
-        bodies: &BodyMotion,
+        bodies: &BodyMotion<S>,
         row: usize,
         mask: &[bool; 6],
         local: bool,
-        rows: &mut ConstraintRows,
+        rows: &mut ConstraintRows<S>,
     ) {
         let first = &self.first;
         // the rows' axes: world, or the first frame's (E)
@@ -156,13 +158,18 @@ impl Held {
             Matrix3::identity()
         };
         // J: the first point's columns minus the second's (world axes: no turn)
-        let turned = |x: &Vec3| if local { axes * x } else { *x };
-        for (motion, sign) in [(Some(first), 1.0), (self.second.as_ref(), -1.0)] {
+        let turned = |x: &Vector3<S>| if local { axes * x } else { *x };
+        for (motion, first) in [(Some(first), true), (self.second.as_ref(), false)] {
             let Some(motion) = motion else { continue };
             point_columns(model, bodies, motion, |column, linear, angular| {
                 let full = six(&turned(linear), &turned(angular));
                 for (r, value) in kept(mask, &full) {
-                    rows.jacobian[(row + r, column)] += sign * value;
+                    let entry = &mut rows.jacobian[(row + r, column)];
+                    *entry = if first {
+                        *entry + value
+                    } else {
+                        *entry - value
+                    };
                 }
             });
         }
@@ -170,18 +177,14 @@ impl Held {
         // γ = p̈_1 − p̈_2 and ω̇_1 − ω̇_2 with q̈ = 0;  φ = p_1 − p_2 and R_2 log(R_2ᵀ R_1)
         let (mut acceleration, mut angular_acceleration) =
             (first.acceleration, first.angular_acceleration);
-        let (mut offset, mut turn) = (Vec3::zeros(), Vec3::zeros());
+        let (mut offset, mut turn) = (Vector3::zeros(), Vector3::zeros());
         if let Some(second) = &self.second {
             acceleration -= second.acceleration;
             angular_acceleration -= second.angular_acceleration;
             offset = first.position - second.position;
             // R = Eᵀ, so R_2ᵀ R_1 = E_2 E_1ᵀ
             let relative = second.rotation * first.rotation.transpose();
-            // through a unit quaternion: the angle from the trace alone is NaN when rounding
-            // puts the trace of a closed weld above 3
-            let turned = Rotation3::from_matrix_unchecked(relative);
-            let log = log_rotation(&UnitQuaternion::from_rotation_matrix(&turned));
-            turn = second.rotation.transpose() * log;
+            turn = second.rotation.transpose() * relative_turn(&relative);
         }
         let drift = six(&(axes * acceleration), &(axes * angular_acceleration));
         let error = six(&(axes * offset), &(axes * turn));
@@ -194,20 +197,25 @@ impl Held {
 
 /// The distance row: with n = (p_1 − p_2)/d, `J = nᵀ (J_1 − J_2)`,
 /// `γ = nᵀ (p̈_1 − p̈_2) + (|ṗ_1 − ṗ_2|² − (nᵀ (ṗ_1 − ṗ_2))²)/d`, φ = d − length.
-fn write_distance(
+fn write_distance<S: Real>(
     model: &Model,
-    bodies: &BodyMotion,
-    (one, other): (&FrameMotion, &FrameMotion),
+    bodies: &BodyMotion<S>,
+    (one, other): (&FrameMotion<S>, &FrameMotion<S>),
     length: f64,
     row: usize,
-    rows: &mut ConstraintRows,
+    rows: &mut ConstraintRows<S>,
 ) {
     let offset = one.position - other.position;
-    let distance = offset.norm().max(f64::MIN_POSITIVE);
+    let distance = offset.norm().simd_max(S::splat(f64::MIN_POSITIVE));
     let n = offset / distance;
-    for (motion, sign) in [(one, 1.0), (other, -1.0)] {
+    for (motion, first) in [(one, true), (other, false)] {
         point_columns(model, bodies, motion, |column, linear, _| {
-            rows.jacobian[(row, column)] += sign * n.dot(linear);
+            let entry = &mut rows.jacobian[(row, column)];
+            *entry = if first {
+                *entry + n.dot(linear)
+            } else {
+                *entry - n.dot(linear)
+            };
         });
     }
     let relative_velocity = one.velocity - other.velocity;
@@ -215,24 +223,31 @@ fn write_distance(
     let gamma = n.dot(&(one.acceleration - other.acceleration))
         + (relative_velocity.norm_squared() - along * along) / distance;
     rows.drift[row] = gamma;
-    rows.error[row] = distance - length;
+    rows.error[row] = distance - S::splat(length);
 }
 
 /// The motion of an attachment's constraint frame (fixed in the world when it has no frame).
-fn frame_motion(model: &Model, bodies: &BodyMotion, attachment: &Attachment) -> FrameMotion {
+fn frame_motion<S: Real>(
+    model: &Model,
+    bodies: &BodyMotion<S>,
+    attachment: &Attachment,
+) -> FrameMotion<S> {
     let Some(frame) = attachment.frame else {
+        let placement = Transform::<S>::splat(&attachment.placement);
         return FrameMotion {
-            rotation: attachment.placement.rotation,
-            position: attachment.placement.translation,
-            velocity: Vec3::zeros(),
-            acceleration: Vec3::zeros(),
-            angular_acceleration: Vec3::zeros(),
+            rotation: placement.rotation,
+            position: placement.translation,
+            velocity: Vector3::zeros(),
+            acceleration: Vector3::zeros(),
+            angular_acceleration: Vector3::zeros(),
             body: 0,
         };
     };
     let body = model.frames[frame].body;
     // X_{c←0} = X_{c←frame} X_{frame←body} X_{body←0}
-    let placement = attachment.placement * (model.frames[frame].placement * bodies.x_world[body]);
+    let (attached, framed) = (&attachment.placement, &model.frames[frame].placement);
+    let placement =
+        Transform::<S>::splat(attached) * (Transform::splat(framed) * bodies.x_world[body]);
     let p = placement.translation;
     // (ω, v_O) and (ω̇, a_O) of the body in world coordinates
     let velocity = bodies.x_world[body].inverse_apply_motion(&bodies.v[body]);
@@ -255,11 +270,11 @@ fn frame_motion(model: &Model, bodies: &BodyMotion, attachment: &Attachment) -> 
 /// The columns of the point's Jacobian that are not zero, world axes, each handed to
 /// `column(index, linear, angular)`: the subspace columns of the joints between the point's
 /// body and the world, taken at the point.
-fn point_columns(
+fn point_columns<S: Real>(
     model: &Model,
-    bodies: &BodyMotion,
-    motion: &FrameMotion,
-    mut column: impl FnMut(usize, &Vec3, &Vec3),
+    bodies: &BodyMotion<S>,
+    motion: &FrameMotion<S>,
+    mut column: impl FnMut(usize, &Vector3<S>, &Vector3<S>),
 ) {
     let mut j = motion.body;
     while j != 0 {
@@ -273,17 +288,17 @@ fn point_columns(
 }
 
 /// `[linear; angular]` as six numbers.
-pub(super) fn six(linear: &Vec3, angular: &Vec3) -> [f64; 6] {
+pub(super) fn six<S: Real>(linear: &Vector3<S>, angular: &Vector3<S>) -> [S; 6] {
     [
         linear.x, linear.y, linear.z, angular.x, angular.y, angular.z,
     ]
 }
 
 /// The entries of `full` that `mask` keeps, numbered from 0 in order.
-pub(super) fn kept<'a>(
+pub(super) fn kept<'a, S: Real>(
     mask: &'a [bool; 6],
-    full: &'a [f64; 6],
-) -> impl Iterator<Item = (usize, f64)> + 'a {
+    full: &'a [S; 6],
+) -> impl Iterator<Item = (usize, S)> + 'a {
     full.iter()
         .zip(mask)
         .filter(|(_, &keep)| keep)
@@ -292,13 +307,29 @@ pub(super) fn kept<'a>(
 }
 
 /// p(x) = Σ c_k x^k and its first three derivatives, by Horner's rule.
-pub(super) fn polynomial_at(c: &[f64; 5], x: f64) -> [f64; 4] {
-    let [mut p, mut dp, mut ddp, mut dddp] = [0.0; 4];
+pub(super) fn polynomial_at<S: Real>(c: &[f64; 5], x: S) -> [S; 4] {
+    let [mut p, mut dp, mut ddp, mut dddp] = [S::zero(); 4];
+    let (two, three) = (S::splat(2.0), S::splat(3.0));
     for &coefficient in c.iter().rev() {
-        dddp = dddp * x + 3.0 * ddp;
-        ddp = ddp * x + 2.0 * dp;
+        dddp = dddp * x + three * ddp;
+        ddp = ddp * x + two * dp;
         dp = dp * x + p;
-        p = p * x + coefficient;
+        p = p * x + S::splat(coefficient);
     }
     [p, dp, ddp, dddp]
+}
+
+/// `log(R_2ᵀ R_1)` of `relative` = R_2ᵀ R_1, each lane alone (its branches differ by lane)
+/// through a unit quaternion: the angle from the trace alone is NaN when rounding puts the
+/// trace of a closed weld above 3.
+fn relative_turn<S: Real>(relative: &Matrix3<S>) -> Vector3<S> {
+    let logs: [[f64; 3]; 8] = std::array::from_fn(|lane| {
+        if lane >= S::LANES {
+            return [0.0; 3];
+        }
+        let matrix = Matrix3::from_fn(|r, c| relative[(r, c)].extract(lane));
+        let turned = Rotation3::from_matrix_unchecked(matrix);
+        log_rotation(&UnitQuaternion::from_rotation_matrix(&turned)).into()
+    });
+    Vector3::from_fn(|k, _| S::from_lanes(|lane| logs[lane][k]))
 }

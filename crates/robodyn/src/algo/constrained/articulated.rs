@@ -17,7 +17,8 @@
 //! A row's inward pass runs only over the ancestors of its bodies (its support), where its J is
 //! not zero; the other u_i are zero. Cost: ABA, then O(d) per row (d: the bodies its support
 //! holds), O(m² d) for Λ⁻¹ and one outward pass. The rows themselves take ABA's placements,
-//! velocities and velocity products along their support.
+//! velocities and velocity products along their support. Every step is generic over [`Real`]:
+//! one state in `f64`, or several in lanes ([`crate::algo::lanes`]).
 
 use super::ConstraintData;
 use crate::algo::aba::aba;
@@ -25,13 +26,82 @@ use crate::constraint::{evaluate, BodyMotion, ConstraintRows, ConstraintSet};
 use crate::error::Result;
 use crate::joint::ArticulatedTerms;
 use crate::model::Model;
-use crate::spatial::{Force, Motion};
+use crate::spatial::{Force, Motion, Real, Transform};
 use crate::Data;
-use nalgebra::{DVectorViewMut, Vector6};
+use nalgebra::{DMatrix, Matrix6, Vector6};
+
+/// ABA's terms that the route reads (one state's from [`Data`], or lanes'), and the placements
+/// `X_{i←0}` it writes along the rows' support.
+pub(crate) struct AbaTerms<'b, S> {
+    pub x_up: &'b [Transform<S>],
+    pub v: &'b [Motion<S>],
+    pub c: &'b [Motion<S>],
+    pub u: &'b mut [[Force<S>; 6]],
+    pub d_inv: &'b mut [Matrix6<S>],
+    pub x_world: &'b mut [Transform<S>],
+    /// a_f = M⁻¹ (τ − h), ABA's q̈.
+    pub free_acceleration: &'b [S],
+}
+
+impl<'b> AbaTerms<'b, f64> {
+    /// `data`'s.
+    pub(crate) fn of(data: &'b mut Data) -> Self {
+        AbaTerms {
+            x_up: &data.x_up,
+            v: &data.v,
+            c: &data.c,
+            u: &mut data.u,
+            d_inv: &mut data.d_inv,
+            x_world: &mut data.x_world,
+            free_acceleration: data.qdd.as_slice(),
+        }
+    }
+}
+
+/// The route's rows, workspace and results (one state's from [`ConstraintData`], or lanes').
+pub(crate) struct RouteBuffers<'b, S> {
+    /// J (m × nv), γ, φ and, after [`free_motion_rows`], `J a_f + γ` in `rhs`.
+    pub jacobian: &'b mut DMatrix<S>,
+    pub drift: &'b mut [S],
+    pub error: &'b mut [S],
+    pub rhs: &'b mut [S],
+    /// Y = K Jᵀ as rows (m × nv), and Λ⁻¹ (m × m).
+    pub transmitted_rows: &'b mut DMatrix<S>,
+    pub delassus: &'b mut DMatrix<S>,
+    /// The forces the inward passes carry (zero between uses), the bodies' accelerations, Yᵀ λ.
+    pub body_forces: &'b mut [[Force<S>; 6]],
+    pub body_accelerations: &'b mut [Motion<S>],
+    pub joint_forces: &'b mut [S],
+    /// One body's columns of Y, row by row, and D_i⁻¹ times them.
+    pub body_rows: &'b mut [(Vector6<S>, Vector6<S>)],
+    /// λ (m).
+    pub forces: &'b mut [S],
+    /// The result (nv): q̈, or q̇ after an impact.
+    pub qdd: &'b mut [S],
+}
+
+impl<'b> RouteBuffers<'b, f64> {
+    /// `constraints`'.
+    pub(crate) fn of(constraints: &'b mut ConstraintData) -> Self {
+        RouteBuffers {
+            jacobian: &mut constraints.jacobian,
+            drift: constraints.drift.as_mut_slice(),
+            error: constraints.error.as_mut_slice(),
+            rhs: &mut constraints.rhs,
+            transmitted_rows: &mut constraints.transmitted_rows,
+            delassus: &mut constraints.delassus,
+            body_forces: &mut constraints.body_forces,
+            body_accelerations: &mut constraints.body_accelerations,
+            joint_forces: constraints.joint_forces.as_mut_slice(),
+            body_rows: &mut constraints.body_rows,
+            forces: constraints.forces.as_mut_slice(),
+            qdd: constraints.qdd.as_mut_slice(),
+        }
+    }
+}
 
 /// The free acceleration `a_f = M⁻¹ (τ − h)` by ABA into `data.qdd` (its articulated terms kept
-/// in `data`), the placements `data.x_world` of the bodies the rows reach, then J, φ, the drift
-/// γ = J̇ q̇ and, in `constraints.rhs`, the rows' acceleration `J a_f + γ` under a_f.
+/// in `data`), then [`rows_under_free_motion`].
 pub(super) fn free_motion_rows(
     model: &Model,
     data: &mut Data,
@@ -41,68 +111,89 @@ pub(super) fn free_motion_rows(
     f_ext: Option<&[Force]>,
 ) -> Result<()> {
     aba(model, data, q, v, tau, f_ext)?;
+    let mut route = RouteBuffers::of(constraints);
+    rows_under_free_motion(model, set, &mut AbaTerms::of(data), &mut route, (q, v));
+    Ok(())
+}
 
+/// From ABA's terms: the placements `X_{i←0}` of the bodies the rows reach, then J, φ, the
+/// drift γ = J̇ q̇ and, in `rhs`, the rows' acceleration `J a_f + γ` under a_f.
+#[inline(always)]
+pub(crate) fn rows_under_free_motion<S: Real>(
+    model: &Model,
+    set: &ConstraintSet,
+    terms: &mut AbaTerms<S>,
+    route: &mut RouteBuffers<S>,
+    (q, v): (&[S], &[S]),
+) {
     // along the bodies the rows reach: X_{i←0} = X_{i←λ(i)} X_{λ(i)←0}, and the accelerations
     // with q̈ = 0 (no gravity) from ABA's velocity products, a_i = X_i a_λ(i) + c_i
-    let accelerations = &mut constraints.body_accelerations;
-    accelerations[0] = Motion::ZERO;
+    let accelerations = &mut *route.body_accelerations;
+    accelerations[0] = Motion::zeros();
     for &i in set.support() {
         let (parent, turn) = (model.parent[i], model.turn(i));
-        data.x_world[i] = data.x_up[i].compose_turned(turn, &data.x_world[parent]);
+        terms.x_world[i] = terms.x_up[i].compose_turned(turn, &terms.x_world[parent]);
         accelerations[i] =
-            data.x_up[i].apply_motion_turned(turn, &accelerations[parent]) + data.c[i];
+            terms.x_up[i].apply_motion_turned(turn, &accelerations[parent]) + terms.c[i];
     }
 
     // J, γ, φ;  then J a_f + γ
     let bodies = BodyMotion {
-        x_world: &data.x_world,
-        v: &data.v,
+        x_world: terms.x_world,
+        v: terms.v,
         a: accelerations,
     };
     let rows = ConstraintRows {
-        jacobian: &mut constraints.jacobian,
-        drift: constraints.drift.as_mut_slice(),
-        error: constraints.error.as_mut_slice(),
+        jacobian: route.jacobian,
+        drift: route.drift,
+        error: route.error,
     };
     evaluate(model, set, &bodies, (q, v), rows);
     let m = set.rows();
-    let mut rows_acceleration = DVectorViewMut::from_slice(&mut constraints.rhs[..m], m);
-    rows_acceleration.copy_from(&constraints.drift);
-    rows_acceleration.gemv(1.0, &constraints.jacobian, &data.qdd, 1.0);
-    Ok(())
+    let rows_acceleration = &mut route.rhs[..m];
+    rows_acceleration.copy_from_slice(route.drift);
+    for (column, a_c) in route
+        .jacobian
+        .as_slice()
+        .chunks_exact(m)
+        .zip(terms.free_acceleration)
+    {
+        for (entry, j_rc) in rows_acceleration.iter_mut().zip(column) {
+            *entry += *j_rc * *a_c;
+        }
+    }
 }
 
-/// Y = K Jᵀ (`constraints.transmitted_rows`, m × nv: row r holds the u_i of J's row r) by each
-/// row's inward pass over its constraint's support, then `Λ⁻¹ = Σ_i Y_iᵀ D_i⁻¹ Y_i` into
-/// `constraints.delassus`. Needs ABA's terms in `data` and J ([`free_motion_rows`]).
-pub(super) fn articulated_delassus(
+/// Y = K Jᵀ (`transmitted_rows`, m × nv: row r holds the u_i of J's row r) by each row's inward
+/// pass over its constraint's support, then `Λ⁻¹ = Σ_i Y_iᵀ D_i⁻¹ Y_i` into `delassus`. Needs
+/// ABA's terms and J ([`rows_under_free_motion`]).
+#[inline(always)]
+pub(crate) fn articulated_delassus<S: Real>(
     model: &Model,
-    data: &Data,
-    constraints: &mut ConstraintData,
     set: &ConstraintSet,
+    terms: &AbaTerms<S>,
+    route: &mut RouteBuffers<S>,
 ) {
-    transmit_rows(model, data, constraints, set);
-    delassus_from_transmitted(model, data, constraints, set);
+    transmit_rows(model, set, terms, route);
+    delassus_from_transmitted(model, set, terms, route);
 }
 
-/// Y = K Jᵀ into `constraints.transmitted_rows`: each row's inward pass over its constraint's
-/// support.
-fn transmit_rows(
+/// Y = K Jᵀ into `transmitted_rows`: each row's inward pass over its constraint's support.
+#[inline(always)]
+fn transmit_rows<S: Real>(
     model: &Model,
-    data: &Data,
-    constraints: &mut ConstraintData,
     set: &ConstraintSet,
+    terms: &AbaTerms<S>,
+    route: &mut RouteBuffers<S>,
 ) {
     let m = set.rows();
-    let ConstraintData {
-        jacobian,
-        transmitted_rows,
-        body_forces: p,
-        ..
-    } = constraints;
+    let p = &mut *route.body_forces;
     // column-major m × nv: entry (r, k) at k m + r
-    let (j, y) = (jacobian.as_slice(), transmitted_rows.as_mut_slice());
-    y.fill(0.0);
+    let (j, y) = (
+        route.jacobian.as_slice(),
+        route.transmitted_rows.as_mut_slice(),
+    );
+    y.fill(S::zero());
     for (k, constraint) in set.constraints().iter().enumerate() {
         // each body once, all the constraint's rows (at most 6) through it
         let rows = set.offset(k)..set.offset(k) + constraint.rows();
@@ -110,47 +201,42 @@ fn transmit_rows(
             let (dofs, subspace, parent) = (model.v_range(i), model.subspace(i), model.parent[i]);
             for (t, r) in rows.clone().enumerate() {
                 // u_i = J_ri − S_iᵀ p_i
-                let mut u = [0.0; 6];
+                let mut u = [S::zero(); 6];
                 for (u_k, dof) in u.iter_mut().zip(dofs.clone()) {
                     *u_k = j[dof * m + r];
                 }
-                let mut p_i = std::mem::replace(&mut p[i][t], Force::ZERO);
+                let mut p_i = std::mem::replace(&mut p[i][t], Force::splat(&Force::ZERO));
                 subspace.subtract_projection(&p_i, &mut u);
                 for (u_k, dof) in u.iter().zip(dofs.clone()) {
                     y[dof * m + r] = *u_k;
                 }
                 // p_λ(i) += X_iᵀ (p_i + U_i D_i⁻¹ u_i)
                 if parent != 0 {
-                    subspace.add_bias_response(&mut p_i, &data.u[i], &data.d_inv[i], &u);
-                    p[parent][t] += data.x_up[i].transpose_apply_force_turned(model.turn(i), &p_i);
+                    subspace.add_bias_response(&mut p_i, &terms.u[i], &terms.d_inv[i], &u);
+                    p[parent][t] += terms.x_up[i].transpose_apply_force_turned(model.turn(i), &p_i);
                 }
             }
         }
     }
 }
 
-/// `Λ⁻¹ = Σ_i Y_iᵀ D_i⁻¹ Y_i` into `constraints.delassus`, from [`transmit_rows`]' Y.
-fn delassus_from_transmitted(
+/// `Λ⁻¹ = Σ_i Y_iᵀ D_i⁻¹ Y_i` into `delassus`, from [`transmit_rows`]' Y.
+#[inline(always)]
+fn delassus_from_transmitted<S: Real>(
     model: &Model,
-    data: &Data,
-    constraints: &mut ConstraintData,
     set: &ConstraintSet,
+    terms: &AbaTerms<S>,
+    route: &mut RouteBuffers<S>,
 ) {
     let m = set.rows();
-    let ConstraintData {
-        transmitted_rows,
-        delassus,
-        body_rows,
-        ..
-    } = constraints;
-    let y = transmitted_rows.as_slice();
+    let (y, body_rows) = (route.transmitted_rows.as_slice(), &mut *route.body_rows);
     // Λ⁻¹ += Y_iᵀ D_i⁻¹ Y_i on the rows whose constraints reach body i, upper triangle; then the
     // lower one mirrored
-    let lambda = delassus.as_mut_slice();
-    lambda.fill(0.0);
+    let lambda = route.delassus.as_mut_slice();
+    lambda.fill(S::zero());
     for (&i, span) in set.support().iter().zip(set.row_spans()) {
         let dofs = model.v_range(i);
-        let (d_inv, columns) = (&data.d_inv[i], &y[dofs.start * m..dofs.end * m]);
+        let (d_inv, columns) = (&terms.d_inv[i], &y[dofs.start * m..dofs.end * m]);
         if dofs.len() == 1 {
             // one coordinate: Λ⁻¹_rc += y_r y_c / D_i
             let y_i = &columns[..m];
@@ -158,7 +244,7 @@ fn delassus_from_transmitted(
                 let w_c = d_inv[(0, 0)] * y_i[c];
                 let column = &mut lambda[c * m + span.start..=c * m + c];
                 for (entry, y_r) in column.iter_mut().zip(&y_i[span.start..=c]) {
-                    *entry += y_r * w_c;
+                    *entry += *y_r * w_c;
                 }
             }
             continue;
@@ -175,7 +261,11 @@ fn delassus_from_transmitted(
             } else {
                 let mut w_r = Vector6::zeros();
                 for (a, w_ra) in w_r.iter_mut().take(dofs.len()).enumerate() {
-                    *w_ra = (0..dofs.len()).map(|b| d_inv[(a, b)] * y_r[b]).sum();
+                    let mut sum = S::zero();
+                    for b in 0..dofs.len() {
+                        sum += d_inv[(a, b)] * y_r[b];
+                    }
+                    *w_ra = sum;
                 }
                 w_r
             };
@@ -195,37 +285,47 @@ fn delassus_from_transmitted(
     }
 }
 
-/// `M⁻¹ Jᵀ λ` (λ in `constraints.forces`) into `out` (nv) by ABA's outward pass from
-/// `u_i = Y_i λ` ([`articulated_delassus`]'s Y), with ABA's terms in `data`.
-pub(super) fn constraint_response(
+/// `base + M⁻¹ Jᵀ λ` (λ in `forces`; base: a_f or q̇) into `qdd` by ABA's outward pass from
+/// `u_i = Y_i λ` ([`articulated_delassus`]'s Y), with ABA's terms.
+#[inline(always)]
+pub(crate) fn constraint_response<S: Real>(
     model: &Model,
-    data: &mut Data,
-    constraints: &mut ConstraintData,
-    out: &mut [f64],
+    set: &ConstraintSet,
+    terms: &mut AbaTerms<S>,
+    route: &mut RouteBuffers<S>,
+    base: &[S],
 ) {
-    let ConstraintData {
-        transmitted_rows: y,
-        forces,
-        joint_forces: u,
-        body_accelerations: a,
-        ..
-    } = constraints;
+    let m = set.rows();
+    let (y, u, a) = (
+        route.transmitted_rows.as_slice(),
+        &mut *route.joint_forces,
+        &mut *route.body_accelerations,
+    );
     // u = Yᵀ λ
-    u.gemv_tr(1.0, y, forces, 0.0);
-    a[0] = Motion::ZERO;
+    for (u_k, column) in u.iter_mut().zip(y.chunks_exact(m)) {
+        let mut sum = S::zero();
+        for (y_rk, lambda_r) in column.iter().zip(&route.forces[..m]) {
+            sum += *y_rk * *lambda_r;
+        }
+        *u_k = sum;
+    }
+    a[0] = Motion::zeros();
     for i in 1..model.nbodies() {
         // a'_i = X_i a_λ(i);  q̈_i = D_i⁻¹ (u_i − U_iᵀ a'_i);  a_i = a'_i + S_i q̈_i
-        let mut a_i = data.x_up[i].apply_motion_turned(model.turn(i), &a[model.parent[i]]);
-        let mut u_i = [0.0; 6];
+        let mut a_i = terms.x_up[i].apply_motion_turned(model.turn(i), &a[model.parent[i]]);
+        let mut u_i = [S::zero(); 6];
         for (u_k, dof) in u_i.iter_mut().zip(model.v_range(i)) {
             *u_k = u[dof];
         }
         let terms = ArticulatedTerms {
-            u: &mut data.u[i],
+            u: &mut terms.u[i],
             u_tau: &mut u_i,
-            d_inv: &mut data.d_inv[i],
+            d_inv: &mut terms.d_inv[i],
         };
-        model.subspace(i).accelerate(&mut a_i, &terms, out);
+        model.subspace(i).accelerate(&mut a_i, &terms, route.qdd);
         a[i] = a_i;
+    }
+    for (x, b) in route.qdd.iter_mut().zip(base) {
+        *x += *b;
     }
 }

@@ -10,15 +10,17 @@
 //! rows reach. Cost: ABA, O(d) per row (d: the bodies its constraint reaches), O(m² d) for Λ⁻¹,
 //! O(m³) to solve it and one outward pass for the forces' effect.
 
-use super::articulated::{articulated_delassus, constraint_response, free_motion_rows};
+use super::articulated::{
+    articulated_delassus, constraint_response, free_motion_rows, AbaTerms, RouteBuffers,
+};
 use super::solve::largest;
 use super::{product_scale, solve_forces, ConstraintData};
 use crate::constraint::ConstraintSet;
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::spatial::Force;
+use crate::spatial::{Force, Real};
 use crate::Data;
-use nalgebra::{DVectorView, DVectorViewMut};
+use nalgebra::{DMatrix, DVectorView, DVectorViewMut};
 
 /// How the constraint equations are solved.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -69,16 +71,22 @@ pub fn constrained_forward_dynamics(
     // a_f = ABA(q, q̇, τ, f_ext); J, φ, γ and the rows' acceleration J a_f + γ under it
     free_motion_rows(model, data, constraints, set, (q, v, tau), f_ext)?;
     // Y = K Jᵀ by each row's inward pass;  Λ⁻¹ = Σ_i Y_iᵀ D_i⁻¹ Y_i
-    articulated_delassus(model, data, constraints, set);
+    articulated_delassus(
+        model,
+        set,
+        &AbaTerms::of(data),
+        &mut RouteBuffers::of(constraints),
+    );
 
     // Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ)
     solve_accelerated_forces(model, set, constraints, (v, data.qdd.as_slice()), options)?;
 
     // q̈ = a_f + M⁻¹ Jᵀ λ
-    let mut qdd = std::mem::take(&mut constraints.qdd);
-    constraint_response(model, data, constraints, qdd.as_mut_slice());
-    qdd += &data.qdd;
-    constraints.qdd = qdd;
+    let free = std::mem::take(&mut data.qdd);
+    let mut terms = AbaTerms::of(data);
+    let route = &mut RouteBuffers::of(constraints);
+    constraint_response(model, set, &mut terms, route, free.as_slice());
+    data.qdd = free;
     Ok(())
 }
 
@@ -108,16 +116,19 @@ pub fn impulse_dynamics(
     );
     constraints.joint_forces = zeros;
     rows?;
-    articulated_delassus(model, data, constraints, set);
+    articulated_delassus(
+        model,
+        set,
+        &AbaTerms::of(data),
+        &mut RouteBuffers::of(constraints),
+    );
 
     // Λ⁻¹ Λ = −(1 + e) J q̇
     solve_impulses(model, set, constraints, v, restitution, damping)?;
 
     // q̇⁺ = q̇ + M⁻¹ Jᵀ Λ
-    let mut after = std::mem::take(&mut constraints.qdd);
-    constraint_response(model, data, constraints, after.as_mut_slice());
-    after += DVectorView::from_slice(v, v.len());
-    constraints.qdd = after;
+    let route = &mut RouteBuffers::of(constraints);
+    constraint_response(model, set, &mut AbaTerms::of(data), route, v);
     Ok(())
 }
 
@@ -139,23 +150,55 @@ pub(super) fn solve_accelerated_forces(
         step,
         ..
     } = constraints;
-    let mut right = DVectorViewMut::from_slice(&mut rhs[..m], m);
-    right.neg_mut();
-    let (kp, kd) = options.baumgarte.unwrap_or((0.0, 0.0));
-    if kd != 0.0 {
-        right.gemv(-kd, jacobian, &DVectorView::from_slice(v, v.len()), 1.0);
-    }
-    if kp != 0.0 {
-        right.axpy(-kp, error, 1.0);
-    }
+    accelerated_right_side(
+        jacobian,
+        error.as_slice(),
+        &mut rhs[..m],
+        v,
+        options.baumgarte,
+    );
     // the size of the terms the right side is made of, for the proximal iterations' accuracy
     // (a direct solve needs none)
     let mut scale = 1.0;
     if options.damping > 0.0 {
+        let (kp, kd) = options.baumgarte.unwrap_or((0.0, 0.0));
         scale += product_scale(jacobian, free, step) + largest(drift.as_slice());
         scale += kd * product_scale(jacobian, v, step) + kp * largest(error.as_slice());
     }
     solve_forces(model, set, constraints, options.damping, scale)
+}
+
+/// `−(J a_f + γ + K_d J q̇ + K_p φ)` in place of `J a_f + γ` in `rhs` (m), with Baumgarte's
+/// gains `(K_p, K_d)`.
+#[inline(always)]
+pub(crate) fn accelerated_right_side<S: Real>(
+    jacobian: &DMatrix<S>,
+    error: &[S],
+    rhs: &mut [S],
+    v: &[S],
+    baumgarte: Option<(f64, f64)>,
+) {
+    for entry in rhs.iter_mut() {
+        *entry = -*entry;
+    }
+    let (kp, kd) = baumgarte.unwrap_or((0.0, 0.0));
+    if kd != 0.0 {
+        // −K_d J q̇
+        let kd = S::splat(kd);
+        for (column, v_c) in jacobian.as_slice().chunks_exact(rhs.len()).zip(v) {
+            let scaled = kd * *v_c;
+            for (entry, j_rc) in rhs.iter_mut().zip(column) {
+                *entry -= *j_rc * scaled;
+            }
+        }
+    }
+    if kp != 0.0 {
+        // −K_p φ
+        let kp = S::splat(kp);
+        for (entry, phi) in rhs.iter_mut().zip(error) {
+            *entry -= kp * *phi;
+        }
+    }
 }
 
 /// The impulses Λ from `Λ⁻¹ Λ = −(1 + e) J q̇`, with J and Λ⁻¹ in `constraints`; a restitution

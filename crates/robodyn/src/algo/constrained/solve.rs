@@ -13,7 +13,8 @@
 //! Matrices are n × n, column-major, in slices.
 
 use crate::dispatch::multiversion;
-use nalgebra::DMatrix;
+use crate::spatial::Real;
+use nalgebra::{DMatrix, SimdBool};
 
 /// A Cholesky pivot below this times its row's diagonal entry means the row is a combination of
 /// the rows before it: `L_kk² / A_kk = sin²` of the angle between that row and their span (in
@@ -61,11 +62,11 @@ pub(crate) struct SolveScratch<'a> {
     pub step: &'a mut [f64],
 }
 
-/// Solves `a x = b` (a: n × n, symmetric positive semi-definite): with `damping` 0 by Cholesky,
-/// refusing a dependent row; with `damping` μ > 0 by proximal iterations on `a + μ 1`, to
-/// [`PROXIMAL_ACCURACY`] times `scale` (at least 1: the size of the terms b comes from).
-/// `factor` (n × n) receives the factor. Returns the number of proximal iterations (0 when
-/// direct).
+/// Solves `a x = b` (a: n × n, symmetric positive semi-definite): with `damping` 0 by Cholesky
+/// ([`solve_direct`]), refusing a dependent row; with `damping` μ > 0 by proximal iterations on
+/// `a + μ 1`, to [`PROXIMAL_ACCURACY`] times `scale` (at least 1: the size of the terms b comes
+/// from). `factor` (n × n) receives the factor. Returns the number of proximal iterations (0
+/// when direct).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_symmetric(
     n: usize,
@@ -78,9 +79,7 @@ pub(crate) fn solve_symmetric(
     scratch: SolveScratch,
 ) -> Result<usize, SolveFailure> {
     if damping == 0.0 {
-        factor_symmetric(n, a, factor)?;
-        x[..n].copy_from_slice(&b[..n]);
-        cholesky_solve(n, factor, x);
+        solve_direct(n, a, factor, b, x)?;
         return Ok(0);
     }
     factor[..n * n].copy_from_slice(&a[..n * n]);
@@ -134,13 +133,29 @@ pub(crate) fn solve_symmetric(
 
 /// The Cholesky factor of `a` (n × n, symmetric positive definite) into `factor`, for
 /// [`cholesky_solve`]; a dependent row is refused as by [`solve_symmetric`].
-pub(crate) fn factor_symmetric(
+pub(crate) fn factor_symmetric<S: Real>(
     n: usize,
-    a: &[f64],
-    factor: &mut [f64],
+    a: &[S],
+    factor: &mut [S],
 ) -> Result<(), SolveFailure> {
     factor[..n * n].copy_from_slice(&a[..n * n]);
     cholesky(n, factor)
+}
+
+/// Solves `a x = b` (a: n × n, symmetric positive definite) by Cholesky, its factor into
+/// `factor`; a dependent row (in any lane) is refused as by [`solve_symmetric`].
+#[inline(always)]
+pub(crate) fn solve_direct<S: Real>(
+    n: usize,
+    a: &[S],
+    factor: &mut [S],
+    b: &[S],
+    x: &mut [S],
+) -> Result<(), SolveFailure> {
+    factor_symmetric(n, a, factor)?;
+    x[..n].copy_from_slice(&b[..n]);
+    cholesky_solve(n, factor, x);
+    Ok(())
 }
 
 /// The largest magnitude of `values` (0 when empty).
@@ -150,8 +165,9 @@ pub(crate) fn largest(values: &[f64]) -> f64 {
 
 /// In place, `a = L Lᵀ` with L lower triangular (below and on the diagonal; above is left as it
 /// was). A pivot not above [`DEPENDENT_ROW_TOLERANCE`] times its diagonal entry is refused.
-fn cholesky(n: usize, a: &mut [f64]) -> Result<(), SolveFailure> {
-    let largest_diagonal = (0..n).fold(0.0f64, |m, k| m.max(a[k + k * n]));
+#[inline(always)]
+fn cholesky<S: Real>(n: usize, a: &mut [S]) -> Result<(), SolveFailure> {
+    let largest_diagonal = (0..n).fold(S::zero(), |m, k| m.simd_max(a[k + k * n]));
     for k in 0..n {
         // L_kk² = A_kk − Σ_{j<k} L_kj²
         let diagonal = a[k + k * n];
@@ -159,11 +175,14 @@ fn cholesky(n: usize, a: &mut [f64]) -> Result<(), SolveFailure> {
         for j in 0..k {
             pivot -= a[k + j * n] * a[k + j * n];
         }
-        let zero_row = diagonal <= f64::EPSILON * largest_diagonal;
-        if zero_row || pivot <= DEPENDENT_ROW_TOLERANCE * diagonal || !pivot.is_finite() {
+        // refused in any lane: a zero row, a pivot too small, or one not finite
+        let zero_row = diagonal.simd_le(S::splat(f64::EPSILON) * largest_diagonal);
+        let dependent = pivot.simd_le(S::splat(DEPENDENT_ROW_TOLERANCE) * diagonal);
+        let finite = pivot.simd_abs().simd_lt(S::splat(f64::INFINITY));
+        if (zero_row | dependent | !finite).any() {
             return Err(SolveFailure::DependentRow(k));
         }
-        let l_kk = pivot.sqrt();
+        let l_kk = pivot.simd_sqrt();
         a[k + k * n] = l_kk;
         // L_ik = (A_ik − Σ_{j<k} L_ij L_kj) / L_kk
         for i in k + 1..n {
@@ -178,24 +197,25 @@ fn cholesky(n: usize, a: &mut [f64]) -> Result<(), SolveFailure> {
 }
 
 /// Solves `L Lᵀ x = b` in place (b in `x[..n]`) with the factor of [`cholesky`].
-pub(crate) fn cholesky_solve(n: usize, l: &[f64], x: &mut [f64]) {
+#[inline(always)]
+pub(crate) fn cholesky_solve<S: Real>(n: usize, l: &[S], x: &mut [S]) {
     // the operations of `cholesky_solve_rows` on one column, without its row slicing
     // L y = b: y_k = (b_k − Σ_{j<k} L_kj y_j) / L_kk
     for k in 0..n {
         let mut y_k = x[k];
         for (j, y_j) in x[..k].iter().enumerate() {
-            y_k -= l[k + j * n] * y_j;
+            y_k -= l[k + j * n] * *y_j;
         }
-        x[k] = y_k * (1.0 / l[k + k * n]);
+        x[k] = y_k * (S::one() / l[k + k * n]);
     }
     // Lᵀ x = y: x_k = (y_k − Σ_{j>k} L_jk x_j) / L_kk
     for k in (0..n).rev() {
         let column = &l[k * n..(k + 1) * n];
         let mut x_k = x[k];
         for (l_jk, x_j) in column[k + 1..].iter().zip(&x[k + 1..n]) {
-            x_k -= l_jk * x_j;
+            x_k -= *l_jk * *x_j;
         }
-        x[k] = x_k * (1.0 / column[k]);
+        x[k] = x_k * (S::one() / column[k]);
     }
 }
 
