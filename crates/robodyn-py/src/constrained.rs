@@ -54,7 +54,9 @@ type ConstrainedAlgorithm<'a> = dyn for<'c> Fn(
 
 impl PyModel {
     /// `algorithm` on the arguments (q, v, x[, f_ext]) for one state or a batch: a dict of its
-    /// vector and the constraint forces, named `names`.
+    /// vector and the constraint forces, named `names`. A batch without external forces runs
+    /// `lanes` when given.
+    #[allow(clippy::too_many_arguments)]
     fn constrained_call<'py>(
         &self,
         py: Python<'py>,
@@ -67,6 +69,7 @@ impl PyModel {
         set: &ConstraintSet,
         names: [&str; 2],
         algorithm: &ConstrainedAlgorithm,
+        lanes: Option<LaneRun>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let nv = self.model.nv;
         let kernel: &Kernel = &|m, w, i, out| {
@@ -86,8 +89,10 @@ impl PyModel {
             out[nv..].copy_from_slice(c.forces.as_slice());
             Ok(())
         };
+        let lanes = lanes.filter(|_| f_ext.is_none());
         let whole = self.with_dynamics_arguments((q, v, x), f_ext, |arguments| {
-            self.evaluate(py, arguments, &[nv + set.rows()], kernel)
+            let shape = [nv + set.rows()];
+            self.evaluate_to(py, arguments, &shape, Target::Zeros, kernel, lanes)
         })?;
         let parts: [(&str, &[usize]); 2] = [(names[0], &[nv]), (names[1], &[set.rows()])];
         Self::split_parts(py, &whole, &parts)
@@ -281,7 +286,9 @@ impl PyModel {
             Ok(&c.qdd)
         };
         let arguments = (q, v, ("tau", tau));
-        self.constrained_call(py, arguments, f_ext, &set, ["qdd", "forces"], algorithm)
+        let names = ["qdd", "forces"];
+        let lanes = Some(LaneRun::ConstrainedForward(&set, &options));
+        self.constrained_call(py, arguments, f_ext, &set, names, algorithm, lanes)
     }
 
     /// The velocity after an impact that makes `constraints` hold: dict of `v` (nv,), the
@@ -347,7 +354,8 @@ impl PyModel {
             Ok(&c.tau)
         };
         let arguments = (q, v, ("a", a));
-        self.constrained_call(py, arguments, f_ext, &set, ["tau", "forces"], algorithm)
+        let names = ["tau", "forces"];
+        self.constrained_call(py, arguments, f_ext, &set, names, algorithm, None)
     }
 
     /// Derivatives of `constrained_forward_dynamics` (of the exact equations: no Baumgarte

@@ -85,6 +85,7 @@ impl PyModel {
             derivatives(m, data, i[0], i[1], i[2], forces, into)
         };
         let lanes = lanes.filter(|_| arguments.len() < 4);
+        let lanes = lanes.map(LaneRun::Algorithm);
         let stack = self.evaluate_to(py, arguments, &[3, nv, nv], Target::Zeros, kernel, lanes)?;
         split_stack(py, &stack, &names)
     }

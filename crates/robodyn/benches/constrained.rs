@@ -4,19 +4,21 @@
 //! where they are, in world axes (Pinocchio's LOCAL_WORLD_ALIGNED), at a velocity the contacts
 //! allow, and an impact there. Besides the whole calls, their parts: ABA (the free acceleration
 //! and the articulated inertias the constrained algorithms build on), the constraint Jacobian,
-//! and `delassus` on its own (CRBA, M's factor, the Jacobian and one sweep per row). Skipped when
+//! and `delassus` on its own (CRBA, M's factor, the Jacobian and one sweep per row); and the
+//! forward dynamics of a batch of `BATCH` states at each lane width this CPU runs. Skipped when
 //! the URDFs are not found (see `cases`).
 
 #[allow(dead_code)]
 mod cases;
 
-use criterion::{criterion_group, criterion_main, Criterion};
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use nalgebra::DVector;
 use rand::{rngs::StdRng, SeedableRng};
 use robodyn::algo::{
-    aba, constrained_forward_dynamics, constrained_forward_dynamics_derivatives,
-    constraint_jacobian, delassus, impulse_dynamics, ConstrainedDerivatives, ConstrainedOptions,
-    ConstraintData,
+    aba, constrained_forward_dynamics, constrained_forward_dynamics_batch,
+    constrained_forward_dynamics_derivatives, constraint_jacobian, delassus, impulse_dynamics,
+    ConstrainedBatchWorkspace, ConstrainedDerivatives, ConstrainedOptions, ConstraintData,
+    LaneWidth, States,
 };
 use robodyn::constraint::{
     Attachment, Constraint, ConstraintKind, ConstraintReference, ConstraintSet,
@@ -40,6 +42,9 @@ const CONTACTS: [(&str, &str, usize, &[&str]); 2] = [
         &["left_sole_link", "right_sole_link"],
     ),
 ];
+
+/// States in one benchmarked batch: enough groups of eight that the leftovers do not count.
+const BATCH: usize = 256;
 
 /// Each frame held to the world where it is: a point (3 rows) or the whole frame (6 rows).
 fn contact_set(model: &Model, rows: usize, frames: &[&str]) -> ConstraintSet {
@@ -165,6 +170,40 @@ fn benchmarks(c: &mut Criterion) {
                 delassus(&model, &mut data, &mut constraints, &set, black_box(&q)).map(|d| d[0])
             })
         });
+        group.finish();
+
+        // a batch: the stance's configuration and velocity, the torques varied per state
+        let mut group = c.benchmark_group(format!("constrained_batch/{name}"));
+        group.throughput(Throughput::Elements(BATCH as u64));
+        let (qs, vs) = (q.repeat(BATCH), v.repeat(BATCH));
+        let taus: Vec<f64> = (0..BATCH * model.nv)
+            .map(|k| (k % 13) as f64 - 6.0)
+            .collect();
+        let states = States {
+            q: &qs,
+            v: Some(&vs),
+            a: None,
+            tau: Some(&taus),
+        };
+        let mut out = vec![0.0; BATCH * (model.nv + set.rows())];
+        for width in LaneWidth::ALL.into_iter().filter(|w| w.available()) {
+            let mut workspace = ConstrainedBatchWorkspace::with_width(&model, &set, width)
+                .expect("an available width");
+            group.bench_function(format!("forward_dynamics/{width:?}"), |b| {
+                b.iter(|| {
+                    let (model, set) = (&model, &set);
+                    constrained_forward_dynamics_batch(
+                        model,
+                        &mut workspace,
+                        set,
+                        black_box(states),
+                        &options,
+                        &mut out,
+                    )
+                    .map(|()| out[0])
+                })
+            });
+        }
         group.finish();
     }
 }

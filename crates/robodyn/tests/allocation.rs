@@ -320,6 +320,17 @@ fn constrained_allocations(
     let mut c = ConstraintData::new(model, &set);
     let mut d = ConstrainedDerivatives::new(model, &set);
     let options = ConstrainedOptions::default();
+    // a batch of two groups of the widest lanes and one state left over
+    let n = 17;
+    let (qs, vs, taus) = (q.repeat(n), v.repeat(n), tau.repeat(n));
+    let states = States {
+        q: &qs,
+        v: Some(&vs),
+        a: None,
+        tau: Some(&taus),
+    };
+    let mut workspace = ConstrainedBatchWorkspace::new(model, &set);
+    let mut out = vec![0.0; n * (model.nv + set.rows())];
     let counts = [
         (
             "constrained_forward_dynamics",
@@ -342,6 +353,21 @@ fn constrained_allocations(
                 let state = (q, v, tau);
                 constrained_forward_dynamics_derivatives(
                     model, data, &mut c, &mut d, &set, state, None, 0.0,
+                )
+                .unwrap();
+            }),
+        ),
+        (
+            "constrained_forward_dynamics_batch",
+            allocations(|| {
+                let out = &mut out;
+                constrained_forward_dynamics_batch(
+                    model,
+                    &mut workspace,
+                    &set,
+                    states,
+                    &options,
+                    out,
                 )
                 .unwrap();
             }),

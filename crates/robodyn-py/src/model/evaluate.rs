@@ -3,7 +3,7 @@
 
 use super::output::{output_array, Target};
 use super::pages::advise_huge_pages;
-use super::schedule::{run_kernel, BatchInputs, Kernel, MAX_ARGUMENTS};
+use super::schedule::{run_kernel, BatchInputs, Kernel, LaneRun, MAX_ARGUMENTS};
 use super::workspace::Workspace;
 use super::PyModel;
 use crate::args::{shape_text, Argument};
@@ -41,6 +41,7 @@ impl PyModel {
         kernel: &Kernel,
         lanes: Option<BatchAlgorithm>,
     ) -> PyResult<Bound<'py, PyAny>> {
+        let lanes = lanes.map(LaneRun::Algorithm);
         self.evaluate_to(py, arguments, output_shape, Target::Out(out), kernel, lanes)
     }
 
@@ -52,7 +53,7 @@ impl PyModel {
         output_shape: &[usize],
         target: Target<'_, 'py>,
         kernel: &Kernel,
-        lanes: Option<BatchAlgorithm>,
+        lanes: Option<LaneRun>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (out, zeroed) = match target {
             Target::Zeros => (None, true),

@@ -14,7 +14,7 @@ mod schedule;
 mod workspace;
 
 pub(crate) use output::*;
-pub(crate) use schedule::Kernel;
+pub(crate) use schedule::{Kernel, LaneRun};
 pub(crate) use workspace::{fill_forces, Workspace, WorkspacePool};
 
 use crate::args::*;

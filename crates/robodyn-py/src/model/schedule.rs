@@ -7,12 +7,55 @@ use super::PyModel;
 use crate::errors::batch_element_error;
 use pyo3::prelude::*;
 use rayon::prelude::*;
-use robodyn::algo::{self, BatchAlgorithm};
+use robodyn::algo::{self, BatchAlgorithm, ConstrainedBatchWorkspace, ConstrainedOptions, States};
+use robodyn::constraint::ConstraintSet;
 use robodyn::{Error, Model};
 
 /// One computation on one sample: inputs (flattened, in argument order) to a flattened output.
 pub(crate) type Kernel<'k> =
     dyn Fn(&Model, &mut Workspace, &[&[f64]], &mut [f64]) -> robodyn::Result<()> + Sync + 'k;
+
+/// A batch computation that runs in lanes (`robodyn::algo::lanes`) on runs of samples.
+#[derive(Clone, Copy)]
+pub(crate) enum LaneRun<'a> {
+    /// One of the free-space algorithms, its inputs as it names them.
+    Algorithm(BatchAlgorithm),
+    /// Constrained forward dynamics on (q, v, τ): rows of q̈ then the forces.
+    ConstrainedForward(&'a ConstraintSet, &'a ConstrainedOptions),
+}
+
+impl LaneRun<'_> {
+    /// Runs on the `states` given as `inputs` (in argument order) into `out`, in `workspace`'s
+    /// lane buffers.
+    fn run(
+        self,
+        model: &Model,
+        workspace: &mut Workspace,
+        inputs: &[&[f64]],
+        out: &mut [f64],
+    ) -> algo::BatchResult {
+        match self {
+            LaneRun::Algorithm(algorithm) => {
+                let width = workspace.lanes(model);
+                algo::batch(algorithm, model, width, algorithm.states(inputs), out)
+            }
+            LaneRun::ConstrainedForward(set, options) => {
+                let states = States {
+                    q: inputs[0],
+                    v: Some(inputs[1]),
+                    a: None,
+                    tau: Some(inputs[2]),
+                };
+                let lanes = crate::constrained::made_for(
+                    &mut workspace.constrained_lanes,
+                    |w| w.fits(model, set),
+                    || ConstrainedBatchWorkspace::new(model, set),
+                );
+                algo::constrained_forward_dynamics_batch(model, lanes, set, states, options, out)
+            }
+        }
+    }
+}
 
 /// The most numeric arguments a method takes (q, v, a, f_ext).
 pub(super) const MAX_ARGUMENTS: usize = 4;
@@ -72,7 +115,7 @@ impl PyModel {
         batch: &BatchInputs,
         out: &mut [f64],
         kernel: &Kernel,
-        lanes: Option<BatchAlgorithm>,
+        lanes: Option<LaneRun>,
     ) -> PyResult<()> {
         let (model, pool) = (&self.model, &self.batch_workspaces);
         let output_size = batch.output_size.max(1);
@@ -103,9 +146,8 @@ impl PyModel {
                                 let first = first + p * piece;
                                 let count = outputs.len() / output_size;
                                 let inputs = select(first, count);
-                                let states = lanes.states(&inputs[..arguments]);
-                                let width = workspace.lanes(model);
-                                algo::batch(lanes, model, width, states, outputs)
+                                lanes
+                                    .run(model, &mut workspace, &inputs[..arguments], outputs)
                                     .map_err(|(k, e)| (first + k, e))?;
                                 if let Some(index) = first_overflow(outputs) {
                                     let value = outputs[index];

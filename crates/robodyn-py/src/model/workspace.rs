@@ -1,7 +1,9 @@
 //! A kernel's workspace, and the pool of them that a batch's threads take from and give back to.
 
 use nalgebra::DMatrix;
-use robodyn::algo::{BatchWorkspace, ConstrainedDerivatives, ConstraintData};
+use robodyn::algo::{
+    BatchWorkspace, ConstrainedBatchWorkspace, ConstrainedDerivatives, ConstraintData,
+};
 use robodyn::integrate::{Constrained, StepWorkspace};
 use robodyn::spatial::Force;
 use robodyn::{Data, Model};
@@ -23,6 +25,8 @@ pub(crate) struct Workspace {
     pub(crate) constrained: Option<Box<ConstraintData>>,
     /// The constrained derivatives' workspace, made for the last constraint set's size.
     pub(crate) constrained_derivatives: Option<Box<ConstrainedDerivatives>>,
+    /// The lane buffers of constrained batches, made for the last constraint set's size.
+    pub(crate) constrained_lanes: Option<Box<ConstrainedBatchWorkspace>>,
 }
 
 impl Workspace {
@@ -39,6 +43,7 @@ impl Workspace {
             lanes: None,
             constrained: None,
             constrained_derivatives: None,
+            constrained_lanes: None,
         }
     }
 

@@ -27,11 +27,16 @@ mod forward;
 mod inverse;
 mod solve;
 
+pub(crate) use articulated::{
+    articulated_delassus, constraint_response, rows_under_free_motion, AbaTerms, RouteBuffers,
+};
 pub use derivatives::{
     constrained_forward_dynamics_derivatives, impulse_dynamics_derivatives, ConstrainedDerivatives,
 };
+pub(crate) use forward::accelerated_right_side;
 pub use forward::{constrained_forward_dynamics, impulse_dynamics, ConstrainedOptions};
 pub use inverse::{constrained_inverse_dynamics, CONSTRAINT_ACCELERATION_TOLERANCE};
+pub(crate) use solve::solve_direct;
 pub use solve::{
     DEPENDENT_ROW_TOLERANCE, PROXIMAL_ACCURACY, PROXIMAL_MAX_ITERATIONS, STALLED_ACCURACY,
 };

@@ -11,6 +11,7 @@
 //! compiled once per instruction set (`#[target_feature]`), so one binary serves every x86-64 CPU.
 
 mod algorithms;
+mod constrained;
 mod groups;
 mod scatter;
 
@@ -18,6 +19,7 @@ pub use algorithms::{
     aba_batch, aba_derivatives_batch, batch, crba_batch, frame_pose_batch, jacobian_batch,
     newton_euler_batch, rnea_derivatives_batch, BatchAlgorithm,
 };
+pub use constrained::{constrained_forward_dynamics_batch, ConstrainedBatchWorkspace};
 
 use crate::algo::aba::aba;
 use crate::algo::crba::crba_into;
@@ -245,7 +247,7 @@ pub fn write_jacobian_column<S: Real>(
 }
 
 /// State k of the batch.
-fn state<'s>(model: &Model, states: &States<'s>, k: usize) -> States<'s> {
+pub(super) fn state<'s>(model: &Model, states: &States<'s>, k: usize) -> States<'s> {
     let (nq, nv) = (model.nq, model.nv);
     let row = |x: &'s [f64]| &x[k * nv..(k + 1) * nv];
     States {
@@ -257,7 +259,7 @@ fn state<'s>(model: &Model, states: &States<'s>, k: usize) -> States<'s> {
 }
 
 /// Checks the batch's shapes, then every state as a one-state call would.
-fn check_states(model: &Model, states: &States, n: usize) -> BatchResult {
+pub(super) fn check_states(model: &Model, states: &States, n: usize) -> BatchResult {
     let whole = |e| (0, e);
     check_length("q", states.q.len(), n * model.nq).map_err(whole)?;
     for (name, values) in [("v", states.v), ("a", states.a), ("tau", states.tau)] {

@@ -43,9 +43,10 @@ pub use inverse_kinematics::{inverse_kinematics, IkOptions, IkSolution};
 pub use jacobian::{jacobian, jacobian_columns, Reference};
 pub use kinematics::{forward_kinematics, frame_placement, frame_pose};
 pub use lanes::{
-    aba_batch, aba_derivatives_batch, batch, crba_batch, frame_pose_batch, jacobian_batch,
-    newton_euler_batch, rnea_derivatives_batch, write_jacobian_column, BatchAlgorithm, BatchResult,
-    BatchWorkspace, LaneWidth, States,
+    aba_batch, aba_derivatives_batch, batch, constrained_forward_dynamics_batch, crba_batch,
+    frame_pose_batch, jacobian_batch, newton_euler_batch, rnea_derivatives_batch,
+    write_jacobian_column, BatchAlgorithm, BatchResult, BatchWorkspace, ConstrainedBatchWorkspace,
+    LaneWidth, States,
 };
 pub use manipulability::manipulability;
 pub use minv::inverse_mass_matrix;

@@ -307,7 +307,7 @@ pub(super) fn groups<S: LaneRows>(
 /// Lane l of `lanes[j]` = entry j of row `first + l` of the row-major `rows` (width
 /// `lanes.len()`).
 #[inline(always)]
-fn gather<S: LaneRows>(lanes: &mut [S], rows: &[f64], first: usize) {
+pub(super) fn gather<S: LaneRows>(lanes: &mut [S], rows: &[f64], first: usize) {
     let size = lanes.len();
     S::gather(&rows[first * size..(first + S::LANES) * size], lanes);
 }
