@@ -16,7 +16,9 @@
 
 use super::{Attachment, ConstraintKind, ConstraintReference, ConstraintSet};
 use crate::model::Model;
-use crate::spatial::{log_rotation, Motion, Real, Transform};
+use crate::spatial::{
+    compose, cross, dot, log_rotation, rotate, rotate_back, transposed, Motion, Real, Transform,
+};
 use nalgebra::{DMatrix, Matrix3, Rotation3, UnitQuaternion, Vector3};
 
 /// Where the rows of a constraint set are written: J (rows × nv), γ and φ (rows each); in `f64`
@@ -59,6 +61,7 @@ struct FrameMotion<S> {
 }
 
 /// Writes J, γ and φ of every constraint of `set` (J's rows zeroed first).
+#[inline(always)]
 pub(crate) fn evaluate<S: Real>(
     model: &Model,
     set: &ConstraintSet,
@@ -128,6 +131,7 @@ struct Held<S> {
 }
 
 impl<S: Real> Held<S> {
+    #[inline(always)]
     fn new(
         model: &Model,
         bodies: &BodyMotion<S>,
@@ -141,6 +145,7 @@ impl<S: Real> Held<S> {
     }
 
     /// Writes the `mask`ed rows `[linear; angular]` from row `row` on.
+    #[inline(always)]
     fn write(
         &self,
         model: &Model,
@@ -158,7 +163,7 @@ impl<S: Real> Held<S> {
             Matrix3::identity()
         };
         // J: the first point's columns minus the second's (world axes: no turn)
-        let turned = |x: &Vector3<S>| if local { axes * x } else { *x };
+        let turned = |x: &Vector3<S>| if local { rotate(&axes, x) } else { *x };
         for (motion, first) in [(Some(first), true), (self.second.as_ref(), false)] {
             let Some(motion) = motion else { continue };
             point_columns(model, bodies, motion, |column, linear, angular| {
@@ -183,11 +188,12 @@ impl<S: Real> Held<S> {
             angular_acceleration -= second.angular_acceleration;
             offset = first.position - second.position;
             // R = Eᵀ, so R_2ᵀ R_1 = E_2 E_1ᵀ
-            let relative = second.rotation * first.rotation.transpose();
-            turn = second.rotation.transpose() * relative_turn(&relative);
+            let relative = compose(&second.rotation, &transposed(&first.rotation));
+            turn = rotate_back(&second.rotation, &relative_turn(&relative));
         }
-        let drift = six(&(axes * acceleration), &(axes * angular_acceleration));
-        let error = six(&(axes * offset), &(axes * turn));
+        let turned = |x: &Vector3<S>| rotate(&axes, x);
+        let drift = six(&turned(&acceleration), &turned(&angular_acceleration));
+        let error = six(&turned(&offset), &turned(&turn));
         for ((r, gamma), (_, phi)) in kept(mask, &drift).zip(kept(mask, &error)) {
             rows.drift[row + r] = gamma;
             rows.error[row + r] = phi;
@@ -197,6 +203,7 @@ impl<S: Real> Held<S> {
 
 /// The distance row: with n = (p_1 − p_2)/d, `J = nᵀ (J_1 − J_2)`,
 /// `γ = nᵀ (p̈_1 − p̈_2) + (|ṗ_1 − ṗ_2|² − (nᵀ (ṗ_1 − ṗ_2))²)/d`, φ = d − length.
+#[inline(always)]
 fn write_distance<S: Real>(
     model: &Model,
     bodies: &BodyMotion<S>,
@@ -206,27 +213,30 @@ fn write_distance<S: Real>(
     rows: &mut ConstraintRows<S>,
 ) {
     let offset = one.position - other.position;
-    let distance = offset.norm().simd_max(S::splat(f64::MIN_POSITIVE));
+    let distance = dot(&offset, &offset)
+        .simd_sqrt()
+        .simd_max(S::splat(f64::MIN_POSITIVE));
     let n = offset / distance;
     for (motion, first) in [(one, true), (other, false)] {
         point_columns(model, bodies, motion, |column, linear, _| {
             let entry = &mut rows.jacobian[(row, column)];
             *entry = if first {
-                *entry + n.dot(linear)
+                *entry + dot(&n, linear)
             } else {
-                *entry - n.dot(linear)
+                *entry - dot(&n, linear)
             };
         });
     }
     let relative_velocity = one.velocity - other.velocity;
-    let along = n.dot(&relative_velocity);
-    let gamma = n.dot(&(one.acceleration - other.acceleration))
-        + (relative_velocity.norm_squared() - along * along) / distance;
+    let along = dot(&n, &relative_velocity);
+    let gamma = dot(&n, &(one.acceleration - other.acceleration))
+        + (dot(&relative_velocity, &relative_velocity) - along * along) / distance;
     rows.drift[row] = gamma;
     rows.error[row] = distance - S::splat(length);
 }
 
 /// The motion of an attachment's constraint frame (fixed in the world when it has no frame).
+#[inline(always)]
 fn frame_motion<S: Real>(
     model: &Model,
     bodies: &BodyMotion<S>,
@@ -253,10 +263,10 @@ fn frame_motion<S: Real>(
     let velocity = bodies.x_world[body].inverse_apply_motion(&bodies.v[body]);
     let acceleration = bodies.x_world[body].inverse_apply_motion(&bodies.a[body]);
     // ṗ = v_O + ω × p;  p̈ = a_O + ω̇ × p + ω × ṗ
-    let point_velocity = velocity.linear + velocity.angular.cross(&p);
+    let point_velocity = velocity.linear + cross(&velocity.angular, &p);
     let point_acceleration = acceleration.linear
-        + acceleration.angular.cross(&p)
-        + velocity.angular.cross(&point_velocity);
+        + cross(&acceleration.angular, &p)
+        + cross(&velocity.angular, &point_velocity);
     FrameMotion {
         rotation: placement.rotation,
         position: p,
@@ -270,6 +280,7 @@ fn frame_motion<S: Real>(
 /// The columns of the point's Jacobian that are not zero, world axes, each handed to
 /// `column(index, linear, angular)`: the subspace columns of the joints between the point's
 /// body and the world, taken at the point.
+#[inline(always)]
 fn point_columns<S: Real>(
     model: &Model,
     bodies: &BodyMotion<S>,
@@ -288,6 +299,7 @@ fn point_columns<S: Real>(
 }
 
 /// `[linear; angular]` as six numbers.
+#[inline(always)]
 pub(super) fn six<S: Real>(linear: &Vector3<S>, angular: &Vector3<S>) -> [S; 6] {
     [
         linear.x, linear.y, linear.z, angular.x, angular.y, angular.z,
@@ -295,6 +307,7 @@ pub(super) fn six<S: Real>(linear: &Vector3<S>, angular: &Vector3<S>) -> [S; 6] 
 }
 
 /// The entries of `full` that `mask` keeps, numbered from 0 in order.
+#[inline(always)]
 pub(super) fn kept<'a, S: Real>(
     mask: &'a [bool; 6],
     full: &'a [S; 6],
@@ -307,6 +320,7 @@ pub(super) fn kept<'a, S: Real>(
 }
 
 /// p(x) = Σ c_k x^k and its first three derivatives, by Horner's rule.
+#[inline(always)]
 pub(super) fn polynomial_at<S: Real>(c: &[f64; 5], x: S) -> [S; 4] {
     let [mut p, mut dp, mut ddp, mut dddp] = [S::zero(); 4];
     let (two, three) = (S::splat(2.0), S::splat(3.0));

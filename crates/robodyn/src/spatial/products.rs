@@ -4,7 +4,7 @@
 //! generic products, called out of line, would not).
 
 use super::{Force, Mat3, Mat6, Motion, Vec3};
-use nalgebra::{Matrix3, Matrix6, SimdRealField, Vector3};
+use nalgebra::{Matrix3, Matrix6, SVector, SimdRealField, Vector3};
 
 /// A number the spatial algebra computes in: `f64` for one state, or a lane type holding one
 /// `f64` per state of a batch (`simba`'s `AutoSimd<[f64; N]>`), so that one kernel serves both
@@ -108,6 +108,17 @@ pub fn cross<S: Real>(a: &Vector3<S>, b: &Vector3<S>) -> Vector3<S> {
         a.z * b.x - a.x * b.z,
         a.x * b.y - a.y * b.x,
     )
+}
+
+/// `a · b`, summed in order (the same operations in `f64` and in lanes, inlined where a lane
+/// kernel is compiled).
+#[inline(always)]
+pub fn dot<S: Real, const N: usize>(a: &SVector<S, N>, b: &SVector<S, N>) -> S {
+    let mut sum = a[0] * b[0];
+    for k in 1..N {
+        sum += a[k] * b[k];
+    }
+    sum
 }
 
 /// `E v`.

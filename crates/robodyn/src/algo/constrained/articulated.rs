@@ -26,7 +26,7 @@ use crate::constraint::{evaluate, BodyMotion, ConstraintRows, ConstraintSet};
 use crate::error::Result;
 use crate::joint::ArticulatedTerms;
 use crate::model::Model;
-use crate::spatial::{Force, Motion, Real, Transform};
+use crate::spatial::{dot, Force, Motion, Real, Transform};
 use crate::Data;
 use nalgebra::{DMatrix, Matrix6, Vector6};
 
@@ -256,25 +256,20 @@ fn delassus_from_transmitted<S: Real>(
             for (a, y_ra) in y_r.iter_mut().take(dofs.len()).enumerate() {
                 *y_ra = columns[a * m + r];
             }
-            let w_r = if dofs.len() == 6 {
-                d_inv * y_r
-            } else {
-                let mut w_r = Vector6::zeros();
-                for (a, w_ra) in w_r.iter_mut().take(dofs.len()).enumerate() {
-                    let mut sum = S::zero();
-                    for b in 0..dofs.len() {
-                        sum += d_inv[(a, b)] * y_r[b];
-                    }
-                    *w_ra = sum;
+            let mut w_r = Vector6::zeros();
+            for (a, w_ra) in w_r.iter_mut().take(dofs.len()).enumerate() {
+                let mut sum = S::zero();
+                for b in 0..dofs.len() {
+                    sum += d_inv[(a, b)] * y_r[b];
                 }
-                w_r
-            };
+                *w_ra = sum;
+            }
             body_rows[r] = (y_r, w_r);
         }
         for c in span.clone() {
             let w_c = &body_rows[c].1;
             for r in span.start..=c {
-                lambda[c * m + r] += body_rows[r].0.dot(w_c);
+                lambda[c * m + r] += dot(&body_rows[r].0, w_c);
             }
         }
     }

@@ -133,6 +133,7 @@ pub(crate) fn solve_symmetric(
 
 /// The Cholesky factor of `a` (n × n, symmetric positive definite) into `factor`, for
 /// [`cholesky_solve`]; a dependent row is refused as by [`solve_symmetric`].
+#[inline(always)]
 pub(crate) fn factor_symmetric<S: Real>(
     n: usize,
     a: &[S],
