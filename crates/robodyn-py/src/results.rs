@@ -11,7 +11,8 @@
 use crate::args::plain_float64;
 use numpy::ndarray::IxDyn;
 use numpy::npyffi::{npy_intp, PyArray_Descr, NPY_ARRAY_CARRAY, PY_ARRAY_API};
-use numpy::PyArrayDyn;
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
 use pyo3::ffi;
 use pyo3::prelude::*;
 use std::ffi::{c_int, c_void};
@@ -84,19 +85,61 @@ fn array_on_buffer<'py>(
     let data = buffer.0.as_mut_ptr().cast::<c_void>();
     // the capsule's pointer: the buffer itself, boxed (its values stay where they are)
     let owner = Box::into_raw(Box::new(buffer));
-    // SAFETY: CPython's and NumPy's API with the GIL held. The capsule owns the boxed buffer
-    // from its creation (its destructor frees it); where it could not be made, the box is freed
-    // here. NumPy's array refers to the buffer's values without owning them, and takes the
-    // capsule's reference as its base; where the array could not be made, dropping the capsule
-    // frees the buffer.
-    unsafe {
+    // SAFETY: CPython's API with the GIL held. The capsule owns the boxed buffer from its
+    // creation (its destructor frees it); where it could not be made, the box is freed here.
+    // Where the array could not be made, dropping the capsule frees the buffer.
+    let capsule = unsafe {
         let capsule =
             ffi::PyCapsule_New(owner.cast::<c_void>(), std::ptr::null(), Some(free_buffer));
         if capsule.is_null() {
             drop(Box::from_raw(owner));
             return Err(PyErr::fetch(py));
         }
-        let capsule = Bound::from_owned_ptr(py, capsule);
+        Bound::from_owned_ptr(py, capsule)
+    };
+    // SAFETY: `data` holds the product of `dims` values, kept alive by the capsule
+    unsafe { array_on(py, dims, data, capsule) }
+}
+
+/// `values[start..]` of the C-ordered float64 `whole` as an array of shape `shape` (a C-ordered
+/// view, `whole` its base), made directly (Python's indexing and `reshape` cost a microsecond
+/// each); refused where `whole` is not C-contiguous or the part does not fit in it.
+pub(crate) fn view_of<'py>(
+    py: Python<'py>,
+    whole: &Bound<'py, PyArray1<f64>>,
+    start: usize,
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyAny>> {
+    let size: usize = shape.iter().product();
+    if !whole.is_c_contiguous() || start + size > whole.len() || shape.len() > MOST_DIMENSIONS {
+        return Err(PyValueError::new_err("a part outside its result's array"));
+    }
+    let mut dims: [npy_intp; MOST_DIMENSIONS] = [0; MOST_DIMENSIONS];
+    for (dim, &n) in dims.iter_mut().zip(shape) {
+        *dim = n as npy_intp;
+    }
+    // SAFETY: the part lies within `whole`'s contiguous values (checked), which `whole`, the
+    // view's base, keeps alive
+    unsafe {
+        let data = whole.data().add(start).cast::<c_void>();
+        let array = array_on(py, &mut dims[..shape.len()], data, whole.clone().into_any())?;
+        Ok(array.into_any())
+    }
+}
+
+/// A C-ordered float64 array of shape `dims` on `data`, which `base` keeps alive.
+///
+/// # Safety
+/// `data` must hold the product of `dims` values, valid and writable while `base` lives.
+unsafe fn array_on<'py>(
+    py: Python<'py>,
+    dims: &mut [npy_intp],
+    data: *mut c_void,
+    base: Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    // SAFETY: NumPy's API with the GIL held. NumPy's array refers to `data` without owning it,
+    // and takes `base`'s reference as its base.
+    unsafe {
         let (array_type, float64) = plain_float64(py);
         // NumPy takes this reference to its descriptor, even where it fails
         ffi::Py_IncRef(float64 as *mut ffi::PyObject);
@@ -112,8 +155,8 @@ fn array_on_buffer<'py>(
             std::ptr::null_mut(),
         );
         let array = Bound::from_owned_ptr_or_err(py, array)?;
-        // takes the capsule's reference, even where it fails
-        if PY_ARRAY_API.PyArray_SetBaseObject(py, array.as_ptr().cast(), capsule.into_ptr()) != 0 {
+        // takes the base's reference, even where it fails
+        if PY_ARRAY_API.PyArray_SetBaseObject(py, array.as_ptr().cast(), base.into_ptr()) != 0 {
             return Err(PyErr::fetch(py));
         }
         Ok(array.cast_into_unchecked())

@@ -29,6 +29,16 @@ fn batch(model: &Model) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     (q, v, tau)
 }
 
+/// The batch's states as the batch call takes them.
+fn states<'a>(q: &'a [f64], v: &'a [f64], tau: &'a [f64]) -> States<'a> {
+    States {
+        q,
+        v: Some(v),
+        a: None,
+        tau: Some(tau),
+    }
+}
+
 /// Each state's one-state call, rows of q̈ then λ.
 fn one_by_one(
     model: &Model,
@@ -67,12 +77,7 @@ fn each_lane_equals_the_one_state_call_bit_for_bit() {
     for (name, model, constraints) in cases() {
         let set = ConstraintSet::new(&model, constraints).unwrap();
         let (q, v, tau) = batch(&model);
-        let states = States {
-            q: &q,
-            v: Some(&v),
-            a: None,
-            tau: Some(&tau),
-        };
+        let states = states(&q, &v, &tau);
         for options in [ConstrainedOptions::default(), baumgarte] {
             let expected = one_by_one(&model, &set, (&q, &v, &tau), &options);
             for width in available_widths() {
@@ -109,12 +114,7 @@ fn damping_and_dependent_rows_run_one_state_at_a_time() {
     let loop_closure = tree_constraints(&model).swap_remove(2);
     let set = ConstraintSet::new(&model, vec![loop_closure.clone(), loop_closure]).unwrap();
     let (q, v, tau) = batch(&model);
-    let states = States {
-        q: &q,
-        v: Some(&v),
-        a: None,
-        tau: Some(&tau),
-    };
+    let states = states(&q, &v, &tau);
     let size = model.nv + set.rows();
     for width in available_widths() {
         let mut workspace = ConstrainedBatchWorkspace::with_width(&model, &set, width).unwrap();
@@ -158,12 +158,7 @@ fn a_workspace_for_another_set_or_a_missing_input_is_refused() {
     let mut out = vec![0.0; STATES * (model.nv + set.rows())];
     let options = ConstrainedOptions::default();
     let mut workspace = ConstrainedBatchWorkspace::new(&model, &smaller);
-    let full = States {
-        q: &q,
-        v: Some(&v),
-        a: None,
-        tau: Some(&tau),
-    };
+    let full = states(&q, &v, &tau);
     let (_, error) =
         constrained_forward_dynamics_batch(&model, &mut workspace, &set, full, &options, &mut out)
             .unwrap_err();
