@@ -72,6 +72,24 @@ def test_batches_equal_one_state_at_a_time(ur5):
         np.testing.assert_array_equal(impulses["v"][k], one["v"])
 
 
+def test_an_empty_list_gives_the_free_dynamics(ur5):
+    rng = np.random.default_rng(8)
+    n = 11
+    q = ur5.random_configuration(n, seed=3)
+    v, tau = rng.uniform(-1, 1, (n, ur5.nv)), rng.uniform(-5, 5, (n, ur5.nv))
+    free = ur5.forward_dynamics(q, v, tau)
+    for options in [{}, {"baumgarte": (40.0, 12.0)}]:
+        batch = ur5.constrained_forward_dynamics(q, v, tau, [], **options)
+        assert batch["forces"].shape == (n, 0)
+        assert_close(batch["qdd"], free, IDENTITY_TOLERANCE)
+        one = ur5.constrained_forward_dynamics(q[0], v[0], tau[0], [], **options)
+        assert_close(one["qdd"], free[0], IDENTITY_TOLERANCE)
+    assert_close(ur5.impulse_dynamics(q, v, [])["v"], v, 0.0)
+    derivatives = ur5.constrained_forward_dynamics_derivatives(q[0], v[0], tau[0], [])
+    assert_close(derivatives["dqdd_dtau"], ur5.inverse_mass_matrix(q[0]), IDENTITY_TOLERANCE)
+    assert ur5.constraint_jacobian(q[0], []).shape == (0, ur5.nv)
+
+
 def test_a_list_passed_again_or_changed_gives_its_own_answer(ur5):
     # a call resolves the constraint objects it is given; the same objects again reuse that
     # set, other objects (a changed list, equal new objects) are resolved anew

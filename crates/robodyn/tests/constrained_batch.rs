@@ -176,3 +176,41 @@ fn a_workspace_for_another_set_or_a_missing_input_is_refused() {
     .unwrap_err();
     assert!(error.to_string().contains("tau"), "{error}");
 }
+
+#[test]
+fn an_empty_set_gives_the_free_dynamics() {
+    let model = test_model("tree");
+    let set = ConstraintSet::new(&model, Vec::new()).unwrap();
+    let (q, v, tau) = batch(&model);
+    let options = ConstrainedOptions {
+        baumgarte: Some((40.0, 12.0)),
+        damping: 0.0,
+    };
+    let expected = one_by_one(&model, &set, (&q, &v, &tau), &options);
+    let mut data = Data::new(&model);
+    let nv = model.nv;
+    for (k, qdd) in expected.chunks_exact(nv).enumerate() {
+        let (q, v, tau) = (
+            &q[k * model.nq..(k + 1) * model.nq],
+            &v[k * nv..(k + 1) * nv],
+            &tau[k * nv..(k + 1) * nv],
+        );
+        let free = robodyn::algo::aba(&model, &mut data, q, v, tau, None).unwrap();
+        assert_eq!(qdd, free.as_slice(), "state {k}");
+    }
+    for width in available_widths() {
+        let mut workspace = ConstrainedBatchWorkspace::with_width(&model, &set, width).unwrap();
+        let mut out = vec![f64::NAN; expected.len()];
+        let states = states(&q, &v, &tau);
+        constrained_forward_dynamics_batch(
+            &model,
+            &mut workspace,
+            &set,
+            states,
+            &options,
+            &mut out,
+        )
+        .unwrap();
+        assert_eq!(out, expected, "{width:?}");
+    }
+}

@@ -152,13 +152,9 @@ pub(crate) fn rows_under_free_motion<S: Real>(
     let m = set.rows();
     let rows_acceleration = &mut route.rhs[..m];
     rows_acceleration.copy_from_slice(route.drift);
-    for (column, a_c) in route
-        .jacobian
-        .as_slice()
-        .chunks_exact(m)
-        .zip(terms.free_acceleration)
-    {
-        for (entry, j_rc) in rows_acceleration.iter_mut().zip(column) {
+    let j = route.jacobian.as_slice();
+    for (c, a_c) in terms.free_acceleration.iter().enumerate() {
+        for (entry, j_rc) in rows_acceleration.iter_mut().zip(&j[c * m..(c + 1) * m]) {
             *entry += *j_rc * *a_c;
         }
     }
@@ -297,9 +293,9 @@ pub(crate) fn constraint_response<S: Real>(
         &mut *route.body_accelerations,
     );
     // u = Yᵀ λ
-    for (u_k, column) in u.iter_mut().zip(y.chunks_exact(m)) {
+    for (k, u_k) in u.iter_mut().enumerate() {
         let mut sum = S::zero();
-        for (y_rk, lambda_r) in column.iter().zip(&route.forces[..m]) {
+        for (y_rk, lambda_r) in y[k * m..(k + 1) * m].iter().zip(&route.forces[..m]) {
             sum += *y_rk * *lambda_r;
         }
         *u_k = sum;

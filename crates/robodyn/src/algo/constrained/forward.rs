@@ -184,10 +184,10 @@ pub(crate) fn accelerated_right_side<S: Real>(
     let (kp, kd) = baumgarte.unwrap_or((0.0, 0.0));
     if kd != 0.0 {
         // −K_d J q̇
-        let kd = S::splat(kd);
-        for (column, v_c) in jacobian.as_slice().chunks_exact(rhs.len()).zip(v) {
+        let (kd, m, j) = (S::splat(kd), rhs.len(), jacobian.as_slice());
+        for (c, v_c) in v.iter().enumerate() {
             let scaled = kd * *v_c;
-            for (entry, j_rc) in rhs.iter_mut().zip(column) {
+            for (entry, j_rc) in rhs.iter_mut().zip(&j[c * m..(c + 1) * m]) {
                 *entry -= *j_rc * scaled;
             }
         }
