@@ -58,7 +58,6 @@ def test_batches_equal_one_state_at_a_time(ur5):
     q = ur5.random_configuration(n, seed=2)
     v, tau = rng.uniform(-1, 1, (n, ur5.nv)), rng.uniform(-5, 5, (n, ur5.nv))
     constraints = loop(ur5)
-    impulses = ur5.impulse_dynamics(q, v, constraints, restitution=0.5)
     assert ur5.delassus(q, constraints).shape == (n, 3, 3)
     for options in [{}, {"baumgarte": (40.0, 12.0)}, {"damping": 1e-6}]:
         batch = ur5.constrained_forward_dynamics(q, v, tau, constraints, **options)
@@ -67,9 +66,13 @@ def test_batches_equal_one_state_at_a_time(ur5):
             one = ur5.constrained_forward_dynamics(q[k], v[k], tau[k], constraints, **options)
             np.testing.assert_array_equal(batch["qdd"][k], one["qdd"])
             np.testing.assert_array_equal(batch["forces"][k], one["forces"])
-    for k in range(n):
-        one = ur5.impulse_dynamics(q[k], v[k], constraints, restitution=0.5)
-        np.testing.assert_array_equal(impulses["v"][k], one["v"])
+    # impulses in lanes too (with damping, one state at a time)
+    for options in [{"restitution": 0.5}, {"restitution": 0.5, "damping": 1e-6}]:
+        impulses = ur5.impulse_dynamics(q, v, constraints, **options)
+        for k in range(n):
+            one = ur5.impulse_dynamics(q[k], v[k], constraints, **options)
+            np.testing.assert_array_equal(impulses["v"][k], one["v"])
+            np.testing.assert_array_equal(impulses["impulses"][k], one["impulses"])
 
 
 def test_an_empty_list_gives_the_free_dynamics(ur5):

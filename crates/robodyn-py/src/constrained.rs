@@ -312,7 +312,9 @@ impl PyModel {
             Ok(())
         };
         let arguments = [self.q_arg("q", q)?, self.v_arg("v", v)?];
-        let whole = self.evaluate(py, &arguments, &[nv + set.rows()], kernel)?;
+        let lanes = Some(LaneRun::Impulse(&set, (restitution, damping)));
+        let shape = [nv + set.rows()];
+        let whole = self.evaluate_to(py, &arguments, &shape, Target::Out(None), kernel, lanes)?;
         Self::split_parts(py, &whole, &[("v", &[nv]), ("impulses", &[set.rows()])])
     }
 

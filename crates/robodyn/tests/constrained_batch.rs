@@ -1,14 +1,16 @@
-//! Constrained forward dynamics of a batch: in lanes at every width this CPU has, each state's
-//! q̈ and λ equal the one-state call's bit for bit (the lanes perform its operations); groups the
-//! lanes cannot share (dependent rows, damping) run one state at a time and say so.
+//! Constrained forward dynamics and impulses of a batch: in lanes at every width this CPU has,
+//! each state's result equals the one-state call's bit for bit (the lanes perform its
+//! operations); groups the lanes cannot share (dependent rows, damping) run one state at a time
+//! and say so.
 
 mod common;
 
 use common::constraints::*;
 use common::*;
 use robodyn::algo::{
-    constrained_forward_dynamics, constrained_forward_dynamics_batch, ConstrainedBatchWorkspace,
-    ConstrainedOptions, ConstraintData, LaneWidth, States,
+    constrained_forward_dynamics, constrained_forward_dynamics_batch, impulse_dynamics,
+    impulse_dynamics_batch, ConstrainedBatchWorkspace, ConstrainedOptions, ConstraintData,
+    LaneWidth, States,
 };
 use robodyn::constraint::ConstraintSet;
 use robodyn::{Data, Model};
@@ -61,6 +63,29 @@ fn one_by_one(
     out
 }
 
+/// Each state's one-state impulses, rows of q̇ after then the impulses.
+fn impulses_one_by_one(
+    model: &Model,
+    set: &ConstraintSet,
+    (q, v): (&[f64], &[f64]),
+    restitution: f64,
+) -> Vec<f64> {
+    let (mut data, mut c) = (Data::new(model), ConstraintData::new(model, set));
+    let (nq, nv) = (model.nq, model.nv);
+    let mut out = Vec::new();
+    for k in 0..STATES {
+        let state = (&q[k * nq..(k + 1) * nq], &v[k * nv..(k + 1) * nv]);
+        impulse_dynamics(model, &mut data, &mut c, set, state, restitution, 0.0).unwrap();
+        out.extend(c.qdd.iter().chain(c.forces.iter()));
+    }
+    out
+}
+
+/// Whether two results are equal bit for bit.
+fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
 fn available_widths() -> Vec<LaneWidth> {
     LaneWidth::ALL
         .into_iter()
@@ -98,12 +123,23 @@ fn each_lane_equals_the_one_state_call_bit_for_bit() {
                     width => STATES - STATES % width.states(),
                 };
                 assert_eq!(workspace.states_in_lanes(), grouped, "{name}, {width:?}");
-                let same = out
-                    .iter()
-                    .zip(&expected)
-                    .all(|(x, y)| x.to_bits() == y.to_bits());
-                assert!(same, "{name}, {width:?}, {options:?}");
+                assert!(same_bits(&out, &expected), "{name}, {width:?}, {options:?}");
             }
+        }
+        // impulses: q and v only
+        let restitution = 0.5;
+        let expected = impulses_one_by_one(&model, &set, (&q, &v), restitution);
+        let at_impact = States {
+            tau: None,
+            ..states
+        };
+        for width in available_widths() {
+            let mut workspace = ConstrainedBatchWorkspace::with_width(&model, &set, width).unwrap();
+            let mut out = vec![f64::NAN; expected.len()];
+            let impact = (restitution, 0.0);
+            impulse_dynamics_batch(&model, &mut workspace, &set, at_impact, impact, &mut out)
+                .unwrap();
+            assert!(same_bits(&out, &expected), "{name}, {width:?}, impulses");
         }
     }
 }

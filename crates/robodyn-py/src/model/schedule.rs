@@ -22,6 +22,8 @@ pub(crate) enum LaneRun<'a> {
     Algorithm(BatchAlgorithm),
     /// Constrained forward dynamics on (q, v, τ): rows of q̈ then the forces.
     ConstrainedForward(&'a ConstraintSet, &'a ConstrainedOptions),
+    /// Impulses on (q, v) with (restitution, damping): rows of q̇ after then the impulses.
+    Impulse(&'a ConstraintSet, (f64, f64)),
 }
 
 impl LaneRun<'_> {
@@ -46,15 +48,34 @@ impl LaneRun<'_> {
                     a: None,
                     tau: Some(inputs[2]),
                 };
-                let lanes = crate::constrained::made_for(
-                    &mut workspace.constrained_lanes,
-                    |w| w.fits(model, set),
-                    || ConstrainedBatchWorkspace::new(model, set),
-                );
+                let lanes = constrained_lanes(workspace, model, set);
                 algo::constrained_forward_dynamics_batch(model, lanes, set, states, options, out)
+            }
+            LaneRun::Impulse(set, impact) => {
+                let states = States {
+                    q: inputs[0],
+                    v: Some(inputs[1]),
+                    a: None,
+                    tau: None,
+                };
+                let lanes = constrained_lanes(workspace, model, set);
+                algo::impulse_dynamics_batch(model, lanes, set, states, impact, out)
             }
         }
     }
+}
+
+/// The lane buffers of constrained batches in `workspace`, made for `set`'s size.
+fn constrained_lanes<'w>(
+    workspace: &'w mut Workspace,
+    model: &Model,
+    set: &ConstraintSet,
+) -> &'w mut ConstrainedBatchWorkspace {
+    crate::constrained::made_for(
+        &mut workspace.constrained_lanes,
+        |w| w.fits(model, set),
+        || ConstrainedBatchWorkspace::new(model, set),
+    )
 }
 
 /// The most numeric arguments a method takes (q, v, a, f_ext).

@@ -33,7 +33,7 @@ pub(crate) use articulated::{
 pub use derivatives::{
     constrained_forward_dynamics_derivatives, impulse_dynamics_derivatives, ConstrainedDerivatives,
 };
-pub(crate) use forward::accelerated_right_side;
+pub(crate) use forward::{accelerated_right_side, check_impact, impact_right_side};
 pub use forward::{constrained_forward_dynamics, impulse_dynamics, ConstrainedOptions};
 pub use inverse::{constrained_inverse_dynamics, CONSTRAINT_ACCELERATION_TOLERANCE};
 pub(crate) use solve::solve_direct;

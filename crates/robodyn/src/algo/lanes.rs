@@ -19,7 +19,9 @@ pub use algorithms::{
     aba_batch, aba_derivatives_batch, batch, crba_batch, frame_pose_batch, jacobian_batch,
     newton_euler_batch, rnea_derivatives_batch, BatchAlgorithm,
 };
-pub use constrained::{constrained_forward_dynamics_batch, ConstrainedBatchWorkspace};
+pub use constrained::{
+    constrained_forward_dynamics_batch, impulse_dynamics_batch, ConstrainedBatchWorkspace,
+};
 
 use crate::algo::aba::aba;
 use crate::algo::crba::crba_into;

@@ -44,9 +44,9 @@ pub use jacobian::{jacobian, jacobian_columns, Reference};
 pub use kinematics::{forward_kinematics, frame_placement, frame_pose};
 pub use lanes::{
     aba_batch, aba_derivatives_batch, batch, constrained_forward_dynamics_batch, crba_batch,
-    frame_pose_batch, jacobian_batch, newton_euler_batch, rnea_derivatives_batch,
-    write_jacobian_column, BatchAlgorithm, BatchResult, BatchWorkspace, ConstrainedBatchWorkspace,
-    LaneWidth, States,
+    frame_pose_batch, impulse_dynamics_batch, jacobian_batch, newton_euler_batch,
+    rnea_derivatives_batch, write_jacobian_column, BatchAlgorithm, BatchResult, BatchWorkspace,
+    ConstrainedBatchWorkspace, LaneWidth, States,
 };
 pub use manipulability::manipulability;
 pub use minv::inverse_mass_matrix;

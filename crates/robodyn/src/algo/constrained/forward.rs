@@ -20,7 +20,7 @@ use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::spatial::{Force, Real};
 use crate::Data;
-use nalgebra::{DMatrix, DVectorView, DVectorViewMut};
+use nalgebra::DMatrix;
 
 /// How the constraint equations are solved.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -211,6 +211,24 @@ pub(super) fn solve_impulses(
     restitution: f64,
     damping: f64,
 ) -> Result<()> {
+    check_impact(restitution, damping)?;
+    let m = set.rows();
+    let ConstraintData {
+        jacobian,
+        rhs,
+        step,
+        ..
+    } = constraints;
+    impact_right_side(jacobian, &mut rhs[..m], v, restitution);
+    let scale = match damping > 0.0 {
+        true => 1.0 + (1.0 + restitution) * product_scale(jacobian, v, step),
+        false => 1.0,
+    };
+    solve_forces(model, set, constraints, damping, scale)
+}
+
+/// Refuses a restitution outside [0, 1] and a negative or non-finite damping.
+pub(crate) fn check_impact(restitution: f64, damping: f64) -> Result<()> {
     if !(0.0..=1.0).contains(&restitution) {
         return Err(Error::InvalidValue {
             argument: "restitution".into(),
@@ -221,24 +239,26 @@ pub(super) fn solve_impulses(
         baumgarte: None,
         damping,
     };
-    options.check()?;
-    let m = set.rows();
-    let ConstraintData {
-        jacobian,
-        rhs,
-        step,
-        ..
-    } = constraints;
-    let velocity = DVectorView::from_slice(v, v.len());
-    DVectorViewMut::from_slice(&mut rhs[..m], m).gemv(
-        -(1.0 + restitution),
-        jacobian,
-        &velocity,
-        0.0,
-    );
-    let scale = match damping > 0.0 {
-        true => 1.0 + (1.0 + restitution) * product_scale(jacobian, v, step),
-        false => 1.0,
-    };
-    solve_forces(model, set, constraints, damping, scale)
+    options.check()
+}
+
+/// `−(1 + e) J q̇` into `rhs` (m), e the restitution.
+#[inline(always)]
+pub(crate) fn impact_right_side<S: Real>(
+    jacobian: &DMatrix<S>,
+    rhs: &mut [S],
+    v: &[S],
+    restitution: f64,
+) {
+    let (m, j) = (rhs.len(), jacobian.as_slice());
+    rhs.fill(S::zero());
+    for (c, v_c) in v.iter().enumerate() {
+        for (entry, j_rc) in rhs.iter_mut().zip(&j[c * m..(c + 1) * m]) {
+            *entry += *j_rc * *v_c;
+        }
+    }
+    let scale = S::splat(-(1.0 + restitution));
+    for entry in rhs.iter_mut() {
+        *entry *= scale;
+    }
 }

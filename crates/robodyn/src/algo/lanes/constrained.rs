@@ -1,8 +1,8 @@
-//! Constrained forward dynamics of a batch in lanes: the articulated route of
-//! [`crate::algo::constrained_forward_dynamics`] (ABA, the rows, their inward passes, Λ⁻¹, its
-//! Cholesky solve and the forces' outward pass) run on `S::LANES` states at once, each lane
-//! performing the operations of a one-state call, so that each lane's q̈ and λ equal that call's
-//! bit for bit.
+//! Constrained forward dynamics and impulses of a batch in lanes: the articulated route of
+//! [`crate::algo::constrained_forward_dynamics`] and [`crate::algo::impulse_dynamics`] (ABA, the
+//! rows, their inward passes, Λ⁻¹, its Cholesky solve and the forces' outward pass) run on
+//! `S::LANES` states at once, each lane performing the operations of a one-state call, so that
+//! each lane's result equals that call's bit for bit.
 //!
 //! A group runs one state at a time instead where its lanes cannot share the instructions: a
 //! lane whose rows are dependent (the Cholesky pivot test fails in some lane; the one-state call
@@ -14,9 +14,9 @@ use super::scatter::LaneRows;
 use super::{check_states, state, BatchResult, LaneWidth, States};
 use crate::algo::aba::{articulated_body_passes, AbaBuffers};
 use crate::algo::constrained::{
-    accelerated_right_side, articulated_delassus, constrained_forward_dynamics,
-    constraint_response, rows_under_free_motion, solve_direct, AbaTerms, ConstrainedOptions,
-    ConstraintData, RouteBuffers,
+    accelerated_right_side, articulated_delassus, check_impact, constrained_forward_dynamics,
+    constraint_response, impact_right_side, impulse_dynamics, rows_under_free_motion, solve_direct,
+    AbaTerms, ConstrainedOptions, ConstraintData, RouteBuffers,
 };
 use crate::constraint::ConstraintSet;
 use crate::error::{Error, Result};
@@ -88,9 +88,58 @@ pub fn constrained_forward_dynamics_batch(
     options: &ConstrainedOptions,
     out: &mut [f64],
 ) -> BatchResult {
+    options.check().map_err(|e| (0, e))?;
+    run_route(model, workspace, set, states, Route::Forward(options), out)
+}
+
+/// [`impulse_dynamics`] on every state of a batch (`states`: q and v), in lanes where it can:
+/// `out` is n × (nv + m), each row q̇ after the impact then the impulses.
+pub fn impulse_dynamics_batch(
+    model: &Model,
+    workspace: &mut ConstrainedBatchWorkspace,
+    set: &ConstraintSet,
+    states: States,
+    (restitution, damping): (f64, f64),
+    out: &mut [f64],
+) -> BatchResult {
+    check_impact(restitution, damping).map_err(|e| (0, e))?;
+    let route = Route::Impulse {
+        restitution,
+        damping,
+    };
+    run_route(model, workspace, set, states, route, out)
+}
+
+/// Which computation a constrained batch runs.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Route<'a> {
+    /// Forward dynamics on (q, v, τ): q̈, then λ.
+    Forward(&'a ConstrainedOptions),
+    /// Impulses on (q, v): q̇ after, then the impulses.
+    Impulse { restitution: f64, damping: f64 },
+}
+
+impl Route<'_> {
+    fn damping(self) -> f64 {
+        match self {
+            Route::Forward(options) => options.damping,
+            Route::Impulse { damping, .. } => damping,
+        }
+    }
+}
+
+/// Checks the workspace and the states, runs the full groups in lanes (none with damping) and
+/// the rest, with any group from the first whose lanes could not share, one state at a time.
+fn run_route(
+    model: &Model,
+    workspace: &mut ConstrainedBatchWorkspace,
+    set: &ConstraintSet,
+    states: States,
+    route: Route,
+    out: &mut [f64],
+) -> BatchResult {
     let (nv, size) = (model.nv, model.nv + set.rows());
     let whole = |e| (0, e);
-    options.check().map_err(whole)?;
     if !workspace.fits(model, set) {
         return Err(whole(Error::Shape {
             argument: "workspace".into(),
@@ -103,13 +152,15 @@ pub fn constrained_forward_dynamics_batch(
     }
     let n = out.len() / size;
     check_states(model, &states, n)?;
-    if states.v.is_none() || states.tau.is_none() {
+    let forward = matches!(route, Route::Forward(_));
+    if states.v.is_none() || (forward && states.tau.is_none()) {
+        let needed = if forward { "v and tau" } else { "v" };
         return Err(whole(Error::InvalidValue {
             argument: "states".into(),
-            message: "constrained forward dynamics needs v and tau".into(),
+            message: format!("this batch needs {needed}"),
         }));
     }
-    let grouped = match (workspace.width, options.damping > 0.0) {
+    let grouped = match (workspace.width, route.damping() > 0.0) {
         (LaneWidth::One, _) | (_, true) => 0,
         (width, false) => n - n % width.states(),
     };
@@ -118,10 +169,10 @@ pub fn constrained_forward_dynamics_batch(
         LaneWidth::One => Ok(()),
         // SAFETY (both): the width was found available on this CPU when the workspace was made
         LaneWidth::Four => unsafe {
-            constrained_four(model, set, options, &mut workspace.four, states, lanes_out)
+            constrained_four(model, set, route, &mut workspace.four, states, lanes_out)
         },
         LaneWidth::Eight => unsafe {
-            constrained_eight(model, set, options, &mut workspace.eight, states, lanes_out)
+            constrained_eight(model, set, route, &mut workspace.eight, states, lanes_out)
         },
     };
     // what is left, and any group from the first whose lanes could not share, one at a time
@@ -132,17 +183,21 @@ pub fn constrained_forward_dynamics_batch(
     } = workspace;
     for k in first..n {
         let one = state(model, &states, k);
-        let (v, tau) = (one.v.unwrap_or_default(), one.tau.unwrap_or_default());
-        constrained_forward_dynamics(
-            model,
-            data,
-            constraints,
-            set,
-            (one.q, v, tau),
-            None,
-            options,
-        )
-        .map_err(|e| (k, e))?;
+        let v = one.v.unwrap_or_default();
+        let solved = match route {
+            Route::Forward(options) => {
+                let state = (one.q, v, one.tau.unwrap_or_default());
+                constrained_forward_dynamics(model, data, constraints, set, state, None, options)
+            }
+            Route::Impulse {
+                restitution,
+                damping,
+            } => {
+                let state = (one.q, v);
+                impulse_dynamics(model, data, constraints, set, state, restitution, damping)
+            }
+        };
+        solved.map_err(|e| (k, e))?;
         let row = &mut out[k * size..(k + 1) * size];
         row[..nv].copy_from_slice(constraints.qdd.as_slice());
         row[nv..].copy_from_slice(constraints.forces.as_slice());
@@ -155,12 +210,12 @@ pub fn constrained_forward_dynamics_batch(
 unsafe fn constrained_four(
     model: &Model,
     set: &ConstraintSet,
-    options: &ConstrainedOptions,
+    route: Route,
     lanes: &mut ConstrainedLanes<AutoF64x4>,
     states: States,
     out: &mut [f64],
 ) -> std::result::Result<(), usize> {
-    constrained_groups(model, set, options, lanes, states, out)
+    constrained_groups(model, set, route, lanes, states, out)
 }
 
 /// [`constrained_groups`] compiled for AVX-512. Safety: only on a CPU with AVX-512F.
@@ -168,35 +223,39 @@ unsafe fn constrained_four(
 unsafe fn constrained_eight(
     model: &Model,
     set: &ConstraintSet,
-    options: &ConstrainedOptions,
+    route: Route,
     lanes: &mut ConstrainedLanes<AutoF64x8>,
     states: States,
     out: &mut [f64],
 ) -> std::result::Result<(), usize> {
-    constrained_groups(model, set, options, lanes, states, out)
+    constrained_groups(model, set, route, lanes, states, out)
 }
 
-/// The groups of states that fill `out` (rows of q̈ then λ), `S::LANES` at a time. An error
-/// gives the first state of a group whose lanes could not share the instructions.
+/// The groups of states that fill `out` (rows of q̈ or q̇ after, then λ), `S::LANES` at a time.
+/// An error gives the first state of a group whose lanes could not share the instructions.
 #[inline(always)]
 pub(super) fn constrained_groups<S: LaneRows>(
     model: &Model,
     set: &ConstraintSet,
-    options: &ConstrainedOptions,
+    route: Route,
     lanes: &mut ConstrainedLanes<S>,
     states: States,
     out: &mut [f64],
 ) -> std::result::Result<(), usize> {
     let (nv, size) = (model.nv, model.nv + set.rows());
-    let (Some(v), Some(tau)) = (states.v, states.tau) else {
+    let Some(v) = states.v else {
         return Err(0);
     };
+    // impulses: ABA's terms at τ = 0, as the one-state call takes them
+    lanes.tau.fill(S::zero());
     for (g, out) in out.chunks_exact_mut(S::LANES * size).enumerate() {
         let first = g * S::LANES;
         gather(&mut lanes.q, states.q, first);
         gather(&mut lanes.v, v, first);
-        gather(&mut lanes.tau, tau, first);
-        lanes.forward(model, set, options).map_err(|()| first)?;
+        if let (Route::Forward(_), Some(tau)) = (route, states.tau) {
+            gather(&mut lanes.tau, tau, first);
+        }
+        lanes.solve(model, set, route).map_err(|()| first)?;
         S::scatter(&lanes.qdd, out, size, 0);
         S::scatter(&lanes.forces, out, size, nv);
     }
@@ -274,14 +333,15 @@ impl<S: Real> ConstrainedLanes<S> {
         }
     }
 
-    /// The steps of [`constrained_forward_dynamics`] on the gathered states (its Cholesky solve,
-    /// without damping); `Err` where some lane's articulated inertia or rows are singular.
+    /// The steps of [`constrained_forward_dynamics`] or [`impulse_dynamics`] on the gathered
+    /// states (their Cholesky solve, without damping); `Err` where some lane's articulated
+    /// inertia or rows are singular.
     #[inline(always)]
-    fn forward(
+    fn solve(
         &mut self,
         model: &Model,
         set: &ConstraintSet,
-        options: &ConstrainedOptions,
+        route: Route,
     ) -> std::result::Result<(), ()> {
         let m = set.rows();
         // a_f = ABA(q, q̇, τ)
@@ -308,7 +368,7 @@ impl<S: Real> ConstrainedLanes<S> {
             x_world: &mut self.x_world,
             free_acceleration: &self.free_acceleration,
         };
-        let mut route = RouteBuffers {
+        let mut route_buffers = RouteBuffers {
             jacobian: &mut self.jacobian,
             drift: &mut self.drift,
             error: &mut self.error,
@@ -322,22 +382,26 @@ impl<S: Real> ConstrainedLanes<S> {
             forces: &mut self.forces,
             qdd: &mut self.qdd,
         };
+        let buffers = &mut route_buffers;
         // J, φ, γ, J a_f + γ;  Y = K Jᵀ and Λ⁻¹
-        rows_under_free_motion(model, set, &mut terms, &mut route, (&self.q, &self.v));
-        articulated_delassus(model, set, &terms, &mut route);
-        // Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ)
-        let (jacobian, error) = (&*route.jacobian, &*route.error);
-        accelerated_right_side(
-            jacobian,
-            error,
-            &mut route.rhs[..m],
-            &self.v,
-            options.baumgarte,
-        );
-        let delassus = route.delassus.as_slice();
-        solve_direct(m, delassus, &mut self.factor, route.rhs, route.forces).map_err(|_| ())?;
-        // q̈ = a_f + M⁻¹ Jᵀ λ
-        constraint_response(model, set, &mut terms, &mut route, &self.free_acceleration);
+        rows_under_free_motion(model, set, &mut terms, buffers, (&self.q, &self.v));
+        articulated_delassus(model, set, &terms, buffers);
+        // Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ), or Λ⁻¹ Λ = −(1 + e) J q̇
+        let (jacobian, rhs) = (&*buffers.jacobian, &mut buffers.rhs[..m]);
+        let base = match route {
+            Route::Forward(options) => {
+                accelerated_right_side(jacobian, buffers.error, rhs, &self.v, options.baumgarte);
+                &self.free_acceleration
+            }
+            Route::Impulse { restitution, .. } => {
+                impact_right_side(jacobian, rhs, &self.v, restitution);
+                &self.v
+            }
+        };
+        let delassus = buffers.delassus.as_slice();
+        solve_direct(m, delassus, &mut self.factor, buffers.rhs, buffers.forces).map_err(|_| ())?;
+        // q̈ = a_f + M⁻¹ Jᵀ λ, or q̇⁺ = q̇ + M⁻¹ Jᵀ Λ
+        constraint_response(model, set, &mut terms, buffers, base);
         Ok(())
     }
 }
@@ -399,7 +463,8 @@ mod tests {
         };
         let mut lanes = vec![0.0; n * size];
         let mut buffers = ConstrainedLanes::<S>::new(&model, &set);
-        constrained_groups(&model, &set, &options, &mut buffers, states, &mut lanes).unwrap();
+        let route = Route::Forward(&options);
+        constrained_groups(&model, &set, route, &mut buffers, states, &mut lanes).unwrap();
         let mut workspace =
             ConstrainedBatchWorkspace::with_width(&model, &set, LaneWidth::One).unwrap();
         let mut one_by_one = vec![0.0; n * size];
@@ -412,11 +477,25 @@ mod tests {
             &mut one_by_one,
         )
         .unwrap();
-        let same = lanes
-            .iter()
-            .zip(&one_by_one)
-            .all(|(x, y)| x.to_bits() == y.to_bits());
-        assert!(same, "{} lanes", S::LANES);
+        let same = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+        assert!(same(&lanes, &one_by_one), "{} lanes", S::LANES);
+        // impulses
+        let impact = Route::Impulse {
+            restitution: 0.5,
+            damping: 0.0,
+        };
+        constrained_groups(&model, &set, impact, &mut buffers, states, &mut lanes).unwrap();
+        let at_impact = (0.5, 0.0);
+        impulse_dynamics_batch(
+            &model,
+            &mut workspace,
+            &set,
+            states,
+            at_impact,
+            &mut one_by_one,
+        )
+        .unwrap();
+        assert!(same(&lanes, &one_by_one), "{} lanes, impulses", S::LANES);
     }
 
     #[test]
