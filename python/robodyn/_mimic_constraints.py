@@ -41,6 +41,17 @@ class ConstrainedMethods:
         """J_red = J G."""
         return self._columns(self.full.constraint_jacobian(self.expand(q), constraints))
 
+    def constraint_error(self, q: Any, constraints: Any) -> np.ndarray:
+        """φ of the full model at the expanded configuration (the followers hold by construction)."""
+        return np.asarray(self.full.constraint_error(self.expand(q), constraints))
+
+    def close_constraints(self, q: Any, constraints: Any, tolerance: float = 1e-12, max_iterations: int = 50,
+                          damping: float = 1e-8) -> dict[str, np.ndarray]:
+        """The full model's closure holding the mimic relations too (so the followers stay on
+        them), reduced; ``residual`` covers both."""
+        full = self.full.close_constraints(self.expand(q), self._held(constraints), tolerance, max_iterations, damping)
+        return {**full, "q": self.reduce(full["q"])}
+
     def delassus(self, q: Any, constraints: Any) -> np.ndarray:
         """J_red M_red⁻¹ J_redᵀ."""
         jacobian = self.constraint_jacobian(q, constraints)

@@ -293,3 +293,30 @@ def test_weighted_inverse_dynamics_moves_the_load_off_heavy_rows():
         solo.constrained_inverse_dynamics(q, rest, rest, feet, weights=np.array([1.0, 1, 1, -1, 1, 1, 1, 1, 1, 1, 1, 1]))
     with pytest.raises(ValueError, match="weights"):
         solo.constrained_inverse_dynamics(q, rest, rest, feet, weights=np.ones(5))
+
+
+def test_an_opened_four_bar_is_closed_again_and_its_error_read():
+    model, closure, closed = four_bar()
+    assert np.max(np.abs(model.constraint_error(closed, closure))) < 1e-14
+    opened = closed + np.array([0.05, -0.03, 0.04])
+    # the rows' error is the tip's offset from the pivot along x and z
+    tip = model.frame_pose(opened, "tip")[:3, 3]
+    assert_close(model.constraint_error(opened, closure), (tip - PIVOT)[[0, 2]], 1e-15)
+    result = model.close_constraints(opened, closure)
+    assert result["success"] and result["residual"] <= 1e-12 and 0 < result["iterations"] <= 6
+    assert np.max(np.abs(model.frame_pose(result["q"], "tip")[:3, 3] - PIVOT)) <= 1e-12
+    # a batch: each configuration on its own, the closed one unchanged
+    batch = model.close_constraints(np.stack([opened, closed]), [closure])
+    np.testing.assert_array_equal(batch["q"][0], result["q"])
+    np.testing.assert_array_equal(batch["q"][1], closed)
+    assert batch["success"].tolist() == [True, True] and batch["iterations"][1] == 0
+    assert model.constraint_error(np.stack([opened, closed]), closure).shape == (2, 2)
+    # held at two places at once: not closed, and said so
+    far = np.eye(4)
+    far[:3, 3] = PIVOT + [10.0, 0.0, 0.0]
+    impossible = [closure, robodyn.FrameAnchor("tip", placement2=far, mask=[True, False, True, False, False, False])]
+    result = model.close_constraints(opened, impossible, max_iterations=10)
+    assert not result["success"] and result["iterations"] == 10 and result["residual"] > 1.0
+    for name, value in (("tolerance", 0.0), ("damping", -1.0), ("max_iterations", -1)):
+        with pytest.raises(ValueError, match=f"argument '{name}'"):
+            model.close_constraints(opened, closure, **{name: value})

@@ -12,6 +12,7 @@ import pytest
 from conftest import REPOSITORY, assert_close
 
 import robodyn
+from robodyn.convert import MujocoLayout
 
 CASSIE = REPOSITORY / "testdata" / "mjcf" / "cassie_nomesh.xml"
 GRIPPER = REPOSITORY / "testdata" / "menagerie" / "robotiq_2f85" / "2f85.xml"
@@ -21,6 +22,9 @@ COMPILER_TOLERANCE = 1e-12
 IDENTITY_TOLERANCE = 1e-9
 #: How far a simulated loop may come apart (m).
 LOOP_DRIFT = 1e-8
+#: How far above 1 RK4's amplification of a stable linear motion may come by rounding (its free
+#: base's six zero eigenvalues come out at about 1e-9 / s).
+STABLE_AMPLIFICATION = 1e-6
 
 EQUALITIES = """<mujoco model="equalities">
   <compiler angle="radian"/>
@@ -159,8 +163,8 @@ def test_cassie_keeps_its_loops_closed():
     # loops are solved in proximal mode
     with pytest.raises(ValueError, match=r"constraints\[0\] \(PointAnchor\('left-plantar-rod' to 'left-foot'\)\), row y"):
         model.constrained_forward_dynamics(q0, np.zeros(model.nv), np.zeros(model.nv), loops)
-    # at Cassie's own time step (its <option timestep>): at 1 ms RK4 is unstable on the stiff
-    # knee and heel springs (1500 and 1250 N m/rad on light links), loops or not
+    # at Cassie's own time step (its <option timestep>): qpos0 puts the foot cranks outside their
+    # ranges, where their damping is too fast for RK4 at 1 ms (see the tests below)
     run = robodyn.simulate(model, q0, t_end=1.0, dt=5e-4, integrator="rk4", constraints=loops, damping=1e-8)
     assert loop_gap(model, loops, run.q[::10]) < LOOP_DRIFT
     # the legs swinging apart at 2 rad/s: the loops open by rounding, so their out-of-plane rows
@@ -206,3 +210,59 @@ def test_simulate_holds_the_models_own_constraints_by_default():
     assert loop_gap(model, model.constraints, loose.q) > 1e3 * LOOP_DRIFT
     with pytest.raises(ValueError, match="constraints"):
         robodyn.simulate(model, q0, constraints="models", **options)
+
+
+def cassie_home(model):
+    """Cassie's `home` keyframe in robodyn's coordinates (read through MuJoCo: robodyn reads
+    keyframes with the contacts work that follows), its loops closed: MuJoCo's soft loops leave
+    them 1.5 mm open there."""
+    compiled = mujoco.MjModel.from_xml_path(str(CASSIE))
+    q = MujocoLayout(model, compiled).q_from_mujoco(compiled.key_qpos[0])
+    assert 1e-4 < np.max(np.abs(model.constraint_error(q, model.constraints))) < 1e-2
+    closed = model.close_constraints(q, model.constraints)
+    assert closed["success"] and closed["residual"] <= 1e-12
+    return closed["q"]
+
+
+def test_cassie_keeps_its_loops_closed_for_10_s_at_1_ms_with_rk4():
+    """The issue's case, from Cassie's keyframe: RK4 at dt = 1 ms for 10 s. Measured: 6.6e-9 m
+    without Baumgarte's terms (RK4's truncation: 180 times less at dt / 2), 2e-11 m with them."""
+    model = load(CASSIE)
+    loops, q0 = model.constraints, cassie_home(model)
+    run = robodyn.simulate(model, q0, t_end=10.0, dt=1e-3, integrator="rk4", constraints=loops, damping=1e-8)
+    assert run.t[-1] == pytest.approx(10.0) and loop_gap(model, loops, run.q[::10]) < LOOP_DRIFT
+    assert np.ptp(run.q[:, model.joint_idx_q[model.joint_names.index("left-knee")]]) > 1e-3, "the legs move"
+    pulled = robodyn.simulate(model, q0, t_end=10.0, dt=1e-3, integrator="rk4", constraints=loops, damping=1e-8,
+                              baumgarte=(100.0, 20.0))
+    assert loop_gap(model, loops, pulled.q[::10]) < LOOP_DRIFT / 100
+
+
+def rk4_amplification(model, q, dt):
+    """The largest |R(λ dt)|, R(z) = 1 + z + z²/2 + z³/6 + z⁴/24 (RK4 on ẋ = λ x), over the
+    eigenvalues λ of Cassie's motion about rest at q with its loops held: M, the joint springs K
+    and dampers D restricted to the null space of the loops' J."""
+    jacobian = model.constraint_jacobian(q, model.constraints)
+    _, singular, vt = np.linalg.svd(jacobian)
+    free = vt[np.sum(singular > 1e-9 * singular[0]):].T
+    mass, stiffness, damping = (free.T @ matrix @ free for matrix in (
+        model.mass_matrix(q), np.diag(model.stiffness), np.diag(model.damping)))
+    n = free.shape[1]
+    motion = np.block([[np.zeros((n, n)), np.eye(n)],
+                       [-np.linalg.solve(mass, stiffness), -np.linalg.solve(mass, damping)]])
+    z = np.linalg.eigvals(motion) * dt
+    return np.max(np.abs(1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24))
+
+
+def test_why_cassie_starts_from_its_keyframe_at_1_ms():
+    """At qpos0 the foot cranks and feet stand at 0 rad, outside their ranges (MuJoCo's soft joint
+    limits push them back in at once); there the crank's damping (1 N m s/rad on a light crank)
+    makes a mode of λ ≈ −5.3e3 / s, beyond RK4's bound |λ dt| < 2.79 at 1 ms. At the keyframe,
+    the cranks inside their ranges, every mode is within it."""
+    model = load(CASSIE)
+    q = model.neutral()
+    for name in ("left-foot-crank", "left-foot"):
+        k = model.joint_idx_q[model.joint_names.index(name)]
+        assert not model.lower_position_limit[k] <= q[k] <= model.upper_position_limit[k], name
+    assert rk4_amplification(model, q, 1e-3) > 10.0
+    assert rk4_amplification(model, q, 5e-4) < 1 + STABLE_AMPLIFICATION
+    assert rk4_amplification(model, cassie_home(model), 1e-3) < 1 + STABLE_AMPLIFICATION

@@ -333,6 +333,14 @@ def test_constraints_on_the_reduced_model(gripper):
     assert_close(impulse["dv_dv"], central_difference(lambda x: m.impulse_dynamics(q, x, [anchor])["v"], v),
                  FINITE_DIFFERENCE_TOLERANCE, "dv_dv")
     assert_close(jacobian @ impulse["v"], np.zeros(3), KKT_TOLERANCE, "J v⁺")
+    # the point held where it is at q: from elsewhere, closing brings it back in reduced coordinates
+    held = robodyn.PointAnchor("rf", offset2=m.frame_pose(q, "rf")[:3, 3])
+    moved = q + np.array([0.05, -0.04, 0.03])
+    assert_close(m.constraint_error(moved, held), m.frame_pose(moved, "rf")[:3, 3] - m.frame_pose(q, "rf")[:3, 3],
+                 IDENTITY_TOLERANCE, "φ")
+    closed = m.close_constraints(moved, held)
+    assert closed["success"] and closed["q"].shape == (3,)
+    assert np.max(np.abs(m.frame_pose(closed["q"], "rf")[:3, 3] - m.frame_pose(q, "rf")[:3, 3])) <= 1e-12
 
 
 def test_every_method_of_a_model_is_reduced(gripper):

@@ -230,6 +230,67 @@ impl PyModel {
         self.evaluate(py, &[self.q_arg("q", q)?], &[rows, self.model.nv], kernel)
     }
 
+    /// The errors φ(q) of `constraints`' rows: (rows,), zero where each holds, in the rows'
+    /// units and axes (m for points and positions, rad for rotations and hinges). A loop that
+    /// has opened by 1 mm shows 1e-3 in its rows.
+    fn constraint_error<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        constraints: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let set = constraint_set(self, constraints)?;
+        let kernel: &Kernel = &|m, w, i, out| {
+            let Workspace {
+                data, constrained, ..
+            } = w;
+            let c = constraint_data(constrained, m, &set);
+            algo::constraint_jacobian(m, data, c, &set, i[0])?;
+            out.copy_from_slice(c.error.as_slice());
+            Ok(())
+        };
+        self.evaluate(py, &[self.q_arg("q", q)?], &[set.rows()], kernel)
+    }
+
+    /// A configuration near `q` at which `constraints` hold (a closed loop assembled from an
+    /// open one, a keyframe put back onto its loops): damped Gauss–Newton steps
+    /// `δ = −Jᵀ (J Jᵀ + μ 1)⁻¹ φ` (least-norm corrections; μ = `damping` × the largest
+    /// diagonal entry of J Jᵀ takes care of repeated rows) until every row's error is at most
+    /// `tolerance`. Returns a dict: "q" (nq,), "success" (bool), "iterations" (int),
+    /// "residual" (the largest row error), with a leading N for a batch of configurations.
+    #[pyo3(signature = (q, constraints, tolerance=1e-12, max_iterations=50, damping=1e-8))]
+    fn close_constraints<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        constraints: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = named::tolerance)] tolerance: f64,
+        #[pyo3(from_py_with = named::max_iterations)] max_iterations: usize,
+        #[pyo3(from_py_with = named::damping)] damping: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let set = constraint_set(self, constraints)?;
+        let options = algo::ClosureOptions {
+            tolerance,
+            max_iterations,
+            damping,
+        };
+        let nq = self.model.nq;
+        let kernel: &Kernel = &|m, w, i, out| {
+            let Workspace {
+                data, constrained, ..
+            } = w;
+            let c = constraint_data(constrained, m, &set);
+            let (closed, found) = out.split_at_mut(nq);
+            let closure = algo::close_constraints(m, data, c, &set, i[0], closed, &options)?;
+            found[0] = f64::from(u8::from(closure.success));
+            found[1] = closure.iterations as f64;
+            found[2] = closure.residual;
+            Ok(())
+        };
+        let packed = self.evaluate(py, &[self.q_arg("q", q)?], &[nq + 3], kernel)?;
+        crate::kinematics::search_result(py, &packed, nq)
+    }
+
     /// The Delassus matrix J M⁻¹ Jᵀ of `constraints` at q: (rows, rows), the inverse inertia
     /// the constraints see.
     fn delassus<'py>(

@@ -426,32 +426,38 @@ impl PyModel {
             out[m.nq + 2] = solution.residual;
             Ok(())
         })?;
-        // unpack [q, success, iterations, residual] along the last axis
-        let result = PyDict::new(py);
-        let ellipsis = py.Ellipsis().into_bound(py);
-        let column = |k: usize| (ellipsis.clone(), k);
-        result.set_item(
-            "q",
-            packed
-                .get_item((
-                    ellipsis.clone(),
-                    pyo3::types::PySlice::new(py, 0, nq as isize, 1),
-                ))?
-                .call_method0("copy")?,
-        )?;
-        result.set_item(
-            "success",
-            packed
-                .get_item(column(nq))?
-                .call_method1("astype", ("bool",))?,
-        )?;
-        result.set_item(
-            "iterations",
-            packed
-                .get_item(column(nq + 1))?
-                .call_method1("astype", ("int64",))?,
-        )?;
-        result.set_item("residual", packed.get_item(column(nq + 2))?)?;
-        Ok(result)
+        search_result(py, &packed, nq)
     }
+}
+
+/// The dict of a configuration search (inverse kinematics, closing constraints) from its
+/// results packed as `[q (nq), success, iterations, residual]` along the last axis: "q",
+/// "success" (bool), "iterations" (int) and "residual", each with the batch's leading axis.
+pub(crate) fn search_result<'py>(
+    py: Python<'py>,
+    packed: &Bound<'py, PyAny>,
+    nq: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    let result = PyDict::new(py);
+    let ellipsis = py.Ellipsis().into_bound(py);
+    let column = |k: usize| (ellipsis.clone(), k);
+    let configurations = (
+        ellipsis.clone(),
+        pyo3::types::PySlice::new(py, 0, nq as isize, 1),
+    );
+    result.set_item("q", packed.get_item(configurations)?.call_method0("copy")?)?;
+    result.set_item(
+        "success",
+        packed
+            .get_item(column(nq))?
+            .call_method1("astype", ("bool",))?,
+    )?;
+    result.set_item(
+        "iterations",
+        packed
+            .get_item(column(nq + 1))?
+            .call_method1("astype", ("int64",))?,
+    )?;
+    result.set_item("residual", packed.get_item(column(nq + 2))?)?;
+    Ok(result)
 }

@@ -8,8 +8,9 @@ use common::constraints::*;
 use common::*;
 use nalgebra::{DMatrix, DVector};
 use robodyn::algo::{
-    self, constrained_forward_dynamics, constrained_inverse_dynamics, constraint_jacobian,
-    delassus, impulse_dynamics, ConstrainedOptions, ConstraintData,
+    self, close_constraints, constrained_forward_dynamics, constrained_inverse_dynamics,
+    constraint_jacobian, delassus, impulse_dynamics, ClosureOptions, ConstrainedOptions,
+    ConstraintData,
 };
 use robodyn::constraint::{Attachment, ConstraintKind, ConstraintReference, ConstraintSet};
 use robodyn::{Data, Model};
@@ -565,5 +566,133 @@ fn a_closed_weld_has_a_finite_zero_error() {
         let mut c = ConstraintData::new(&model, &set);
         constraint_jacobian(&model, &mut data, &mut c, &set, q.as_slice()).unwrap();
         assert!(c.error.amax() < IDENTITY_TOLERANCE, "{}", c.error);
+    }
+}
+
+/// How closely [`close_constraints`] closes a loop by default (m): its tolerance.
+const CLOSED: f64 = 1e-12;
+
+#[test]
+fn closing_constraints_brings_an_opened_loop_back_onto_them() {
+    let (model, set, closed) = four_bar();
+    let (mut data, mut c) = (Data::new(&model), ConstraintData::new(&model, &set));
+    let options = ClosureOptions::default();
+    let mut q = DVector::zeros(model.nq);
+    // opened by a few degrees at each joint: Gauss–Newton's quadratic convergence
+    let opened = &closed + DVector::from_vec(vec![0.05, -0.03, 0.04]);
+    let closure = close_constraints(
+        &model,
+        &mut data,
+        &mut c,
+        &set,
+        opened.as_slice(),
+        q.as_mut_slice(),
+        &options,
+    )
+    .unwrap();
+    assert!(closure.success && closure.iterations <= 6, "{closure:?}");
+    constraint_jacobian(&model, &mut data, &mut c, &set, q.as_slice()).unwrap();
+    assert!(c.error.amax() <= CLOSED && closure.residual == c.error.amax());
+    // the correction is (to first order) across the loop's motion, not along it: its part along
+    // the null space of J is of second order in the opening
+    let correction = &q - &opened;
+    // (three joints, two rows: the null space is the cross product of the rows)
+    let row = |r: usize| nalgebra::Vector3::from_iterator(c.jacobian.row(r).iter().copied());
+    let along = row(0).cross(&row(1)).normalize();
+    let correction = nalgebra::Vector3::from_iterator(correction.iter().copied());
+    assert!(
+        along.dot(&correction).abs() < 0.1 * correction.norm(),
+        "{correction}"
+    );
+    // a closed configuration is left as it is
+    let again = close_constraints(
+        &model,
+        &mut data,
+        &mut c,
+        &set,
+        closed.as_slice(),
+        q.as_mut_slice(),
+        &options,
+    )
+    .unwrap();
+    assert_eq!((again.iterations, q.as_slice()), (0, closed.as_slice()));
+    // the closure stated twice (dependent rows) closes as well
+    let twice =
+        ConstraintSet::new(&model, [set.constraints(), set.constraints()].concat()).unwrap();
+    let mut c2 = ConstraintData::new(&model, &twice);
+    let closure = close_constraints(
+        &model,
+        &mut data,
+        &mut c2,
+        &twice,
+        opened.as_slice(),
+        q.as_mut_slice(),
+        &options,
+    )
+    .unwrap();
+    assert!(closure.success && closure.residual <= CLOSED, "{closure:?}");
+}
+
+#[test]
+fn constraints_that_cannot_hold_are_reported_not_closed() {
+    let (model, set, closed) = four_bar();
+    // the tip held at the pivot and 10 m away from it
+    let far = Attachment {
+        frame: None,
+        placement: robodyn::spatial::Transform::from_translation(&robodyn::spatial::Vec3::new(
+            10.0, 0.0, 0.0,
+        )),
+    };
+    let mut both = set.constraints().to_vec();
+    let mut away = both[0].clone();
+    if let ConstraintKind::Frame { second, .. } = &mut away.kind {
+        *second = Some(far);
+    }
+    both.push(away);
+    let impossible = ConstraintSet::new(&model, both).unwrap();
+    let (mut data, mut c) = (Data::new(&model), ConstraintData::new(&model, &impossible));
+    let options = ClosureOptions {
+        max_iterations: 20,
+        ..ClosureOptions::default()
+    };
+    let mut q = DVector::zeros(model.nq);
+    let closure = close_constraints(
+        &model,
+        &mut data,
+        &mut c,
+        &impossible,
+        closed.as_slice(),
+        q.as_mut_slice(),
+        &options,
+    )
+    .unwrap();
+    assert!(
+        !closure.success && closure.iterations == 20 && closure.residual > 1.0,
+        "{closure:?}"
+    );
+    for bad in [
+        ClosureOptions {
+            tolerance: 0.0,
+            ..options
+        },
+        ClosureOptions {
+            damping: f64::NAN,
+            ..options
+        },
+    ] {
+        let error = close_constraints(
+            &model,
+            &mut data,
+            &mut c,
+            &impossible,
+            closed.as_slice(),
+            q.as_mut_slice(),
+            &bad,
+        )
+        .unwrap_err();
+        assert!(
+            error.to_string().contains("expected a finite value > 0"),
+            "{error}"
+        );
     }
 }

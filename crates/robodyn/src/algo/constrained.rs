@@ -1,5 +1,6 @@
 //! Dynamics under rigid constraints: forward dynamics, impulses and inverse dynamics with the
-//! constraints of a [`ConstraintSet`], and the constraint Jacobian and Delassus matrix.
+//! constraints of a [`ConstraintSet`], the constraint Jacobian and Delassus matrix, and a
+//! configuration at which the constraints hold (`closure`).
 //!
 //! Reference: Featherstone, *Rigid Body Dynamics Algorithms* (2008), §8.1-8.3 (the constrained
 //! equations of motion, solved through the constraint-space inverse inertia), Table 7.1 (the
@@ -22,6 +23,7 @@
 //! The results live in a [`ConstraintData`] made for the set.
 
 mod articulated;
+mod closure;
 mod derivatives;
 mod forward;
 mod inverse;
@@ -30,6 +32,7 @@ mod solve;
 pub(crate) use articulated::{
     articulated_delassus, constraint_response, rows_under_free_motion, AbaTerms, RouteBuffers,
 };
+pub use closure::{close_constraints, Closure, ClosureOptions};
 pub use derivatives::{
     constrained_forward_dynamics_derivatives, impulse_dynamics_derivatives, ConstrainedDerivatives,
 };

@@ -29,9 +29,10 @@ pub mod textbook_forms;
 pub use aba::aba;
 pub use centroidal::centroidal_momentum_matrix;
 pub use constrained::{
-    constrained_forward_dynamics, constrained_forward_dynamics_derivatives,
+    close_constraints, constrained_forward_dynamics, constrained_forward_dynamics_derivatives,
     constrained_inverse_dynamics, constraint_jacobian, delassus, impulse_dynamics,
-    impulse_dynamics_derivatives, ConstrainedDerivatives, ConstrainedOptions, ConstraintData,
+    impulse_dynamics_derivatives, ClosureOptions, ConstrainedDerivatives, ConstrainedOptions,
+    ConstraintData,
 };
 pub use coriolis::{christoffel_symbols, coriolis_matrix};
 pub use crba::{crba, crba_into};
