@@ -273,8 +273,10 @@ multiversion! {
     }
 }
 
-/// [`multiply_add`]: out's rows a block at a time, the block's sums held in registers while
-/// A's columns are gathered into them.
+/// [`multiply_add`]: out four columns at a time (the last few one at a time), its rows a block
+/// at a time, each tile's sums held in registers while A's columns are gathered into them; a
+/// loaded block of A serves the tile's four columns. Every entry sums over k in order, whatever
+/// tile it falls in.
 #[inline(always)]
 fn multiply_add_with(
     out: &mut DMatrix<f64>,
@@ -289,38 +291,51 @@ fn multiply_add_with(
         out.as_mut_slice().iter_mut().for_each(|x| *x *= beta);
         return;
     }
+    let tiled = out.ncols() / 4 * 4;
     let (a, b, out) = (a.as_slice(), b.as_slice(), out.as_mut_slice());
-    for (column, b_j) in out.chunks_exact_mut(r).zip(b.chunks_exact(k)) {
-        let mut start = gather_block::<16>(column, alpha, (a, b_j), beta, 0);
-        start = gather_block::<8>(column, alpha, (a, b_j), beta, start);
-        start = gather_block::<4>(column, alpha, (a, b_j), beta, start);
-        gather_block::<1>(column, alpha, (a, b_j), beta, start);
+    let (out, rest) = out.split_at_mut(tiled * r);
+    let (b, b_rest) = b.split_at(tiled * k);
+    for (tile, b_tile) in out.chunks_exact_mut(4 * r).zip(b.chunks_exact(4 * k)) {
+        let mut start = gather_tile::<8, 4>(tile, alpha, (a, b_tile), beta, 0);
+        start = gather_tile::<4, 4>(tile, alpha, (a, b_tile), beta, start);
+        gather_tile::<1, 4>(tile, alpha, (a, b_tile), beta, start);
+    }
+    for (column, b_j) in rest.chunks_exact_mut(r).zip(b_rest.chunks_exact(k)) {
+        let mut start = gather_tile::<16, 1>(column, alpha, (a, b_j), beta, 0);
+        start = gather_tile::<8, 1>(column, alpha, (a, b_j), beta, start);
+        start = gather_tile::<4, 1>(column, alpha, (a, b_j), beta, start);
+        gather_tile::<1, 1>(column, alpha, (a, b_j), beta, start);
     }
 }
 
-/// Rows `start..` of one column of [`multiply_add_with`], `W` at a time while whole blocks fit:
-/// `out_i = β out_i + Σ_k α b_k A_ik`. Returns the first row left.
+/// Rows `start..` of `C` columns of [`multiply_add_with`] (`columns`: C × r, `b_tile`: their C
+/// columns of B), `W` rows at a time while whole blocks fit: `out_ij = β out_ij + Σ_k α b_kj
+/// A_ik`. Returns the first row left.
 #[inline(always)]
-fn gather_block<const W: usize>(
-    column: &mut [f64],
+fn gather_tile<const W: usize, const C: usize>(
+    columns: &mut [f64],
     alpha: f64,
-    (a, b_j): (&[f64], &[f64]),
+    (a, b_tile): (&[f64], &[f64]),
     beta: f64,
     mut start: usize,
 ) -> usize {
-    let r = column.len();
+    let (r, k) = (columns.len() / C, b_tile.len() / C);
     while start + W <= r {
-        let mut sum = [0.0; W];
-        for (a_k, &b_kj) in a.chunks_exact(r).zip(b_j) {
-            let factor = alpha * b_kj;
+        let mut sums = [[0.0; W]; C];
+        for (index, a_k) in a.chunks_exact(r).enumerate() {
             let block: &[f64; W] = a_k[start..start + W].try_into().expect("W rows");
-            for (s, a_ik) in sum.iter_mut().zip(block) {
-                *s += factor * a_ik;
+            for (c, sum) in sums.iter_mut().enumerate() {
+                let factor = alpha * b_tile[c * k + index];
+                for (s, a_ik) in sum.iter_mut().zip(block) {
+                    *s += factor * a_ik;
+                }
             }
         }
-        let block: &mut [f64; W] = (&mut column[start..start + W]).try_into().expect("W rows");
-        for (x, s) in block.iter_mut().zip(sum) {
-            *x = if beta == 0.0 { s } else { beta * *x + s };
+        for (c, sum) in sums.iter().enumerate() {
+            let block = &mut columns[c * r + start..c * r + start + W];
+            for (x, s) in block.iter_mut().zip(sum) {
+                *x = if beta == 0.0 { *s } else { beta * *x + s };
+            }
         }
         start += W;
     }
@@ -415,15 +430,22 @@ mod tests {
 
     #[test]
     fn multiply_add_is_the_matrix_product() {
-        // row counts that take each block size (16, 8, 4, 1) and a mix of them
-        for rows in [1, 4, 8, 16, 29] {
+        // row counts that take each block size (16, 8, 4, 1) and a mix of them; column counts
+        // in tiles of four, alone, and both
+        for (rows, columns) in [1, 4, 8, 13, 16, 29]
+            .into_iter()
+            .flat_map(|r| [1, 4, 5, 11].map(|c| (r, c)))
+        {
             for beta in [0.0, 0.5, 1.0] {
                 let a = DMatrix::from_fn(rows, 7, |i, j| (i * 3 + j) as f64 - 4.0);
-                let b = DMatrix::from_fn(7, 5, |i, j| (i + 2 * j) as f64 * 0.5);
-                let mut out = DMatrix::from_fn(rows, 5, |i, j| (i + j) as f64);
+                let b = DMatrix::from_fn(7, columns, |i, j| (i + 2 * j) as f64 * 0.5);
+                let mut out = DMatrix::from_fn(rows, columns, |i, j| (i + j) as f64);
                 let expected = &out * beta + &a * &b * -2.0;
                 multiply_add(&mut out, -2.0, &a, &b, beta);
-                assert!((out - expected).amax() < 1e-12, "{rows} rows, β = {beta}");
+                assert!(
+                    (out - expected).amax() < 1e-12,
+                    "{rows} × {columns}, β = {beta}"
+                );
             }
         }
     }
