@@ -49,6 +49,7 @@ class ConstrainedMethods:
                           damping: float = 1e-8) -> dict[str, np.ndarray]:
         """The full model's closure holding the mimic relations too (so the followers stay on
         them), reduced; ``residual`` covers both."""
+        self._user_rows(q, constraints)  # the argument checked as given, before the relations join it
         full = self.full.close_constraints(self.expand(q), self._held(constraints), tolerance, max_iterations, damping)
         return {**full, "q": self.reduce(full["q"])}
 
