@@ -54,6 +54,35 @@ type ConstrainedAlgorithm<'a> = dyn for<'c> Fn(
     + 'a;
 
 impl PyModel {
+    /// `compute(model, data, constraint data, set, q, out)` at one configuration or a batch of
+    /// them, with the set `constraints` resolves to; each result of the shape `shape(rows)`.
+    fn at_configuration<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        constraints: &Bound<'py, PyAny>,
+        shape: impl FnOnce(usize) -> Vec<usize>,
+        compute: impl Fn(
+                &Model,
+                &mut robodyn::Data,
+                &mut ConstraintData,
+                &ConstraintSet,
+                &[f64],
+                &mut [f64],
+            ) -> robodyn::Result<()>
+            + Sync,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let set = constraint_set(self, constraints)?;
+        let kernel: &Kernel = &|m, w, i, out| {
+            let Workspace {
+                data, constrained, ..
+            } = w;
+            let c = constraint_data(constrained, m, &set);
+            compute(m, data, c, &set, i[0], out)
+        };
+        self.evaluate(py, &[self.q_arg("q", q)?], &shape(set.rows()), kernel)
+    }
+
     /// `algorithm` on the arguments (q, v, x[, f_ext]) for one state or a batch: a dict of its
     /// vector and the constraint forces, named `names`. A batch without external forces runs
     /// `lanes` when given.
@@ -213,21 +242,21 @@ impl PyModel {
         q: &Bound<'py, PyAny>,
         constraints: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let set = constraint_set(self, constraints)?;
-        let rows = set.rows();
-        let kernel: &Kernel = &|m, w, i, out| {
-            let Workspace {
-                data, constrained, ..
-            } = w;
-            let c = constraint_data(constrained, m, &set);
-            write_row_major(
-                algo::constraint_jacobian(m, data, c, &set, i[0])?,
-                rows,
-                out,
-            );
-            Ok(())
-        };
-        self.evaluate(py, &[self.q_arg("q", q)?], &[rows, self.model.nv], kernel)
+        let nv = self.model.nv;
+        self.at_configuration(
+            py,
+            q,
+            constraints,
+            |rows| vec![rows, nv],
+            |m, data, c, set, q, out| {
+                write_row_major(
+                    algo::constraint_jacobian(m, data, c, set, q)?,
+                    set.rows(),
+                    out,
+                );
+                Ok(())
+            },
+        )
     }
 
     /// The errors φ(q) of `constraints`' rows: (rows,), zero where each holds, in the rows'
@@ -239,17 +268,17 @@ impl PyModel {
         q: &Bound<'py, PyAny>,
         constraints: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let set = constraint_set(self, constraints)?;
-        let kernel: &Kernel = &|m, w, i, out| {
-            let Workspace {
-                data, constrained, ..
-            } = w;
-            let c = constraint_data(constrained, m, &set);
-            algo::constraint_jacobian(m, data, c, &set, i[0])?;
-            out.copy_from_slice(c.error.as_slice());
-            Ok(())
-        };
-        self.evaluate(py, &[self.q_arg("q", q)?], &[set.rows()], kernel)
+        self.at_configuration(
+            py,
+            q,
+            constraints,
+            |rows| vec![rows],
+            |m, data, c, set, q, out| {
+                algo::constraint_jacobian(m, data, c, set, q)?;
+                out.copy_from_slice(c.error.as_slice());
+                Ok(())
+            },
+        )
     }
 
     /// A configuration near `q` at which `constraints` hold (a closed loop assembled from an
@@ -268,26 +297,26 @@ impl PyModel {
         #[pyo3(from_py_with = named::max_iterations)] max_iterations: usize,
         #[pyo3(from_py_with = named::damping)] damping: f64,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let set = constraint_set(self, constraints)?;
         let options = algo::ClosureOptions {
             tolerance,
             max_iterations,
             damping,
         };
         let nq = self.model.nq;
-        let kernel: &Kernel = &|m, w, i, out| {
-            let Workspace {
-                data, constrained, ..
-            } = w;
-            let c = constraint_data(constrained, m, &set);
-            let (closed, found) = out.split_at_mut(nq);
-            let closure = algo::close_constraints(m, data, c, &set, i[0], closed, &options)?;
-            found[0] = f64::from(u8::from(closure.success));
-            found[1] = closure.iterations as f64;
-            found[2] = closure.residual;
-            Ok(())
-        };
-        let packed = self.evaluate(py, &[self.q_arg("q", q)?], &[nq + 3], kernel)?;
+        let packed = self.at_configuration(
+            py,
+            q,
+            constraints,
+            |_| vec![nq + 3],
+            |m, data, c, set, q, out| {
+                let (closed, found) = out.split_at_mut(nq);
+                let closure = algo::close_constraints(m, data, c, set, q, closed, &options)?;
+                found[0] = f64::from(u8::from(closure.success));
+                found[1] = closure.iterations as f64;
+                found[2] = closure.residual;
+                Ok(())
+            },
+        )?;
         crate::kinematics::search_result(py, &packed, nq)
     }
 
@@ -299,17 +328,16 @@ impl PyModel {
         q: &Bound<'py, PyAny>,
         constraints: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let set = constraint_set(self, constraints)?;
-        let rows = set.rows();
-        let kernel: &Kernel = &|m, w, i, out| {
-            let Workspace {
-                data, constrained, ..
-            } = w;
-            let c = constraint_data(constrained, m, &set);
-            write_row_major(algo::delassus(m, data, c, &set, i[0])?, rows, out);
-            Ok(())
-        };
-        self.evaluate(py, &[self.q_arg("q", q)?], &[rows, rows], kernel)
+        self.at_configuration(
+            py,
+            q,
+            constraints,
+            |rows| vec![rows, rows],
+            |m, data, c, set, q, out| {
+                write_row_major(algo::delassus(m, data, c, set, q)?, set.rows(), out);
+                Ok(())
+            },
+        )
     }
 
     /// Forward dynamics under `constraints`: dict of `qdd` (nv,) and `forces` (rows,) with
