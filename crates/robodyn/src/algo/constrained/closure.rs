@@ -10,8 +10,9 @@
 //! ```
 //! the least-norm correction of the linearised rows (so q moves as little as it must); rows
 //! that repeat others (a loop stated twice, Cassie's out-of-plane rows) are taken care of by μ.
-//! Writes what [`super::constraint_jacobian`] writes, `constraints.delassus` (J Jᵀ + μ 1) and
-//! `constraints.forces` (the step's multipliers). Allocates one configuration.
+//! Writes what [`super::constraint_jacobian`] writes, `constraints.delassus` (J Jᵀ + μ 1),
+//! `constraints.forces` (the step's multipliers) and `constraints.qdd` (the step δ). Allocates
+//! one configuration.
 
 use super::solve::{largest, solve_direct};
 use super::{rows_at_rest, ConstraintData};
