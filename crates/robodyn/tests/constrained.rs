@@ -656,16 +656,19 @@ fn constraints_that_cannot_hold_are_reported_not_closed() {
         ..ClosureOptions::default()
     };
     let mut q = DVector::zeros(model.nq);
-    let closure = close_constraints(
-        &model,
-        &mut data,
-        &mut c,
-        &impossible,
-        closed.as_slice(),
-        q.as_mut_slice(),
-        &options,
-    )
-    .unwrap();
+    let mut close = |options: &ClosureOptions| {
+        let start = closed.as_slice();
+        close_constraints(
+            &model,
+            &mut data,
+            &mut c,
+            &impossible,
+            start,
+            q.as_mut_slice(),
+            options,
+        )
+    };
+    let closure = close(&options).unwrap();
     assert!(
         !closure.success && closure.iterations == 20 && closure.residual > 1.0,
         "{closure:?}"
@@ -680,16 +683,7 @@ fn constraints_that_cannot_hold_are_reported_not_closed() {
             ..options
         },
     ] {
-        let error = close_constraints(
-            &model,
-            &mut data,
-            &mut c,
-            &impossible,
-            closed.as_slice(),
-            q.as_mut_slice(),
-            &bad,
-        )
-        .unwrap_err();
+        let error = close(&bad).unwrap_err();
         assert!(
             error.to_string().contains("expected a finite value > 0"),
             "{error}"
