@@ -307,6 +307,7 @@ fn factor_with_rows(
 /// Solves `Λ⁻¹ λ = rhs` (the right-hand side in `constraints.rhs`, computed from terms of size
 /// `scale`) into `constraints.forces`; a dependent row without damping, or an inconsistent set,
 /// is an error naming its rows.
+#[inline(always)]
 fn solve_forces(
     model: &Model,
     set: &ConstraintSet,

@@ -162,18 +162,22 @@ impl<S: Real> Held<S> {
         } else {
             Matrix3::identity()
         };
-        // J: the first point's columns minus the second's (world axes: no turn)
+        // J: the first point's columns minus the second's (world axes: no turn), each column's
+        // kept entries written straight into J's storage (column-major, m rows)
         let turned = |x: &Vector3<S>| if local { rotate(&axes, x) } else { *x };
+        let (kept_entries, count) = kept_indices(mask);
+        let m = rows.jacobian.nrows();
+        let jacobian = rows.jacobian.as_mut_slice();
         for (motion, first) in [(Some(first), true), (self.second.as_ref(), false)] {
             let Some(motion) = motion else { continue };
             point_columns(model, bodies, motion, |column, linear, angular| {
                 let full = six(&turned(linear), &turned(angular));
-                for (r, value) in kept(mask, &full) {
-                    let entry = &mut rows.jacobian[(row + r, column)];
+                let entries = &mut jacobian[column * m + row..column * m + row + count];
+                for (entry, &k) in entries.iter_mut().zip(&kept_entries[..count]) {
                     *entry = if first {
-                        *entry + value
+                        *entry + full[k]
                     } else {
-                        *entry - value
+                        *entry - full[k]
                     };
                 }
             });
@@ -317,6 +321,17 @@ pub(super) fn kept<'a, S: Real>(
         .filter(|(_, &keep)| keep)
         .map(|(&value, _)| value)
         .enumerate()
+}
+
+/// The indices of the entries `mask` keeps, in order, and how many there are.
+#[inline(always)]
+fn kept_indices(mask: &[bool; 6]) -> ([usize; 6], usize) {
+    let (mut indices, mut count) = ([0; 6], 0);
+    for (k, _) in mask.iter().enumerate().filter(|(_, &keep)| keep) {
+        indices[count] = k;
+        count += 1;
+    }
+    (indices, count)
 }
 
 /// p(x) = Σ c_k x^k and its first three derivatives, by Horner's rule.

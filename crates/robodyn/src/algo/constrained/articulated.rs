@@ -26,9 +26,10 @@ use crate::constraint::{evaluate, BodyMotion, ConstraintRows, ConstraintSet};
 use crate::error::Result;
 use crate::joint::ArticulatedTerms;
 use crate::model::Model;
-use crate::spatial::{dot, Force, Motion, Real, Transform};
+use crate::spatial::{Force, Motion, Real, Transform};
 use crate::Data;
 use nalgebra::{DMatrix, Matrix6, Vector6};
+use std::ops::Range;
 
 /// ABA's terms that the route reads (one state's from [`Data`], or lanes'), and the placements
 /// `X_{i←0}` it writes along the rows' support.
@@ -102,6 +103,7 @@ impl<'b> RouteBuffers<'b, f64> {
 
 /// The free acceleration `a_f = M⁻¹ (τ − h)` by ABA into `data.qdd` (its articulated terms kept
 /// in `data`), then [`rows_under_free_motion`].
+#[inline(always)]
 pub(super) fn free_motion_rows(
     model: &Model,
     data: &mut Data,
@@ -233,45 +235,80 @@ fn delassus_from_transmitted<S: Real>(
     for (&i, span) in set.support().iter().zip(set.row_spans()) {
         let dofs = model.v_range(i);
         let (d_inv, columns) = (&terms.d_inv[i], &y[dofs.start * m..dofs.end * m]);
-        if dofs.len() == 1 {
-            // one coordinate: Λ⁻¹_rc += y_r y_c / D_i
-            let y_i = &columns[..m];
-            for c in span.clone() {
-                let w_c = d_inv[(0, 0)] * y_i[c];
-                let column = &mut lambda[c * m + span.start..=c * m + c];
-                for (entry, y_r) in column.iter_mut().zip(&y_i[span.start..=c]) {
-                    *entry += *y_r * w_c;
-                }
-            }
-            continue;
-        }
-        // several: each row's y_r (body i's columns of row r) and w_r = D_i⁻¹ y_r as 6-vectors
-        // (zero past the joint's coordinates), then Λ⁻¹_rc += y_r · w_c
-        for r in span.clone() {
-            let mut y_r = Vector6::zeros();
-            for (a, y_ra) in y_r.iter_mut().take(dofs.len()).enumerate() {
-                *y_ra = columns[a * m + r];
-            }
-            let mut w_r = Vector6::zeros();
-            for (a, w_ra) in w_r.iter_mut().take(dofs.len()).enumerate() {
-                let mut sum = S::zero();
-                for b in 0..dofs.len() {
-                    sum += d_inv[(a, b)] * y_r[b];
-                }
-                *w_ra = sum;
-            }
-            body_rows[r] = (y_r, w_r);
-        }
-        for c in span.clone() {
-            let w_c = &body_rows[c].1;
-            for r in span.start..=c {
-                lambda[c * m + r] += dot(&body_rows[r].0, w_c);
-            }
+        let body = (d_inv, columns, span.clone());
+        // the joint's number of coordinates as a constant, so that its loops unroll
+        match dofs.len() {
+            1 => add_body_delassus::<S, 1>(lambda, body_rows, body),
+            2 => add_body_delassus::<S, 2>(lambda, body_rows, body),
+            3 => add_body_delassus::<S, 3>(lambda, body_rows, body),
+            6 => add_body_delassus::<S, 6>(lambda, body_rows, body),
+            _ => add_body_delassus_of(dofs.len(), lambda, body_rows, body),
         }
     }
     for c in 0..m {
         for r in c + 1..m {
             lambda[c * m + r] = lambda[r * m + c];
+        }
+    }
+}
+
+/// One body's term of [`delassus_from_transmitted`], for a joint of N coordinates:
+/// `Λ⁻¹_rc += y_r · D_i⁻¹ y_c` for the rows r ≤ c of `span`, y_r the body's N entries of Y's row
+/// r (Y's columns of the body in `columns`, m each).
+#[inline(always)]
+fn add_body_delassus<S: Real, const N: usize>(
+    lambda: &mut [S],
+    body_rows: &mut [(Vector6<S>, Vector6<S>)],
+    body: (&Matrix6<S>, &[S], Range<usize>),
+) {
+    add_body_delassus_of(N, lambda, body_rows, body);
+}
+
+/// [`add_body_delassus`] for `n` coordinates.
+#[inline(always)]
+fn add_body_delassus_of<S: Real>(
+    n: usize,
+    lambda: &mut [S],
+    body_rows: &mut [(Vector6<S>, Vector6<S>)],
+    (d_inv, columns, span): (&Matrix6<S>, &[S], Range<usize>),
+) {
+    let m = columns.len() / n;
+    if n == 1 {
+        // one coordinate: Λ⁻¹_rc += y_r y_c / D_i
+        for c in span.clone() {
+            let w_c = d_inv[(0, 0)] * columns[c];
+            let column = &mut lambda[c * m + span.start..=c * m + c];
+            for (entry, y_r) in column.iter_mut().zip(&columns[span.start..=c]) {
+                *entry += *y_r * w_c;
+            }
+        }
+        return;
+    }
+    // y_r and w_r = D_i⁻¹ y_r as 6-vectors (zero past the joint's coordinates)
+    for r in span.clone() {
+        let mut y_r = Vector6::zeros();
+        for a in 0..n {
+            y_r[a] = columns[a * m + r];
+        }
+        let mut w_r = Vector6::zeros();
+        for a in 0..n {
+            let mut sum = S::zero();
+            for b in 0..n {
+                sum += d_inv[(a, b)] * y_r[b];
+            }
+            w_r[a] = sum;
+        }
+        body_rows[r] = (y_r, w_r);
+    }
+    for c in span.clone() {
+        let w_c = &body_rows[c].1;
+        for r in span.start..=c {
+            let y_r = &body_rows[r].0;
+            let mut sum = S::zero();
+            for a in 0..n {
+                sum += y_r[a] * w_c[a];
+            }
+            lambda[c * m + r] += sum;
         }
     }
 }

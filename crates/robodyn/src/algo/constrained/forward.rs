@@ -16,6 +16,7 @@ use super::articulated::{
 use super::solve::largest;
 use super::{product_scale, solve_forces, ConstraintData};
 use crate::constraint::ConstraintSet;
+use crate::dispatch::multiversion;
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::spatial::{Force, Real};
@@ -67,7 +68,40 @@ pub fn constrained_forward_dynamics(
 ) -> Result<()> {
     super::check_fits(model, constraints, set)?;
     options.check()?;
+    forward_route(model, data, constraints, set, (q, v, tau), f_ext, options)
+}
 
+multiversion! {
+    /// [`constrained_forward_dynamics`]' steps on checked inputs, built for AVX2 and FMA as well
+    /// ([`crate::dispatch`]).
+    #[inline(never)]
+    fn forward_route(
+        model: &Model,
+        data: &mut Data,
+        constraints: &mut ConstraintData,
+        set: &ConstraintSet,
+        state: (&[f64], &[f64], &[f64]),
+        f_ext: Option<&[Force]>,
+        options: &ConstrainedOptions,
+    ) -> Result<()> {
+        forward_route_avx2 for ["avx2", "fma"] => {
+            forward_steps(model, data, constraints, set, state, f_ext, options)
+        }
+        baseline => { forward_steps(model, data, constraints, set, state, f_ext, options) }
+    }
+}
+
+/// The steps of [`constrained_forward_dynamics`].
+#[inline(always)]
+fn forward_steps(
+    model: &Model,
+    data: &mut Data,
+    constraints: &mut ConstraintData,
+    set: &ConstraintSet,
+    (q, v, tau): (&[f64], &[f64], &[f64]),
+    f_ext: Option<&[Force]>,
+    options: &ConstrainedOptions,
+) -> Result<()> {
     // a_f = ABA(q, q̇, τ, f_ext); J, φ, γ and the rows' acceleration J a_f + γ under it
     free_motion_rows(model, data, constraints, set, (q, v, tau), f_ext)?;
     // Y = K Jᵀ by each row's inward pass;  Λ⁻¹ = Σ_i Y_iᵀ D_i⁻¹ Y_i
@@ -103,6 +137,45 @@ pub fn impulse_dynamics(
     damping: f64,
 ) -> Result<()> {
     super::check_fits(model, constraints, set)?;
+    impulse_route(
+        model,
+        data,
+        constraints,
+        set,
+        (q, v),
+        (restitution, damping),
+    )
+}
+
+multiversion! {
+    /// [`impulse_dynamics`]' steps on checked inputs, built for AVX2 and FMA as well
+    /// ([`crate::dispatch`]).
+    #[inline(never)]
+    fn impulse_route(
+        model: &Model,
+        data: &mut Data,
+        constraints: &mut ConstraintData,
+        set: &ConstraintSet,
+        state: (&[f64], &[f64]),
+        impact: (f64, f64),
+    ) -> Result<()> {
+        impulse_route_avx2 for ["avx2", "fma"] => {
+            impulse_steps(model, data, constraints, set, state, impact)
+        }
+        baseline => { impulse_steps(model, data, constraints, set, state, impact) }
+    }
+}
+
+/// The steps of [`impulse_dynamics`], `impact` its restitution and damping.
+#[inline(always)]
+fn impulse_steps(
+    model: &Model,
+    data: &mut Data,
+    constraints: &mut ConstraintData,
+    set: &ConstraintSet,
+    (q, v): (&[f64], &[f64]),
+    (restitution, damping): (f64, f64),
+) -> Result<()> {
     // ABA's terms at (q, q̇, τ = 0) and J
     let mut zeros = std::mem::take(&mut constraints.joint_forces);
     zeros.fill(0.0);
@@ -134,6 +207,7 @@ pub fn impulse_dynamics(
 
 /// λ from `Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ)`, with `J a_f + γ` (a_f: the free
 /// acceleration `free`) in `constraints.rhs` and J, φ and Λ⁻¹ in `constraints`.
+#[inline(always)]
 pub(super) fn solve_accelerated_forces(
     model: &Model,
     set: &ConstraintSet,
@@ -203,6 +277,7 @@ pub(crate) fn accelerated_right_side<S: Real>(
 
 /// The impulses Λ from `Λ⁻¹ Λ = −(1 + e) J q̇`, with J and Λ⁻¹ in `constraints`; a restitution
 /// outside [0, 1] or a negative damping is refused.
+#[inline(always)]
 pub(super) fn solve_impulses(
     model: &Model,
     set: &ConstraintSet,
@@ -260,5 +335,75 @@ pub(crate) fn impact_right_side<S: Real>(
     let scale = S::splat(-(1.0 + restitution));
     for entry in rhs.iter_mut() {
         *entry *= scale;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::constraint::{Attachment, Constraint, ConstraintKind, ConstraintReference};
+    use crate::io::bundled::floating_ur5_state;
+    use crate::spatial::Transform;
+
+    /// The floating UR5 with its last frame held to the world where it is.
+    fn held_ur5() -> (Model, ConstraintSet, Vec<f64>, Vec<f64>, Vec<f64>) {
+        let (model, q, v, tau) = floating_ur5_state();
+        let frame = model.frames.len() - 1;
+        let held = Constraint {
+            kind: ConstraintKind::Frame {
+                first: Attachment {
+                    frame: Some(frame),
+                    placement: Transform::IDENTITY,
+                },
+                second: None,
+                mask: [true; 6],
+            },
+            reference: ConstraintReference::World,
+        };
+        let set = ConstraintSet::new(&model, vec![held]).unwrap();
+        (model, set, q, v, tau)
+    }
+
+    /// One call, built for AVX2 and FMA where the processor has them, equals the baseline build
+    /// of the same steps bit for bit (the claim of `forward_route` and `impulse_route`).
+    #[test]
+    fn the_dispatched_routes_equal_the_baseline_build_bit_for_bit() {
+        let (model, set, q, v, tau) = held_ur5();
+        let options = ConstrainedOptions::default();
+        let (mut data, mut constraints) = (Data::new(&model), ConstraintData::new(&model, &set));
+        let state = (q.as_slice(), v.as_slice(), tau.as_slice());
+        constrained_forward_dynamics(
+            &model,
+            &mut data,
+            &mut constraints,
+            &set,
+            state,
+            None,
+            &options,
+        )
+        .unwrap();
+        let (mut base_data, mut base) = (Data::new(&model), ConstraintData::new(&model, &set));
+        forward_steps(
+            &model,
+            &mut base_data,
+            &mut base,
+            &set,
+            state,
+            None,
+            &options,
+        )
+        .unwrap();
+        assert_eq!(
+            (&constraints.qdd, &constraints.forces),
+            (&base.qdd, &base.forces)
+        );
+
+        let (q, v) = (q.as_slice(), v.as_slice());
+        impulse_dynamics(&model, &mut data, &mut constraints, &set, (q, v), 0.5, 0.0).unwrap();
+        impulse_steps(&model, &mut base_data, &mut base, &set, (q, v), (0.5, 0.0)).unwrap();
+        assert_eq!(
+            (&constraints.qdd, &constraints.forces),
+            (&base.qdd, &base.forces)
+        );
     }
 }

@@ -68,6 +68,7 @@ pub(crate) struct SolveScratch<'a> {
 /// from). `factor` (n × n) receives the factor. Returns the number of proximal iterations (0
 /// when direct).
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 pub(crate) fn solve_symmetric(
     n: usize,
     a: &[f64],
