@@ -235,7 +235,7 @@ fn delassus_from_transmitted<S: Real>(
     for (&i, span) in set.support().iter().zip(set.row_spans()) {
         let dofs = model.v_range(i);
         let (d_inv, columns) = (&terms.d_inv[i], &y[dofs.start * m..dofs.end * m]);
-        let body = (d_inv, columns, span.clone());
+        let body = (d_inv, columns, m, span.clone());
         // the joint's number of coordinates as a constant, so that its loops unroll
         match dofs.len() {
             1 => add_body_delassus::<S, 1>(lambda, body_rows, body),
@@ -259,7 +259,7 @@ fn delassus_from_transmitted<S: Real>(
 fn add_body_delassus<S: Real, const N: usize>(
     lambda: &mut [S],
     body_rows: &mut [(Vector6<S>, Vector6<S>)],
-    body: (&Matrix6<S>, &[S], Range<usize>),
+    body: (&Matrix6<S>, &[S], usize, Range<usize>),
 ) {
     add_body_delassus_of(N, lambda, body_rows, body);
 }
@@ -270,9 +270,8 @@ fn add_body_delassus_of<S: Real>(
     n: usize,
     lambda: &mut [S],
     body_rows: &mut [(Vector6<S>, Vector6<S>)],
-    (d_inv, columns, span): (&Matrix6<S>, &[S], Range<usize>),
+    (d_inv, columns, m, span): (&Matrix6<S>, &[S], usize, Range<usize>),
 ) {
-    let m = columns.len() / n;
     if n == 1 {
         // one coordinate: Λ⁻¹_rc += y_r y_c / D_i
         for c in span.clone() {
