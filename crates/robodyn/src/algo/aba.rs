@@ -29,15 +29,25 @@ pub fn aba<'d>(
     tau: &[f64],
     f_ext: Option<&[Force]>,
 ) -> Result<&'d DVector<f64>> {
-    model.check_configuration(q)?;
-    check_vector("v", v, model.nv)?;
-    check_vector("tau", tau, model.nv)?;
-    if let Some(forces) = f_ext {
-        check_external_forces(model, forces)?;
-    }
+    check_dynamics_inputs(model, (q, v, tau), f_ext)?;
     one_state_passes(model, (q, v, tau, f_ext), AbaBuffers::of(data))
         .map_err(|joint| singular_joint(model, joint))?;
     Ok(&data.qdd)
+}
+
+/// Refuses a q, q̇, τ or f_ext of the wrong size, or a q that is not a configuration.
+pub(crate) fn check_dynamics_inputs(
+    model: &Model,
+    (q, v, tau): (&[f64], &[f64], &[f64]),
+    f_ext: Option<&[Force]>,
+) -> Result<()> {
+    model.check_configuration(q)?;
+    check_vector("v", v, model.nv)?;
+    check_vector("tau", tau, model.nv)?;
+    match f_ext {
+        Some(forces) => check_external_forces(model, forces),
+        None => Ok(()),
+    }
 }
 
 multiversion! {
@@ -93,7 +103,7 @@ pub(crate) struct AbaBuffers<'b, S> {
 
 impl<'b> AbaBuffers<'b, f64> {
     /// `data`'s fields.
-    fn of(data: &'b mut Data) -> Self {
+    pub(crate) fn of(data: &'b mut Data) -> Self {
         AbaBuffers {
             x_up: &mut data.x_up,
             v: &mut data.v,
@@ -118,7 +128,23 @@ pub(crate) fn articulated_body_passes<S: Real>(
     v: &[S],
     tau: &[S],
     f_ext: Option<&[Force<S>]>,
-    out: AbaBuffers<S>,
+    mut out: AbaBuffers<S>,
+) -> std::result::Result<(), usize> {
+    articulated_inertia_passes(model, (q, v, tau), f_ext, &mut out)?;
+    let (terms, accelerations) = out.outward();
+    acceleration_pass(model, 1..model.nbodies(), &terms, None, accelerations);
+    Ok(())
+}
+
+/// Passes 1 and 2 of Table 7.1 on checked inputs: the transforms, velocities, articulated
+/// inertias and bias forces, and each joint's `U_i`, `u_i`, `D_i⁻¹`. An error gives the first
+/// body whose `D_i` is singular in some lane.
+#[inline(always)]
+pub(crate) fn articulated_inertia_passes<S: Real>(
+    model: &Model,
+    (q, v, tau): (&[S], &[S], &[S]),
+    f_ext: Option<&[Force<S>]>,
+    out: &mut AbaBuffers<S>,
 ) -> std::result::Result<(), usize> {
     joint_transforms(model, q, out.x_up);
 
@@ -169,26 +195,72 @@ pub(crate) fn articulated_body_passes<S: Real>(
             out.p_a[parent] += p_parent;
         }
     }
-    if let Some(joint) = singular {
-        return Err(joint);
+    match singular {
+        Some(joint) => Err(joint),
+        None => Ok(()),
     }
+}
 
-    // pass 3, outward: accelerations
-    out.a[0] = Motion::new(zero_vector(), -splat_vector::<S>(&model.gravity));
-    for i in 1..model.nbodies() {
+/// What ABA's outward pass writes: the bodies' accelerations a_i and q̈.
+pub(crate) type OutwardResults<'b, S> = (&'b mut [Motion<S>], &'b mut [S]);
+
+/// What ABA's outward pass (pass 3 of Table 7.1) reads of passes 1 and 2.
+pub(crate) struct OutwardTerms<'b, S> {
+    pub x_up: &'b [Transform<S>],
+    pub c: &'b [Motion<S>],
+    pub u: &'b [[Force<S>; 6]],
+    pub u_tau: &'b [[S; 6]],
+    pub d_inv: &'b [Matrix6<S>],
+}
+
+impl<S> AbaBuffers<'_, S> {
+    /// What the outward pass reads, and what it writes: the accelerations a_i and q̈.
+    pub(crate) fn outward(&mut self) -> (OutwardTerms<'_, S>, OutwardResults<'_, S>) {
+        let terms = OutwardTerms {
+            x_up: self.x_up,
+            c: self.c,
+            u: self.u,
+            u_tau: self.u_tau,
+            d_inv: self.d_inv,
+        };
+        (terms, (&mut *self.a, &mut *self.qdd))
+    }
+}
+
+/// Pass 3 of Table 7.1, outward from `a_0 = −g` over `bodies` (each after its parent; the
+/// others' a_i and q̈_i are left as they were), into `(a, qdd)`. `transmitted`: per coordinate,
+/// the u_i that ABA's inward pass makes of further generalised forces f (K f: for constraint
+/// forces f = Jᵀ λ, `Yᵀ λ`), added to τ's; none: zero.
+#[inline(always)]
+pub(crate) fn acceleration_pass<S: Real>(
+    model: &Model,
+    bodies: impl IntoIterator<Item = usize>,
+    terms: &OutwardTerms<S>,
+    transmitted: Option<&[S]>,
+    (a, qdd): OutwardResults<S>,
+) {
+    a[0] = Motion::new(zero_vector(), -splat_vector::<S>(&model.gravity));
+    for i in bodies {
         // a'_i = X_i a_λ(i) + c_i
         let turn = model.turn(i);
-        let mut a_i = out.x_up[i].apply_motion_turned(turn, &out.a[model.parent[i]]) + out.c[i];
-        // q̈_i = D_i⁻¹ (u_i - U_iᵀ a'_i);  a_i = a'_i + S_i q̈_i
-        let terms = ArticulatedTerms {
-            u: &mut out.u[i],
-            u_tau: &mut out.u_tau[i],
-            d_inv: &mut out.d_inv[i],
+        let mut a_i = terms.x_up[i].apply_motion_turned(turn, &a[model.parent[i]]) + terms.c[i];
+        // q̈_i = D_i⁻¹ (u_i − U_iᵀ a'_i);  a_i = a'_i + S_i q̈_i
+        let mut u_i;
+        let u_i = match transmitted {
+            None => &terms.u_tau[i],
+            Some(transmitted) => {
+                u_i = terms.u_tau[i];
+                for (u_k, t_k) in u_i.iter_mut().zip(&transmitted[model.v_range(i)]) {
+                    *u_k += *t_k;
+                }
+                &u_i
+            }
         };
-        model.subspace(i).accelerate(&mut a_i, &terms, out.qdd);
-        out.a[i] = a_i;
+        model
+            .subspace(i)
+            .accelerate(&mut a_i, (&terms.u[i], u_i, &terms.d_inv[i]), qdd);
+        a[i] = a_i;
     }
-    Ok(())
 }
 
 /// The lower triangle of `m` set from the upper one.

@@ -30,7 +30,8 @@ mod inverse;
 mod solve;
 
 pub(crate) use articulated::{
-    articulated_delassus, constraint_response, rows_under_free_motion, AbaTerms, RouteBuffers,
+    articulated_delassus, constrained_accelerations, constraint_response, rows_under_free_motion,
+    support_acceleration_pass, AbaTerms, RouteBuffers,
 };
 pub use closure::{close_constraints, Closure, ClosureOptions};
 pub use derivatives::{

@@ -223,6 +223,49 @@ impl MotionSubspace<'_> {
         }
     }
 
+    /// ABA's inward pass through this joint of rows of J taken as generalised forces
+    /// (`algo::constrained::articulated`): for each row r of `rows` and the force p it carries
+    /// in (`carried`, one per row), `u = J_r,i − S_iᵀ p` into Y's entries of the joint's
+    /// coordinates (J and Y column-major, m rows), then, with `onward` (the parent is not the
+    /// world), `p += U_i D_i⁻¹ u`. `(u_forces, d_inv)`: U_i's columns and D_i⁻¹. One match on
+    /// the joint for all the rows.
+    #[inline(always)]
+    pub(crate) fn transmit_rows<S: Real>(
+        &self,
+        carried: &mut [Force<S>],
+        (j, y, m, rows): (&[S], &mut [S], usize, Range<usize>),
+        (u_forces, d_inv): (&[Force<S>; 6], &Matrix6<S>),
+        onward: bool,
+    ) {
+        match *self {
+            MotionSubspace::Axis { c, negative, dof } => {
+                for (p, r) in carried.iter_mut().zip(rows) {
+                    // u = J_r,i ∓ p_c;  p += U_i u / D_i
+                    let u = j[dof * m + r] - signed(p.component(c), negative);
+                    y[dof * m + r] = u;
+                    if onward {
+                        *p += u_forces[0] * (d_inv[(0, 0)] * u);
+                    }
+                }
+            }
+            MotionSubspace::Columns { .. } => {
+                for (p, r) in carried.iter_mut().zip(rows) {
+                    let mut u = [S::zero(); 6];
+                    for (u_k, dof) in u.iter_mut().zip(self.dofs()) {
+                        *u_k = j[dof * m + r];
+                    }
+                    self.subtract_projection(p, &mut u);
+                    for (u_k, dof) in u.iter().zip(self.dofs()) {
+                        y[dof * m + r] = *u_k;
+                    }
+                    if onward {
+                        self.add_bias_response(p, u_forces, d_inv, &u);
+                    }
+                }
+            }
+        }
+    }
+
     /// `p += U D⁻¹ u` (`u_forces`: U's columns; `d_inv`: D⁻¹ in its leading block): ABA's bias
     /// force passed on to the parent, before the transform.
     #[inline(always)]
@@ -244,15 +287,14 @@ impl MotionSubspace<'_> {
     }
 
     /// ABA's accelerations: `q̈_i = D_i⁻¹ (u_i − U_iᵀ a'_i)` into `qdd`, then `a_i = a'_i + S_i q̈_i`
-    /// in place of `a`.
+    /// in place of `a`; `(u, u_tau, d_inv)`: U_i's columns, u_i and D_i⁻¹.
     #[inline(always)]
     pub(crate) fn accelerate<S: Real>(
         &self,
         a: &mut Motion<S>,
-        terms: &ArticulatedTerms<S>,
+        (u, u_tau, d_inv): (&[Force<S>; 6], &[S; 6], &Matrix6<S>),
         qdd: &mut [S],
     ) {
-        let (u, u_tau, d_inv) = (&*terms.u, &*terms.u_tau, &*terms.d_inv);
         match *self {
             MotionSubspace::Axis { c, negative, dof } => {
                 let qdd_i = d_inv[(0, 0)] * (u_tau[0] - a.dot(&u[0]));

@@ -15,16 +15,20 @@
 //!   Λ⁻¹ = J M⁻¹ Jᵀ = Σ_i Y_iᵀ D_i⁻¹ Y_i,      M⁻¹ Jᵀ λ = outward pass from u_i = Y_i λ
 //! ```
 //! A row's inward pass runs only over the ancestors of its bodies (its support), where its J is
-//! not zero; the other u_i are zero. Cost: ABA, then O(d) per row (d: the bodies its support
-//! holds), O(m² d) for Λ⁻¹ and one outward pass. The rows themselves take ABA's placements,
-//! velocities and velocity products along their support. Every step is generic over [`Real`]:
-//! one state in `f64`, or several in lanes ([`crate::algo::lanes`]).
+//! not zero; the other u_i are zero. ABA is linear in its u_i: its outward pass from
+//! `u_i + Y_i λ` gives `M⁻¹ (τ − h + Jᵀ λ)` at once, so forward dynamics runs that pass once,
+//! after λ, and before it only along the support, where `J a_f` needs a_f. Cost: ABA, then O(d)
+//! per row (d: the bodies its support holds), O(m² d) for Λ⁻¹. The rows themselves take ABA's
+//! placements, velocities and velocity products along their support. Every step is generic over
+//! [`Real`]: one state in `f64`, or several in lanes ([`crate::algo::lanes`]).
 
 use super::ConstraintData;
-use crate::algo::aba::aba;
+use crate::algo::aba::{
+    acceleration_pass, articulated_inertia_passes, check_dynamics_inputs, singular_joint,
+    AbaBuffers, OutwardTerms,
+};
 use crate::constraint::{evaluate, BodyMotion, ConstraintRows, ConstraintSet};
 use crate::error::Result;
-use crate::joint::ArticulatedTerms;
 use crate::model::Model;
 use crate::spatial::{Force, Motion, Real, Transform};
 use crate::Data;
@@ -37,10 +41,11 @@ pub(crate) struct AbaTerms<'b, S> {
     pub x_up: &'b [Transform<S>],
     pub v: &'b [Motion<S>],
     pub c: &'b [Motion<S>],
-    pub u: &'b mut [[Force<S>; 6]],
-    pub d_inv: &'b mut [Matrix6<S>],
+    pub u: &'b [[Force<S>; 6]],
+    pub u_tau: &'b [[S; 6]],
+    pub d_inv: &'b [Matrix6<S>],
     pub x_world: &'b mut [Transform<S>],
-    /// a_f = M⁻¹ (τ − h), ABA's q̈.
+    /// a_f = M⁻¹ (τ − h), ABA's q̈, on the coordinates of the rows' support (zero on the others).
     pub free_acceleration: &'b [S],
 }
 
@@ -51,10 +56,24 @@ impl<'b> AbaTerms<'b, f64> {
             x_up: &data.x_up,
             v: &data.v,
             c: &data.c,
-            u: &mut data.u,
-            d_inv: &mut data.d_inv,
+            u: &data.u,
+            u_tau: &data.u_tau,
+            d_inv: &data.d_inv,
             x_world: &mut data.x_world,
             free_acceleration: data.qdd.as_slice(),
+        }
+    }
+}
+
+impl<S> AbaTerms<'_, S> {
+    /// What ABA's outward pass reads.
+    fn outward(&self) -> OutwardTerms<'_, S> {
+        OutwardTerms {
+            x_up: self.x_up,
+            c: self.c,
+            u: self.u,
+            u_tau: self.u_tau,
+            d_inv: self.d_inv,
         }
     }
 }
@@ -101,8 +120,9 @@ impl<'b> RouteBuffers<'b, f64> {
     }
 }
 
-/// The free acceleration `a_f = M⁻¹ (τ − h)` by ABA into `data.qdd` (its articulated terms kept
-/// in `data`), then [`rows_under_free_motion`].
+/// ABA's passes 1 and 2 at (q, q̇, τ, f_ext) into `data` (checked as [`crate::algo::aba()`]
+/// checks them), the free acceleration `a_f = M⁻¹ (τ − h)` along the rows' support
+/// ([`support_acceleration_pass`]), then [`rows_under_free_motion`].
 #[inline(always)]
 pub(super) fn free_motion_rows(
     model: &Model,
@@ -112,10 +132,27 @@ pub(super) fn free_motion_rows(
     (q, v, tau): (&[f64], &[f64], &[f64]),
     f_ext: Option<&[Force]>,
 ) -> Result<()> {
-    aba(model, data, q, v, tau, f_ext)?;
+    check_dynamics_inputs(model, (q, v, tau), f_ext)?;
+    let mut buffers = AbaBuffers::of(data);
+    articulated_inertia_passes(model, (q, v, tau), f_ext, &mut buffers)
+        .map_err(|joint| singular_joint(model, joint))?;
+    support_acceleration_pass(model, set, &mut buffers);
     let mut route = RouteBuffers::of(constraints);
     rows_under_free_motion(model, set, &mut AbaTerms::of(data), &mut route, (q, v));
     Ok(())
+}
+
+/// ABA's outward pass along the rows' support only: a_f on its bodies' coordinates, zero on the
+/// others' (J's columns there are zero).
+#[inline(always)]
+pub(crate) fn support_acceleration_pass<S: Real>(
+    model: &Model,
+    set: &ConstraintSet,
+    buffers: &mut AbaBuffers<S>,
+) {
+    let (terms, (a, qdd)) = buffers.outward();
+    qdd.fill(S::zero());
+    acceleration_pass(model, set.support().iter().copied(), &terms, None, (a, qdd));
 }
 
 /// From ABA's terms: the placements `X_{i←0}` of the bodies the rows reach, then J, φ, the
@@ -155,9 +192,10 @@ pub(crate) fn rows_under_free_motion<S: Real>(
     let rows_acceleration = &mut route.rhs[..m];
     rows_acceleration.copy_from_slice(route.drift);
     let j = route.jacobian.as_slice();
-    for (c, a_c) in terms.free_acceleration.iter().enumerate() {
+    for c in set.support().iter().flat_map(|&i| model.v_range(i)) {
+        let a_c = terms.free_acceleration[c];
         for (entry, j_rc) in rows_acceleration.iter_mut().zip(&j[c * m..(c + 1) * m]) {
-            *entry += *j_rc * *a_c;
+            *entry += *j_rc * a_c;
         }
     }
 }
@@ -196,24 +234,23 @@ fn transmit_rows<S: Real>(
         // each body once, all the constraint's rows (at most 6) through it
         let rows = set.offset(k)..set.offset(k) + constraint.rows();
         for &i in set.support_of(k) {
-            let (dofs, subspace, parent) = (model.v_range(i), model.subspace(i), model.parent[i]);
-            for (t, r) in rows.clone().enumerate() {
-                // u_i = J_ri − S_iᵀ p_i
-                let mut u = [S::zero(); 6];
-                for (u_k, dof) in u.iter_mut().zip(dofs.clone()) {
-                    *u_k = j[dof * m + r];
-                }
-                let mut p_i = std::mem::replace(&mut p[i][t], Force::splat(&Force::ZERO));
-                subspace.subtract_projection(&p_i, &mut u);
-                for (u_k, dof) in u.iter().zip(dofs.clone()) {
-                    y[dof * m + r] = *u_k;
-                }
+            let parent = model.parent[i];
+            let (toward_root, from_i) = p.split_at_mut(i);
+            let carried = &mut from_i[0][..rows.len()];
+            // u_i = J_ri − S_iᵀ p_i into Y;  p_i + U_i D_i⁻¹ u_i where there is a parent
+            let rows = (j, &mut *y, m, rows.clone());
+            let own = (&terms.u[i], &terms.d_inv[i]);
+            model
+                .subspace(i)
+                .transmit_rows(carried, rows, own, parent != 0);
+            if parent != 0 {
                 // p_λ(i) += X_iᵀ (p_i + U_i D_i⁻¹ u_i)
-                if parent != 0 {
-                    subspace.add_bias_response(&mut p_i, &terms.u[i], &terms.d_inv[i], &u);
-                    p[parent][t] += terms.x_up[i].transpose_apply_force_turned(model.turn(i), &p_i);
+                terms.x_up[i].transpose_apply_forces_turned(model.turn(i), carried);
+                for (sum, p_i) in toward_root[parent].iter_mut().zip(carried.iter()) {
+                    *sum += *p_i;
                 }
             }
+            carried.fill(Force::splat(&Force::ZERO));
         }
     }
 }
@@ -312,30 +349,41 @@ fn add_body_delassus_of<S: Real>(
     }
 }
 
-/// `base + M⁻¹ Jᵀ λ` (λ in `forces`; base: a_f or q̇) into `qdd` by ABA's outward pass from
-/// `u_i = Y_i λ` ([`articulated_delassus`]'s Y), with ABA's terms.
+/// `q̈ = M⁻¹ (τ − h + Jᵀ λ)` (λ in `forces`) into `qdd`: ABA's outward pass from `u_i + Y_i λ`
+/// ([`articulated_delassus`]'s Y), with ABA's terms. The bodies' accelerations are left in
+/// `body_accelerations`.
+#[inline(always)]
+pub(crate) fn constrained_accelerations<S: Real>(
+    model: &Model,
+    set: &ConstraintSet,
+    terms: &AbaTerms<S>,
+    route: &mut RouteBuffers<S>,
+) {
+    transmit_forces(set, route);
+    let (a, qdd) = (&mut *route.body_accelerations, &mut *route.qdd);
+    let transmitted = Some(&*route.joint_forces);
+    acceleration_pass(
+        model,
+        1..model.nbodies(),
+        &terms.outward(),
+        transmitted,
+        (a, qdd),
+    );
+}
+
+/// `base + M⁻¹ Jᵀ λ` (λ in `forces`; base: q̇ before an impact) into `qdd` by ABA's outward pass
+/// from `u_i = Y_i λ` ([`articulated_delassus`]'s Y) alone (q̇ = 0, no gravity), with ABA's
+/// terms.
 #[inline(always)]
 pub(crate) fn constraint_response<S: Real>(
     model: &Model,
     set: &ConstraintSet,
-    terms: &mut AbaTerms<S>,
+    terms: &AbaTerms<S>,
     route: &mut RouteBuffers<S>,
     base: &[S],
 ) {
-    let m = set.rows();
-    let (y, u, a) = (
-        route.transmitted_rows.as_slice(),
-        &mut *route.joint_forces,
-        &mut *route.body_accelerations,
-    );
-    // u = Yᵀ λ
-    for (k, u_k) in u.iter_mut().enumerate() {
-        let mut sum = S::zero();
-        for (y_rk, lambda_r) in y[k * m..(k + 1) * m].iter().zip(&route.forces[..m]) {
-            sum += *y_rk * *lambda_r;
-        }
-        *u_k = sum;
-    }
+    transmit_forces(set, route);
+    let (u, a) = (&*route.joint_forces, &mut *route.body_accelerations);
     a[0] = Motion::zeros();
     for i in 1..model.nbodies() {
         // a'_i = X_i a_λ(i);  q̈_i = D_i⁻¹ (u_i − U_iᵀ a'_i);  a_i = a'_i + S_i q̈_i
@@ -344,15 +392,26 @@ pub(crate) fn constraint_response<S: Real>(
         for (u_k, dof) in u_i.iter_mut().zip(model.v_range(i)) {
             *u_k = u[dof];
         }
-        let terms = ArticulatedTerms {
-            u: &mut terms.u[i],
-            u_tau: &mut u_i,
-            d_inv: &mut terms.d_inv[i],
-        };
-        model.subspace(i).accelerate(&mut a_i, &terms, route.qdd);
+        let own = (&terms.u[i], &u_i, &terms.d_inv[i]);
+        model.subspace(i).accelerate(&mut a_i, own, route.qdd);
         a[i] = a_i;
     }
     for (x, b) in route.qdd.iter_mut().zip(base) {
         *x += *b;
+    }
+}
+
+/// The u_i that ABA's inward pass makes of the constraint forces, `Yᵀ λ` (λ in `forces`), into
+/// `joint_forces`.
+#[inline(always)]
+fn transmit_forces<S: Real>(set: &ConstraintSet, route: &mut RouteBuffers<S>) {
+    let m = set.rows();
+    let y = route.transmitted_rows.as_slice();
+    for (k, u_k) in route.joint_forces.iter_mut().enumerate() {
+        let mut sum = S::zero();
+        for (y_rk, lambda_r) in y[k * m..(k + 1) * m].iter().zip(&route.forces[..m]) {
+            sum += *y_rk * *lambda_r;
+        }
+        *u_k = sum;
     }
 }

@@ -6,12 +6,13 @@
 //! header for the equations; both run on the articulated-body algorithm's terms, M is never
 //! formed (`articulated`). Inputs: q, q̇, τ (or only q, q̇), the constraint set. Writes
 //! `constraints.qdd`, `constraints.forces` and everything on the way (J, γ, φ, Y, Λ⁻¹), and in
-//! `data`: ABA's fields (`data.qdd` the free acceleration) and the placements of the bodies the
-//! rows reach. Cost: ABA, O(d) per row (d: the bodies its constraint reaches), O(m² d) for Λ⁻¹,
-//! O(m³) to solve it and one outward pass for the forces' effect.
+//! `data`: ABA's fields (`data.qdd` the free acceleration on the rows' support, zero elsewhere)
+//! and the placements of the bodies the rows reach. Cost: ABA, O(d) per row (d: the bodies its
+//! constraint reaches), O(m² d) for Λ⁻¹, O(m³) to solve it.
 
 use super::articulated::{
-    articulated_delassus, constraint_response, free_motion_rows, AbaTerms, RouteBuffers,
+    articulated_delassus, constrained_accelerations, constraint_response, free_motion_rows,
+    AbaTerms, RouteBuffers,
 };
 use super::solve::largest;
 use super::{product_scale, solve_forces, ConstraintData};
@@ -115,12 +116,9 @@ fn forward_steps(
     // Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ)
     solve_accelerated_forces(model, set, constraints, (v, data.qdd.as_slice()), options)?;
 
-    // q̈ = a_f + M⁻¹ Jᵀ λ
-    let free = std::mem::take(&mut data.qdd);
-    let mut terms = AbaTerms::of(data);
+    // q̈ = M⁻¹ (τ − h + Jᵀ λ): ABA's outward pass from u_i + Y_i λ
     let route = &mut RouteBuffers::of(constraints);
-    constraint_response(model, set, &mut terms, route, free.as_slice());
-    data.qdd = free;
+    constrained_accelerations(model, set, &AbaTerms::of(data), route);
     Ok(())
 }
 
@@ -201,7 +199,7 @@ fn impulse_steps(
 
     // q̇⁺ = q̇ + M⁻¹ Jᵀ Λ
     let route = &mut RouteBuffers::of(constraints);
-    constraint_response(model, set, &mut AbaTerms::of(data), route, v);
+    constraint_response(model, set, &AbaTerms::of(data), route, v);
     Ok(())
 }
 

@@ -12,11 +12,12 @@
 use super::groups::gather;
 use super::scatter::LaneRows;
 use super::{check_states, state, BatchResult, LaneWidth, States};
-use crate::algo::aba::{articulated_body_passes, AbaBuffers};
+use crate::algo::aba::{articulated_inertia_passes, AbaBuffers};
 use crate::algo::constrained::{
-    accelerated_right_side, articulated_delassus, check_impact, constrained_forward_dynamics,
-    constraint_response, impact_right_side, impulse_dynamics, rows_under_free_motion, solve_direct,
-    AbaTerms, ConstrainedOptions, ConstraintData, RouteBuffers,
+    accelerated_right_side, articulated_delassus, check_impact, constrained_accelerations,
+    constrained_forward_dynamics, constraint_response, impact_right_side, impulse_dynamics,
+    rows_under_free_motion, solve_direct, support_acceleration_pass, AbaTerms, ConstrainedOptions,
+    ConstraintData, RouteBuffers,
 };
 use crate::constraint::ConstraintSet;
 use crate::error::{Error, Result};
@@ -344,8 +345,8 @@ impl<S: Real> ConstrainedLanes<S> {
         route: Route,
     ) -> std::result::Result<(), ()> {
         let m = set.rows();
-        // a_f = ABA(q, q̇, τ)
-        let buffers = AbaBuffers {
+        // ABA's passes 1 and 2 at (q, q̇, τ), and a_f along the rows' support
+        let mut buffers = AbaBuffers {
             x_up: &mut self.x_up,
             v: &mut self.velocities,
             c: &mut self.velocity_products,
@@ -357,14 +358,16 @@ impl<S: Real> ConstrainedLanes<S> {
             d_inv: &mut self.d_inv,
             qdd: &mut self.free_acceleration,
         };
-        articulated_body_passes(model, &self.q, &self.v, &self.tau, None, buffers)
-            .map_err(|_| ())?;
+        let state = (&self.q[..], &self.v[..], &self.tau[..]);
+        articulated_inertia_passes(model, state, None, &mut buffers).map_err(|_| ())?;
+        support_acceleration_pass(model, set, &mut buffers);
         let mut terms = AbaTerms {
             x_up: &self.x_up,
             v: &self.velocities,
             c: &self.velocity_products,
-            u: &mut self.u,
-            d_inv: &mut self.d_inv,
+            u: &self.u,
+            u_tau: &self.u_tau,
+            d_inv: &self.d_inv,
             x_world: &mut self.x_world,
             free_acceleration: &self.free_acceleration,
         };
@@ -388,20 +391,21 @@ impl<S: Real> ConstrainedLanes<S> {
         articulated_delassus(model, set, &terms, buffers);
         // Λ⁻¹ λ = −(J a_f + γ + K_d J q̇ + K_p φ), or Λ⁻¹ Λ = −(1 + e) J q̇
         let (jacobian, rhs) = (&*buffers.jacobian, &mut buffers.rhs[..m]);
-        let base = match route {
+        match route {
             Route::Forward(options) => {
-                accelerated_right_side(jacobian, buffers.error, rhs, &self.v, options.baumgarte);
-                &self.free_acceleration
+                accelerated_right_side(jacobian, buffers.error, rhs, &self.v, options.baumgarte)
             }
             Route::Impulse { restitution, .. } => {
-                impact_right_side(jacobian, rhs, &self.v, restitution);
-                &self.v
+                impact_right_side(jacobian, rhs, &self.v, restitution)
             }
-        };
+        }
         let delassus = buffers.delassus.as_slice();
         solve_direct(m, delassus, &mut self.factor, buffers.rhs, buffers.forces).map_err(|_| ())?;
-        // q̈ = a_f + M⁻¹ Jᵀ λ, or q̇⁺ = q̇ + M⁻¹ Jᵀ Λ
-        constraint_response(model, set, &mut terms, buffers, base);
+        // q̈ = M⁻¹ (τ − h + Jᵀ λ), or q̇⁺ = q̇ + M⁻¹ Jᵀ Λ
+        match route {
+            Route::Forward(_) => constrained_accelerations(model, set, &terms, buffers),
+            Route::Impulse { .. } => constraint_response(model, set, &terms, buffers, &self.v),
+        }
         Ok(())
     }
 }
