@@ -69,7 +69,8 @@ pub(crate) fn evaluate<S: Real>(
     (q, v): (&[S], &[S]),
     mut rows: ConstraintRows<S>,
 ) {
-    rows.jacobian.fill(S::zero());
+    // a slice's fill: the matrix's own goes entry by entry through an iterator
+    rows.jacobian.as_mut_slice().fill(S::zero());
     for (k, constraint) in set.constraints().iter().enumerate() {
         let row = set.offset(k);
         let local = constraint.reference == ConstraintReference::Local;

@@ -230,6 +230,7 @@ fn transmit_rows<S: Real>(
         route.transmitted_rows.as_mut_slice(),
     );
     y.fill(S::zero());
+    let zero = Force::splat(&Force::ZERO);
     for (k, constraint) in set.constraints().iter().enumerate() {
         // each body once, all the constraint's rows (at most 6) through it
         let rows = set.offset(k)..set.offset(k) + constraint.rows();
@@ -243,14 +244,15 @@ fn transmit_rows<S: Real>(
             model
                 .subspace(i)
                 .transmit_rows(carried, rows, own, parent != 0);
+            // p_λ(i) += X_iᵀ (p_i + U_i D_i⁻¹ u_i), and p_i back to zero for the next rows
             if parent != 0 {
-                // p_λ(i) += X_iᵀ (p_i + U_i D_i⁻¹ u_i)
                 terms.x_up[i].transpose_apply_forces_turned(model.turn(i), carried);
-                for (sum, p_i) in toward_root[parent].iter_mut().zip(carried.iter()) {
-                    *sum += *p_i;
+                for (sum, p_i) in toward_root[parent].iter_mut().zip(carried.iter_mut()) {
+                    *sum += std::mem::replace(p_i, zero);
                 }
+            } else {
+                carried.iter_mut().for_each(|p_i| *p_i = zero);
             }
-            carried.fill(Force::splat(&Force::ZERO));
         }
     }
 }

@@ -186,13 +186,14 @@ fn cholesky<S: Real>(n: usize, a: &mut [S]) -> Result<(), SolveFailure> {
         }
         let l_kk = pivot.simd_sqrt();
         a[k + k * n] = l_kk;
-        // L_ik = (A_ik − Σ_{j<k} L_ij L_kj) / L_kk
+        // L_ik = (A_ik − Σ_{j<k} L_ij L_kj) / L_kk, by one division
+        let inverse = S::one() / l_kk;
         for i in k + 1..n {
             let mut sum = a[i + k * n];
             for j in 0..k {
                 sum -= a[i + j * n] * a[k + j * n];
             }
-            a[i + k * n] = sum / l_kk;
+            a[i + k * n] = sum * inverse;
         }
     }
     Ok(())
