@@ -245,15 +245,15 @@ pub(crate) fn acceleration_pass<S: Real>(
         let turn = model.turn(i);
         let mut a_i = terms.x_up[i].apply_motion_turned(turn, &a[model.parent[i]]) + terms.c[i];
         // q̈_i = D_i⁻¹ (u_i − U_iᵀ a'_i);  a_i = a'_i + S_i q̈_i
-        let mut u_i;
+        let mut sum;
         let u_i = match transmitted {
             None => &terms.u_tau[i],
             Some(transmitted) => {
-                u_i = terms.u_tau[i];
-                for (u_k, t_k) in u_i.iter_mut().zip(&transmitted[model.v_range(i)]) {
+                sum = terms.u_tau[i];
+                for (u_k, t_k) in sum.iter_mut().zip(&transmitted[model.v_range(i)]) {
                     *u_k += *t_k;
                 }
-                &u_i
+                &sum
             }
         };
         model
