@@ -184,20 +184,18 @@ pub fn constrained_forward_dynamics_derivatives(
     // r₁ = ∂τ/∂x − ∂(ID − Jᵀλ)/∂x,  r₂ = −∂(J q̈ + γ)/∂x
     difference_into(&mut d.dqdd_dq, &d.rows.forces_by_q, &data.dtau_dq);
     negated_into(&mut d.dqdd_dv, &data.dtau_dv);
-    d.dqdd_dtau.fill_with_identity();
     negated_into(&mut d.dforces_dq, &d.rows.by_q);
     negated_into(&mut d.dforces_dv, &d.rows.by_v);
-    d.dforces_dtau.as_mut_slice().fill(0.0);
     let pairs = [
         (&mut d.dqdd_dq, &mut d.dforces_dq),
         (&mut d.dqdd_dv, &mut d.dforces_dv),
-        (&mut d.dqdd_dtau, &mut d.dforces_dtau),
     ];
+    let torques = Some((&mut d.dqdd_dtau, &mut d.dforces_dtau));
     solve_saddle_points(
         model,
         data,
         (constraints, set),
-        pairs,
+        (pairs, torques),
         &mut d.saddle,
         damping,
     )
@@ -270,7 +268,7 @@ pub fn impulse_dynamics_derivatives(
         model,
         data,
         (constraints, set),
-        pairs,
+        (pairs, None),
         &mut d.saddle,
         damping,
     )
@@ -384,14 +382,21 @@ struct SaddleScratch {
     response: DMatrix<f64>,
 }
 
+/// A pair of [`solve_saddle_points`]: X (nv × k) and Y (m × k).
+type SaddlePair<'p> = (&'p mut DMatrix<f64>, &'p mut DMatrix<f64>);
+
 /// Solves `[M −Jᵀ; J 0] [X; Y] = [R₁; R₂]` in place for each pair (R₁ in the first, nv × k; R₂ in
 /// the second, m × k) with forward dynamics' factor of M, J, J M⁻¹ and the Delassus matrix,
-/// inverted once: `X₀ = M⁻¹ R₁`, `Y = Λ (R₂ − J X₀)`, `X = X₀ + (J M⁻¹)ᵀ Y`.
+/// inverted once: `X₀ = M⁻¹ R₁`, `Y = Λ (R₂ − J X₀)`, `X = X₀ + (J M⁻¹)ᵀ Y`. With `torques`, also
+/// the pair of R₁ = 1, R₂ = 0 (whatever the matrices held): X₀ = M⁻¹ and J X₀ = J M⁻¹, known.
 fn solve_saddle_points<'p>(
     model: &Model,
     data: &Data,
     (constraints, set): (&mut ConstraintData, &ConstraintSet),
-    pairs: impl IntoIterator<Item = (&'p mut DMatrix<f64>, &'p mut DMatrix<f64>)>,
+    (pairs, torques): (
+        impl IntoIterator<Item = SaddlePair<'p>>,
+        Option<SaddlePair<'p>>,
+    ),
     scratch: &mut SaddleScratch,
     damping: f64,
 ) -> Result<()> {
@@ -412,6 +417,14 @@ fn solve_saddle_points<'p>(
         multiply_add(y, -1.0, &constraints.jacobian, x, 1.0);
         multiply_add(forces, 1.0, inverse, y, 0.0);
         y.as_mut_slice().copy_from_slice(forces.as_slice());
+        multiply_add(x, 1.0, response, y, 1.0);
+    }
+    if let Some((x, y)) = torques {
+        // X₀ = M⁻¹: the identity solved row by row (M⁻¹ is symmetric, so no transposes)
+        x.fill_with_identity();
+        solve_rows(model, data, x.as_mut_slice());
+        // Y = −Λ J M⁻¹, X = M⁻¹ + (J M⁻¹)ᵀ Y
+        multiply_add(y, -1.0, inverse, &constraints.jacobian_inverse_inertia, 0.0);
         multiply_add(x, 1.0, response, y, 1.0);
     }
     Ok(())
