@@ -311,8 +311,9 @@ fn multiply_add_with(
 }
 
 /// Rows `start..` of `C` columns of [`multiply_add_with`] (`columns`: C × r, `b_tile`: their C
-/// columns of B), `W` rows at a time while whole blocks fit: `out_ij = β out_ij + Σ_k α b_kj
-/// A_ik`. Returns the first row left.
+/// columns of B), `W` rows at a time while whole blocks fit: `out_ij = β out_ij + α Σ_k b_kj
+/// A_ik`, α applied to the sum (exact for α = ±1, which is all the derivatives use). Returns the
+/// first row left.
 #[inline(always)]
 fn gather_tile<const W: usize, const C: usize>(
     columns: &mut [f64],
@@ -322,12 +323,14 @@ fn gather_tile<const W: usize, const C: usize>(
     mut start: usize,
 ) -> usize {
     let (r, k) = (columns.len() / C, b_tile.len() / C);
+    // B's C columns, k entries each: indexed below within k, so without checks
+    let b_columns: [&[f64]; C] = std::array::from_fn(|c| &b_tile[c * k..(c + 1) * k]);
     while start + W <= r {
         let mut sums = [[0.0; W]; C];
-        for (index, a_k) in a.chunks_exact(r).enumerate() {
+        for (index, a_k) in a.chunks_exact(r).take(k).enumerate() {
             let block: &[f64; W] = a_k[start..start + W].try_into().expect("W rows");
-            for (c, sum) in sums.iter_mut().enumerate() {
-                let factor = alpha * b_tile[c * k + index];
+            for (sum, b_column) in sums.iter_mut().zip(&b_columns) {
+                let factor = b_column[index];
                 for (s, a_ik) in sum.iter_mut().zip(block) {
                     *s += factor * a_ik;
                 }
@@ -336,7 +339,11 @@ fn gather_tile<const W: usize, const C: usize>(
         for (c, sum) in sums.iter().enumerate() {
             let block = &mut columns[c * r + start..c * r + start + W];
             for (x, s) in block.iter_mut().zip(sum) {
-                *x = if beta == 0.0 { *s } else { beta * *x + s };
+                *x = if beta == 0.0 {
+                    alpha * s
+                } else {
+                    beta * *x + alpha * s
+                };
             }
         }
         start += W;
