@@ -85,16 +85,15 @@ pub(super) fn output_array<'py>(
     Ok(array.clone())
 }
 
-/// Writes the first `rows` rows of a matrix (column-major in nalgebra) into a row-major output.
+/// Writes the first `rows` rows of a matrix (column-major in nalgebra) into a row-major output
+/// (as many whole rows as `out` holds).
 pub(crate) fn write_row_major(matrix: &nalgebra::DMatrix<f64>, rows: usize, out: &mut [f64]) {
     let (stored_rows, columns) = matrix.shape();
-    // output row by row, reading along the matrix's row (a stride of its column length)
-    for (r, out_row) in out.chunks_exact_mut(columns.max(1)).take(rows).enumerate() {
-        let row = matrix.as_slice()[r..].iter().step_by(stored_rows);
-        for (target, value) in out_row.iter_mut().zip(row) {
-            *target = *value;
-        }
-    }
+    let rows = rows.min(stored_rows).min(out.len() / columns.max(1));
+    // row-major rows × columns is column-major columns × rows: the transpose, written in place
+    let mut target =
+        nalgebra::DMatrixViewMut::from_slice(&mut out[..rows * columns], columns, rows);
+    matrix.rows(0, rows).transpose_to(&mut target);
 }
 
 pub(crate) fn vector_array<'py>(py: Python<'py>, values: &[f64]) -> Bound<'py, PyArray1<f64>> {
