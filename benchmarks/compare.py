@@ -322,19 +322,21 @@ def compare_constrained(name: str, batch: int) -> list[tuple[str, float, float]]
 
 
 def native_constrained(criterion: Path, timed) -> list[tuple[str, float, float]]:
-    """The Rust core's time of each constrained one-call row (criterion's estimate from the last
-    `cargo bench -p robodyn --bench constrained` whose results are in `criterion`), beside that
-    row's time from Python in `timed` (the rows of `compare_constrained`)."""
+    """The Rust core's time of each constrained one-call row (the fastest of criterion's samples,
+    per iteration, from the last `cargo bench -p robodyn --bench constrained` whose results are in
+    `criterion`: the best of several, as the calls from Python are timed), beside that row's time
+    from Python in `timed` (the rows of `compare_constrained`). Criterion's headline figure is a
+    mean, which on a shared machine sits above a best-of time by the machine's noise."""
     from_python = {case: ours for case, ours, _ in timed}
     rows = []
     for name in CONTACTS:
         for algorithm, bench in CONSTRAINED_ALGORITHMS.items():
             case = constrained_case(name, algorithm)
-            estimates = criterion / f"constrained_{name}" / bench / "new" / "estimates.json"
-            if case in from_python and estimates.is_file():
-                estimate = json.loads(estimates.read_text(encoding="utf-8"))
-                # the slope of time against iterations (criterion's headline figure), in ns
-                nanoseconds = (estimate.get("slope") or estimate["mean"])["point_estimate"]
+            samples = criterion / f"constrained_{name}" / bench / "new" / "sample.json"
+            if case in from_python and samples.is_file():
+                sample = json.loads(samples.read_text(encoding="utf-8"))
+                # each sample: its total time (ns) over its iteration count
+                nanoseconds = min(t / n for t, n in zip(sample["times"], sample["iters"]))
                 rows.append((case, nanoseconds * 1e-9, from_python[case]))
     return rows
 
