@@ -198,7 +198,7 @@ figure.tight_layout()
 # turns them as one piece: a velocity they allow); its knee and heel springs take up the motion. Without the
 # constraints, the open tree's rods come apart from the feet and heels at once.
 with warnings.catch_warnings():
-    # its actuators, sensors and keyframe are not read (robodyn models the rigid-body tree)
+    # its actuators and sensors are not read (robodyn models the rigid-body tree)
     warnings.simplefilter("ignore", robodyn.ModelWarning)
     cassie = robodyn.load(REPOSITORY / "testdata" / "mjcf" / "cassie_nomesh.xml")
 loops = [loop for loop in cassie.constraints if isinstance(loop, robodyn.PointAnchor)]  # the connects
@@ -229,6 +229,15 @@ def loop_gaps(trajectory: robodyn.Trajectory) -> np.ndarray:
 closed, opened = loop_gaps(fall), loop_gaps(loose)
 show("Cassie's four loops over 0.5 s, the largest gap (m)", 0.0, closed.max(), 1e-8)
 print(f"the open tree's largest gap: {1e3 * opened.max():.0f} mm")
+
+# %%
+# Cassie's file also names a standing pose, its keyframe `home` (MuJoCo's `<key>`, in robodyn's
+# coordinates): MuJoCo's loops are soft, and its saved pose leaves the rods open by a little;
+# `close_constraints` closes them before a simulation starts there.
+home = cassie.keyframe("home")
+standing = cassie.close_constraints(home.q, loops)
+print(f"keyframe '{home.name}': loops open by {1e3 * np.abs(cassie.constraint_error(home.q, loops)).max():.1f} mm, "
+      f"closed to {standing['residual']:.0e} m in {standing['iterations']} steps")
 
 figure = plt.figure(figsize=(10, 4.2))
 axis = figure.add_subplot(1, 2, 1)

@@ -223,6 +223,22 @@ class MimicModel(ConstrainedMethods):
         return [c for c in self.full.constraints
                 if not (isinstance(c, _core.JointCoupling) and c.joint in self.followers)]
 
+    @property
+    def keyframes(self) -> list[_core.Keyframe]:
+        """The model file's keyframes in reduced coordinates (the leaders' q and v)."""
+        return [self._reduced_keyframe(key) for key in self.full.keyframes]
+
+    def keyframe(self, key: Any) -> _core.Keyframe:
+        """The model file's keyframe ``key`` (a name or an index) in reduced coordinates."""
+        return self._reduced_keyframe(self.full.keyframe(key))
+
+    def _reduced_keyframe(self, key: _core.Keyframe) -> _core.Keyframe:
+        return _core.Keyframe(key.name, key.time, self.reduce(key.q), key.v[self.independent_v], key.ctrl)
+
+    def actuator_forces(self, q: Any, v: Any, ctrl: Any) -> np.ndarray:
+        """Gᵀ of the full model's actuator forces at the expanded state."""
+        return self._generalized(self.full.actuator_forces(self._expand(q, "q"), self._expand_velocity(v, "v"), ctrl))
+
     def _diagonal(self, values: np.ndarray, power: int) -> np.ndarray:
         """Σ_k |G_kj|^power values_k over each reduced coordinate's group (Gᵀ diag(x) G is
         diagonal: each full coordinate moves with one reduced coordinate)."""
@@ -553,7 +569,7 @@ class MimicModel(ConstrainedMethods):
 #: What the reduced model takes unchanged from the full one.
 _SHARED = frozenset({
     "name", "body_names", "body_parents", "body_masses", "frame_names", "frame_bodies", "joint_names",
-    "joint_types", "mimic_joints", "total_mass", "visuals", "skybox",
+    "joint_types", "mimic_joints", "total_mass", "visuals", "skybox", "nu", "actuator_names", "ctrl_range",
 })
 
 

@@ -75,7 +75,11 @@ VALID: dict[str, Any] = {
     "quantities": ("tau",), "chunk": 4, "per_task": 2, "progress": None, "client": None,
     "constraints": [robodyn.PointAnchor("tool0")], "joint": "elbow_joint", "leader": "shoulder_lift_joint",
     "frame1": "tool0", "frame2": "wrist_3_link", "q_full": MIMIC.full.neutral(),
+    "ctrl": np.zeros(UR5.nu), "key": "home",
 }
+#: Methods that need another model than UR5 to run (a keyframe): the method -> its model.
+PANDA = robodyn.load(REPOSITORY / "testdata" / "mjcf" / "panda_nomesh.xml")
+BOUND = {"robodyn.Model.keyframe": PANDA, "robodyn.MimicModel.keyframe": robodyn.MimicModel(PANDA)}
 
 
 def _urdf_file(folder: Path) -> str:
@@ -209,7 +213,8 @@ def _call(qualified: str, wrong_parameter: str, wrong_value: Any, folder: Path) 
     parameters = list(inspect.signature(function).parameters.values())
     if qualified.startswith(("robodyn.Model.", "robodyn.MimicModel.")):
         # bound to a copy: a setter must not change the model the other cases use
-        positional.append(pickle.loads(pickle.dumps(MIMIC if qualified.startswith("robodyn.MimicModel.") else UR5)))
+        bound = BOUND.get(qualified, MIMIC if qualified.startswith("robodyn.MimicModel.") else UR5)
+        positional.append(pickle.loads(pickle.dumps(bound)))
         parameters = parameters[1:]
     for parameter in parameters:
         if parameter.kind in (parameter.VAR_POSITIONAL, parameter.VAR_KEYWORD):

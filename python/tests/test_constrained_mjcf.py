@@ -12,7 +12,6 @@ import pytest
 from conftest import REPOSITORY, assert_close
 
 import robodyn
-from robodyn.convert import MujocoLayout
 
 CASSIE = REPOSITORY / "testdata" / "mjcf" / "cassie_nomesh.xml"
 GRIPPER = REPOSITORY / "testdata" / "menagerie" / "robotiq_2f85" / "2f85.xml"
@@ -213,11 +212,9 @@ def test_simulate_holds_the_models_own_constraints_by_default():
 
 
 def cassie_home(model):
-    """Cassie's `home` keyframe in robodyn's coordinates (read through MuJoCo: robodyn reads
-    keyframes with the contacts work that follows), its loops closed: MuJoCo's soft loops leave
-    them 1.5 mm open there."""
-    compiled = mujoco.MjModel.from_xml_path(str(CASSIE))
-    q = MujocoLayout(model, compiled).q_from_mujoco(compiled.key_qpos[0])
+    """Cassie's `home` keyframe, its loops closed: MuJoCo's soft loops leave them 1.5 mm open
+    there."""
+    q = model.keyframe("home").q
     assert 1e-4 < np.max(np.abs(model.constraint_error(q, model.constraints))) < 1e-2
     closed = model.close_constraints(q, model.constraints)
     assert closed["success"] and closed["residual"] <= 1e-12

@@ -14,6 +14,9 @@ import mujoco
 import numpy as np
 import pytest
 
+from test_actuators import FORCE_TOLERANCE, mujoco_actuator_forces
+from test_actuators import states as actuated_states
+
 import robodyn
 from robodyn.crosscheck import DISAGREES, mujoco_agreement
 
@@ -81,3 +84,12 @@ def test_published_model_loads_and_agrees_with_mujoco_or_names_what_is_missing(p
     assert model.nq == mj.nq and model.nv == mj.nv
     agreement = mujoco_agreement(model, mj, seed=1, states=2, name=file)
     assert agreement.verdict != DISAGREES, str(agreement)
+    # its actuators give MuJoCo's qfrc_actuator where robodyn models each of them
+    assert model.nu == mj.nu
+    if model.nu and not [w for w in model.warnings if "exerts no force" in w]:
+        q, v, ctrl = actuated_states(model, 3, seed=2)
+        compiled = mujoco_model(path, file)  # as the file has it (the agreement changed mj's)
+        for k in range(len(q)):
+            expected = mujoco_actuator_forces(model, compiled, q[k], v[k], ctrl[k])
+            scale = max(1.0, np.max(np.abs(expected)))
+            assert np.max(np.abs(model.actuator_forces(q[k], v[k], ctrl[k]) - expected)) <= FORCE_TOLERANCE * scale

@@ -9,11 +9,13 @@ use pyo3::prelude::*;
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
+mod actuators;
 mod args;
 mod constrained;
 mod constraints;
 mod dynamics;
 mod errors;
+mod keyframes;
 mod kinematics;
 mod loaders;
 mod model;
@@ -35,6 +37,7 @@ fn _core(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<constraints::PyFrameAnchor>()?;
     module.add_class::<constraints::PyJointCoupling>()?;
     module.add_class::<constraints::PyDistance>()?;
+    module.add_class::<keyframes::PyKeyframe>()?;
     module.add("SimulationError", module.py().get_type::<SimulationError>())?;
     module.add_function(wrap_pyfunction!(load_urdf, module)?)?;
     module.add_function(wrap_pyfunction!(load_urdf_string, module)?)?;

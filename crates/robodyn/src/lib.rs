@@ -26,4 +26,4 @@ pub mod visual;
 pub use data::Data;
 pub use error::{Error, Result};
 pub use joint::Joint;
-pub use model::{Frame, JointProperties, Mimic, Model, ModelBuilder, NewBody};
+pub use model::{Actuator, Frame, JointProperties, Keyframe, Mimic, Model, ModelBuilder, NewBody};

@@ -1,14 +1,18 @@
 //! The model: topology and constants of a robot. Algorithms never mutate it; everything they
 //! write goes into [`crate::Data`].
 
+mod actuator;
 mod builder;
 mod derived;
+mod keyframe;
 mod physical;
 
+pub use actuator::Actuator;
 pub use builder::{ModelBuilder, NewBody};
 use derived::run_start;
 pub(crate) use derived::tree_transform;
 pub use derived::AncestorRuns;
+pub use keyframe::Keyframe;
 pub use physical::{
     check_mass_and_inertia, check_physical_parameters, check_positive_semidefinite, Unphysical,
 };
@@ -191,6 +195,12 @@ pub struct Model {
     /// The constraints the model file declares (MJCF `<equality>`), active or not.
     #[serde(default)]
     pub constraints: Vec<crate::constraint::ModelConstraint>,
+    /// The states the model file names (MJCF `<keyframe>`), in its order.
+    #[serde(default)]
+    pub keyframes: Vec<Keyframe>,
+    /// The actuators (MJCF `<actuator>`), in the file's order: the controls' order.
+    #[serde(default)]
+    pub actuators: Vec<Actuator>,
     /// What the loader accepted but the user should know (ignored tags, unchecked inertias).
     pub warnings: Vec<String>,
     /// What the links look like (URDF `<visual>`, MJCF geoms); only the viewer reads it.

@@ -72,15 +72,9 @@ fn tree_classes_and_degrees() {
     );
     let tip = neutral_pose(&model, "tip");
     assert!((tip.translation - nalgebra::Vector3::new(0.0, 0.0, 0.3)).norm() < 1e-12);
-    // the actuator section is reported, not read
-    assert!(
-        model
-            .warnings
-            .iter()
-            .any(|w| w.contains("<actuator>") && w.contains("not read")),
-        "{:?}",
-        model.warnings
-    );
+    // the motor is read, on the shoulder's coordinate
+    assert_eq!(model.nu(), 1);
+    assert_eq!(model.actuators[0].coordinate, Some(0));
 }
 
 #[test]
@@ -177,4 +171,157 @@ fn each_compiler_element_changes_only_what_it_sets() {
     let pose = neutral_pose(&model, "turned").to_homogeneous();
     // a quarter turn about z: the body's x axis along world y
     assert!((pose[(1, 0)] - 1.0).abs() < 1e-12, "{pose}");
+}
+
+/// A turned free body with a ball joint and a hinge below it, two actuators, and three keys: one
+/// moving, one with nothing (qpos0), one whose quaternions are not of unit norm.
+const KEYED: &str = include_str!("../../../testdata/mjcf/keyframes.xml");
+
+#[test]
+fn keyframes_in_robodyns_coordinates() {
+    let model = load_mjcf_str(KEYED, "keyframes.xml").unwrap();
+    assert_eq!(model.keyframes.len(), 3);
+    // MuJoCo's [x y z | w x y z] (normalised: w = 2 is the identity), then [w x y z] and the hinge
+    let unnormalised = model.keyframe("unnormalised").unwrap();
+    let q = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, -0.4];
+    assert_eq!(unnormalised.q.as_slice(), &q);
+    // a moving key: the free joint's linear velocity turned into its body's axes, the rest as given
+    let moving = model.keyframe("moving").unwrap();
+    assert_eq!(
+        (moving.time, moving.ctrl.as_slice()),
+        (1.5, &[0.5, -0.5][..])
+    );
+    assert_eq!(
+        &moving.v.as_slice()[3..],
+        &[0.3, -0.2, 1.0, 0.1, 0.2, 0.3, -2.0]
+    );
+    let speed = moving.v.rows(0, 3).norm();
+    assert!((speed - (1.0f64 + 4.0 + 0.25).sqrt()).abs() < 1e-14);
+    // a key with nothing holds qpos0 (the hinge at its ref, in degrees), no velocity, no control
+    let empty = model.keyframe("qpos0").unwrap();
+    assert_eq!(empty.q, model.neutral());
+    assert_eq!(empty.q[11], 10f64.to_radians());
+    assert!(empty.v.iter().chain(empty.ctrl.iter()).all(|x| *x == 0.0));
+    assert_eq!(empty.ctrl.len(), 2);
+    let unknown = model.keyframe("home").unwrap_err().to_string();
+    assert!(
+        unknown.contains("'home'") && unknown.contains("'moving'"),
+        "{unknown}"
+    );
+}
+
+#[test]
+fn a_free_joints_velocity_turns_into_its_body_axes() {
+    // the body turned 90° about z: v_body = Rᵀ v_world = (y, −x, z)
+    let half = std::f64::consts::FRAC_1_SQRT_2;
+    let qpos = format!("0 0 1 {half} 0 0 {half}");
+    let text = KEYED.replace("0.1 0.2 1.3 0.9 0.1 -0.3 0.2", &qpos);
+    let model = load_mjcf_str(&text, "keyframes.xml").unwrap();
+    let v = &model.keyframes[0].v;
+    let expected = [-2.0, -1.0, 0.5];
+    assert!(
+        (v.rows(0, 3) - nalgebra::Vector3::from(expected)).norm() < 1e-15,
+        "{v}"
+    );
+    // the angular velocity is in the body's axes in both layouts
+    assert_eq!(&v.as_slice()[3..6], &[0.3, -0.2, 1.0]);
+}
+
+#[test]
+fn a_short_key_is_completed_and_a_long_one_refused_by_name() {
+    // as in MuJoCo 4: the first entries given, the rest from qpos0 and zeros
+    let text = KEYED.replace(
+        "<key name=\"qpos0\"/>",
+        r#"<key qpos="5 6 7" qvel="3" ctrl="1"/>"#,
+    );
+    let model = load_mjcf_str(&text, "keyframes.xml").unwrap();
+    let (short, neutral) = (&model.keyframes[1], model.neutral());
+    assert_eq!(&short.q.as_slice()[..3], &[5.0, 6.0, 7.0]);
+    // (qpos0's quaternion normalised once more: equal to rounding)
+    let rest = short.q.rows(3, 9) - neutral.rows(3, 9);
+    assert!(rest.amax() < 1e-15, "{rest}");
+    // (3, 0, 0) in world axes, turned into the body's
+    assert!((short.v.rows(0, 3).norm() - 3.0).abs() < 1e-15);
+    assert!(short.v.iter().skip(3).all(|x| *x == 0.0));
+    assert_eq!(short.ctrl.as_slice(), &[1.0, 0.0]);
+    for (attribute, wrong, expected) in [
+        (
+            "qpos",
+            "qpos=\"0 0 1 1 0 0 0 1 0 0 0 0 9\"",
+            "expected at most 12 numbers, got 13",
+        ),
+        (
+            "qvel",
+            "qvel=\"0 0 0 0 0 0 0 0 0 0 9\"",
+            "expected at most 10 numbers, got 11",
+        ),
+        (
+            "ctrl",
+            "ctrl=\"1 2 3\"",
+            "expected at most 2 numbers, got 3",
+        ),
+        ("time", "time=\"soon\"", "expected finite numbers"),
+    ] {
+        let text = KEYED.replace(
+            "<key name=\"qpos0\"/>",
+            &format!("<key name=\"bad\" {wrong}/>"),
+        );
+        let message = load_mjcf_str(&text, "keyframes.xml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains("<key") && message.contains(attribute) && message.contains(expected),
+            "{message}"
+        );
+    }
+    // what robodyn does not model is a warning naming it
+    let text = KEYED.replace("<key name=\"qpos0\"/>", r#"<key act="" mpos="0 0 0"/>"#);
+    let model = load_mjcf_str(&text, "keyframes.xml").unwrap();
+    let warned = |name: &str| {
+        model
+            .warnings
+            .iter()
+            .any(|w| w.contains(&format!("'{name}' not read")))
+    };
+    assert!(warned("act") && warned("mpos") && !warned("mquat"));
+}
+
+#[test]
+fn actuators_on_hinges_with_gears_and_ranges() {
+    let text = r#"<mujoco>
+      <compiler angle="radian"/>
+      <worldbody><body><joint name="j" axis="0 1 0" range="-1 3"/><geom size="0.1"/></body></worldbody>
+      <actuator>
+        <motor joint="j" gear="2" ctrlrange="-1 1"/>
+        <position joint="j" kp="10" kv="2" inheritrange="0.5"/>
+        <velocity joint="j" kv="3" forcerange="-1 1"/>
+        <general joint="j" gaintype="affine" gainprm="1 2 3" biastype="affine" biasprm="4 5 6"/>
+        <position joint="j" dampratio="1"/>
+      </actuator>
+    </mujoco>"#;
+    let model = load_mjcf_str(text, "actuated.xml").unwrap();
+    assert_eq!(model.nu(), 5);
+    // inheritrange 0.5 of [−1, 3]: [0, 2] about the middle
+    assert_eq!(model.actuators[1].ctrl_range, Some((0.0, 2.0)));
+    // a position actuator with dampratio is not modelled: a warning, no force
+    assert!(model.warnings.iter().any(|w| w.contains("'dampratio'")));
+    assert_eq!(model.actuators[4].coordinate, None);
+    let (q, v) = ([0.5], [0.25]);
+    let mut tau = [0.0];
+    let one = |k: usize, u: f64| {
+        let mut ctrl = [0.0; 5];
+        ctrl[k] = u;
+        let mut tau = [0.0];
+        model.actuator_forces(&q, &v, &ctrl, &mut tau).unwrap();
+        tau[0]
+    };
+    // motor: g f with u clamped to 1
+    assert_eq!(one(0, 5.0) - one(0, 0.0), 2.0);
+    // position: k_p (u − q) − k_v q̇, u clamped to 2, plus the zero controls' biases of the others
+    let others = one(1, 0.0) - (10.0 * (0.0 - 0.5) - 2.0 * 0.25);
+    assert!((one(1, 9.0) - others - (10.0 * (2.0 - 0.5) - 2.0 * 0.25)).abs() < 1e-14);
+    // general: (1 + 2 l + 3 l̇) u + (4 + 5 l + 6 l̇)
+    let general = (1.0 + 2.0 * 0.5 + 3.0 * 0.25) * 2.0;
+    assert!((one(3, 2.0) - one(3, 0.0) - general).abs() < 1e-14);
+    assert!(model.actuator_forces(&q, &v, &[0.0; 2], &mut tau).is_err());
 }

@@ -13,9 +13,11 @@
 //! q is the body's pose in the world (the XML pose is only MuJoCo's initial qpos).
 //! Every element and attribute is first checked against MuJoCo's schema (`schema_table.rs`): an
 //! unknown name is an error, as in MuJoCo.
-//! `<equality>` `connect`, `weld` and `joint` become the model's constraints (`mjcf/equality.rs`).
-//! Not read (a warning each): actuators, sensors, contacts, tendons (and their equalities),
-//! keyframes. Of the assets, the meshes are read, for the inertia of mesh geoms (`mjcf/meshes.rs`).
+//! `<equality>` `connect`, `weld` and `joint` become the model's constraints (`mjcf/equality.rs`),
+//! `<actuator>` its actuators (`mjcf/actuators.rs`), `<keyframe>` keys its keyframes
+//! (`mjcf/keyframes.rs`).
+//! Not read (a warning each): sensors, contacts, tendons (and their equalities).
+//! Of the assets, the meshes are read, for the inertia of mesh geoms (`mjcf/meshes.rs`).
 
 use crate::error::{Error, Result};
 use crate::io::read_model_file;
@@ -29,9 +31,11 @@ use std::cell::{Cell, RefCell};
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
+mod actuators;
 mod bodies;
 mod equality;
 mod inertia;
+mod keyframes;
 mod mass;
 mod meshes;
 mod schema_table;
@@ -43,15 +47,7 @@ use mass::MassRules;
 use schema_table::MJCF_SCHEMA;
 
 /// Sections of an MJCF file that do not describe the tree.
-const IGNORED_SECTIONS: [&str; 7] = [
-    "actuator",
-    "sensor",
-    "contact",
-    "tendon",
-    "keyframe",
-    "visual",
-    "statistic",
-];
+const IGNORED_SECTIONS: [&str; 5] = ["sensor", "contact", "tendon", "visual", "statistic"];
 
 /// Loads an MJCF file and the files it includes.
 pub fn load_mjcf_file(path: &Path) -> Result<Model> {
@@ -225,6 +221,8 @@ fn load_sources(sources: &Sources) -> Result<Model> {
     }
     let mut model = builder.build();
     reader.read_equalities(&sections, &mut model)?;
+    reader.read_actuators(&sections, &mut model)?;
+    reader.read_keyframes(&sections, &mut model)?;
     Ok(model)
 }
 

@@ -14,7 +14,7 @@ use crate::model::Model;
 const TAG: &[u8; 8] = b"robodyn\0";
 
 /// The snapshot format: bumped whenever `Model` (or a type inside it) changes its fields.
-pub const MODEL_FORMAT: u32 = 2;
+pub const MODEL_FORMAT: u32 = 3;
 
 /// The model as bytes.
 pub fn model_to_bytes(model: &Model) -> Vec<u8> {
@@ -129,6 +129,18 @@ fn check_structure(model: &Model) -> Result<()> {
     if let Some((name, length, expected)) = by_coordinate.iter().find(|(_, l, e)| l != e) {
         return damaged(format!("{name} has {length} entries, expected {expected}"));
     }
+    if let Some(key) = model
+        .keyframes
+        .iter()
+        .find(|k| (k.q.len(), k.v.len()) != (nq, nv))
+    {
+        return damaged(format!(
+            "keyframe '{}' has {} + {} coordinates, expected {nq} + {nv}",
+            key.name,
+            key.q.len(),
+            key.v.len()
+        ));
+    }
     let bodies_named = model
         .frames
         .iter()
@@ -184,5 +196,14 @@ mod tests {
         let mut model = bundled_model("pendulum", false).unwrap();
         model.armature = nalgebra::DVector::zeros(3);
         assert!(message(&model_to_bytes(&model)).contains("armature has 3 entries"));
+        let mut model = bundled_model("pendulum", false).unwrap();
+        model.keyframes.push(crate::model::Keyframe {
+            name: "home".into(),
+            time: 0.0,
+            q: nalgebra::DVector::zeros(5),
+            v: nalgebra::DVector::zeros(1),
+            ctrl: nalgebra::DVector::zeros(0),
+        });
+        assert!(message(&model_to_bytes(&model)).contains("keyframe 'home' has 5 + 1"));
     }
 }

@@ -70,6 +70,8 @@ impl ModelBuilder {
                 gravity: Vec3::new(0.0, 0.0, -STANDARD_GRAVITY),
                 mimics: Vec::new(),
                 constraints: Vec::new(),
+                keyframes: Vec::new(),
+                actuators: Vec::new(),
                 warnings: Vec::new(),
                 visuals: Vec::new(),
                 skybox: None,

@@ -229,6 +229,20 @@ impl<'a> Reader<'a> {
                 properties.lower = position_unit(lower);
                 properties.upper = position_unit(upper);
             }
+            let clamped = self
+                .attribute(*joint_node, joint_class, "actuatorfrclimited")
+                .is_none_or(|l| l != "false");
+            if clamped
+                && self
+                    .attribute(*joint_node, joint_class, "actuatorfrcrange")
+                    .is_some()
+            {
+                self.warnings.borrow_mut().push(format!(
+                    "{}: attribute 'actuatorfrcrange' not read (robodyn clamps each actuator's \
+                     force, not a joint's sum of them)",
+                    self.location(*joint_node)
+                ));
+            }
             // `ref`: the joint position at which the body has its XML pose, so the joint moves
             // by q − ref: X_J(q − ref) X_tree = X_J(q) X_J(−ref) X_tree
             let reference = position_unit(scalar("ref", 0.0)?);

@@ -1,0 +1,188 @@
+//! `<actuator>`: each element an [`Actuator`], in the file's order (the controls' order).
+//!
+//! Modelled, as MuJoCo compiles them: `motor`, `position` (`kp`, `kv`, `inheritrange`),
+//! `velocity` (`kv`) and `general` with `dyntype="none"` and a fixed or affine gain and bias
+//! (`gainprm`, `biasprm`), on a hinge or slide (`joint`, `gear`'s first entry), with `ctrlrange`
+//! and `forcerange` (`ctrllimited`, `forcelimited`: "auto" limits where a range is given).
+//! Any other actuator (activation dynamics, `dampratio`, muscles, tendon, site or body
+//! transmissions, a ball or free joint) keeps its place in the controls but exerts no force,
+//! with a warning naming it. Defaults come from the element's class, per element name.
+
+use super::Reader;
+use crate::error::Result;
+use crate::io::xml::parse_number_list;
+use crate::model::{Actuator, Model};
+use roxmltree::Node;
+
+/// What robodyn models, for the warning about an actuator it does not.
+const MODELLED: &str = "robodyn models motor, position, velocity and general actuators without \
+                        activation dynamics on a hinge or slide";
+
+impl<'a> Reader<'a> {
+    /// The elements of the `<actuator>` sections among `sections`, in order, into
+    /// `model.actuators` (after the tree is built: a transmission names a joint).
+    pub(super) fn read_actuators(
+        &self,
+        sections: &[Node<'a, 'a>],
+        model: &mut Model,
+    ) -> Result<()> {
+        for section in sections.iter().filter(|c| c.has_tag_name("actuator")) {
+            for element in self.children(*section)? {
+                let index = model.actuators.len();
+                let actuator = match self.actuator(element, model, index)? {
+                    Ok(actuator) => actuator,
+                    Err((actuator, why)) => {
+                        model.warnings.push(format!(
+                            "{}: not read ({why}; {MODELLED}): it keeps its place in the \
+                             controls and exerts no force",
+                            self.location(element)
+                        ));
+                        actuator
+                    }
+                };
+                model.actuators.push(actuator);
+            }
+        }
+        Ok(())
+    }
+
+    /// One actuator element: `Ok` the modelled actuator, or `Ok(Err)` one that exerts no force
+    /// and why; `Err` for a value MuJoCo refuses.
+    #[allow(clippy::type_complexity)]
+    fn actuator(
+        &self,
+        element: Node<'a, 'a>,
+        model: &Model,
+        index: usize,
+    ) -> Result<std::result::Result<Actuator, (Actuator, String)>> {
+        let tag = element.tag_name().name();
+        let text = |name: &str| self.attribute(element, "main", name);
+        let list = |name: &str| -> Result<Option<Vec<f64>>> {
+            text(name)
+                .map(|t| parse_number_list(&t, name).map_err(|m| self.error(element, m)))
+                .transpose()
+        };
+        let scalar = |name: &str, default: f64| -> Result<f64> {
+            Ok(list(name)?
+                .and_then(|v| v.first().copied())
+                .unwrap_or(default))
+        };
+        let mut actuator = Actuator {
+            name: element
+                .attribute("name")
+                .map_or_else(|| format!("actuator{index}"), str::to_string),
+            coordinate: None,
+            position: 0,
+            gear: scalar("gear", 1.0)?,
+            gain: [1.0, 0.0, 0.0],
+            bias: [0.0; 3],
+            ctrl_range: self.range(element, "ctrl")?,
+            force_range: self.range(element, "force")?,
+        };
+        let unmodelled = |actuator: Actuator, why: String| Ok(Err((actuator, why)));
+
+        // the gain and bias of each kind
+        match tag {
+            "motor" => {}
+            "position" => {
+                for name in ["dampratio", "timeconst"] {
+                    if scalar(name, 0.0)? != 0.0 {
+                        return unmodelled(actuator, format!("attribute '{name}'"));
+                    }
+                }
+                let (kp, kv) = (scalar("kp", 1.0)?, scalar("kv", 0.0)?);
+                actuator.gain = [kp, 0.0, 0.0];
+                actuator.bias = [0.0, -kp, -kv];
+            }
+            "velocity" => {
+                let kv = scalar("kv", 1.0)?;
+                actuator.gain = [kv, 0.0, 0.0];
+                actuator.bias = [0.0, 0.0, -kv];
+            }
+            "general" => {
+                let kinds = ["dyntype", "gaintype", "biastype"].map(text);
+                let [dynamics, gain, bias] = kinds.each_ref().map(|k| k.as_deref());
+                if !matches!(dynamics, None | Some("none")) {
+                    return unmodelled(actuator, "activation dynamics".into());
+                }
+                let prm = |name: &str, default: [f64; 3]| -> Result<[f64; 3]> {
+                    let mut values = default;
+                    for (value, given) in values.iter_mut().zip(list(name)?.unwrap_or_default()) {
+                        *value = given;
+                    }
+                    Ok(values)
+                };
+                actuator.gain = match gain {
+                    None | Some("fixed") => [prm("gainprm", [1.0, 0.0, 0.0])?[0], 0.0, 0.0],
+                    Some("affine") => prm("gainprm", [1.0, 0.0, 0.0])?,
+                    Some(other) => return unmodelled(actuator, format!("gaintype '{other}'")),
+                };
+                actuator.bias = match bias {
+                    None | Some("none") => [0.0; 3],
+                    Some("affine") => prm("biasprm", [0.0; 3])?,
+                    Some(other) => return unmodelled(actuator, format!("biastype '{other}'")),
+                };
+            }
+            other => return unmodelled(actuator, format!("<{other}>")),
+        }
+
+        // the transmission: a hinge or slide
+        let Some(joint_name) = element.attribute("joint") else {
+            return unmodelled(actuator, "a transmission other than 'joint'".into());
+        };
+        let body = model.joint_names.iter().position(|n| n == joint_name);
+        let body = body.ok_or_else(|| {
+            self.error(
+                element,
+                format!("attribute 'joint': no joint named '{joint_name}'"),
+            )
+        })?;
+        if model.joints()[body].nv() != 1 {
+            let kind = model.joints()[body].kind();
+            return unmodelled(actuator, format!("a {kind} joint's transmission"));
+        }
+        actuator.coordinate = Some(model.v_range(body).start);
+        actuator.position = model.q_range(body).start;
+
+        // `inheritrange`: the control range from the joint's, scaled about its middle
+        let inherit = scalar("inheritrange", 0.0)?;
+        if tag == "position" && inherit > 0.0 {
+            let (lower, upper) = (
+                model.lower_position_limit[actuator.position],
+                model.upper_position_limit[actuator.position],
+            );
+            if !(lower.is_finite() && upper.is_finite()) {
+                let message = "attribute 'inheritrange': the joint has no range to inherit";
+                return Err(self.error(element, message));
+            }
+            let (middle, half) = ((lower + upper) / 2.0, inherit * (upper - lower) / 2.0);
+            actuator.ctrl_range = Some((middle - half, middle + half));
+        }
+        Ok(Ok(actuator))
+    }
+
+    /// `<name>range` where `<name>limited` limits it ("auto": where the range is given); a
+    /// limited range whose lower end is not below its upper end is refused, as in MuJoCo.
+    fn range(&self, element: Node<'a, 'a>, name: &str) -> Result<Option<(f64, f64)>> {
+        let (range, limited) = (format!("{name}range"), format!("{name}limited"));
+        let values = self.numbers::<2>(element, "main", &range)?;
+        let limited = match self.attribute(element, "main", &limited).as_deref() {
+            None | Some("auto") => values.is_some(),
+            Some("true") => true,
+            Some("false") => false,
+            Some(other) => {
+                let message =
+                    format!("attribute '{limited}': expected true, false or auto, got '{other}'");
+                return Err(self.error(element, message));
+            }
+        };
+        match (limited, values) {
+            (false, _) => Ok(None),
+            (true, Some([lower, upper])) if lower < upper => Ok(Some((lower, upper))),
+            (true, _) => {
+                let message = format!("attribute '{range}': a limited range needs lower < upper");
+                Err(self.error(element, message))
+            }
+        }
+    }
+}
