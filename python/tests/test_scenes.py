@@ -6,6 +6,7 @@ offscreen render of the same scene from the same camera."""
 
 from __future__ import annotations
 
+import shutil
 import warnings
 from pathlib import Path
 
@@ -141,6 +142,16 @@ def test_textured_pieces_carry_their_images_and_coordinates():
     # texrepeat 5 per two metres on an unbounded floor: s = 5 x / 2 - 1/2
     x = floor.vertices[:, 0]
     np.testing.assert_allclose(floor.uv[:, 0], 2.5 * x - 0.5)
+
+
+def test_an_unnamed_texture_goes_by_its_files_name_as_in_mujoco(tmp_path: Path):
+    shutil.copytree(SCENE.parent, tmp_path / "textured")
+    scene = tmp_path / "textured" / "scene.xml"
+    scene.write_text(scene.read_text().replace('<texture type="2d" name="quadrants" file=', '<texture type="2d" file='))
+    mujoco.MjModel.from_xml_path(str(scene))
+    with pytest.warns(robodyn.ModelWarning, match="texture 'marble'"):
+        pieces = {piece.name.split("/")[0]: piece for piece in visual_pieces(robodyn.load(scene))}
+    assert pieces["panel"].image.size == (8, 8)
 
 
 def test_the_first_view_frames_the_robot_not_the_floor():

@@ -13,6 +13,20 @@ use crate::visual::{MeshSource, Shape};
 use roxmltree::Node;
 use std::path::PathBuf;
 
+/// An asset's name: its `name`, else its file's name without the extension, as MuJoCo names
+/// an unnamed mesh or texture.
+pub(super) fn asset_name(asset: Node) -> Option<String> {
+    match (asset.attribute("name"), asset.attribute("file")) {
+        (Some(name), _) => Some(name.to_string()),
+        (None, Some(file)) => Some(
+            std::path::Path::new(file)
+                .file_stem()
+                .map_or_else(String::new, |s| s.to_string_lossy().into_owned()),
+        ),
+        (None, None) => None,
+    }
+}
+
 impl<'a> Reader<'a> {
     /// Remembers every `<mesh>` of an `<asset>` section by name (its `name`, else its file's stem),
     /// and every `<material>` by name.
@@ -24,14 +38,9 @@ impl<'a> Reader<'a> {
             }
         }
         for mesh in children.into_iter().filter(|c| c.has_tag_name("mesh")) {
-            let name = match (mesh.attribute("name"), mesh.attribute("file")) {
-                (Some(name), _) => name.to_string(),
-                (None, Some(file)) => std::path::Path::new(file)
-                    .file_stem()
-                    .map_or_else(String::new, |s| s.to_string_lossy().into_owned()),
-                (None, None) => continue,
-            };
-            self.meshes.insert(name, mesh);
+            if let Some(name) = asset_name(mesh) {
+                self.meshes.insert(name, mesh);
+            }
         }
         Ok(())
     }

@@ -25,7 +25,8 @@ const CUBE_FACE_FILES: [&str; 6] = [
 ];
 
 impl<'a> Reader<'a> {
-    /// Keeps an `<asset>`'s `<texture>`s by name, and the first skybox.
+    /// Keeps an `<asset>`'s `<texture>`s by name (MuJoCo's: its file's, unnamed), and the first
+    /// skybox.
     pub(super) fn read_textures(&mut self, asset: Node<'a, 'a>) -> Result<()> {
         for texture in self.children(asset)? {
             if !texture.has_tag_name("texture") {
@@ -36,8 +37,9 @@ impl<'a> Reader<'a> {
             if kind.as_deref() == Some("skybox") && self.skybox.is_none() {
                 self.skybox = Some(texture);
             }
-            if let Some(name) = texture.attribute("name") {
-                self.textures.insert(name.to_string(), texture);
+            // named, or by its file's name (a cube's six files give it none)
+            if let Some(name) = super::meshes::asset_name(texture) {
+                self.textures.insert(name, texture);
             }
         }
         Ok(())
