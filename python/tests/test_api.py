@@ -362,11 +362,17 @@ def test_mimic_joints_are_reported_and_held():
     m = robodyn.load_urdf_string(massive.replace('<link name="right"/>', f'<link name="right">{inertial}</link>'))
     run = robodyn.simulate(m, [0.01, -0.01], [0.2, -0.2], t_end=0.1, dt=1e-3)
     assert np.max(np.abs(run.q[:, 1] + run.q[:, 0])) < 1e-12
-    # a prismatic joint mimicking a revolute one cannot be coupled: reported, not held, warned
+    # a prismatic joint mimicking a revolute one is held too (a rack and pinion)
     mixed = urdf.replace('<joint name="l" type="prismatic">', '<joint name="l" type="revolute"><axis xyz="0 0 1"/>')
     m = robodyn.load_urdf_string(mixed)
+    assert m.warnings == [] and m.mimic_joints == [("r", "l", -1.0, 0.0)]
+    (coupling,) = m.constraints
+    assert (coupling.joint, coupling.leader, coupling.polycoef[:2]) == ("r", "l", [0.0, -1.0])
+    # a spherical joint (four coordinates) cannot lead a coupling: reported, not held, warned
+    spherical = urdf.replace('<joint name="l" type="prismatic">', '<joint name="l" type="spherical">')
+    m = robodyn.load_urdf_string(spherical)
     (warning,) = m.warnings
-    assert "1 <mimic> relation(s) reported" in warning and "'r' (prismatic) and 'l' (revolute)" in warning
+    assert "1 <mimic> relation(s) reported" in warning and "'l' (spherical)" in warning
     assert m.constraints == [] and m.mimic_joints == [("r", "l", -1.0, 0.0)]
 
 

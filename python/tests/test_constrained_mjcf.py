@@ -124,12 +124,37 @@ def test_welds_sites_classes_and_inactive_equalities():
     assert np.max(np.abs(model.constraint_jacobian(q, constraints) @ result["qdd"])) < 1e-8
 
 
+RACK_AND_PINION = """<mujoco model="rack_and_pinion">
+  <option gravity="0 0 0"/>
+  <worldbody>
+    <body name="pinion"><joint name="turn" type="hinge" axis="0 0 1"/>
+      <inertial pos="0 0 0" mass="1" diaginertia="0.01 0.01 0.02"/></body>
+    <body name="rack" pos="0 0.1 0"><joint name="slide" type="slide" axis="1 0 0"/>
+      <inertial pos="0 0 0" mass="2" diaginertia="0.1 0.1 0.1"/></body>
+  </worldbody>
+  <equality><joint joint1="slide" joint2="turn" polycoef="0 0.05 0 0 0"/></equality>
+</mujoco>"""
+
+
+def test_a_hinge_drives_a_slide_as_a_rack_and_pinion():
+    """A joint equality between a hinge and a slide (as MS-Human-700's knees hold them): with
+    x = r θ, a torque τ on the pinion gives θ̈ = τ / (I + m r²) and ẍ = r θ̈."""
+    model = load(text=RACK_AND_PINION)
+    (coupling,) = model.constraints
+    assert (coupling.joint, coupling.leader) == ("slide", "turn")
+    radius, inertia, mass, torque = 0.05, 0.02, 2.0, 1.0
+    q, v = model.neutral(), np.zeros(model.nv)
+    result = model.constrained_forward_dynamics(q, v, np.array([torque, 0.0]), model.constraints)
+    turn = torque / (inertia + mass * radius**2)
+    assert_close(result["qdd"], [turn, radius * turn], IDENTITY_TOLERANCE, "rack and pinion")
+
+
 def test_an_equality_naming_a_missing_body_or_joint_is_refused_by_line():
     broken = EQUALITIES.replace('body1="b" body2="c"', 'body1="b" body2="nowhere"')
     with pytest.raises(ValueError, match=r"line \d+.*'body2': no body or site is called 'nowhere'"):
         robodyn.load_mjcf_string(broken)
-    broken = EQUALITIES.replace('joint1="jd" joint2="jc"', 'joint1="jd" joint2="ja"')
-    with pytest.raises(ValueError, match=r"'jd' \(prismatic\) and 'ja' \(revolute\)"):
+    broken = EQUALITIES.replace('joint1="jd" joint2="jc"', 'joint1="jd" joint2="jd"')
+    with pytest.raises(ValueError, match=r"line \d+.*joint 'jd' is coupled to itself"):
         robodyn.load_mjcf_string(broken)
 
 

@@ -188,8 +188,9 @@ impl PyFrameAnchor {
 
 /// Joint `joint`'s coordinate held to `ratio · q_leader + offset`, or, with `polycoef` (up to five
 /// numbers c0 … c4), to `c0 + c1 q_leader + … + c4 q_leader⁴`; with `leader` None, held at
-/// `offset` (or c0). Both joints revolute or both
-/// prismatic. 1 row; its force is the torque (or force) on `joint`.
+/// `offset` (or c0). Each joint revolute or prismatic
+/// (a revolute leader may drive a prismatic joint, as a rack and pinion does). 1 row; its force
+/// is the torque (or force) on `joint`.
 #[pyclass(name = "JointCoupling", module = "robodyn", frozen)]
 pub(crate) struct PyJointCoupling {
     /// The joint that follows.

@@ -21,6 +21,7 @@ mod loaders;
 mod model;
 mod properties;
 mod results;
+mod scene;
 mod simulation;
 mod visuals;
 
@@ -38,6 +39,7 @@ fn _core(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<constraints::PyJointCoupling>()?;
     module.add_class::<constraints::PyDistance>()?;
     module.add_class::<keyframes::PyKeyframe>()?;
+    module.add_class::<scene::PyOptions>()?;
     module.add("SimulationError", module.py().get_type::<SimulationError>())?;
     module.add_function(wrap_pyfunction!(load_urdf, module)?)?;
     module.add_function(wrap_pyfunction!(load_urdf_string, module)?)?;

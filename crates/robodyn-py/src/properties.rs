@@ -201,7 +201,7 @@ impl PyModel {
     }
 
     /// URDF mimic relations as (joint, mimicked joint, multiplier, offset):
-    /// q[joint] = multiplier * q[mimicked] + offset. Those between two revolute or two prismatic
+    /// q[joint] = multiplier * q[mimicked] + offset. Those between two revolute or prismatic
     /// joints are also in `constraints` (as `JointCoupling`s), which `simulate` holds.
     #[getter]
     fn mimic_joints(&self) -> Vec<(String, String, f64, f64)> {

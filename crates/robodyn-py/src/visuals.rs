@@ -15,9 +15,29 @@ use robodyn::visual::{MeshSource, Shape, Texture, TextureImage};
 type MeshArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>);
 
 /// A 4x4 matrix as a NumPy array.
-fn matrix<'py>(py: Python<'py>, m: &Matrix4<f64>) -> PyResult<Bound<'py, PyAny>> {
+pub(crate) fn matrix<'py>(py: Python<'py>, m: &Matrix4<f64>) -> PyResult<Bound<'py, PyAny>> {
     let rows: Vec<f64> = (0..16).map(|k| m[(k / 4, k % 4)]).collect();
     Ok(PyArray1::from_vec(py, rows).reshape([4, 4])?.into_any())
+}
+
+/// A shape's size in MJCF's convention: half-extents, radius, [radius, half-length]; none for a
+/// mesh.
+pub(crate) fn shape_size(shape: &Shape) -> Vec<f64> {
+    match shape {
+        Shape::Box { half_extents } => half_extents.as_slice().to_vec(),
+        Shape::Ellipsoid { radii } => radii.as_slice().to_vec(),
+        Shape::Sphere { radius } => vec![*radius],
+        Shape::Cylinder {
+            radius,
+            half_length,
+        }
+        | Shape::Capsule {
+            radius,
+            half_length,
+        } => vec![*radius, *half_length],
+        Shape::Plane { half_extents } => half_extents.to_vec(),
+        Shape::Mesh { .. } => Vec::new(),
+    }
 }
 
 /// A triangle mesh as (vertices (n, 3), faces (m, 3)) arrays.
@@ -97,22 +117,7 @@ impl PyModel {
             item.set_item("body", visual.body)?;
             item.set_item("placement", matrix(py, &visual.placement.to_homogeneous())?)?;
             item.set_item("kind", visual.shape.kind())?;
-            let size = match &visual.shape {
-                Shape::Box { half_extents } => half_extents.as_slice().to_vec(),
-                Shape::Ellipsoid { radii } => radii.as_slice().to_vec(),
-                Shape::Sphere { radius } => vec![*radius],
-                Shape::Cylinder {
-                    radius,
-                    half_length,
-                }
-                | Shape::Capsule {
-                    radius,
-                    half_length,
-                } => vec![*radius, *half_length],
-                Shape::Plane { half_extents } => half_extents.to_vec(),
-                Shape::Mesh { .. } => Vec::new(),
-            };
-            item.set_item("size", size)?;
+            item.set_item("size", shape_size(&visual.shape))?;
             item.set_item("rgba", visual.rgba.to_vec())?;
             item.set_item("group", visual.group)?;
             item.set_item("element", &visual.element)?;

@@ -81,9 +81,10 @@ pub enum ConstraintKind {
         /// The rows kept, in the order `[linear; angular]`.
         mask: [bool; 6],
     },
-    /// `q_f − q_f,ref = Σ_k c_k (q_l − q_l,ref)^k` between two one-coordinate joints of the
-    /// same kind (bodies `follower` and `leader`), or, without a leader, `q_f − q_f,ref = c_0`
-    /// (the joint held). 1 row.
+    /// `q_f − q_f,ref = Σ_k c_k (q_l − q_l,ref)^k` between two one-coordinate joints (bodies
+    /// `follower` and `leader`; a hinge may drive a slide, as a rack and pinion does, the
+    /// coefficients then carrying the units), or, without a leader, `q_f − q_f,ref = c_0` (the
+    /// joint held). 1 row.
     Coupling {
         /// The body whose joint follows.
         follower: usize,
@@ -141,8 +142,8 @@ impl Constraint {
         }
     }
 
-    /// Why it does not fit `model` (an unknown frame or joint, joints of different kinds, ...), if
-    /// it does not; [`ConstraintSet::new`] refuses it with this reason.
+    /// Why it does not fit `model` (an unknown frame or joint, a coupled joint of several
+    /// coordinates, ...), if it does not; [`ConstraintSet::new`] refuses it with this reason.
     pub fn check(&self, model: &Model) -> std::result::Result<(), String> {
         check_constraint(model, self)
     }
@@ -211,10 +212,7 @@ pub struct ModelConstraint {
     pub torquescale: f64,
 }
 
-/// MuJoCo's defaults of an equality's `solref` (time constant, damping ratio).
-pub const DEFAULT_SOLREF: [f64; 2] = [0.02, 1.0];
-/// MuJoCo's defaults of an equality's `solimp`.
-pub const DEFAULT_SOLIMP: [f64; 5] = [0.9, 0.95, 0.001, 0.5, 2.0];
+pub use crate::model::{DEFAULT_SOLIMP, DEFAULT_SOLREF};
 
 impl ModelConstraint {
     /// An active constraint named `name` with MuJoCo's default `solref` and `solimp`.
@@ -248,7 +246,7 @@ pub struct ConstraintSet {
 
 impl ConstraintSet {
     /// Checks each constraint against `model`: its frames and joints exist, a coupling joins two
-    /// one-coordinate joints of the same kind and not a joint to itself, a frame mask keeps a
+    /// one-coordinate joints and not a joint to itself, a frame mask keeps a
     /// row, a distance is positive and finite, placements are finite.
     pub fn new(model: &Model, constraints: Vec<Constraint>) -> Result<Self> {
         for (k, constraint) in constraints.iter().enumerate() {
@@ -435,12 +433,9 @@ fn check_constraint(model: &Model, constraint: &Constraint) -> std::result::Resu
                 if follower == leader {
                     return Err(format!("joint '{}' is coupled to itself", name(follower)));
                 }
-                if !one_coordinate(l) || f.kind() != l.kind() {
+                if !one_coordinate(l) {
                     return Err(format!(
-                        "a coupling joins two revolute or two prismatic joints, got '{}' ({}) \
-                         and '{}' ({})",
-                        name(follower),
-                        f.kind(),
+                        "a coupling is led by a revolute or prismatic joint, got '{}' ({})",
                         name(leader),
                         l.kind()
                     ));

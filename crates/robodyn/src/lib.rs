@@ -12,6 +12,7 @@
 #![warn(missing_docs)]
 
 pub mod algo;
+pub mod collision;
 pub mod constraint;
 pub mod data;
 mod dispatch;

@@ -4,7 +4,9 @@
 mod actuator;
 mod builder;
 mod derived;
+mod geom;
 mod keyframe;
+mod options;
 mod physical;
 
 pub use actuator::Actuator;
@@ -12,7 +14,15 @@ pub use builder::{ModelBuilder, NewBody};
 use derived::run_start;
 pub(crate) use derived::tree_transform;
 pub use derived::AncestorRuns;
+pub use geom::{
+    ContactExclude, ContactPair, ContactParameters, Geom, JointSoftness, SourceBody,
+    CONTACT_DIMENSIONS, DEFAULT_GEOM_FRICTION, DEFAULT_PAIR_FRICTION,
+};
 pub use keyframe::Keyframe;
+pub use options::{
+    ConstraintSolver, FrictionCone, Integrator, SimulationOptions, SolverParameters,
+    DEFAULT_SOLIMP, DEFAULT_SOLREF, DISABLE_FLAGS, ENABLE_FLAGS,
+};
 pub use physical::{
     check_mass_and_inertia, check_physical_parameters, check_positive_semidefinite, Unphysical,
 };
@@ -85,6 +95,8 @@ pub struct JointProperties {
     pub stiffness: f64,
     /// The position at which the spring is relaxed (MJCF `springref`); one-coordinate joints only.
     pub spring_reference: f64,
+    /// How its limit and dry friction act in MuJoCo's soft constraint model.
+    pub softness: JointSoftness,
 }
 
 impl Default for JointProperties {
@@ -99,6 +111,7 @@ impl Default for JointProperties {
             friction: 0.0,
             stiffness: 0.0,
             spring_reference: 0.0,
+            softness: JointSoftness::default(),
         }
     }
 }
@@ -201,6 +214,26 @@ pub struct Model {
     /// The actuators (MJCF `<actuator>`), in the file's order: the controls' order.
     #[serde(default)]
     pub actuators: Vec<Actuator>,
+    /// Each body's joint limit and dry friction in MuJoCo's soft constraint model, nbodies (the
+    /// world's unused).
+    #[serde(default)]
+    pub joint_softness: Vec<JointSoftness>,
+    /// The collision shapes (MJCF geoms), in the file's order.
+    #[serde(default)]
+    pub geoms: Vec<Geom>,
+    /// The file's bodies by MuJoCo body id (the world first), which [`Geom::source_body`] and
+    /// [`ContactExclude`] number; empty for a model from another format.
+    #[serde(default)]
+    pub source_bodies: Vec<SourceBody>,
+    /// The geom pairs the file asks to be checked for contact (MJCF `<contact><pair>`).
+    #[serde(default)]
+    pub contact_pairs: Vec<ContactPair>,
+    /// The file's bodies whose geoms never touch (MJCF `<contact><exclude>`).
+    #[serde(default)]
+    pub contact_excludes: Vec<ContactExclude>,
+    /// How the file asks to be simulated (MJCF `<option>`; MuJoCo's defaults otherwise).
+    #[serde(default)]
+    pub options: SimulationOptions,
     /// What the loader accepted but the user should know (ignored tags, unchecked inertias).
     pub warnings: Vec<String>,
     /// What the links look like (URDF `<visual>`, MJCF geoms); only the viewer reads it.

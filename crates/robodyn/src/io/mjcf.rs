@@ -2,12 +2,14 @@
 //! part that describes a robot's rigid-body tree.
 //!
 //! Reads `<include file>` (resolved against the including file's folder, each file once),
-//! `<compiler angle eulerseq inertiafromgeom inertiagrouprange>`, `<option gravity>`, `<default>`
-//! classes (nested, with `class` and `childclass`), and in `<worldbody>` nested `<body>`s with `pos`
-//! and any orientation (`quat` w-first, `axisangle`, `euler`, `xyaxes`, `zaxis`), `<inertial>`
-//! (`mass`, `pos`, orientation, `diaginertia` or `fullinertia`), `<geom>`s for the inertia of a body
-//! without `<inertial>`, `<joint>` (`hinge`, `slide`, `ball`, `free`; `pos`, `axis`, `ref`, `range`,
-//! `armature`, `damping`, `frictionloss`, `stiffness`, `springref`), `<freejoint>` and `<site>`s.
+//! `<compiler angle eulerseq inertiafromgeom inertiagrouprange>`, `<default>` classes (nested,
+//! with `class` and `childclass`), and in `<worldbody>` nested `<body>`s with `pos` and any
+//! orientation (`quat` w-first, `axisangle`, `euler`, `xyaxes`, `zaxis`), `<inertial>` (`mass`,
+//! `pos`, orientation, `diaginertia` or `fullinertia`), `<geom>`s (for the inertia of a body
+//! without `<inertial>`, as visuals and as collision shapes: `mjcf/geoms.rs`), `<joint>` (`hinge`,
+//! `slide`, `ball`, `free`; `pos`, `axis`, `ref`, `range`, `armature`, `damping`, `frictionloss`,
+//! `stiffness`, `springref`, and the soft limit's and friction's `solreflimit`, `solimplimit`,
+//! `margin`, `solreffriction`, `solimpfriction`), `<freejoint>` and `<site>`s.
 //! Bodies and sites become frames; a body without joints is merged into its parent; several joints
 //! in one body become a chain of massless bodies, applied in order as MuJoCo does. A free joint's
 //! q is the body's pose in the world (the XML pose is only MuJoCo's initial qpos).
@@ -15,15 +17,18 @@
 //! unknown name is an error, as in MuJoCo.
 //! `<equality>` `connect`, `weld` and `joint` become the model's constraints (`mjcf/equality.rs`),
 //! `<actuator>` its actuators (`mjcf/actuators.rs`), `<keyframe>` keys its keyframes
-//! (`mjcf/keyframes.rs`).
-//! Not read (a warning each): sensors, contacts, tendons (and their equalities).
+//! (`mjcf/keyframes.rs`), `<option>` its simulation options and gravity (`mjcf/options.rs`),
+//! `<contact>` its contact pairs and exclusions (`mjcf/contacts.rs`).
+//! Not read (a warning each): sensors, tendons (and their equalities). Contacts are not yet
+//! computed: a warning says so when geoms could touch.
 //! Of the assets, the meshes are read, for the inertia of mesh geoms (`mjcf/meshes.rs`).
 
+use crate::collision::candidate_pairs;
 use crate::error::{Error, Result};
 use crate::io::read_model_file;
 use crate::io::schema;
 use crate::io::xml::{check_nesting, location, parse_numbers};
-use crate::model::{Model, ModelBuilder};
+use crate::model::{Model, ModelBuilder, SourceBody};
 use crate::spatial::{Mat3, Transform, Vec3};
 use nalgebra::{Rotation3, Unit, UnitQuaternion};
 use roxmltree::{Document, Node};
@@ -33,11 +38,14 @@ use std::path::{Path, PathBuf};
 
 mod actuators;
 mod bodies;
+mod contacts;
 mod equality;
+mod geoms;
 mod inertia;
 mod keyframes;
 mod mass;
 mod meshes;
+mod options;
 mod schema_table;
 mod textures;
 mod visuals;
@@ -47,7 +55,40 @@ use mass::MassRules;
 use schema_table::MJCF_SCHEMA;
 
 /// Sections of an MJCF file that do not describe the tree.
-const IGNORED_SECTIONS: [&str; 5] = ["sensor", "contact", "tendon", "visual", "statistic"];
+const IGNORED_SECTIONS: [&str; 4] = ["sensor", "tendon", "visual", "statistic"];
+
+/// Attributes of which an element may give only the first values, the others kept from its class
+/// or MuJoCo's defaults (MuJoCo reads `solimp="0.9 0.95"` as the first two of five).
+const LEADING_ATTRIBUTES: [&str; 9] = [
+    "friction",
+    "solref",
+    "solimp",
+    "solreflimit",
+    "solimplimit",
+    "solreffriction",
+    "solimpfriction",
+    "polycoef",
+    "o_friction",
+];
+
+/// `values` with their first entries replaced by the numbers of `text` (1 to `values.len()`).
+fn overlay_numbers(values: &mut [f64], text: &str, name: &str) -> std::result::Result<(), String> {
+    let words: Vec<&str> = text.split_whitespace().collect();
+    if words.is_empty() || words.len() > values.len() {
+        let n = values.len();
+        return Err(format!(
+            "attribute '{name}': expected 1 to {n} numbers, got '{text}'"
+        ));
+    }
+    for (value, word) in values.iter_mut().zip(words) {
+        *value = word
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("attribute '{name}': '{word}' is not a finite number"))?;
+    }
+    Ok(())
+}
 
 /// Loads an MJCF file and the files it includes.
 pub fn load_mjcf_file(path: &Path) -> Result<Model> {
@@ -160,6 +201,11 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         skybox: None,
         texture_directory: None,
         warnings: RefCell::new(Vec::new()),
+        source_bodies: RefCell::new(vec![SourceBody {
+            name: "world".to_string(),
+            parent: 0,
+            body: 0,
+        }]),
     };
     if !root.has_tag_name("mujoco") {
         return Err(reader.error(root, "expected the root element <mujoco>"));
@@ -185,13 +231,6 @@ fn load_sources(sources: &Sources) -> Result<Model> {
     }
     let mut builder = ModelBuilder::new(root.attribute("model").unwrap_or("mjcf"), "world");
     builder.add_frame("world", 0, Transform::IDENTITY);
-    for option in sections.iter().filter(|c| c.has_tag_name("option")) {
-        if let Some(text) = option.attribute("gravity") {
-            let gravity =
-                parse_numbers::<3>(text, "gravity").map_err(|m| reader.error(*option, m))?;
-            builder.gravity(Vec3::from(gravity));
-        }
-    }
     for section in &sections {
         if IGNORED_SECTIONS.contains(&section.tag_name().name()) {
             builder.warn(format!(
@@ -201,14 +240,14 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         }
     }
     for world in sections.iter().filter(|c| c.has_tag_name("worldbody")) {
-        reader.add_visuals(
+        reader.add_geoms(
             &mut builder,
             &reader.children(*world)?,
             "main",
-            0,
+            (0, 0),
             Transform::IDENTITY,
         )?;
-        reader.read_children(&mut builder, *world, 0, Transform::IDENTITY, "main")?;
+        reader.read_children(&mut builder, *world, (0, 0), Transform::IDENTITY, "main")?;
     }
     if let Some(skybox) = reader.skybox_texture()? {
         builder.set_skybox(skybox);
@@ -223,6 +262,22 @@ fn load_sources(sources: &Sources) -> Result<Model> {
     reader.read_equalities(&sections, &mut model)?;
     reader.read_actuators(&sections, &mut model)?;
     reader.read_keyframes(&sections, &mut model)?;
+    reader.read_options(&sections, &mut model)?;
+    model.source_bodies = reader.source_bodies.take();
+    reader.read_contacts(&sections, &mut model)?;
+    for message in reader.warnings.take() {
+        model.warnings.push(message);
+    }
+    // a warning only where MuJoCo would check some pair of geoms for contact
+    let touching = !model.contact_pairs.is_empty() || !candidate_pairs(&model).is_empty();
+    if touching && model.options.flag("contact") && model.options.flag("constraint") {
+        model.warnings.push(format!(
+            "{}: geoms read as collision shapes (m.geoms, m.contact_candidates) but robodyn \
+             does not compute contacts yet: in simulation bodies pass through each other and \
+             the floor",
+            reader.location(root)
+        ));
+    }
     Ok(model)
 }
 
@@ -256,6 +311,8 @@ struct Reader<'a> {
     texture_directory: Option<String>,
     /// what the model's warnings will say of the files read on the way (meshes' dropped faces)
     warnings: RefCell<Vec<String>>,
+    /// the file's bodies' names by MuJoCo body id (the world first), as they are read
+    source_bodies: RefCell<Vec<SourceBody>>,
 }
 
 impl<'a> Reader<'a> {
@@ -354,13 +411,7 @@ impl<'a> Reader<'a> {
             self.fit_aabb = value == "true";
         }
         // the options that rewrite masses and inertias (mjcf/mass.rs)
-        let number = |name: &str| -> Result<Option<f64>> {
-            compiler
-                .attribute(name)
-                .map(|text| parse_numbers::<1>(text, name).map(|[x]| x))
-                .transpose()
-                .map_err(|m| self.error(compiler, m))
-        };
+        let number = |name: &str| self.own_number(compiler, name);
         let mut rules = self.mass_rules;
         rules.bound_mass = number("boundmass")?.unwrap_or(rules.bound_mass);
         rules.bound_inertia = number("boundinertia")?.unwrap_or(rules.bound_inertia);
@@ -401,7 +452,17 @@ impl<'a> Reader<'a> {
                 .entry(element.tag_name().name().to_string())
                 .or_default();
             for attribute in element.attributes() {
-                entry.insert(attribute.name().to_string(), attribute.value().to_string());
+                let (name, mut value) = (attribute.name(), attribute.value().to_string());
+                // a leading attribute keeps the inherited values it does not give
+                if let Some(inherited) = entry
+                    .get(name)
+                    .filter(|_| LEADING_ATTRIBUTES.contains(&name))
+                {
+                    let given = value.split_whitespace().count();
+                    let rest: Vec<&str> = inherited.split_whitespace().skip(given).collect();
+                    value = format!("{value} {}", rest.join(" ")).trim().to_string();
+                }
+                entry.insert(name.to_string(), value);
             }
         }
         self.defaults.insert(class.clone(), values);
@@ -422,6 +483,54 @@ impl<'a> Reader<'a> {
             .get(node.tag_name().name())?
             .get(name)
             .cloned()
+    }
+
+    /// Up to `N` numbers of attribute `name` of `node`, each source replacing only the values it
+    /// gives: MuJoCo's `defaults`, then `tag`'s default in the class in effect (`node`'s `class`,
+    /// else `class`), then the element's own.
+    fn leading_numbers<const N: usize>(
+        &self,
+        node: Node<'a, 'a>,
+        class: &str,
+        tag: &str,
+        name: &str,
+        defaults: [f64; N],
+    ) -> Result<[f64; N]> {
+        let class = node.attribute("class").unwrap_or(class);
+        let inherited = self
+            .defaults
+            .get(class)
+            .and_then(|d| d.get(tag))
+            .and_then(|d| d.get(name));
+        let mut values = defaults;
+        for text in [inherited.map(String::as_str), node.attribute(name)]
+            .into_iter()
+            .flatten()
+        {
+            overlay_numbers(&mut values, text, name).map_err(|m| self.error(node, m))?;
+        }
+        Ok(values)
+    }
+
+    /// A number `node` gives itself (an element that takes no defaults, such as `<compiler>`).
+    fn own_number(&self, node: Node<'a, 'a>, name: &str) -> Result<Option<f64>> {
+        node.attribute(name)
+            .map(|text| parse_numbers::<1>(text, name).map(|[x]| x))
+            .transpose()
+            .map_err(|m| self.error(node, m))
+    }
+
+    /// An integer attribute of `node` (or its class), `default` when neither gives it.
+    fn integer(&self, node: Node<'a, 'a>, class: &str, name: &str, default: i64) -> Result<i64> {
+        match self.attribute(node, class, name) {
+            None => Ok(default),
+            Some(text) => text.trim().parse::<i64>().map_err(|_| {
+                self.error(
+                    node,
+                    format!("attribute '{name}': expected an integer, got '{text}'"),
+                )
+            }),
+        }
     }
 
     /// The class named by `node`'s `attribute` (`class`: the one it takes its defaults from;

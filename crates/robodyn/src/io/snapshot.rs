@@ -14,7 +14,7 @@ use crate::model::Model;
 const TAG: &[u8; 8] = b"robodyn\0";
 
 /// The snapshot format: bumped whenever `Model` (or a type inside it) changes its fields.
-pub const MODEL_FORMAT: u32 = 3;
+pub const MODEL_FORMAT: u32 = 4;
 
 /// The model as bytes.
 pub fn model_to_bytes(model: &Model) -> Vec<u8> {

@@ -525,9 +525,9 @@ impl<'a> Parser<'a> {
     }
 }
 
-/// Each mimic relation between two revolute or two prismatic joints as a held
+/// Each mimic relation between two revolute or prismatic joints as a held
 /// [`ConstraintKind::Coupling`] in `model.constraints` (q_f = multiplier q_l + offset), so that
-/// simulation holds it; the others (continuous joints, mixed kinds) are reported in one warning.
+/// simulation holds it; the others (continuous joints) are reported in one warning.
 fn hold_mimics(model: &mut Model, source: &str) {
     let mut reported = Vec::new();
     for mimic in model.mimics.clone() {

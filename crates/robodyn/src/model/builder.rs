@@ -1,8 +1,8 @@
 //! [`ModelBuilder`]: a model built body by body, as every loader builds one.
 
 use super::{
-    check_unit_quaternion, run_start, tree_transform, Frame, JointProperties, Mimic, Model,
-    STANDARD_GRAVITY,
+    check_unit_quaternion, run_start, tree_transform, Frame, Geom, JointProperties, JointSoftness,
+    Mimic, Model, SimulationOptions, STANDARD_GRAVITY,
 };
 use crate::error::{Error, Result};
 use crate::joint::Joint;
@@ -72,6 +72,12 @@ impl ModelBuilder {
                 constraints: Vec::new(),
                 keyframes: Vec::new(),
                 actuators: Vec::new(),
+                joint_softness: vec![JointSoftness::default()],
+                geoms: Vec::new(),
+                source_bodies: Vec::new(),
+                contact_pairs: Vec::new(),
+                contact_excludes: Vec::new(),
+                options: SimulationOptions::default(),
                 warnings: Vec::new(),
                 visuals: Vec::new(),
                 skybox: None,
@@ -110,6 +116,7 @@ impl ModelBuilder {
         m.body_names.push(name.to_string());
         m.x_tree.push(tree_transform(x_tree));
         m.inertias.push(inertia);
+        m.joint_softness.push(properties.softness);
         m.idx_q.push(m.nq);
         m.idx_v.push(m.nv);
         let (nq, nv) = (joint.nq(), joint.nv());
@@ -241,6 +248,11 @@ impl ModelBuilder {
         let start = m.idx_q[body];
         m.neutral_configuration.as_mut_slice()[start..start + q.len()].copy_from_slice(q);
         Ok(())
+    }
+
+    /// Adds a collision shape.
+    pub fn add_geom(&mut self, geom: Geom) {
+        self.model.geoms.push(geom);
     }
 
     /// Sets the gravity vector.

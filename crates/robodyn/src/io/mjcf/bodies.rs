@@ -4,7 +4,9 @@
 use super::Reader;
 use crate::error::Result;
 use crate::joint::Joint;
-use crate::model::{JointProperties, ModelBuilder, NewBody};
+use crate::model::{
+    JointProperties, JointSoftness, ModelBuilder, NewBody, SolverParameters, SourceBody,
+};
 use crate::spatial::{Inertia, Transform, Vec3};
 use nalgebra::{Rotation3, Unit, UnitQuaternion};
 use roxmltree::Node;
@@ -65,12 +67,13 @@ impl<'a> Reader<'a> {
     }
 
     /// The children of a body element (or the worldbody) attached to model body `body`, whose
-    /// frame is at `to_element` (`X_{element←body}`).
+    /// frame is at `to_element` (`X_{element←body}`); `source_body` is the element's MuJoCo body
+    /// id.
     pub(super) fn read_children(
         &self,
         builder: &mut ModelBuilder,
         element: Node<'a, 'a>,
-        body: usize,
+        (body, source_body): (usize, usize),
         to_element: Transform,
         class: &str,
     ) -> Result<()> {
@@ -90,12 +93,12 @@ impl<'a> Reader<'a> {
                     };
                     builder.add_frame(&name, body, placement * to_element);
                 }
-                "body" => self.read_body(builder, child, body, to_element, class)?,
+                "body" => self.read_body(builder, child, (body, source_body), to_element, class)?,
                 // a <frame> only places what it holds: its pose composes with theirs
                 "frame" => {
                     let to_frame = self.placement(child, class)? * to_element;
                     let frame_class = self.declared_class(child, "childclass", class)?;
-                    self.read_children(builder, child, body, to_frame, frame_class)?;
+                    self.read_children(builder, child, (body, source_body), to_frame, frame_class)?;
                 }
                 // in a body's <frame>s they are read with the body; the world has none
                 "joint" | "freejoint" | "inertial" if in_world_frame(element) => {
@@ -115,11 +118,13 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
+    /// A body element under model body `parent` (whose file body is `parent_source`), where its
+    /// parent element's frame is at `parent_element` (`X_{element←parent body}`).
     pub(super) fn read_body(
         &self,
         builder: &mut ModelBuilder,
         node: Node<'a, 'a>,
-        parent: usize,
+        (parent, parent_source): (usize, usize),
         parent_element: Transform,
         class: &str,
     ) -> Result<()> {
@@ -127,6 +132,16 @@ impl<'a> Reader<'a> {
             .attribute("name")
             .map_or_else(|| format!("body{}", node.range().start), str::to_string);
         let child_class = self.declared_class(node, "childclass", class)?;
+        // MuJoCo numbers the file's bodies in document order, the world 0
+        let source_body = {
+            let mut bodies = self.source_bodies.borrow_mut();
+            bodies.push(SourceBody {
+                name: name.clone(),
+                parent: parent_source,
+                body: parent,
+            });
+            bodies.len() - 1
+        };
         // X_{B←parent body}
         let mut to_body = self.placement(node, class)? * parent_element;
         let elements = self.children(node)?;
@@ -147,8 +162,14 @@ impl<'a> Reader<'a> {
         if joints.is_empty() {
             // no joint: merged into the parent, kept as a frame
             builder.add_fixed_link(parent, to_body, inertia, &name);
-            self.add_visuals(builder, &elements, child_class, parent, to_body)?;
-            return self.read_children(builder, node, parent, to_body, child_class);
+            self.add_geoms(
+                builder,
+                &elements,
+                child_class,
+                (parent, source_body),
+                to_body,
+            )?;
+            return self.read_children(builder, node, (parent, source_body), to_body, child_class);
         }
         let mut body = parent;
         let mut previous_position = Vec3::zeros();
@@ -217,6 +238,7 @@ impl<'a> Reader<'a> {
                 friction: scalar("frictionloss", 0.0)?,
                 stiffness: scalar("stiffness", 0.0)?,
                 spring_reference: position_unit(scalar("springref", 0.0)?),
+                softness: self.joint_softness(*joint_node, joint_class)?,
                 ..JointProperties::default()
             };
             let limited = self
@@ -316,7 +338,36 @@ impl<'a> Reader<'a> {
         if to_body != Transform::IDENTITY {
             builder.add_frame(&name, body, to_body);
         }
-        self.add_visuals(builder, &elements, child_class, body, to_body)?;
-        self.read_children(builder, node, body, to_body, child_class)
+        self.source_bodies.borrow_mut()[source_body].body = body;
+        self.add_geoms(
+            builder,
+            &elements,
+            child_class,
+            (body, source_body),
+            to_body,
+        )?;
+        self.read_children(builder, node, (body, source_body), to_body, child_class)
+    }
+
+    /// A joint's limit and dry friction in MuJoCo's soft constraint model: `solreflimit`,
+    /// `solimplimit`, `margin` (in radians for a hinge whatever the compiler's angle unit, as
+    /// MuJoCo reads it), `solreffriction`, `solimpfriction`.
+    fn joint_softness(&self, joint: Node<'a, 'a>, class: &str) -> Result<JointSoftness> {
+        // a <freejoint> takes no joint defaults
+        let tag = joint.tag_name().name();
+        let parameters = |solref: &str, solimp: &str| -> Result<SolverParameters> {
+            let defaults = SolverParameters::default();
+            Ok(SolverParameters {
+                solref: self.leading_numbers(joint, class, tag, solref, defaults.solref)?,
+                solimp: self.leading_numbers(joint, class, tag, solimp, defaults.solimp)?,
+            })
+        };
+        Ok(JointSoftness {
+            limit: parameters("solreflimit", "solimplimit")?,
+            margin: self
+                .numbers::<1>(joint, class, "margin")?
+                .map_or(0.0, |[m]| m),
+            friction: parameters("solreffriction", "solimpfriction")?,
+        })
     }
 }

@@ -83,8 +83,8 @@ impl<'a> Reader<'a> {
             name: element.attribute("name").unwrap_or_default().to_string(),
             constraint,
             active,
-            solref: self.leading_numbers(element, "solref", DEFAULT_SOLREF)?,
-            solimp: self.leading_numbers(element, "solimp", DEFAULT_SOLIMP)?,
+            solref: self.leading_numbers(element, "main", "equality", "solref", DEFAULT_SOLREF)?,
+            solimp: self.leading_numbers(element, "main", "equality", "solimp", DEFAULT_SOLIMP)?,
             torquescale: self
                 .equality_numbers::<1>(element, "torquescale")?
                 .map_or(1.0, |[t]| t),
@@ -110,38 +110,6 @@ impl<'a> Reader<'a> {
         self.equality_attribute(element, name)?
             .map(|text| parse_numbers::<N>(&text, name).map_err(|m| self.error(element, m)))
             .transpose()
-    }
-
-    /// Up to `N` numbers of an attribute whose missing trailing values keep `defaults` (MuJoCo
-    /// reads `solimp="0.9 0.95 0.001"` as the first three of five).
-    fn leading_numbers<const N: usize>(
-        &self,
-        element: Node<'a, 'a>,
-        name: &str,
-        defaults: [f64; N],
-    ) -> Result<[f64; N]> {
-        let mut values = defaults;
-        let Some(text) = self.equality_attribute(element, name)? else {
-            return Ok(values);
-        };
-        let words: Vec<&str> = text.split_whitespace().collect();
-        if words.is_empty() || words.len() > N {
-            let message = format!("attribute '{name}': expected 1 to {N} numbers, got '{text}'");
-            return Err(self.error(element, message));
-        }
-        for (value, word) in values.iter_mut().zip(words) {
-            *value = word
-                .parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| {
-                    self.error(
-                        element,
-                        format!("attribute '{name}': '{word}' is not a finite number"),
-                    )
-                })?;
-        }
-        Ok(values)
     }
 
     /// The frame of the body or site named by `attribute`, `None` when the element has none.
@@ -305,7 +273,13 @@ impl<'a> Reader<'a> {
         Ok(ConstraintKind::Coupling {
             follower,
             leader,
-            polynomial: self.leading_numbers(element, "polycoef", [0.0, 1.0, 0.0, 0.0, 0.0])?,
+            polynomial: self.leading_numbers(
+                element,
+                "main",
+                "equality",
+                "polycoef",
+                [0.0, 1.0, 0.0, 0.0, 0.0],
+            )?,
             references: (neutral(follower), leader.map_or(0.0, neutral)),
         })
     }

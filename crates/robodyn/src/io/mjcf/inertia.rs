@@ -69,15 +69,7 @@ impl<'a> Reader<'a> {
 
     /// A geom's `group` (0 unless given).
     pub(super) fn geom_group(&self, geom: Node<'a, 'a>, class: &str) -> Result<i64> {
-        match self.attribute(geom, class, "group") {
-            None => Ok(0),
-            Some(g) => g.trim().parse::<i64>().map_err(|_| {
-                self.error(
-                    geom,
-                    format!("attribute 'group': expected an integer, got '{g}'"),
-                )
-            }),
-        }
+        self.integer(geom, class, "group", 0)
     }
 
     /// A geom's `type` (MuJoCo's default: a sphere).

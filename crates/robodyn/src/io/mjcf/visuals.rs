@@ -1,59 +1,17 @@
-//! What an MJCF body looks like: each of its geoms (those in its `<frame>`s too) as a visual, sized
-//! and placed as MuJoCo places it (`fromto`, a primitive fitted to a mesh), coloured as MuJoCo
-//! colours it: the geom's `rgba` when it differs from MuJoCo's default, else its `material`'s,
-//! else the default grey. Height fields and SDF geoms are not drawn.
+//! What an MJCF geom looks like: its shape, sized as MuJoCo sizes it, coloured as MuJoCo colours
+//! it: the geom's `rgba` when it differs from MuJoCo's default, else its `material`'s, else the
+//! default grey.
 
 use super::Reader;
 use crate::error::Result;
-use crate::model::ModelBuilder;
-use crate::spatial::{Transform, Vec3};
-use crate::visual::{Shape, Visual, DEFAULT_RGBA};
+use crate::spatial::Vec3;
+use crate::visual::{Shape, DEFAULT_RGBA};
 use roxmltree::Node;
 
 /// A material's colour when it gives none (MuJoCo's default).
 const MATERIAL_RGBA: [f64; 4] = [1.0, 1.0, 1.0, 1.0];
 
 impl<'a> Reader<'a> {
-    /// Adds the geoms among a body's `elements` as visuals of model body `body`, where the body
-    /// element's frame is at `to_element` (`X_{element←body}`).
-    pub(super) fn add_visuals(
-        &self,
-        builder: &mut ModelBuilder,
-        elements: &[Node<'a, 'a>],
-        class: &str,
-        body: usize,
-        to_element: Transform,
-    ) -> Result<()> {
-        let mut geoms = Vec::new();
-        self.framed_elements(elements, class, &["geom"], Transform::IDENTITY, &mut geoms)?;
-        for (geom, to_frame, frame_class) in geoms {
-            let class = self.declared_class(geom, "class", frame_class)?;
-            let kind = self.geom_type(geom, class);
-            if matches!(kind.as_str(), "hfield" | "sdf") {
-                continue;
-            }
-            let (size, frame) = self.geom_size_and_frame(geom, class, &kind)?;
-            let shape = self.geom_shape(geom, class, &kind, &size)?;
-            builder.add_visual(Visual {
-                name: geom
-                    .attribute("name")
-                    .map_or_else(|| format!("geom{}", geom.range().start), str::to_string),
-                body,
-                // X_{geom←body} = X_{geom←frame} X_{frame←element} X_{element←body}
-                placement: frame * to_frame * to_element,
-                shape,
-                rgba: self.geom_rgba(geom, class)?,
-                group: self.geom_group(geom, class)?,
-                element: self.location(geom),
-                texture: match self.geom_material(geom, class)? {
-                    Some(material) => self.material_texture(material)?,
-                    None => None,
-                },
-            });
-        }
-        Ok(())
-    }
-
     /// The shape of a geom of type `kind` and `size` (every size positive and finite; a plane's
     /// may be 0, unbounded).
     pub(super) fn geom_shape(
@@ -111,7 +69,7 @@ impl<'a> Reader<'a> {
     }
 
     /// A geom's colour: its `rgba` unless that is MuJoCo's default and it names a material.
-    fn geom_rgba(&self, geom: Node<'a, 'a>, class: &str) -> Result<[f64; 4]> {
+    pub(super) fn geom_rgba(&self, geom: Node<'a, 'a>, class: &str) -> Result<[f64; 4]> {
         let own = self.numbers::<4>(geom, class, "rgba")?;
         let material = self.geom_material(geom, class)?;
         let rgba = match (own, material) {
@@ -127,7 +85,11 @@ impl<'a> Reader<'a> {
     }
 
     /// The `<material>` a geom names, if any.
-    fn geom_material(&self, geom: Node<'a, 'a>, class: &str) -> Result<Option<Node<'a, 'a>>> {
+    pub(super) fn geom_material(
+        &self,
+        geom: Node<'a, 'a>,
+        class: &str,
+    ) -> Result<Option<Node<'a, 'a>>> {
         match self.attribute(geom, class, "material") {
             None => Ok(None),
             Some(name) => Ok(Some(*self.materials.get(&name).ok_or_else(|| {

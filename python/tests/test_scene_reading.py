@@ -1,0 +1,304 @@
+"""What an MJCF scene says of contacts and simulation, read as MuJoCo compiles it: the geoms as
+collision shapes with their contact parameters, `<contact>` pairs and exclusions, `<option>` and
+its flags, the joints' soft limits and friction. Compared field by field with `mujoco`'s compiled
+model, on a scene written to exercise defaults, classes and leading values, and on robots from
+Menagerie and mjlab."""
+
+from __future__ import annotations
+
+import importlib.util
+import warnings
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+from conftest import REPOSITORY, assert_close
+
+import robodyn
+
+#: MuJoCo's compiler and robodyn place the geoms from the same poses in double precision.
+COMPILER_TOLERANCE = 1e-12
+
+SCENE = """<mujoco model="scene">
+  <compiler angle="degree"/>
+  <option timestep="0.001" integrator="implicitfast" cone="elliptic" impratio="10" tolerance="1e-10"
+          iterations="50" ls_iterations="20" noslip_iterations="3" o_margin="0.01" o_solimp="0.8 0.9"
+          o_friction="0.5 0.5">
+    <flag warmstart="disable" energy="enable"/>
+  </option>
+  <default>
+    <geom friction="0.6 0.01" solimp="0.8 0.9" condim="4"/>
+    <joint solreflimit="0.03" solimplimit="0.8 0.9 0.002"/>
+    <pair condim="1" friction="0.2"/>
+    <default class="soft">
+      <geom friction="0.3" solref="0.05 0.9" solmix="2" margin="0.002" gap="0.001" priority="1"/>
+      <joint solimplimit="0.7" margin="0.01" solreffriction="0.01 0.5" solimpfriction="0.5"/>
+      <pair solimp="0.7 0.8"/>
+    </default>
+  </default>
+  <worldbody>
+    <geom name="floor" type="plane" size="0 0 0.05" contype="1" conaffinity="3"/>
+    <body name="base" pos="0 0 0.5">
+      <freejoint name="root"/>
+      <geom name="torso" type="box" size="0.2 0.1 0.05" class="soft" friction="0.9"/>
+      <body name="thigh" pos="0.2 0 0">
+        <joint name="hip" axis="0 1 0" range="-60 60" class="soft"/>
+        <geom name="leg" type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03" contype="2" conaffinity="0"/>
+        <body name="shin" pos="0 0 -0.3">
+          <joint name="knee" axis="0 1 0" range="-120 0" frictionloss="0.1" margin="0.05"/>
+          <geom name="ankle" size="0.03"/>
+          <geom name="foot" type="sphere" size="0.04" pos="0 0 -0.25" solimp="0.95" condim="6"/>
+          <body name="toe" pos="0.05 0 -0.25">
+            <geom name="toe" type="ellipsoid" size="0.02 0.01 0.01" friction="1.2 0.02 0.003"/>
+          </body>
+        </body>
+      </body>
+      <frame pos="-0.2 0 0" euler="0 90 0">
+        <geom name="tail" type="cylinder" size="0.02 0.1" class="soft"/>
+      </frame>
+    </body>
+  </worldbody>
+  <contact>
+    <pair geom1="floor" geom2="foot"/>
+    <pair name="soft_toe" geom1="floor" geom2="toe" class="soft" friction="0.4 0.3 0.01" margin="0.003"
+          solreffriction="0.02 0.8"/>
+    <exclude body1="base" body2="shin"/>
+  </contact>
+</mujoco>"""
+
+
+def load(path=None, text=None):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", robodyn.ModelWarning)
+        return robodyn.load(path) if text is None else robodyn.load_mjcf_string(text)
+
+
+def package_folder(name: str) -> Path:
+    """Where a test-data package is installed (found without importing it)."""
+    spec = importlib.util.find_spec(name)
+    assert spec is not None and spec.submodule_search_locations, f"{name} is a test dependency: run ./scripts/test"
+    return Path(list(spec.submodule_search_locations)[0])
+
+
+def mujoco_name(compiled, kind, index):
+    return mujoco.mj_id2name(compiled, kind, index)
+
+
+def assert_geoms_are_mujocos(model, compiled, label):
+    """Every geom's filter and contact parameters, and a primitive's size and world pose at
+    qpos0, equal MuJoCo's (height fields and SDFs are not read)."""
+    unread = (mujoco.mjtGeom.mjGEOM_HFIELD, mujoco.mjtGeom.mjGEOM_SDF)
+    kept = [g for g in range(compiled.ngeom) if compiled.geom_type[g] not in unread]
+    geoms = model.geoms
+    assert len(geoms) == len(kept), label
+    data = mujoco.MjData(compiled)
+    mujoco.mj_kinematics(compiled, data)
+    poses = model.body_poses(model.neutral())
+    for geom, g in zip(geoms, kept, strict=True):
+        where = f"{label} geom {g} ({geom['name']})"
+        name = mujoco_name(compiled, mujoco.mjtObj.mjOBJ_GEOM, g)
+        if name:
+            assert geom["name"] == name, where
+        body = mujoco_name(compiled, mujoco.mjtObj.mjOBJ_BODY, int(compiled.geom_bodyid[g]))
+        if body:
+            assert geom["source_body"] == body, where
+        integers = ("contype", "conaffinity", "condim", "priority")
+        expected = (compiled.geom_contype[g], compiled.geom_conaffinity[g], compiled.geom_condim[g], compiled.geom_priority[g])
+        assert tuple(geom[k] for k in integers) == tuple(int(x) for x in expected), where
+        for key, value in [
+            ("friction", compiled.geom_friction[g]),
+            ("solmix", compiled.geom_solmix[g]),
+            ("solref", compiled.geom_solref[g]),
+            ("solimp", compiled.geom_solimp[g]),
+            ("margin", compiled.geom_margin[g]),
+            ("gap", compiled.geom_gap[g]),
+        ]:
+            assert_close(geom[key], value, 0.0, f"{where} {key}")
+        if geom["kind"] == "mesh":
+            continue  # MuJoCo moves a mesh geom's frame to the mesh's inertia frame
+        assert_close(geom["size"], compiled.geom_size[g][: len(geom["size"])], COMPILER_TOLERANCE, f"{where} size")
+        world = poses[geom["body"]] @ geom["placement"]
+        assert_close(world[:3, 3], data.geom_xpos[g], COMPILER_TOLERANCE, f"{where} position")
+        assert_close(world[:3, :3], data.geom_xmat[g].reshape(3, 3), COMPILER_TOLERANCE, f"{where} rotation")
+
+
+def assert_contacts_are_mujocos(model, compiled, label):
+    pairs = model.contact_pairs
+    assert len(pairs) == compiled.npair, label
+    for k, pair in enumerate(pairs):
+        where = f"{label} pair {k}"
+        geom = lambda g: mujoco_name(compiled, mujoco.mjtObj.mjOBJ_GEOM, int(g))  # noqa: E731
+        assert (pair["geom1"], pair["geom2"]) == (geom(compiled.pair_geom1[k]), geom(compiled.pair_geom2[k])), where
+        assert pair["condim"] == compiled.pair_dim[k], where
+        for key, value in [
+            ("friction", compiled.pair_friction[k]),
+            ("solref", compiled.pair_solref[k]),
+            ("solreffriction", compiled.pair_solreffriction[k]),
+            ("solimp", compiled.pair_solimp[k]),
+            ("margin", compiled.pair_margin[k]),
+            ("gap", compiled.pair_gap[k]),
+        ]:
+            assert_close(pair[key], value, 0.0, f"{where} {key}")
+    # MuJoCo keeps an exclusion as the signature body1 << 16 | body2, whichever way it is written
+    body = lambda name: mujoco.mj_name2id(compiled, mujoco.mjtObj.mjOBJ_BODY, name)  # noqa: E731
+    signature = lambda one, other: min(one, other) << 16 | max(one, other)  # noqa: E731
+    ours = sorted(signature(body(one), body(other)) for one, other in model.contact_excludes)
+    theirs = sorted(signature(s >> 16, s & 0xFFFF) for s in compiled.exclude_signature)
+    assert ours == theirs, label
+
+
+def assert_options_are_mujocos(model, compiled, label):
+    options, expected = model.options, compiled.opt
+    assert options.integrator == ["Euler", "RK4", "implicit", "implicitfast", "discrete"][expected.integrator], label
+    assert options.cone == ["pyramidal", "elliptic"][expected.cone], label
+    assert options.solver == ["PGS", "CG", "Newton"][expected.solver], label
+    for key in ("timestep", "impratio", "tolerance", "ls_tolerance", "noslip_tolerance"):
+        assert getattr(options, key) == getattr(expected, key), f"{label} {key}"
+    for key in ("iterations", "ls_iterations", "noslip_iterations"):
+        assert getattr(options, key) == getattr(expected, key), f"{label} {key}"
+    assert options.o_margin == expected.o_margin, label
+    assert_close(options.o_solref, expected.o_solref, 0.0, f"{label} o_solref")
+    assert_close(options.o_solimp, expected.o_solimp, 0.0, f"{label} o_solimp")
+    assert_close(options.o_friction, expected.o_friction, 0.0, f"{label} o_friction")
+    # each flag as MuJoCo's bit says
+    for name, bit in mujoco.mjtDisableBit.__members__.items():
+        if name != "mjNDISABLE":
+            flag = name.removeprefix("mjDSBL_").lower()
+            assert options.flag(flag) == (not expected.disableflags & int(bit)), f"{label} {flag}"
+    for name, bit in mujoco.mjtEnableBit.__members__.items():
+        if name != "mjNENABLE":
+            flag = name.removeprefix("mjENBL_").lower()
+            assert options.flag(flag) == bool(expected.enableflags & int(bit)), f"{label} {flag}"
+
+
+def assert_joint_softness_is_mujocos(model, compiled, label):
+    for name, softness in zip(model.joint_names, model.joint_softness, strict=True):
+        j = mujoco.mj_name2id(compiled, mujoco.mjtObj.mjOBJ_JOINT, name)
+        if j < 0:
+            continue  # an unnamed joint robodyn names itself
+        dof = compiled.jnt_dofadr[j]
+        for key, value in [
+            ("solreflimit", compiled.jnt_solref[j]),
+            ("solimplimit", compiled.jnt_solimp[j]),
+            ("margin", compiled.jnt_margin[j]),
+            ("solreffriction", compiled.dof_solref[dof]),
+            ("solimpfriction", compiled.dof_solimp[dof]),
+        ]:
+            assert_close(softness[key], value, 0.0, f"{label} joint {name} {key}")
+
+
+def assert_scene_is_mujocos(model, compiled, label):
+    assert_geoms_are_mujocos(model, compiled, label)
+    assert_contacts_are_mujocos(model, compiled, label)
+    assert_options_are_mujocos(model, compiled, label)
+    assert_joint_softness_is_mujocos(model, compiled, label)
+
+
+def test_a_scene_with_classes_and_leading_values_is_mujocos():
+    model, compiled = load(text=SCENE), mujoco.MjModel.from_xml_string(SCENE)
+    assert_scene_is_mujocos(model, compiled, "scene")
+    # what the classes and leading values make of it, spelled out
+    geoms = {geom["name"]: geom for geom in model.geoms}
+    torso, foot = geoms["torso"], geoms["foot"]
+    assert torso["friction"] == [0.9, 0.01, 0.0001] and torso["priority"] == 1
+    assert foot["solimp"] == [0.95, 0.9, 0.001, 0.5, 2.0] and foot["condim"] == 6
+    assert model.contact_pairs[0]["friction"] == [0.2, 1.0, 0.005, 0.0001, 0.0001]
+    assert model.contact_excludes == [("base", "shin")]
+    assert model.options.disabled == ["warmstart"] and model.options.enabled == ["energy"]
+
+
+SCENE_FILES = [
+    ("testdata", "mjcf/cassie_nomesh.xml"),
+    ("testdata", "mjcf/iiwa14_scene.xml"),
+    ("testdata", "menagerie/robotiq_2f85/2f85.xml"),
+    ("mjlab", "asset_zoo/robots/unitree_g1/xmls/g1.xml"),
+    ("mjlab", "asset_zoo/robots/unitree_go1/xmls/go1.xml"),
+    ("mjlab", "asset_zoo/robots/i2rt_yam/xmls/yam.xml"),
+]
+
+
+@pytest.mark.parametrize(("package", "file"), SCENE_FILES)
+def test_published_scenes_are_read_as_mujoco_compiles_them(package, file):
+    folder = REPOSITORY / "testdata" if package == "testdata" else package_folder(package)
+    path = folder / file
+    model, compiled = load(path), mujoco.MjModel.from_xml_path(str(path))
+    assert_scene_is_mujocos(model, compiled, file)
+
+
+def test_disabled_gravity_and_equalities_are_followed_and_the_rest_named():
+    held = SCENE.replace("</contact>", '</contact><equality><joint joint1="knee"/></equality>')
+    assert len(load(text=held).constraints) == 1
+    flags = '<flag gravity="disable" equality="disable" limit="disable"/>'
+    text = held.replace('<flag warmstart="disable" energy="enable"/>', flags)
+    model = robodyn.load_mjcf_string(text)
+    assert_close(model.gravity, np.zeros(3), 0.0, "gravity")
+    assert model.constraints == []
+    assert not model.options.flag("gravity") and not model.options.flag("limit")
+    messages = " ".join(model.warnings)
+    assert "<flag> 'limit' not followed" in messages
+    assert "robodyn does not compute contacts yet" in messages
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (('condim="6"', 'condim="2"'), r"line \d+.*attribute 'condim': expected 1, 3, 4 or 6, got 2"),
+        (('geom2="foot"', 'geom2="hand"'), r"line \d+.*attribute 'geom2': no geom is called 'hand'"),
+        (('body2="shin"', 'body2="arm"'), r"line \d+.*attribute 'body2': no body is called 'arm'"),
+        (('energy="enable"', 'energy="on"'), r"line \d+.*attribute 'energy': expected enable or disable, got 'on'"),
+        (('cone="elliptic"', 'cone="Elliptic"'), r"line \d+.*attribute 'cone': expected one of pyramidal, elliptic"),
+        (('solimp="0.95"', 'solimp="0.95 0.9 0.001 0.5 2 7"'), r"line \d+.*attribute 'solimp': expected 1 to 5 numbers"),
+        (('contype="2"', 'contype="two"'), r"line \d+.*attribute 'contype': expected an integer, got 'two'"),
+    ],
+)
+def test_what_mujoco_refuses_is_refused_by_name_and_line(change, message):
+    broken = SCENE.replace(*change)
+    assert broken != SCENE
+    with pytest.raises(ValueError, match=message):
+        robodyn.load_mjcf_string(broken)
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_string(broken)
+
+
+def test_a_time_step_that_is_not_positive_is_refused():
+    """MuJoCo compiles timestep="0"; no simulation can step with it."""
+    with pytest.raises(ValueError, match=r"line \d+.*attribute 'timestep': expected a positive time step"):
+        robodyn.load_mjcf_string(SCENE.replace('timestep="0.001"', 'timestep="0"'))
+
+
+def test_models_from_other_formats_have_mujocos_defaults_and_no_geoms():
+    model = robodyn.load_bundled(robodyn.bundled_names()[0])
+    assert model.geoms == [] and model.contact_pairs == [] and model.contact_excludes == []
+    assert model.options.timestep == 0.002 and model.options.integrator == "Euler"
+    assert all(s["solreflimit"] == [0.02, 1.0] for s in model.joint_softness)
+    with pytest.raises(ValueError, match="argument 'name': unknown flag 'gravty'"):
+        model.options.flag("gravty")
+
+
+def pairs_mujoco_checks(compiled):
+    """The geom pairs MuJoCo's collision driver checks, as sorted geom ids: with every margin
+    overridden to 100 m, each checked pair of primitives and convex meshes is found in contact."""
+    compiled.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_OVERRIDE)
+    compiled.opt.o_margin = 100.0
+    data = mujoco.MjData(compiled)
+    mujoco.mj_forward(compiled, data)
+    return {tuple(sorted((int(c.geom1), int(c.geom2)))) for c in data.contact[: data.ncon]}
+
+
+@pytest.mark.parametrize(("package", "file"), [("text", "scene"), *SCENE_FILES])
+def test_the_pairs_checked_for_contact_are_mujocos(package, file):
+    if package == "text":
+        model, compiled = load(text=SCENE), mujoco.MjModel.from_xml_string(SCENE)
+    else:
+        folder = REPOSITORY / "testdata" if package == "testdata" else package_folder(package)
+        model, compiled = load(folder / file), mujoco.MjModel.from_xml_path(str(folder / file))
+    # robodyn's geoms are MuJoCo's in order, height fields and SDFs left out
+    unread = (mujoco.mjtGeom.mjGEOM_HFIELD, mujoco.mjtGeom.mjGEOM_SDF)
+    kept = [g for g in range(compiled.ngeom) if compiled.geom_type[g] not in unread]
+    index = {geom["name"]: kept[k] for k, geom in enumerate(model.geoms)}
+    ids = lambda one, other: tuple(sorted((index[one], index[other])))  # noqa: E731
+    explicit = {ids(p["geom1"], p["geom2"]) for p in model.contact_pairs}
+    candidates = [ids(*pair) for pair in model.contact_candidates]
+    assert len(set(candidates)) == len(candidates) and not set(candidates) & explicit
+    assert set(candidates) | explicit == pairs_mujoco_checks(compiled), file
