@@ -150,9 +150,13 @@ impl PyOptions {
 
     fn __repr__(&self) -> String {
         let o = &self.options;
+        let names = |flags: &[String]| {
+            let quoted: Vec<String> = flags.iter().map(|f| format!("'{f}'")).collect();
+            format!("[{}]", quoted.join(", "))
+        };
         format!(
-            "Options(timestep={}, integrator='{}', cone='{}', solver='{}', impratio={}, \
-             tolerance={}, iterations={}, disabled={:?}, enabled={:?})",
+            "Options(timestep={:?}, integrator='{}', cone='{}', solver='{}', impratio={:?}, \
+             tolerance={:?}, iterations={}, disabled={}, enabled={})",
             o.timestep,
             o.integrator.keyword(),
             self.cone(),
@@ -160,8 +164,8 @@ impl PyOptions {
             o.impratio,
             o.tolerance,
             o.iterations,
-            o.disabled,
-            o.enabled
+            names(&o.disabled),
+            names(&o.enabled)
         )
     }
 }

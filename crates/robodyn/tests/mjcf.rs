@@ -325,3 +325,48 @@ fn actuators_on_hinges_with_gears_and_ranges() {
     assert!((one(3, 2.0) - one(3, 0.0) - general).abs() < 1e-14);
     assert!(model.actuator_forces(&q, &v, &[0.0; 2], &mut tau).is_err());
 }
+
+const SCENE: &str = r#"<mujoco model="scene">
+  <option timestep="0.005" integrator="RK4" cone="elliptic">
+    <flag gravity="disable" filterparent="disable" energy="enable"/>
+  </option>
+  <default>
+    <geom friction="0.5 0.01"/>
+    <default class="bumper"><geom friction="0.9" contype="2" conaffinity="2"/></default>
+  </default>
+  <worldbody>
+    <geom name="floor" type="plane" size="1 1 0.1"/>
+    <body name="cart" pos="0 0 0.2">
+      <joint name="rail" type="slide" axis="1 0 0" range="-1 1" solreflimit="0.05" margin="0.01"/>
+      <geom name="cart" type="box" size="0.2 0.1 0.05" class="bumper"/>
+      <body name="pole">
+        <joint name="hinge" axis="0 1 0"/>
+        <geom name="pole" type="capsule" fromto="0 0 0 0 0 0.5" size="0.02" conaffinity="3"/>
+      </body>
+    </body>
+  </worldbody>
+  <contact><pair geom1="floor" geom2="pole"/></contact>
+</mujoco>"#;
+
+#[test]
+fn scene_geoms_options_and_the_pairs_checked() {
+    let model = load_mjcf_str(SCENE, "scene").unwrap();
+    let options = &model.options;
+    assert_eq!(options.timestep, 0.005);
+    assert_eq!(options.integrator, robodyn::model::Integrator::Rk4);
+    assert_eq!(options.cone, robodyn::model::FrictionCone::Elliptic);
+    assert!(!options.flag("gravity") && !options.flag("filterparent") && options.flag("energy"));
+    // a disabled gravity flag leaves the model without gravity
+    assert_eq!(model.gravity, robodyn::spatial::Vec3::zeros());
+    // a class's leading friction keeps the default class's torsional term
+    let cart = &model.geoms[1];
+    assert_eq!((cart.name.as_str(), cart.contype), ("cart", 2));
+    assert_eq!(cart.friction, [0.9, 0.01, 0.0001]);
+    let rail = &model.joint_softness[1];
+    assert_eq!((rail.limit.solref, rail.margin), ([0.05, 1.0], 0.01));
+    // the floor and the cart share no bit; the cart and its child pole touch because filterparent
+    // is disabled; the floor and the pole are an explicit pair, not a dynamic one
+    assert_eq!(robodyn::collision::candidate_pairs(&model), vec![(1, 2)]);
+    let pair = &model.contact_pairs[0];
+    assert_eq!((pair.geoms, pair.contact.condim), ((0, 2), 3));
+}
