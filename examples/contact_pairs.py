@@ -13,6 +13,7 @@ in contact).
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.colors import ListedColormap
 from _compare import show
 
 import robodyn
@@ -91,19 +92,19 @@ parents = [0, *(p + 1 for p in scene.body_parents)]  # into ["world"] + body_nam
 excluded = {frozenset(pair) for pair in scene.contact_excludes}
 explicit = {frozenset((p["geom1"], p["geom2"])) for p in scene.contact_pairs}
 by_rules = np.zeros_like(checked)
-for i, one in enumerate(scene.geoms):
-    for j, other in enumerate(scene.geoms):
-        family = one["body"] != 0 and other["body"] != 0 and (
-            parents[one["body"]] == other["body"] or parents[other["body"]] == one["body"])
-        bits = one["contype"] & other["conaffinity"] or other["contype"] & one["conaffinity"]
-        if (one["body"] != other["body"] and not family and bits
-                and frozenset((one["source_body"], other["source_body"])) not in excluded
-                and frozenset((one["name"], other["name"])) not in explicit):
+for i, first in enumerate(scene.geoms):
+    for j, second in enumerate(scene.geoms):
+        family = first["body"] != 0 and second["body"] != 0 and (
+            parents[first["body"]] == second["body"] or parents[second["body"]] == first["body"])
+        bits = first["contype"] & second["conaffinity"] or second["contype"] & first["conaffinity"]
+        if (first["body"] != second["body"] and not family and bits
+                and frozenset((first["source_body"], second["source_body"])) not in excluded
+                and frozenset((first["name"], second["name"])) not in explicit):
             by_rules[i, j] = 1
 show("pairs checked (the rules written out vs robodyn)", by_rules, np.where(checked == 1, 1, 0), 0.0)
 
 fig, ax = plt.subplots(figsize=(6.5, 5.5))
-ax.imshow(checked, cmap=plt.matplotlib.colors.ListedColormap(["white", "tab:blue", "tab:orange"]), vmin=0, vmax=2)
+ax.imshow(checked, cmap=ListedColormap(["white", "tab:blue", "tab:orange"]), vmin=0, vmax=2)
 ax.set_xticks(range(len(names)), names, rotation=60, ha="right")
 ax.set_yticks(range(len(names)), names)
 ax.set_title("geom pairs checked for contact\nblue: MuJoCo's filters pass them, orange: explicit <pair>")
@@ -114,7 +115,7 @@ fig.tight_layout()
 #
 # With every margin overridden to 100 m, each pair MuJoCo checks is found in contact.
 try:
-    import mujoco
+    import mujoco  # type: ignore[import-untyped]
 except ImportError:
     mujoco = None
 if mujoco is not None:
