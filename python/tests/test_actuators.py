@@ -18,7 +18,8 @@ FORCE_TOLERANCE = 1e-12
 PANDA = REPOSITORY / "testdata" / "mjcf" / "panda_nomesh.xml"
 
 #: A slide and three hinges (one with a ref, one limited), each kind of modelled actuator, gears,
-#: ranges given directly, by class and by `inheritrange`.
+#: ranges given directly, by class and by `inheritrange`, and two joints whose total actuator
+#: force is clamped (`actuatorfrcrange`).
 ACTUATED = """<mujoco model="actuated">
   <compiler angle="radian"/>
   <default>
@@ -32,10 +33,10 @@ ACTUATED = """<mujoco model="actuated">
         <joint name="shoulder" axis="0 1 0" ref="0.3"/>
         <geom type="capsule" fromto="0 0 0 0 0 -0.4" size="0.04"/>
         <body name="forearm" pos="0 0 -0.4">
-          <joint name="elbow" axis="0 1 0" range="-1 2"/>
+          <joint name="elbow" axis="0 1 0" range="-1 2" actuatorfrcrange="-6 4"/>
           <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03"/>
           <body name="hand" pos="0 0 -0.3">
-            <joint name="wrist" axis="1 0 0"/>
+            <joint name="wrist" axis="1 0 0" actuatorfrcrange="-2.5 2.5" actuatorfrclimited="true"/>
             <geom type="sphere" size="0.05"/>
           </body>
         </body>
@@ -119,4 +120,10 @@ def test_what_is_not_modelled_warns_and_bad_input_is_refused():
         model.actuator_forces(q, v, np.zeros(3))
     with pytest.raises(ValueError, match=r"argument 'ctrl'"):
         model.actuator_forces(q, v, np.full(7, np.nan))
+    # a clamped joint needs a range MuJoCo accepts
+    text = ACTUATED.replace('actuatorfrcrange="-2.5 2.5"', 'actuatorfrcrange="2.5 -2.5"')
+    with pytest.raises(ValueError, match=r"<joint name='wrist'> \(line \d+\): attribute 'actuatorfrclimited' is true"):
+        robodyn.load_mjcf_string(text)
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_string(text)
     assert robodyn.load("ur5").nu == 0

@@ -97,6 +97,9 @@ pub struct JointProperties {
     pub spring_reference: f64,
     /// How its limit and dry friction act in MuJoCo's soft constraint model.
     pub softness: JointSoftness,
+    /// The range the total actuator force on it is clamped to (MJCF `actuatorfrcrange`);
+    /// one-coordinate joints only.
+    pub actuator_force_range: Option<(f64, f64)>,
 }
 
 impl Default for JointProperties {
@@ -112,6 +115,7 @@ impl Default for JointProperties {
             stiffness: 0.0,
             spring_reference: 0.0,
             softness: JointSoftness::default(),
+            actuator_force_range: None,
         }
     }
 }
@@ -214,6 +218,10 @@ pub struct Model {
     /// The actuators (MJCF `<actuator>`), in the file's order: the controls' order.
     #[serde(default)]
     pub actuators: Vec<Actuator>,
+    /// The range each body's joint's total actuator force is clamped to (MJCF
+    /// `actuatorfrcrange`), nbodies; read for hinges and slides only.
+    #[serde(default)]
+    pub actuator_force_range: Vec<Option<(f64, f64)>>,
     /// Each body's joint limit and dry friction in MuJoCo's soft constraint model, nbodies (the
     /// world's unused).
     #[serde(default)]

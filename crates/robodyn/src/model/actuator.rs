@@ -7,7 +7,8 @@
 //!   f = (a₀ + a₁ l + a₂ l̇) u + (b₀ + b₁ l + b₂ l̇)        (gain a, bias b: MuJoCo's
 //!                                                             gainprm and biasprm, affine)
 //! ```
-//! clamped to `forcerange` when limited, and it adds `g f` to the joint's generalised force. A
+//! clamped to `forcerange` when limited, and it adds `g f` to the joint's generalised force, whose
+//! total is clamped to the joint's `actuatorfrcrange` where it has one. A
 //! `motor` has a = (1, 0, 0), b = 0; a `position` a = (k_p, 0, 0), b = (0, −k_p, −k_v); a `velocity`
 //! a = (k_v, 0, 0), b = (0, 0, −k_v). Inputs: q, q̇, the controls (nu). Cost: O(nu).
 
@@ -71,6 +72,13 @@ impl Model {
         for (actuator, &u) in self.actuators.iter().zip(ctrl) {
             if let Some(c) = actuator.coordinate {
                 tau[c] += actuator.gear * actuator.force(q[actuator.position], v[c], u);
+            }
+        }
+        // a hinge's or slide's total actuator force is clamped to its range
+        for (body, range) in self.actuator_force_range.iter().enumerate() {
+            if let (Some((low, high)), 1) = (range, self.joints[body].nv()) {
+                let c = self.idx_v[body];
+                tau[c] = tau[c].clamp(*low, *high);
             }
         }
         Ok(())

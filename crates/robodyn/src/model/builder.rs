@@ -72,6 +72,7 @@ impl ModelBuilder {
                 constraints: Vec::new(),
                 keyframes: Vec::new(),
                 actuators: Vec::new(),
+                actuator_force_range: vec![None],
                 joint_softness: vec![JointSoftness::default()],
                 geoms: Vec::new(),
                 source_bodies: Vec::new(),
@@ -117,6 +118,7 @@ impl ModelBuilder {
         m.x_tree.push(tree_transform(x_tree));
         m.inertias.push(inertia);
         m.joint_softness.push(properties.softness);
+        m.actuator_force_range.push(properties.actuator_force_range);
         m.idx_q.push(m.nq);
         m.idx_v.push(m.nv);
         let (nq, nv) = (joint.nq(), joint.nv());

@@ -251,20 +251,8 @@ impl<'a> Reader<'a> {
                 properties.lower = position_unit(lower);
                 properties.upper = position_unit(upper);
             }
-            let clamped = self
-                .attribute(*joint_node, joint_class, "actuatorfrclimited")
-                .is_none_or(|l| l != "false");
-            if clamped
-                && self
-                    .attribute(*joint_node, joint_class, "actuatorfrcrange")
-                    .is_some()
-            {
-                self.warnings.borrow_mut().push(format!(
-                    "{}: attribute 'actuatorfrcrange' not read (robodyn clamps each actuator's \
-                     force, not a joint's sum of them)",
-                    self.location(*joint_node)
-                ));
-            }
+            properties.actuator_force_range =
+                self.actuator_force_range(*joint_node, joint_class)?;
             // `ref`: the joint position at which the body has its XML pose, so the joint moves
             // by q − ref: X_J(q − ref) X_tree = X_J(q) X_J(−ref) X_tree
             let reference = position_unit(scalar("ref", 0.0)?);
@@ -369,5 +357,35 @@ impl<'a> Reader<'a> {
                 .map_or(0.0, |[m]| m),
             friction: parameters("solreffriction", "solimpfriction")?,
         })
+    }
+
+    /// The range a joint's total actuator force is clamped to, as MuJoCo reads it:
+    /// `actuatorfrcrange` where `actuatorfrclimited` is true (a range with low < high needed), or
+    /// "auto" (the default) and a range with low < high is given.
+    fn actuator_force_range(&self, joint: Node<'a, 'a>, class: &str) -> Result<Option<(f64, f64)>> {
+        let range = self
+            .numbers::<2>(joint, class, "actuatorfrcrange")?
+            .filter(|[low, high]| low < high)
+            .map(|[low, high]| (low, high));
+        match self
+            .attribute(joint, class, "actuatorfrclimited")
+            .as_deref()
+        {
+            None | Some("auto") => Ok(range),
+            Some("false") => Ok(None),
+            Some("true") => range.map(Some).ok_or_else(|| {
+                self.error(
+                    joint,
+                    "attribute 'actuatorfrclimited' is true: expected an 'actuatorfrcrange' \
+                     with low < high",
+                )
+            }),
+            Some(other) => Err(self.error(
+                joint,
+                format!(
+                    "attribute 'actuatorfrclimited': expected true, false or auto, got '{other}'"
+                ),
+            )),
+        }
     }
 }
