@@ -75,11 +75,16 @@ VALID: dict[str, Any] = {
     "quantities": ("tau",), "chunk": 4, "per_task": 2, "progress": None, "client": None,
     "constraints": [robodyn.PointAnchor("tool0")], "joint": "elbow_joint", "leader": "shoulder_lift_joint",
     "frame1": "tool0", "frame2": "wrist_3_link", "q_full": MIMIC.full.neutral(),
-    "ctrl": np.zeros(UR5.nu), "key": "home",
+    "ctrl": np.zeros(UR5.nu), "key": "home", "geom1": "floor", "geom2": "upper_link",
 }
 #: Methods that need another model than UR5 to run (a keyframe): the method -> its model.
 PANDA = robodyn.load(REPOSITORY / "testdata" / "mjcf" / "panda_nomesh.xml")
-BOUND = {"robodyn.Model.keyframe": PANDA, "robodyn.MimicModel.keyframe": robodyn.MimicModel(PANDA)}
+#: ... and contact parameters (geoms)
+ARM = robodyn.load(REPOSITORY / "testdata" / "mjcf" / "viewer_arm.xml")
+BOUND = {
+    "robodyn.Model.keyframe": PANDA, "robodyn.MimicModel.keyframe": robodyn.MimicModel(PANDA),
+    "robodyn.Model.contact_parameters": ARM, "robodyn.MimicModel.contact_parameters": robodyn.MimicModel(ARM),
+}
 
 
 def _urdf_file(folder: Path) -> str:

@@ -302,3 +302,47 @@ def test_the_pairs_checked_for_contact_are_mujocos(package, file):
     candidates = [ids(*pair) for pair in model.contact_candidates]
     assert len(set(candidates)) == len(candidates) and not set(candidates) & explicit
     assert set(candidates) | explicit == pairs_mujoco_checks(compiled), file
+
+
+#: MuJoCo and robodyn add the same two margins of about 50 m in double precision.
+MARGIN_TOLERANCE = 1e-12
+
+
+@pytest.mark.parametrize("override", [False, True])
+def test_each_contact_takes_mujocos_parameters(override):
+    """Every contact MuJoCo finds (every margin raised by 50 or 100 m so that every checked pair is in
+    contact) has the condim, friction, solref, solreffriction, solimp and margin robodyn's
+    `contact_parameters` gives its two geoms: explicit pairs as they are, dynamic pairs mixed
+    by priority and solmix; with the `<option>` override, the override's."""
+    text = SCENE.replace('<flag warmstart="disable" energy="enable"/>', '<flag override="enable"/>') if override else SCENE
+    # solmix, priority and direct (negative) solref cases beside the scene's
+    text = text.replace('name="leg" type="capsule"', 'name="leg" solmix="0" solref="-2000 -50" type="capsule"')
+    # margins of 50 m on every geom and 100 m on every pair (100 m overriding), so that every
+    # pair MuJoCo checks is in contact: the file's own margins are raised in the text both read
+    text = text.replace('margin="0.002"', 'margin="50.002"').replace('margin="0.003"', 'margin="100.003"')
+    text = text.replace('<geom friction="0.6 0.01"', '<geom margin="50" friction="0.6 0.01"')
+    text = text.replace('<pair condim="1"', '<pair margin="100" condim="1"').replace('o_margin="0.01"', 'o_margin="100"')
+    model, compiled = load(text=text), mujoco.MjModel.from_xml_string(text)
+    data = mujoco.MjData(compiled)
+    mujoco.mj_forward(compiled, data)
+    names = [mujoco_name(compiled, mujoco.mjtObj.mjOBJ_GEOM, g) for g in range(compiled.ngeom)]
+    checked = set()
+    for contact in data.contact[: data.ncon]:
+        one, other = names[contact.geom1], names[contact.geom2]
+        expected = model.contact_parameters(one, other)
+        where = f"{one}-{other}"
+        assert contact.dim == expected["condim"], where
+        for key, value in [
+            ("friction", contact.friction),
+            ("solref", contact.solref),
+            ("solreffriction", contact.solreffriction),
+            ("solimp", contact.solimp),
+        ]:
+            assert_close(expected[key], value, 1e-15, f"{where} {key}")
+        assert abs(contact.includemargin - expected["margin"]) <= MARGIN_TOLERANCE, where
+        checked.add(tuple(sorted((one, other))))
+    assert len(checked) == len(model.contact_candidates) + len(model.contact_pairs)
+    with pytest.raises(ValueError, match="argument 'geom1': no geom is called 'hand'"):
+        model.contact_parameters("hand", "floor")
+    with pytest.raises(ValueError, match="argument 'geom2': expected a geom other than geom1"):
+        model.contact_parameters("floor", "floor")

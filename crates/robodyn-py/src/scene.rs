@@ -1,6 +1,7 @@
 //! What a scene file says of contacts and simulation: the collision geoms, the contact pairs and
 //! exclusions, the joints' soft limits and friction, and the `<option>`s (`robodyn.Options`).
 
+use crate::args::text;
 use crate::model::PyModel;
 use crate::visuals::{matrix, shape_size};
 use pyo3::exceptions::PyValueError;
@@ -170,6 +171,21 @@ impl PyOptions {
     }
 }
 
+impl PyModel {
+    /// The index of the geom named by argument `argument`.
+    fn geom_index(&self, argument: &str, name: &Bound<PyAny>) -> PyResult<usize> {
+        let name = text(argument, name)?;
+        let geoms = &self.model.geoms;
+        geoms.iter().position(|g| g.name == name).ok_or_else(|| {
+            let names: Vec<String> = geoms.iter().map(|g| format!("'{}'", g.name)).collect();
+            PyValueError::new_err(format!(
+                "argument '{argument}': no geom is called '{name}'; the model's geoms: [{}]",
+                names.join(", ")
+            ))
+        })
+    }
+}
+
 /// `solref` and `solimp` into `item` under `solref_key` and `solimp_key`.
 fn set_solver(
     item: &Bound<PyDict>,
@@ -258,6 +274,37 @@ impl PyModel {
             .into_iter()
             .map(|(i, j)| (geoms[i].name.clone(), geoms[j].name.clone()))
             .collect()
+    }
+
+    /// The parameters a contact between geoms `geom1` and `geom2` (names) takes, as MuJoCo sets
+    /// them: their explicit pair's if they form one, else the two geoms' mixed (the higher
+    /// `priority`'s, or `condim` and `friction` the larger, `solref` and `solimp` weighted by
+    /// `solmix`), margins and gaps added, the `<option>` override applied where enabled. A dict:
+    /// `condim`, `friction` (sliding ×2, torsional, rolling ×2), `solref`, `solreffriction`,
+    /// `solimp`, `margin` (MuJoCo's `includemargin`), `gap`.
+    fn contact_parameters<'py>(
+        &self,
+        py: Python<'py>,
+        geom1: &Bound<PyAny>,
+        geom2: &Bound<PyAny>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let first = self.geom_index("geom1", geom1)?;
+        let second = self.geom_index("geom2", geom2)?;
+        if first == second {
+            return Err(PyValueError::new_err(format!(
+                "argument 'geom2': expected a geom other than geom1, got '{}' twice",
+                self.model.geoms[first].name
+            )));
+        }
+        let parameters = robodyn::soft::contact_parameters(&self.model, first, second);
+        let item = PyDict::new(py);
+        item.set_item("condim", parameters.condim)?;
+        item.set_item("friction", parameters.friction.to_vec())?;
+        set_solver(&item, ("solref", "solimp"), &parameters.solver)?;
+        item.set_item("solreffriction", parameters.solreffriction.to_vec())?;
+        item.set_item("margin", parameters.margin)?;
+        item.set_item("gap", parameters.gap)?;
+        Ok(item)
     }
 
     /// The file's body pairs whose geoms never touch (MJCF `<contact><exclude>`), as

@@ -21,6 +21,7 @@ pub mod integrate;
 pub mod io;
 pub mod joint;
 pub mod model;
+pub mod soft;
 pub mod spatial;
 pub mod visual;
 
