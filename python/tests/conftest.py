@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -76,3 +77,10 @@ def pinocchio_robot(request, robots_dir):
 
 def load_reference(name: str) -> dict:
     return json.loads((REFERENCE_DIR / f"{name}.json").read_text())
+
+
+def load_quietly(path=None, text=None):
+    """A model from a file or an MJCF string, its ModelWarnings silenced."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", robodyn.ModelWarning)
+        return robodyn.load(path) if text is None else robodyn.load_mjcf_string(text)

@@ -4,12 +4,12 @@ forward dynamics and in simulation (Cassie)."""
 
 from __future__ import annotations
 
-import warnings
 
 import mujoco
 import numpy as np
 import pytest
 from conftest import REPOSITORY, assert_close
+from conftest import load_quietly as load
 
 import robodyn
 
@@ -54,12 +54,6 @@ EQUALITIES = """<mujoco model="equalities">
     <joint joint1="jb" polycoef="0.25 0 0 0 0" active="false"/>
   </equality>
 </mujoco>"""
-
-
-def load(path=None, text=None):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", robodyn.ModelWarning)
-        return robodyn.load(path) if text is None else robodyn.load_mjcf_string(text)
 
 
 def pose(rotation, position):

@@ -7,13 +7,13 @@ Menagerie and mjlab."""
 from __future__ import annotations
 
 import importlib.util
-import warnings
 from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
 from conftest import REPOSITORY, assert_close
+from conftest import load_quietly as load
 
 import robodyn
 
@@ -66,12 +66,6 @@ SCENE = """<mujoco model="scene">
     <exclude body1="base" body2="shin"/>
   </contact>
 </mujoco>"""
-
-
-def load(path=None, text=None):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", robodyn.ModelWarning)
-        return robodyn.load(path) if text is None else robodyn.load_mjcf_string(text)
 
 
 def package_folder(name: str) -> Path:

@@ -33,20 +33,9 @@ impl<'a> Reader<'a> {
 
     fn contact_pair(&self, element: Node<'a, 'a>, model: &Model) -> Result<ContactPair> {
         let class = self.declared_class(element, "class", "main")?;
-        let geom = |attribute: &str| -> Result<usize> {
-            let name = element
-                .attribute(attribute)
-                .ok_or_else(|| self.error(element, format!("missing attribute '{attribute}'")))?;
-            model
-                .geoms
-                .iter()
-                .position(|g| g.name == name)
-                .ok_or_else(|| {
-                    self.error(
-                        element,
-                        format!("attribute '{attribute}': no geom is called '{name}'"),
-                    )
-                })
+        let geom = |attribute: &str| {
+            let names = model.geoms.iter().map(|g| g.name.as_str());
+            self.named_index(element, attribute, "geom", names)
         };
         let geoms = (geom("geom1")?, geom("geom2")?);
         if geoms.0 == geoms.1 {
@@ -89,18 +78,27 @@ impl<'a> Reader<'a> {
         attribute: &str,
         model: &Model,
     ) -> Result<usize> {
+        let names = model.source_bodies.iter().map(|b| b.name.as_str());
+        self.named_index(element, attribute, "body", names)
+    }
+
+    /// The position among `names` of the `kind` named by `element`'s `attribute`, which it must
+    /// have.
+    fn named_index<'n>(
+        &self,
+        element: Node<'a, 'a>,
+        attribute: &str,
+        kind: &str,
+        mut names: impl Iterator<Item = &'n str>,
+    ) -> Result<usize> {
         let name = element
             .attribute(attribute)
             .ok_or_else(|| self.error(element, format!("missing attribute '{attribute}'")))?;
-        model
-            .source_bodies
-            .iter()
-            .position(|b| b.name == name)
-            .ok_or_else(|| {
-                self.error(
-                    element,
-                    format!("attribute '{attribute}': no body is called '{name}'"),
-                )
-            })
+        names.position(|n| n == name).ok_or_else(|| {
+            self.error(
+                element,
+                format!("attribute '{attribute}': no {kind} is called '{name}'"),
+            )
+        })
     }
 }
