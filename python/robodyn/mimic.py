@@ -464,6 +464,9 @@ class MimicModel(ConstrainedMethods):
     def body_poses(self, q: Any) -> np.ndarray:
         return self.full.body_poses(self.expand(q))
 
+    def collide(self, q: Any) -> list[dict[str, Any]]:
+        return self.full.collide(self.expand(q))
+
     def jacobian(self, q: Any, frame: Any, reference: str = "world", out: Any = None) -> np.ndarray:
         """J_red = J G."""
         return _written(self._columns(self.full.jacobian(self.expand(q), frame, reference)), out)

@@ -8,7 +8,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 import pytest
-from conftest import CROSS_CHECK_TOLERANCE, REPOSITORY
+from conftest import CROSS_CHECK_TOLERANCE, REPOSITORY, load_quietly
 
 import robodyn
 from robodyn.convert import MujocoLayout
@@ -150,3 +150,15 @@ def test_urdf_neutral_is_zero_angles_and_identity_quaternions():
     expected = np.zeros(model.nq)
     expected[6] = 1.0
     assert np.asarray(model.neutral()).tolist() == expected.tolist()
+
+
+def test_a_free_body_inside_a_frame_of_the_world_starts_where_mujoco_puts_it():
+    text = """<mujoco><worldbody><frame pos="1 0 0" euler="0 0 90">
+      <body name="b" pos="0 1 0" euler="30 0 0"><freejoint/><geom size="0.1"/></body>
+    </frame></worldbody></mujoco>"""
+    model, compiled = load_quietly(text=text), mujoco.MjModel.from_xml_string(text)
+    data = mujoco.MjData(compiled)
+    mujoco.mj_kinematics(compiled, data)
+    pose = model.body_poses(model.neutral())[1]
+    np.testing.assert_allclose(pose[:3, 3], data.xpos[1], atol=1e-12)
+    np.testing.assert_allclose(pose[:3, :3], data.xmat[1].reshape(3, 3), atol=1e-12)

@@ -232,7 +232,7 @@ def test_mjcf_include(tmp_path):
     ("text", "message"),
     [
         ("<mujoco><worldbody><body name='x'><geom type='mesh' mesh='m'/><joint/></body></worldbody></mujoco>", "<body name='x'>/<geom> \\(line 1\\): attribute 'mesh': no <mesh name='m'> in the <asset>s"),
-        ("<mujoco><worldbody><body name='x'><geom type='plane' size='1 1 1'/><joint/></body></worldbody></mujoco>", "'plane' geom has no volume"),
+        ("<mujoco><worldbody><body name='x'><geom type='plane' size='1 1 1'/><joint/></body></worldbody></mujoco>", "a plane may only be on a body welded to the world"),
         ("<mujoco><worldbody><body name='x'><geom type='box' size='0.1 0.1'/><joint/></body></worldbody></mujoco>", "a box needs 3 positive numbers"),
         ("<mujoco><worldbody><body name='x'><geom type='sphere' fromto='0 0 0 1 0 0' size='0.1'/><joint/></body></worldbody></mujoco>", "'fromto'"),
         ("<mujoco><include file='robot.xml'/></mujoco>", "<include>.*load the model from its file"),

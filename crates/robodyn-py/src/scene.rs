@@ -1,9 +1,11 @@
 //! What a scene file says of contacts and simulation: the collision geoms, the contact pairs and
 //! exclusions, the joints' soft limits and friction, and the `<option>`s (`robodyn.Options`).
 
-use crate::args::text;
+use crate::args::{read_sample, text, SampleShape};
+use crate::errors::to_py_err;
 use crate::model::PyModel;
 use crate::visuals::{matrix, shape_size};
+use numpy::{PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -305,6 +307,51 @@ impl PyModel {
         item.set_item("margin", parameters.margin)?;
         item.set_item("gap", parameters.gap)?;
         Ok(item)
+    }
+
+    /// The contacts of the model's geoms at configuration `q`, as MuJoCo's collision
+    /// detection finds them (its pairs, order, points, frames and distances): a list of dicts,
+    /// one per contact: `geom1`, `geom2` (names; `geom1` the geom of lower MuJoCo type: plane,
+    /// sphere, capsule, ellipsoid, cylinder, box, mesh), `pair` (the explicit pair's name, or
+    /// None), `distance` (signed, m: negative when they overlap), `position` (3,) (midway
+    /// between the surfaces), `frame` (3, 3) (rows: the normal from geom1 to geom2, then two
+    /// tangents), `normal` (3,). A contact is listed while `distance` is below the pair's
+    /// `margin + gap` (`contact_parameters`).
+    fn collide<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let model = &self.model;
+        let q = read_sample("q", q, SampleShape::vector(model.nq))?;
+        let mut data = robodyn::Data::new(model);
+        let x_world = robodyn::algo::forward_kinematics(model, &mut data, &q).map_err(to_py_err)?;
+        let pairs = robodyn::collision::checked_pairs(model);
+        let (mut touches, mut contacts) = (Vec::new(), Vec::new());
+        robodyn::collision::collide(model, x_world, &pairs, &mut touches, &mut contacts);
+        let mut items = Vec::with_capacity(contacts.len());
+        for contact in &contacts {
+            let item = PyDict::new(py);
+            item.set_item("geom1", &model.geoms[contact.geoms.0].name)?;
+            item.set_item("geom2", &model.geoms[contact.geoms.1].name)?;
+            let pair = contact.pair.map(|k| model.contact_pairs[k].name.clone());
+            item.set_item("pair", pair)?;
+            item.set_item("distance", contact.distance)?;
+            item.set_item(
+                "position",
+                PyArray1::from_slice(py, contact.position.as_slice()),
+            )?;
+            let normal = contact.frame.row(0).transpose();
+            item.set_item("normal", PyArray1::from_slice(py, normal.as_slice()))?;
+            let rows: Vec<Vec<f64>> = contact
+                .frame
+                .row_iter()
+                .map(|row| row.iter().copied().collect())
+                .collect();
+            item.set_item("frame", PyArray2::from_vec2(py, &rows)?)?;
+            items.push(item);
+        }
+        Ok(items)
     }
 
     /// The file's body pairs whose geoms never touch (MJCF `<contact><exclude>`), as

@@ -1,4 +1,5 @@
-//! MuJoCo's soft constraint model. So far: the parameters a contact between two geoms takes.
+//! MuJoCo's soft constraint model. So far: the parameters a contact between two geoms takes, and
+//! ([`impedance`]) how soft a constraint row is.
 //!
 //! Reference: MuJoCo's documentation, "Modeling", §Contact parameters, and "Computation",
 //! §Contact. A contact of an explicit pair takes the pair's parameters as they are. A contact
@@ -17,6 +18,8 @@
 //! `gap = gap₁ + gap₂` (MuJoCo ≥ 3.5). With the `override` flag enabled, every contact's margin,
 //! `solref` (its friction rows' too), `solimp` and friction are the `<option>`'s `o_margin`,
 //! `o_solref`, `o_solimp` and `o_friction`. Every friction term is at least [`MIN_FRICTION`].
+
+pub mod impedance;
 
 use crate::model::{ContactPair, Geom, Model, SolverParameters};
 

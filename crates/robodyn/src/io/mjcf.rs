@@ -23,7 +23,7 @@
 //! computed: a warning says so when geoms could touch.
 //! Of the assets, the meshes are read, for the inertia of mesh geoms (`mjcf/meshes.rs`).
 
-use crate::collision::candidate_pairs;
+use crate::collision::{checked_pairs, collider};
 use crate::error::{Error, Result};
 use crate::io::read_model_file;
 use crate::io::schema;
@@ -269,12 +269,32 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         model.warnings.push(message);
     }
     // a warning only where MuJoCo would check some pair of geoms for contact
-    let touching = !model.contact_pairs.is_empty() || !candidate_pairs(&model).is_empty();
-    if touching && model.options.flag("contact") && model.options.flag("constraint") {
+    let checked = checked_pairs(&model);
+    if !checked.is_empty() && model.options.flag("contact") && model.options.flag("constraint") {
+        // the kinds of pairs whose contacts are not found yet
+        let mut unfound: Vec<String> = Vec::new();
+        for pair in &checked {
+            let (one, other) = (
+                &model.geoms[pair.geoms.0].shape,
+                &model.geoms[pair.geoms.1].shape,
+            );
+            let kinds = format!("{}–{}", one.kind(), other.kind());
+            if collider(one, other).is_none() && !unfound.contains(&kinds) {
+                unfound.push(kinds);
+            }
+        }
+        let unfound = if unfound.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; the contacts of {} pairs are not found yet (m.collide leaves them out)",
+                unfound.join(", ")
+            )
+        };
         model.warnings.push(format!(
-            "{}: geoms read as collision shapes (m.geoms, m.contact_candidates) but robodyn \
-             does not compute contacts yet: in simulation bodies pass through each other and \
-             the floor",
+            "{}: geoms read as collision shapes (m.geoms, m.collide) but robodyn does not \
+             compute contact forces yet: in simulation bodies pass through each other and the \
+             floor{unfound}",
             reader.location(root)
         ));
     }

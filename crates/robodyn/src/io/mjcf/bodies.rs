@@ -268,11 +268,12 @@ impl<'a> Reader<'a> {
             };
             // a free joint places the body in the world: its XML pose is only MuJoCo's qpos0
             let x_tree = if joint == Joint::Free {
-                if k > 0
-                    || !node
-                        .parent_element()
-                        .is_some_and(|p| p.has_tag_name("worldbody"))
-                {
+                // the body's parent, through any <frame>s, is the world
+                let mut parent = node.parent_element();
+                while parent.is_some_and(|p| p.has_tag_name("frame")) {
+                    parent = parent.and_then(|p| p.parent_element());
+                }
+                if k > 0 || !parent.is_some_and(|p| p.has_tag_name("worldbody")) {
                     return Err(self.error(
                         *joint_node,
                         "a free joint must be the only joint of a child of the worldbody",

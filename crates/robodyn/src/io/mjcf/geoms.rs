@@ -44,6 +44,13 @@ impl<'a> Reader<'a> {
                 }
                 continue;
             }
+            if kind == "plane" && body != 0 {
+                return Err(self.error(
+                    geom,
+                    "a plane may only be on a body welded to the world (without joints from it \
+                     to the world), as in MuJoCo",
+                ));
+            }
             let (size, frame) = self.geom_size_and_frame(geom, class, &kind)?;
             let shape = self.geom_shape(geom, class, &kind, &size)?;
             let name = geom

@@ -218,7 +218,9 @@ impl<'a> Reader<'a> {
                     "an sdf geom's inertia comes from its plugin, which robodyn does not run: give the body an <inertial>",
                 ))
             }
-            "plane" | "hfield" => return Err(no_volume()),
+            // a plane has no mass (it may only be on a body welded to the world)
+            "plane" => return Ok(Inertia::ZERO),
+            "hfield" => return Err(no_volume()),
             _ => {}
         }
         // the shape checks the size, as the viewer reads it

@@ -1,5 +1,4 @@
-//! Collision: which of a model's geoms may touch. This layer knows shapes, bodies and the
-//! file's filters, nothing of dynamics.
+//! Which of a model's geoms may touch.
 //!
 //! Reference: MuJoCo's documentation, "Computation", §Collision detection. The geom pairs checked
 //! for contact are the file's explicit pairs (`<contact><pair>`), always, and every other pair of
