@@ -289,7 +289,7 @@ pub fn sphere_cylinder(first: &Placed, second: &Placed, margin: f64, touches: &m
 
 /// Capsule `first` against capsule `second`: the spheres at the nearest points of their
 /// segments `c₁ + x₁ a₁` and `c₂ + x₂ a₂` (`aᵢ = hᵢ zᵢ`, xᵢ ∈ [−1, 1]). Parallel segments
-/// (sin²θ below [`PARALLEL`]) touch along the stretch where they overlap: at its two ends, in
+/// (sin²θ below 1e-8) touch along the stretch where they overlap: at its two ends, in
 /// the order of x₁, each end a point of one segment and the nearest point of the other.
 pub fn capsule_capsule(first: &Placed, second: &Placed, margin: f64, touches: &mut Vec<Touch>) {
     let (radius1, half_length1) = round_of(first.shape);

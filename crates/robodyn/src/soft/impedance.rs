@@ -98,7 +98,7 @@ pub fn spring_and_damper(
 }
 
 /// A row's reference acceleration `a_ref = −b v − k d r` and regulariser `R = (1 − d)/d · Â`
-/// (at least [`TINY`]), from its violation `r`, velocity `v` and approximate inverse inertia
+/// (at least 1e-15), from its violation `r`, velocity `v` and approximate inverse inertia
 /// `Â`.
 pub fn reference_and_regulariser(
     solver: &SolverParameters,
