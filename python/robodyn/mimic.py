@@ -574,7 +574,7 @@ _SHARED = frozenset({
     "name", "body_names", "body_parents", "body_masses", "frame_names", "frame_bodies", "joint_names",
     "joint_types", "mimic_joints", "total_mass", "visuals", "skybox", "nu", "actuator_names", "ctrl_range",
     "options", "geoms", "contact_pairs", "contact_excludes", "contact_candidates", "joint_softness",
-    "contact_parameters",
+    "contact_parameters", "collide_placed",
 })
 
 

@@ -76,6 +76,7 @@ VALID: dict[str, Any] = {
     "constraints": [robodyn.PointAnchor("tool0")], "joint": "elbow_joint", "leader": "shoulder_lift_joint",
     "frame1": "tool0", "frame2": "wrist_3_link", "q_full": MIMIC.full.neutral(),
     "ctrl": np.zeros(UR5.nu), "key": "home", "geom1": "floor", "geom2": "upper_link",
+    "positions": np.zeros((8, 3)), "rotations": np.tile(np.eye(3).ravel(), (8, 1)),
 }
 #: Methods that need another model than UR5 to run (a keyframe): the method -> its model.
 PANDA = robodyn.load(REPOSITORY / "testdata" / "mjcf" / "panda_nomesh.xml")
@@ -84,6 +85,7 @@ ARM = robodyn.load(REPOSITORY / "testdata" / "mjcf" / "viewer_arm.xml")
 BOUND = {
     "robodyn.Model.keyframe": PANDA, "robodyn.MimicModel.keyframe": robodyn.MimicModel(PANDA),
     "robodyn.Model.contact_parameters": ARM, "robodyn.MimicModel.contact_parameters": robodyn.MimicModel(ARM),
+    "robodyn.Model.collide_placed": ARM, "robodyn.MimicModel.collide_placed": robodyn.MimicModel(ARM),
 }
 
 

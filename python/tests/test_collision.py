@@ -15,10 +15,11 @@ from robodyn.convert import MujocoLayout
 
 # Closed-form colliders: the same formulas in another order of floating-point operations.
 CLOSED_FORM_AGREEMENT = 1e-9
+# The convex colliders (GJK, EPA, multi-contact) given the very placements MuJoCo computed: the
+# same arithmetic, but for the contact frame's normal, made unit in another order (2 ulp).
+CONVEX_AGREEMENT = 1e-15
 CASES = 300
 MARGIN = 0.01
-#: MuJoCo's geom type numbers
-TYPE_NUMBER = {"plane": 0, "sphere": 2, "capsule": 3, "ellipsoid": 4, "cylinder": 5, "box": 6}
 
 SIZES = {
     "plane": "0 0 1",
@@ -49,7 +50,20 @@ CLOSED_FORM_PAIRS = [
     ("box", "box"),
 ]
 
-CLOSED_FORM_TYPES = {(TYPE_NUMBER[a], TYPE_NUMBER[b]) for a, b in CLOSED_FORM_PAIRS}
+#: The pairs MuJoCo collides by support functions (GJK, EPA and its multi-contact).
+CONVEX_PAIRS = [
+    ("plane", "ellipsoid"),
+    ("sphere", "ellipsoid"),
+    ("capsule", "ellipsoid"),
+    ("ellipsoid", "ellipsoid"),
+    ("capsule", "cylinder"),
+    ("ellipsoid", "cylinder"),
+    ("ellipsoid", "box"),
+    ("cylinder", "cylinder"),
+    ("cylinder", "box"),
+]
+#: MuJoCo's height field and mesh types, which robodyn does not collide yet.
+NOT_COLLIDED_TYPES = {1, 7}
 
 
 def scene(first, second, margin=MARGIN):
@@ -100,9 +114,16 @@ def mujoco_contacts(mj_model, mj_data, qpos):
     ]
 
 
-def disagreements(first, second, tolerance, cases=CASES, seed=0, placements=None):
+def placed_as_in_mujoco(model, mj_model, mj_data):
+    """`model.collide_placed`'s arguments: the geoms where MuJoCo placed them (by name)."""
+    ids = [mj_model.geom(geom["name"]).id for geom in model.geoms]
+    return mj_data.geom_xpos[ids], mj_data.geom_xmat[ids]
+
+
+def disagreements(first, second, tolerance, cases=CASES, seed=0, placements=None, same_placements=False):
     """The cases where robodyn's contacts differ from MuJoCo's, and how many touched: random
-    cases, or the given `placements` (qpos)."""
+    cases, or the given `placements` (qpos); the geoms placed by robodyn's kinematics, or
+    (`same_placements`) exactly where MuJoCo placed them."""
     text = scene(first, second)
     model, mj_model = load_quietly(text=text), mujoco.MjModel.from_xml_string(text)
     mj_data, layout = mujoco.MjData(mj_model), MujocoLayout(model, mj_model)
@@ -111,7 +132,10 @@ def disagreements(first, second, tolerance, cases=CASES, seed=0, placements=None
     for case in range(cases if placements is None else len(placements)):
         qpos = random_qpos(first, second, mj_model, mj_data, rng) if placements is None else np.asarray(placements[case], float)
         expected = mujoco_contacts(mj_model, mj_data, qpos)
-        found = model.collide(layout.q_from_mujoco(qpos))
+        if same_placements:
+            found = model.collide_placed(*placed_as_in_mujoco(model, mj_model, mj_data))
+        else:
+            found = model.collide(layout.q_from_mujoco(qpos))
         touching += bool(expected)
         if len(found) != len(expected):
             failures.append((case, f"{len(found)} contacts, MuJoCo {len(expected)}"))
@@ -130,6 +154,17 @@ def disagreements(first, second, tolerance, cases=CASES, seed=0, placements=None
 @pytest.mark.parametrize("first,second", CLOSED_FORM_PAIRS, ids=lambda kind: kind)
 def test_closed_form_pairs_collide_as_in_mujoco(first, second):
     failures, touching = disagreements(first, second, CLOSED_FORM_AGREEMENT)
+    assert touching > CASES // 4, "too few cases touch to check anything"
+    assert not failures, f"{len(failures)} of {CASES} cases differ: {failures[:5]}"
+
+
+@pytest.mark.parametrize("first,second", CONVEX_PAIRS, ids=lambda kind: kind)
+def test_convex_pairs_collide_as_in_mujoco(first, second):
+    """Given MuJoCo's own placements (`collide_placed`): robodyn's kinematics rounds differently
+    from MuJoCo's (1e-16), and these colliders amplify rounding as MuJoCo's do (EPA stops within
+    `ccd_tolerance` 1e-6 of the depth; the multi-contact picks faces by angle thresholds), so only
+    the same inputs can show they compute what MuJoCo computes."""
+    failures, touching = disagreements(first, second, CONVEX_AGREEMENT, same_placements=True)
     assert touching > CASES // 4, "too few cases touch to check anything"
     assert not failures, f"{len(failures)} of {CASES} cases differ: {failures[:5]}"
 
@@ -166,9 +201,28 @@ SPECIAL_CASES = {
 }
 
 
-@pytest.mark.parametrize("first,second", list(SPECIAL_CASES), ids=lambda kind: kind)
+#: Where the convex colliders switch branches: faces flat on faces (four contacts), a capsule
+#: flat on a cap (two), coaxial cylinders, a cylinder's side on a box's edge, centres together.
+CONVEX_SPECIAL_CASES = {
+    ("cylinder", "box"): [
+        [0, 0, 0, *UPRIGHT, 0, 0, 0.165, *UPRIGHT],
+        [0, 0, 0, *SIDEWAYS, 0, 0, 0.125, *UPRIGHT],
+        [0, 0, 0, *UPRIGHT, 0.12, 0.02, 0.16, *TILTED],
+    ],
+    ("cylinder", "cylinder"): [
+        [0, 0, 0, *UPRIGHT, 0, 0, 0.235, *UPRIGHT],
+        [0, 0, 0, *UPRIGHT, 0.05, 0.03, 0.235, *FLIPPED],
+        [0, 0, 0, *UPRIGHT, 0.155, 0, 0, *UPRIGHT],
+    ],
+    ("capsule", "cylinder"): [[0, 0, 0.185, *SIDEWAYS, 0, 0, 0, *UPRIGHT], [0, 0, 0, *UPRIGHT, 0, 0, 0, *UPRIGHT]],
+    ("ellipsoid", "ellipsoid"): [[0, 0, 0, *UPRIGHT, 0, 0, 0, *UPRIGHT], [0, 0, 0, *UPRIGHT, 0.2, 0, 0, *UPRIGHT]],
+}
+
+
+@pytest.mark.parametrize("first,second", list(SPECIAL_CASES) + list(CONVEX_SPECIAL_CASES), ids=lambda kind: kind)
 def test_special_placements_collide_as_in_mujoco(first, second):
-    placements = SPECIAL_CASES[(first, second)]
+    convex = (first, second) in CONVEX_SPECIAL_CASES
+    placements = (CONVEX_SPECIAL_CASES if convex else SPECIAL_CASES)[(first, second)]
     if first == "plane":
         # the plane is tilted: set the geom on it by the plane's frame
         text = scene(first, second)
@@ -182,22 +236,37 @@ def test_special_placements_collide_as_in_mujoco(first, second):
             mujoco.mju_mulQuat(quaternion, plane_quaternion, np.asarray(qpos[3:7], float))
             placed.append([*(plane_rotation @ np.asarray(qpos[0:3], float)), *quaternion])
         placements = placed
-    failures, touching = disagreements(first, second, CLOSED_FORM_AGREEMENT, placements=placements)
+    tolerance = CONVEX_AGREEMENT if convex else CLOSED_FORM_AGREEMENT
+    failures, touching = disagreements(first, second, tolerance, placements=placements, same_placements=convex)
     assert touching == len(placements)
     assert not failures, failures
 
 
 def test_pairs_without_a_collider_are_named_at_load():
-    """An ellipsoid, and a cylinder against a box: no contacts yet, and the warning says so."""
-    text = """<mujoco><worldbody><geom name="floor" type="plane" size="0 0 1"/>
-      <body pos="0 0 0.05"><freejoint/><geom type="ellipsoid" size="0.1 0.08 0.06"/></body>
+    """A mesh: no contacts yet, and the warning says so; the other pairs are found."""
+    text = """<mujoco><asset><mesh name="tet" vertex="0 0 0 0.1 0 0 0 0.1 0 0 0 0.1" face="0 2 1 0 1 3 0 3 2 1 2 3"/></asset>
+    <worldbody><geom name="floor" type="plane" size="0 0 1"/>
+      <body pos="0 0 0.05"><freejoint/><geom name="egg" type="ellipsoid" size="0.1 0.08 0.06"/></body>
       <body pos="0.5 0 0.05"><freejoint/><geom name="drum" type="cylinder" size="0.1 0.06"/></body>
-      <body pos="0.5 0 0.2"><freejoint/><geom type="box" size="0.1 0.1 0.1"/></body>
+      <body pos="0.5 0 0.1"><freejoint/><geom name="tet" type="mesh" mesh="tet"/></body>
     </worldbody></mujoco>"""
     model = load_quietly(text=text)
-    said = "the contacts of plane–ellipsoid, ellipsoid–cylinder, ellipsoid–box, cylinder–box pairs are not found yet"
+    said = "the contacts of plane–mesh, ellipsoid–mesh, cylinder–mesh pairs are not found yet"
     assert any(said in message for message in model.warnings), model.warnings
-    assert {(c["geom1"], c["geom2"]) for c in model.collide(model.neutral())} == {("floor", "drum")}
+    found = [(c["geom1"], c["geom2"]) for c in model.collide(model.neutral())]
+    assert found == [("floor", "egg")] + [("floor", "drum")] * 3
+
+
+def test_placements_must_be_rotations():
+    """`collide_placed` refuses a matrix that is not a rotation, naming the geom."""
+    model = load_quietly(text=scene("sphere", "box"))
+    positions, rotations = np.zeros((2, 3)), np.tile(np.eye(3).ravel(), (2, 1))
+    assert model.collide_placed(positions, rotations)
+    rotations[1, 0] = 2.0
+    with pytest.raises(ValueError, match="argument 'rotations': expected rotation matrices, row 1 .geom 'b'"):
+        model.collide_placed(positions, rotations)
+    with pytest.raises(ValueError, match="argument 'positions'"):
+        model.collide_placed(np.zeros((3, 3)), rotations)
 
 
 def test_contact_fields_and_order():
@@ -235,7 +304,7 @@ SUITE_CASES = 40
 def test_dm_control_contacts_as_in_mujoco(name):
     """At random configurations about each model's `qpos0` (its joints turned by 0.3 rad or
     moved 0.3 m at random), the same contacts as MuJoCo's, but those robodyn does not find yet
-    (warned at load): the quadruped's height field and its ellipsoid feet on the floor."""
+    (warned at load): the quadruped's height field."""
     path = REPOSITORY / "testdata" / "dm_control" / f"{name}.xml"
     model, mj_model = load_quietly(path), mujoco.MjModel.from_xml_path(str(path))
     mj_data, layout = mujoco.MjData(mj_model), MujocoLayout(model, mj_model)
@@ -245,7 +314,7 @@ def test_dm_control_contacts_as_in_mujoco(name):
         mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.3, 1.0)
         expected = mujoco_contacts(mj_model, mj_data, qpos)
         types = lambda g: int(mj_model.geom_type[mj_model.geom(g).id])
-        expected = [c for c in expected if (types(c[0]), types(c[1])) in CLOSED_FORM_TYPES]
+        expected = [c for c in expected if not {types(c[0]), types(c[1])} & NOT_COLLIDED_TYPES]
         found = model.collide(layout.q_from_mujoco(qpos))
         assert [(c["geom1"], c["geom2"]) for c in found] == [(g1, g2) for g1, g2, *_ in expected], case
         for ours, (g1, g2, dist, pos, frame) in zip(found, expected):

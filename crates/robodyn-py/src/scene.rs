@@ -5,6 +5,7 @@ use crate::args::{read_sample, text, SampleShape};
 use crate::errors::to_py_err;
 use crate::model::PyModel;
 use crate::visuals::{matrix, shape_size};
+use nalgebra::{Matrix3, Vector3};
 use numpy::{PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -329,29 +330,49 @@ impl PyModel {
         let pairs = robodyn::collision::checked_pairs(model);
         let (mut touches, mut contacts) = (Vec::new(), Vec::new());
         robodyn::collision::collide(model, x_world, &pairs, &mut touches, &mut contacts);
-        let mut items = Vec::with_capacity(contacts.len());
-        for contact in &contacts {
-            let item = PyDict::new(py);
-            item.set_item("geom1", &model.geoms[contact.geoms.0].name)?;
-            item.set_item("geom2", &model.geoms[contact.geoms.1].name)?;
-            let pair = contact.pair.map(|k| model.contact_pairs[k].name.clone());
-            item.set_item("pair", pair)?;
-            item.set_item("distance", contact.distance)?;
-            item.set_item(
-                "position",
-                PyArray1::from_slice(py, contact.position.as_slice()),
-            )?;
-            let normal = contact.frame.row(0).transpose();
-            item.set_item("normal", PyArray1::from_slice(py, normal.as_slice()))?;
-            let rows: Vec<Vec<f64>> = contact
-                .frame
-                .row_iter()
-                .map(|row| row.iter().copied().collect())
-                .collect();
-            item.set_item("frame", PyArray2::from_vec2(py, &rows)?)?;
-            items.push(item);
+        contact_dicts(py, model, &contacts)
+    }
+
+    /// The contacts (as `collide` lists them) of the geoms placed in the world directly:
+    /// `positions` (ngeom, 3) and `rotations` (ngeom, 9), each rotation matrix row by row, its
+    /// columns the geom's axes (MuJoCo's `geom_xpos` and `geom_xmat`), in the order of `geoms`.
+    fn collide_placed<'py>(
+        &self,
+        py: Python<'py>,
+        positions: &Bound<'py, PyAny>,
+        rotations: &Bound<'py, PyAny>,
+    ) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let model = &self.model;
+        let count = model.geoms.len();
+        let positions = read_sample("positions", positions, SampleShape::matrix(count, 3))?;
+        let rotations = read_sample("rotations", rotations, SampleShape::matrix(count, 9))?;
+        let rotations: Vec<Matrix3<f64>> = rotations
+            .chunks_exact(9)
+            .map(Matrix3::from_row_slice)
+            .collect();
+        for (g, rotation) in rotations.iter().enumerate() {
+            let error = (rotation.transpose() * rotation - Matrix3::identity())
+                .abs()
+                .max();
+            if error > ROTATION_TOLERANCE || rotation.determinant() < 0.0 {
+                return Err(PyValueError::new_err(format!(
+                    "argument 'rotations': expected rotation matrices, row {g} (geom '{}') is \
+                     {} (|RᵀR − I| = {error:.1e}, det {:.3})",
+                    model.geoms[g].name,
+                    rotation.transpose(),
+                    rotation.determinant()
+                )));
+            }
         }
-        Ok(items)
+        let place = |g: usize| robodyn::collision::Placed {
+            shape: &model.geoms[g].shape,
+            rotation: rotations[g],
+            position: Vector3::new(positions[3 * g], positions[3 * g + 1], positions[3 * g + 2]),
+        };
+        let pairs = robodyn::collision::checked_pairs(model);
+        let (mut touches, mut contacts) = (Vec::new(), Vec::new());
+        robodyn::collision::collide_placed(model, place, &pairs, &mut touches, &mut contacts);
+        contact_dicts(py, model, &contacts)
     }
 
     /// The file's body pairs whose geoms never touch (MJCF `<contact><exclude>`), as
@@ -385,4 +406,40 @@ impl PyModel {
         }
         Ok(joints)
     }
+}
+
+/// How far a rotation given to `collide_placed` may be from orthonormal: far looser than the
+/// rounding of any rotation a program computes (MuJoCo's `geom_xmat` is orthonormal to ~1e-15),
+/// far tighter than a matrix that is not one.
+const ROTATION_TOLERANCE: f64 = 1e-9;
+
+/// The contacts as Python dicts (see `collide`).
+fn contact_dicts<'py>(
+    py: Python<'py>,
+    model: &robodyn::Model,
+    contacts: &[robodyn::collision::Contact],
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let mut items = Vec::with_capacity(contacts.len());
+    for contact in contacts {
+        let item = PyDict::new(py);
+        item.set_item("geom1", &model.geoms[contact.geoms.0].name)?;
+        item.set_item("geom2", &model.geoms[contact.geoms.1].name)?;
+        let pair = contact.pair.map(|k| model.contact_pairs[k].name.clone());
+        item.set_item("pair", pair)?;
+        item.set_item("distance", contact.distance)?;
+        item.set_item(
+            "position",
+            PyArray1::from_slice(py, contact.position.as_slice()),
+        )?;
+        let normal = contact.frame.row(0).transpose();
+        item.set_item("normal", PyArray1::from_slice(py, normal.as_slice()))?;
+        let rows: Vec<Vec<f64>> = contact
+            .frame
+            .row_iter()
+            .map(|row| row.iter().copied().collect())
+            .collect();
+        item.set_item("frame", PyArray2::from_vec2(py, &rows)?)?;
+        items.push(item);
+    }
+    Ok(items)
 }

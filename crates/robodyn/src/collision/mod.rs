@@ -15,13 +15,15 @@
 //! and exists when `d ≤ margin + gap` of the pair ([`crate::soft::contact_parameters`]).
 //!
 //! The modules: [`pairs`] (which geoms may touch), [`primitives`] (planes, spheres, capsules,
-//! cylinders, in closed form) and [`boxes`] and [`box_box`] (boxes against spheres, capsules
-//! and boxes). The other pairs (an ellipsoid, a cylinder against a round shape or a box, a
-//! mesh), which MuJoCo collides by the support functions of convex shapes, have no collider
-//! yet.
+//! cylinders, in closed form), [`boxes`] and [`box_box`] (boxes against spheres, capsules
+//! and boxes), and [`convex`] with [`gjk`] for the pairs MuJoCo collides by the support
+//! functions of convex shapes (an ellipsoid against anything, a cylinder against a capsule, a
+//! cylinder or a box). Meshes have no collider yet.
 
 pub mod box_box;
 pub mod boxes;
+pub mod convex;
+pub mod gjk;
 pub mod pairs;
 pub mod primitives;
 
@@ -132,8 +134,8 @@ pub fn contact_frame(normal: &Vec3, tangent: &Vec3) -> Mat3 {
     Mat3::from_rows(&[normal.transpose(), t1.transpose(), t2.transpose()])
 }
 
-/// The collision function of two shapes, the lower type first (`None`: none yet, see the
-/// module's header; a plane never touches a plane).
+/// The collision function of two shapes, the lower type first (`None`: a mesh, which has no
+/// collider yet, or two planes, which never touch).
 pub fn collider(first: &Shape, second: &Shape) -> Option<Collider> {
     use Shape::*;
     let function: Collider = match (first, second) {
@@ -148,7 +150,9 @@ pub fn collider(first: &Shape, second: &Shape) -> Option<Collider> {
         (Capsule { .. }, Capsule { .. }) => primitives::capsule_capsule,
         (Capsule { .. }, Box { .. }) => boxes::capsule_box,
         (Box { .. }, Box { .. }) => box_box::box_box,
-        _ => return None,
+        (Plane { .. }, Ellipsoid { .. }) => convex::plane_convex,
+        (Plane { .. } | Mesh { .. }, _) | (_, Plane { .. } | Mesh { .. }) => return None,
+        _ => convex::convex_convex,
     };
     Some(function)
 }
@@ -232,6 +236,21 @@ pub fn collide(
     touches: &mut Vec<Touch>,
     contacts: &mut Vec<Contact>,
 ) {
+    let place = |g: usize| {
+        let geom = &model.geoms[g];
+        Placed::new(&geom.shape, &(geom.placement * x_world[geom.body]))
+    };
+    collide_placed(model, place, pairs, touches, contacts);
+}
+
+/// [`collide`] with each geom `g` placed in the world by `place(g)` instead of by its body.
+pub fn collide_placed<'m>(
+    model: &'m Model,
+    place: impl Fn(usize) -> Placed<'m>,
+    pairs: &[CheckedPair],
+    touches: &mut Vec<Touch>,
+    contacts: &mut Vec<Contact>,
+) {
     contacts.clear();
     for checked in pairs {
         let (g1, g2) = checked.geoms;
@@ -240,10 +259,13 @@ pub fn collide(
             continue;
         };
         let parameters = crate::soft::contact_parameters(model, g1, g2);
-        let first = Placed::new(&one.shape, &(one.placement * x_world[one.body]));
-        let second = Placed::new(&other.shape, &(other.placement * x_world[other.body]));
         touches.clear();
-        function(&first, &second, parameters.margin + parameters.gap, touches);
+        function(
+            &place(g1),
+            &place(g2),
+            parameters.margin + parameters.gap,
+            touches,
+        );
         contacts.extend(touches.iter().map(|touch| Contact {
             geoms: checked.geoms,
             pair: checked.pair,
