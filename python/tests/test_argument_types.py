@@ -86,6 +86,8 @@ BOUND = {
     "robodyn.Model.keyframe": PANDA, "robodyn.MimicModel.keyframe": robodyn.MimicModel(PANDA),
     "robodyn.Model.contact_parameters": ARM, "robodyn.MimicModel.contact_parameters": robodyn.MimicModel(ARM),
     "robodyn.Model.collide_placed": ARM, "robodyn.MimicModel.collide_placed": robodyn.MimicModel(ARM),
+    # ... and contact dynamics: a reduction without mimic joints (the full model's)
+    "robodyn.MimicModel.contact_forward_dynamics": robodyn.MimicModel(UR5),
 }
 
 

@@ -13,6 +13,7 @@ mod actuators;
 mod args;
 mod constrained;
 mod constraints;
+mod contact_dynamics;
 mod dynamics;
 mod errors;
 mod keyframes;

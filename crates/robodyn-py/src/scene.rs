@@ -414,7 +414,7 @@ impl PyModel {
 const ROTATION_TOLERANCE: f64 = 1e-9;
 
 /// The contacts as Python dicts (see `collide`).
-fn contact_dicts<'py>(
+pub(crate) fn contact_dicts<'py>(
     py: Python<'py>,
     model: &robodyn::Model,
     contacts: &[robodyn::collision::Contact],

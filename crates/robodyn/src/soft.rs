@@ -19,7 +19,11 @@
 //! `solref` (its friction rows' too), `solimp` and friction are the `<option>`'s `o_margin`,
 //! `o_solref`, `o_solimp` and `o_friction`. Every friction term is at least [`MIN_FRICTION`].
 
+pub mod dynamics;
 pub mod impedance;
+pub mod rows;
+pub mod solver;
+pub mod weights;
 
 use crate::model::{ContactPair, Geom, Model, SolverParameters};
 

@@ -187,7 +187,7 @@ pub fn spring_energy(model: &Model, q: &[f64], scratch: &mut [f64]) -> f64 {
 }
 
 /// q ⊖ q_ref, joint by joint on its group, into `out` (nv).
-fn spring_displacement(model: &Model, q: &[f64], out: &mut [f64]) {
+pub(crate) fn spring_displacement(model: &Model, q: &[f64], out: &mut [f64]) {
     for i in 1..model.nbodies() {
         let (configuration, dofs) = (model.q_range(i), model.v_range(i));
         model.joints[i].difference(

@@ -205,6 +205,8 @@ fn load_sources(sources: &Sources) -> Result<Model> {
             name: "world".to_string(),
             parent: 0,
             body: 0,
+            mass: 0.0,
+            com: crate::spatial::Vec3::zeros(),
         }]),
     };
     if !root.has_tag_name("mujoco") {
@@ -292,9 +294,9 @@ fn load_sources(sources: &Sources) -> Result<Model> {
             )
         };
         model.warnings.push(format!(
-            "{}: geoms read as collision shapes (m.geoms, m.collide) but robodyn does not \
-             compute contact forces yet: in simulation bodies pass through each other and the \
-             floor{unfound}",
+            "{}: geoms read as collision shapes (m.geoms, m.collide; their forces: \
+             m.contact_forward_dynamics) but robodyn's simulation does not use contact forces \
+             yet: in simulation bodies pass through each other and the floor{unfound}",
             reader.location(root)
         ));
     }

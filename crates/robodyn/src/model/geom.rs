@@ -5,7 +5,7 @@
 //! §Contact parameters (how two geoms' parameters combine). The defaults are MuJoCo's.
 
 use super::options::SolverParameters;
-use crate::spatial::Transform;
+use crate::spatial::{Transform, Vec3};
 use crate::visual::Shape;
 
 /// MuJoCo's default `friction` of a geom: sliding, torsional, rolling.
@@ -78,7 +78,7 @@ pub struct ContactPair {
 }
 
 /// One of the file's bodies (MuJoCo's body), which a model body may merge with others.
-#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SourceBody {
     /// Its `name` (`body<offset>` when the file gives none; the world's is "world").
     pub name: String,
@@ -86,6 +86,11 @@ pub struct SourceBody {
     pub parent: usize,
     /// The model body it moves with (0: welded to the world).
     pub body: usize,
+    /// Its own mass (kg), before any merging.
+    pub mass: f64,
+    /// Its own centre of mass (its frame's origin when massless) in the frame of `body`
+    /// (MuJoCo's `xipos` there).
+    pub com: Vec3,
 }
 
 /// Two of the file's bodies whose geoms never touch (`<contact><exclude>`), as
@@ -108,6 +113,9 @@ pub struct JointSoftness {
     pub margin: f64,
     /// The dry friction's solver parameters.
     pub friction: SolverParameters,
+    /// A limited ball joint's largest angle (rad): MuJoCo's `max(range)`.
+    #[serde(default)]
+    pub cone_limit: Option<f64>,
 }
 
 impl Default for JointSoftness {
@@ -116,6 +124,7 @@ impl Default for JointSoftness {
             limit: SolverParameters::default(),
             margin: 0.0,
             friction: SolverParameters::default(),
+            cone_limit: None,
         }
     }
 }

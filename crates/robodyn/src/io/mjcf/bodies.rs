@@ -139,6 +139,8 @@ impl<'a> Reader<'a> {
                 name: name.clone(),
                 parent: parent_source,
                 body: parent,
+                mass: 0.0,
+                com: Vec3::zeros(),
             });
             bodies.len() - 1
         };
@@ -250,6 +252,10 @@ impl<'a> Reader<'a> {
             ) {
                 properties.lower = position_unit(lower);
                 properties.upper = position_unit(upper);
+                // a ball's limit is a cone: its largest angle
+                if joint == Joint::Spherical {
+                    properties.softness.cone_limit = Some(self.angle(lower.max(upper)));
+                }
             }
             properties.actuator_force_range =
                 self.actuator_force_range(*joint_node, joint_class)?;
@@ -327,7 +333,17 @@ impl<'a> Reader<'a> {
         if to_body != Transform::IDENTITY {
             builder.add_frame(&name, body, to_body);
         }
-        self.source_bodies.borrow_mut()[source_body].body = body;
+        // its own mass and centre of mass, in the model body's frame (X_{B←body} = to_body)
+        let own = to_body.transpose_apply_inertia(&inertia);
+        let com = if inertia.mass > 0.0 {
+            own.first_moment / own.mass
+        } else {
+            to_body.translation
+        };
+        let mut bodies = self.source_bodies.borrow_mut();
+        (bodies[source_body].body, bodies[source_body].mass) = (body, inertia.mass);
+        bodies[source_body].com = com;
+        drop(bodies);
         self.add_geoms(
             builder,
             &elements,
@@ -357,6 +373,7 @@ impl<'a> Reader<'a> {
                 .numbers::<1>(joint, class, "margin")?
                 .map_or(0.0, |[m]| m),
             friction: parameters("solreffriction", "solimpfriction")?,
+            cone_limit: None,
         })
     }
 

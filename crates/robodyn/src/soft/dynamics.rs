@@ -1,0 +1,160 @@
+//! Forward dynamics with MuJoCo's soft constraints: contacts, joint limits and dry friction as
+//! MuJoCo's `mj_forward` computes them, its solver run to convergence.
+//!
+//! Reference: MuJoCo's documentation, "Computation", §Forward dynamics. At (q, q̇) under applied
+//! forces τ and controls u:
+//! ```text
+//!   1. contacts   where the geoms touch (crate::collision)
+//!   2. q̈₀ = M⁻¹ (τ + τ_actuator(u) + τ_passive − C q̇ − g)      unconstrained
+//!   3. rows       J, R, a_ref of every active constraint (super::rows)
+//!   4. q̈, f      the soft model's solution (super::solver)
+//! ```
+//! MuJoCo measures a free joint's linear velocity in world axes, robodyn in the body's: its
+//! accelerations are then `T (q̈ + w)`, w = (ω × v, 0) on free joints, and its rows ask
+//! `J (q̈ + w)` to follow a_ref. Solving for robodyn's q̈ with `a_ref − J w` gives its very
+//! solution, and the forces of its rows.
+
+use super::rows::{constraint_rows, Rows};
+use super::solver::{solve, Solution};
+use super::weights::{inverse_weights, InverseWeights};
+use crate::algo::{bias_forces, crba, forward_kinematics};
+use crate::collision::{checked_pairs, collide, CheckedPair, Contact, Touch};
+use crate::error::{check_vector, Result};
+use crate::integrate::forces::spring_displacement;
+use crate::joint::Joint;
+use crate::model::Model;
+use crate::Data;
+use nalgebra::DVector;
+
+/// What [`ContactDynamics::forward`] finds.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ContactForward {
+    /// The contacts ([`crate::collision::collide`]).
+    pub contacts: Vec<Contact>,
+    /// The constraint rows.
+    pub rows: Rows,
+    /// q̈ and the rows' forces.
+    pub solution: Solution,
+    /// The actuators' generalised forces (MuJoCo's `qfrc_actuator`).
+    pub actuator: DVector<f64>,
+    /// The constraints' generalised forces `Jᵀ f` (MuJoCo's `qfrc_constraint`).
+    pub constraint: DVector<f64>,
+}
+
+/// A model's soft-constraint dynamics: its constant weights, pairs and scratch space.
+#[derive(Debug, Clone)]
+pub struct ContactDynamics {
+    weights: InverseWeights,
+    pairs: Vec<CheckedPair>,
+    data: Data,
+    touches: Vec<Touch>,
+}
+
+impl ContactDynamics {
+    /// The weights and pairs of `model`.
+    pub fn new(model: &Model) -> Result<Self> {
+        let mut data = Data::new(model);
+        Ok(ContactDynamics {
+            weights: inverse_weights(model, &mut data)?,
+            pairs: checked_pairs(model),
+            data,
+            touches: Vec::new(),
+        })
+    }
+
+    /// The soft model's q̈ at (q, q̇) under applied forces `tau` (nv) and controls `ctrl` (nu),
+    /// into `out` (see the module's header).
+    pub fn forward(
+        &mut self,
+        model: &Model,
+        (q, v): (&[f64], &[f64]),
+        tau: &[f64],
+        ctrl: &[f64],
+        out: &mut ContactForward,
+    ) -> Result<()> {
+        check_vector("v", v, model.nv)?;
+        check_vector("tau", tau, model.nv)?;
+        let nv = model.nv;
+        // 1. the contacts
+        let x_world = forward_kinematics(model, &mut self.data, q)?.to_vec();
+        collide(
+            model,
+            &x_world,
+            &self.pairs,
+            &mut self.touches,
+            &mut out.contacts,
+        );
+        // 2. q̈₀ = M⁻¹ (τ + τ_actuator + τ_passive − C q̇ − g)
+        out.actuator = DVector::zeros(nv);
+        model.actuator_forces(q, v, ctrl, out.actuator.as_mut_slice())?;
+        let mut total = DVector::from_column_slice(tau) + &out.actuator;
+        total += passive_forces(model, q, v);
+        total -= bias_forces(model, &mut self.data, q, v)?;
+        let mass = crba(model, &mut self.data, q)?.clone();
+        let free = mass
+            .clone()
+            .cholesky()
+            .ok_or_else(|| crate::error::Error::InvalidValue {
+                argument: "q".into(),
+                message: "the mass matrix is not positive definite".into(),
+            })?
+            .solve(&total);
+        // 3. the rows, their a_ref as robodyn's accelerations see it: a_ref − J w
+        constraint_rows(
+            model,
+            &self.weights,
+            (q, v),
+            &x_world,
+            &out.contacts,
+            &mut out.rows,
+        )?;
+        let w = free_joint_velocity_product(model, v);
+        let reference: Vec<f64> = (0..out.rows.len())
+            .map(|i| out.rows.reference[i] - dot(out.rows.row(i), w.as_slice()))
+            .collect();
+        // 4. the solution
+        out.solution = solve(&out.rows, &mass, &free, &reference)?;
+        out.constraint = DVector::zeros(nv);
+        for (i, force) in out.solution.forces.iter().enumerate() {
+            for (c, j) in out.rows.row(i).iter().enumerate() {
+                out.constraint[c] += j * force;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// τ_passive = −K (q ⊖ q_ref) − D q̇: the joints' springs and dampers (MuJoCo's `qfrc_passive`
+/// without gravity compensation and fluid forces; dry friction is a constraint row).
+fn passive_forces(model: &Model, q: &[f64], v: &[f64]) -> DVector<f64> {
+    let options = &model.options;
+    let mut tau = DVector::zeros(model.nv);
+    if options.flag("spring") && model.stiffness.iter().any(|k| *k != 0.0) {
+        spring_displacement(model, q, tau.as_mut_slice());
+        tau.component_mul_assign(&(-&model.stiffness));
+    }
+    if options.flag("damper") {
+        tau -= model.damping.component_mul(&DVector::from_column_slice(v));
+    }
+    tau
+}
+
+/// w = (ω × v, 0) on each free joint's coordinates, 0 elsewhere: MuJoCo's free-joint
+/// acceleration is `T (q̈ + w)`.
+fn free_joint_velocity_product(model: &Model, v: &[f64]) -> DVector<f64> {
+    let mut w = DVector::zeros(model.nv);
+    for i in 1..model.nbodies() {
+        if matches!(model.joints[i], Joint::Free) {
+            let s = model.idx_v[i];
+            let linear = nalgebra::Vector3::new(v[s], v[s + 1], v[s + 2]);
+            let angular = nalgebra::Vector3::new(v[s + 3], v[s + 4], v[s + 5]);
+            let product = angular.cross(&linear);
+            w.rows_mut(s, 3).copy_from(&product);
+        }
+    }
+    w
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(a, b)| a * b).sum()
+}

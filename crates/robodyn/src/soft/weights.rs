@@ -1,0 +1,123 @@
+//! How heavy each body and each degree of freedom looks from outside, at the model's neutral
+//! configuration: the approximate inverse inertias `Â` that scale MuJoCo's regulariser
+//! `R = (1 − d)/d · Â` (MuJoCo's `body_invweight0` and `dof_invweight0`, computed once per model
+//! by its `mj_setConst` at `qpos0`).
+//!
+//! Reference: MuJoCo's documentation, "Computation", §Soft constraints ("the approximate
+//! diagonal"). For a body with centre of mass c, its 6 × nv Jacobian `J_c` (the velocity of c,
+//! then the angular velocity, in world axes) gives the inverse inertia felt there,
+//! ```text
+//!   A = J_c M⁻¹ J_cᵀ,   Â_body = (tr A_tt / 3,  tr A_rr / 3)
+//! ```
+//! (0 for a body welded to the world), and a joint's block of `M⁻¹` gives its own:
+//! `(M⁻¹)_ii` for a hinge or slide, the mean of the block's diagonal for a ball, of the
+//! translation and rotation blocks apart for a free joint. Both traces are the same in any
+//! coordinates of the velocities, so robodyn's free-joint velocities (linear in the body's axes)
+//! give MuJoCo's numbers (linear in the world's).
+//!
+//! MuJoCo takes 1/m instead for a "simple" body (a root body with only axis-aligned slides, its
+//! inertia frame its own): such bodies are not recognised here yet (see the guide's "Not yet").
+
+use crate::algo::{crba, forward_kinematics};
+use crate::error::{Error, Result};
+use crate::joint::Joint;
+use crate::model::Model;
+use crate::spatial::Vec3;
+use crate::Data;
+use nalgebra::DMatrix;
+
+/// The approximate inverse inertias of the file's bodies and of the degrees of freedom.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InverseWeights {
+    /// Per file body ([`Model::source_bodies`]): (translation, rotation).
+    pub bodies: Vec<[f64; 2]>,
+    /// Per velocity coordinate.
+    pub dofs: Vec<f64>,
+}
+
+/// The weights of `model` at its neutral configuration (see the module's header).
+pub fn inverse_weights(model: &Model, data: &mut Data) -> Result<InverseWeights> {
+    let nv = model.nv;
+    let q = model.neutral_configuration.clone();
+    let mass_matrix = crba(model, data, q.as_slice())?.clone();
+    let inverse = mass_matrix
+        .cholesky()
+        .ok_or_else(|| Error::InvalidValue {
+            argument: "model".into(),
+            message: "the mass matrix at the neutral configuration is not positive definite".into(),
+        })?
+        .inverse();
+    let x_world = forward_kinematics(model, data, q.as_slice())?.to_vec();
+    // the bodies: A = J_c M⁻¹ J_cᵀ at each centre of mass
+    let mut bodies = Vec::with_capacity(model.source_bodies.len());
+    let mut jacobian = DMatrix::zeros(6, nv);
+    for source in &model.source_bodies {
+        if source.body == 0 {
+            bodies.push([0.0, 0.0]);
+            continue;
+        }
+        let centre = world_point(&x_world[source.body], &source.com);
+        centre_jacobian(model, &x_world, source.body, &centre, &mut jacobian);
+        let a = &jacobian * &inverse * jacobian.transpose();
+        let trace = |from: usize| {
+            (a[(from, from)] + a[(from + 1, from + 1)] + a[(from + 2, from + 2)]) / 3.0
+        };
+        bodies.push([trace(0), trace(3)]);
+    }
+    // the joints: their blocks of M⁻¹
+    let mut dofs = vec![0.0; nv];
+    for i in 1..model.nbodies() {
+        let range = model.v_range(i);
+        let mean = |from: usize, count: usize| {
+            (from..from + count).map(|k| inverse[(k, k)]).sum::<f64>() / count as f64
+        };
+        match model.joints[i] {
+            Joint::Free => {
+                let (translation, rotation) = (mean(range.start, 3), mean(range.start + 3, 3));
+                dofs[range.start..range.start + 3].fill(translation);
+                dofs[range.start + 3..range.end].fill(rotation);
+            }
+            Joint::Spherical => {
+                let value = mean(range.start, 3);
+                dofs[range].fill(value);
+            }
+            _ => {
+                for k in range {
+                    dofs[k] = inverse[(k, k)];
+                }
+            }
+        }
+    }
+    Ok(InverseWeights { bodies, dofs })
+}
+
+/// The 6 × nv Jacobian of the world point `point` moving with `body`: rows the point's velocity,
+/// then the body's angular velocity, in world axes (into `out`, overwritten).
+pub(crate) fn centre_jacobian(
+    model: &Model,
+    x_world: &[crate::spatial::Transform],
+    body: usize,
+    point: &Vec3,
+    out: &mut DMatrix<f64>,
+) {
+    out.fill(0.0);
+    let mut j = body;
+    while j != 0 {
+        for (k, column) in model.v_range(j).enumerate() {
+            // the joint's column (ω, v_O) at the world origin; at p: v_O + ω × p
+            let s = model.joints[j].subspace_column_from(k, &x_world[j]);
+            let linear = s.linear + s.angular.cross(point);
+            for r in 0..3 {
+                out[(r, column)] = linear[r];
+                out[(3 + r, column)] = s.angular[r];
+            }
+        }
+        j = model.parent[j];
+    }
+}
+
+/// A point given in the frame of a body placed at `X_{body←0}` = (E, r), in world coordinates:
+/// `Eᵀ p + r`.
+pub(crate) fn world_point(x: &crate::spatial::Transform, p: &Vec3) -> Vec3 {
+    x.rotation.transpose() * p + x.translation
+}
