@@ -17,7 +17,7 @@
 use super::rows::{constraint_rows, Rows};
 use super::solver::{solve, Solution};
 use super::weights::{inverse_weights, InverseWeights};
-use crate::algo::{bias_forces, crba, forward_kinematics};
+use crate::algo::{aba, crba, forward_kinematics};
 use crate::collision::{checked_pairs, collide, CheckedPair, Contact, Touch};
 use crate::error::{check_vector, Result};
 use crate::integrate::forces::spring_displacement;
@@ -84,21 +84,12 @@ impl ContactDynamics {
             &mut self.touches,
             &mut out.contacts,
         );
-        // 2. q̈₀ = M⁻¹ (τ + τ_actuator + τ_passive − C q̇ − g)
+        // 2. q̈₀ = M⁻¹ (τ + τ_actuator + τ_passive − C q̇ − g), by the articulated-body algorithm
         out.actuator = DVector::zeros(nv);
         model.actuator_forces(q, v, ctrl, out.actuator.as_mut_slice())?;
-        let mut total = DVector::from_column_slice(tau) + &out.actuator;
-        total += passive_forces(model, q, v);
-        total -= bias_forces(model, &mut self.data, q, v)?;
+        let total = DVector::from_column_slice(tau) + &out.actuator + passive_forces(model, q, v);
+        let free = aba(model, &mut self.data, q, v, total.as_slice(), None)?.clone();
         let mass = crba(model, &mut self.data, q)?.clone();
-        let free = mass
-            .clone()
-            .cholesky()
-            .ok_or_else(|| crate::error::Error::InvalidValue {
-                argument: "q".into(),
-                message: "the mass matrix is not positive definite".into(),
-            })?
-            .solve(&total);
         // 3. the rows, their a_ref as robodyn's accelerations see it: a_ref − J w
         constraint_rows(
             model,

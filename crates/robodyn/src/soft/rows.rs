@@ -24,7 +24,7 @@
 //! with (k, b) from `solref` ([`super::impedance::spring_and_damper`]).
 
 use super::impedance::{impedance, spring_and_damper};
-use super::weights::InverseWeights;
+use super::weights::{point_columns, InverseWeights};
 use crate::collision::Contact;
 use crate::error::{Error, Result};
 use crate::joint::Joint;
@@ -445,21 +445,20 @@ fn contact_jacobian(
     out: &mut [f64],
 ) {
     let nv = model.nv;
+    let frame: &Mat3 = &contact.frame;
     for (body, sign) in [(b2, 1.0), (b1, -1.0)] {
-        let mut j = body;
-        while j != 0 {
-            for (k, column) in model.v_range(j).enumerate() {
-                // the joint's (ω, v_O) at the world origin; the point p moves at v_O + ω × p
-                let s = model.joints[j].subspace_column_from(k, &x_world[j]);
-                let linear: Vec3 = s.linear + s.angular.cross(&contact.position);
-                let frame: &Mat3 = &contact.frame;
-                let (t, r) = (frame * linear, frame * s.angular);
+        point_columns(
+            model,
+            x_world,
+            body,
+            &contact.position,
+            |column, linear, angular| {
+                let (t, r) = (frame * linear, frame * angular);
                 for row in 0..3 {
                     out[row * nv + column] += sign * t[row];
                     out[(3 + row) * nv + column] += sign * r[row];
                 }
-            }
-            j = model.parent[j];
-        }
+            },
+        );
     }
 }

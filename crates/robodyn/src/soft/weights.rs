@@ -18,11 +18,11 @@
 //! MuJoCo takes 1/m instead for a "simple" body (a root body with only axis-aligned slides, its
 //! inertia frame its own): such bodies are not recognised here yet (see the guide's "Not yet").
 
-use crate::algo::{crba, forward_kinematics};
-use crate::error::{Error, Result};
+use crate::algo::{forward_kinematics, inverse_mass_matrix};
+use crate::error::Result;
 use crate::joint::Joint;
 use crate::model::Model;
-use crate::spatial::Vec3;
+use crate::spatial::{Transform, Vec3};
 use crate::Data;
 use nalgebra::DMatrix;
 
@@ -38,16 +38,9 @@ pub struct InverseWeights {
 /// The weights of `model` at its neutral configuration (see the module's header).
 pub fn inverse_weights(model: &Model, data: &mut Data) -> Result<InverseWeights> {
     let nv = model.nv;
-    let q = model.neutral_configuration.clone();
-    let mass_matrix = crba(model, data, q.as_slice())?.clone();
-    let inverse = mass_matrix
-        .cholesky()
-        .ok_or_else(|| Error::InvalidValue {
-            argument: "model".into(),
-            message: "the mass matrix at the neutral configuration is not positive definite".into(),
-        })?
-        .inverse();
-    let x_world = forward_kinematics(model, data, q.as_slice())?.to_vec();
+    let q = model.neutral_configuration.as_slice();
+    let inverse = inverse_mass_matrix(model, data, q)?.clone();
+    let x_world = forward_kinematics(model, data, q)?.to_vec();
     // the bodies: A = J_c M⁻¹ J_cᵀ at each centre of mass
     let mut bodies = Vec::with_capacity(model.source_bodies.len());
     let mut jacobian = DMatrix::zeros(6, nv);
@@ -57,7 +50,19 @@ pub fn inverse_weights(model: &Model, data: &mut Data) -> Result<InverseWeights>
             continue;
         }
         let centre = world_point(&x_world[source.body], &source.com);
-        centre_jacobian(model, &x_world, source.body, &centre, &mut jacobian);
+        jacobian.fill(0.0);
+        point_columns(
+            model,
+            &x_world,
+            source.body,
+            &centre,
+            |column, linear, angular| {
+                for r in 0..3 {
+                    jacobian[(r, column)] = linear[r];
+                    jacobian[(3 + r, column)] = angular[r];
+                }
+            },
+        );
         let a = &jacobian * &inverse * jacobian.transpose();
         let trace = |from: usize| {
             (a[(from, from)] + a[(from + 1, from + 1)] + a[(from + 2, from + 2)]) / 3.0
@@ -91,26 +96,22 @@ pub fn inverse_weights(model: &Model, data: &mut Data) -> Result<InverseWeights>
     Ok(InverseWeights { bodies, dofs })
 }
 
-/// The 6 × nv Jacobian of the world point `point` moving with `body`: rows the point's velocity,
-/// then the body's angular velocity, in world axes (into `out`, overwritten).
-pub(crate) fn centre_jacobian(
+/// The columns of the Jacobian of the world point `point` moving with `body`, those of the
+/// joints between it and the world: each handed to `column(index, linear, angular)`, the point's
+/// velocity and the body's angular velocity (world axes) that the coordinate makes.
+pub(crate) fn point_columns(
     model: &Model,
-    x_world: &[crate::spatial::Transform],
+    x_world: &[Transform],
     body: usize,
     point: &Vec3,
-    out: &mut DMatrix<f64>,
+    mut column: impl FnMut(usize, &Vec3, &Vec3),
 ) {
-    out.fill(0.0);
     let mut j = body;
     while j != 0 {
-        for (k, column) in model.v_range(j).enumerate() {
+        for (k, index) in model.v_range(j).enumerate() {
             // the joint's column (ω, v_O) at the world origin; at p: v_O + ω × p
             let s = model.joints[j].subspace_column_from(k, &x_world[j]);
-            let linear = s.linear + s.angular.cross(point);
-            for r in 0..3 {
-                out[(r, column)] = linear[r];
-                out[(3 + r, column)] = s.angular[r];
-            }
+            column(index, &(s.linear + s.angular.cross(point)), &s.angular);
         }
         j = model.parent[j];
     }
@@ -118,6 +119,6 @@ pub(crate) fn centre_jacobian(
 
 /// A point given in the frame of a body placed at `X_{body←0}` = (E, r), in world coordinates:
 /// `Eᵀ p + r`.
-pub(crate) fn world_point(x: &crate::spatial::Transform, p: &Vec3) -> Vec3 {
+pub(crate) fn world_point(x: &Transform, p: &Vec3) -> Vec3 {
     x.rotation.transpose() * p + x.translation
 }
