@@ -24,7 +24,7 @@ from robodyn.plot import stick_figure_points
 # the repository's root: examples/ lies beside testdata/ (the Go2 without its visual meshes)
 SCENE = Path(_compare.__file__).resolve().parents[1] / "testdata" / "menagerie" / "unitree_go2" / "scene.xml"
 with warnings.catch_warnings():
-    # the scene's <visual> is not read, and robodyn's simulation does not use contacts yet
+    # the scene's <visual> is not read, and its contacts are felt only with integrator='mujoco'
     warnings.simplefilter("ignore", robodyn.ModelWarning)
     go2 = robodyn.load(SCENE)
 home = go2.keyframe("home")

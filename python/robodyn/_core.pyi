@@ -31,6 +31,8 @@ __all__ = [
     "_model_from_bytes",
     "simulate",
     "step",
+    "simulate_scene",
+    "step_scene",
     "read_mesh_file",
     "check_physical_parameters",
 ]
@@ -429,3 +431,14 @@ def step(
     baumgarte: tuple[float, float] | None = None,
     damping: float = 0.0,
 ) -> _FloatArray: ...
+def simulate_scene(
+    model: Model,
+    q0: ArrayLike,
+    v0: ArrayLike,
+    steps: int,
+    record_every: int,
+    ctrl: ArrayLike | Callable[[float, _FloatArray, _FloatArray], ArrayLike] | None = None,
+    controller: dict | Callable[[float, _FloatArray, _FloatArray], ArrayLike] | None = None,
+    progress: Callable[[float], object] | None = None,
+) -> dict[str, Any]: ...
+def step_scene(model: Model, q: ArrayLike, v: ArrayLike, tau: ArrayLike, ctrl: ArrayLike) -> _FloatArray: ...

@@ -63,8 +63,12 @@ __all__ = [
     "step",
 ]
 
-#: The integrator names :func:`simulate` accepts.
-INTEGRATORS = ("euler", "semi_implicit_euler", "rk4", "rk45")
+#: The integrator names :func:`simulate` accepts (``"mujoco"``: the scene's own, as ``mj_step``).
+INTEGRATORS = ("euler", "semi_implicit_euler", "rk4", "rk45", "mujoco")
+#: The default recording interval of the integrators other than ``"mujoco"`` (s).
+DEFAULT_DT = 1e-3
+#: How close ``dt`` must be to a whole number of a scene's time steps (relative).
+STEP_MULTIPLE_TOLERANCE = 1e-9
 #: What :func:`simulate` does at a joint limit: report it, or also push back with a penalty.
 LIMIT_MODELS = ("report", "penalty")
 #: What :func:`simulate` does with a fixed-step run less accurate than ``rtol``.
@@ -211,6 +215,8 @@ class Trajectory:
     error_estimate: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False)
     energy_drift: float | None = None
     accuracy_issue: dict[str, Any] | None = None
+    ctrl: np.ndarray | None = field(default=None, repr=False)
+    tau_constraint: np.ndarray | None = field(default=None, repr=False)
     kinetic_energy: np.ndarray = field(init=False, repr=False)
     potential_energy: np.ndarray = field(init=False, repr=False)
     spring_energy: np.ndarray = field(init=False, repr=False)
@@ -321,33 +327,33 @@ Configurations = Union["np.ndarray[tuple[int, int], np.dtype[Any]]", Sequence[Se
 
 
 @overload
-def simulate(model: _core.Model | MimicModel, q0: Configuration, v0: ArrayLike | None = None, t_end: float = 1.0,
-             dt: float = 1e-3, integrator: str = "rk4", controller: Any = None, wrenches: Any = None, *,
+def simulate(model: _core.Model | MimicModel, q0: Configuration | str, v0: ArrayLike | None = None, t_end: float = 1.0,
+             dt: float | None = None, integrator: str = "rk4", controller: Any = None, wrenches: Any = None, *,
              rtol: float | None = None, atol: float = 1e-9, max_step: float | None = None,
              friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
              limit_damping: float = 1e2, progress: Callable[[float], Any] | None = None,
              accuracy: str = "warn", constraints: Any | None = "model", baumgarte: tuple[float, float] | None = None,
-             damping: float = 0.0) -> Trajectory: ...
+             damping: float = 0.0, ctrl: Any = None) -> Trajectory: ...
 
 
 @overload
 def simulate(model: _core.Model | MimicModel, q0: Configurations, v0: ArrayLike | None = None, t_end: float = 1.0,
-             dt: float = 1e-3, integrator: str = "rk4", controller: Any = None, wrenches: Any = None, *,
+             dt: float | None = None, integrator: str = "rk4", controller: Any = None, wrenches: Any = None, *,
              rtol: float | None = None, atol: float = 1e-9, max_step: float | None = None,
              friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
              limit_damping: float = 1e2, progress: Callable[[float], Any] | None = None,
              accuracy: str = "warn", constraints: Any | None = "model", baumgarte: tuple[float, float] | None = None,
-             damping: float = 0.0) -> list[Trajectory]: ...
+             damping: float = 0.0, ctrl: Any = None) -> list[Trajectory]: ...
 
 
 @overload
 def simulate(model: _core.Model | MimicModel, q0: ArrayLike, v0: ArrayLike | None = None, t_end: float = 1.0,
-             dt: float = 1e-3, integrator: str = "rk4", controller: Any = None, wrenches: Any = None, *,
+             dt: float | None = None, integrator: str = "rk4", controller: Any = None, wrenches: Any = None, *,
              rtol: float | None = None, atol: float = 1e-9, max_step: float | None = None,
              friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
              limit_damping: float = 1e2, progress: Callable[[float], Any] | None = None,
              accuracy: str = "warn", constraints: Any | None = "model", baumgarte: tuple[float, float] | None = None,
-             damping: float = 0.0) -> Trajectory | list[Trajectory]: ...
+             damping: float = 0.0, ctrl: Any = None) -> Trajectory | list[Trajectory]: ...
 
 
 def simulate(
@@ -355,7 +361,7 @@ def simulate(
     q0: ArrayLike,
     v0: ArrayLike | None = None,
     t_end: float = 1.0,
-    dt: float = 1e-3,
+    dt: float | None = None,
     integrator: str = "rk4",
     controller: Any = None,
     wrenches: Any = None,
@@ -372,6 +378,7 @@ def simulate(
     constraints: Any | None = "model",
     baumgarte: tuple[float, float] | None = None,
     damping: float = 0.0,
+    ctrl: Any = None,
 ) -> Trajectory | list[Trajectory]:
     """Simulate ``model`` from (``q0``, ``v0``) at t = 0 to ``t_end``, recording every ``dt``.
 
@@ -424,9 +431,17 @@ def simulate(
     the time it happened; :class:`robodyn.SimulationError`); an exception raised by a callback
     propagates unchanged.
     """
+    if integrator == "mujoco":
+        return _simulate_scene(model, q0, v0, t_end, dt, controller, wrenches, progress, constraints, ctrl)
+    if ctrl is not None:
+        raise bad("ctrl", "None: controls drive a scene's actuators with integrator='mujoco'", "controls")
     if isinstance(model, MimicModel):
         return simulate_reduced(dict(locals()))
     robot_model("model", model)
+    dt = DEFAULT_DT if dt is None else dt
+    if isinstance(q0, str):
+        key = _keyframe(model, q0)
+        q0, v0 = key.q, key.v if v0 is None else v0
     q0 = numbers("q0", q0)
     v0 = np.zeros(q0.shape[:-1] + (model.nv,)) if v0 is None else numbers("v0", v0)
     choice("integrator", integrator, INTEGRATORS)
@@ -456,6 +471,71 @@ def simulate(
     ]
     _report_accuracy(runs, accuracy, batch)
     return runs if batch else runs[0]
+
+
+def _simulate_scene(model: Any, q0: Any, v0: Any, t_end: float, dt: float | None, controller: Any, wrenches: Any,
+                    progress: Any, constraints: Any, ctrl: Any) -> Trajectory | list[Trajectory]:
+    """:func:`simulate` with ``integrator="mujoco"``: the scene stepped as ``mj_step`` steps it."""
+    model = _scene_model(model)
+    if wrenches is not None:
+        raise bad("wrenches", "None with integrator='mujoco' (wrenches on bodies are not taken there yet)",
+                  "wrenches")
+    if not (isinstance(constraints, str) and constraints == "model") and constraints:
+        raise bad("constraints", "'model' with integrator='mujoco' (the scene's own equality constraints)",
+                  repr(constraints))
+    q0, v0, ctrl = _scene_start(model, q0, v0, ctrl)
+    h = model.options.timestep
+    dt = h if dt is None else real("dt", dt)
+    record_every = round(dt / h)
+    if record_every < 1 or abs(record_every * h - dt) > STEP_MULTIPLE_TOLERANCE * dt:
+        raise bad("dt", f"a whole number of the scene's time steps ({h} s) with integrator='mujoco'", repr(dt))
+    steps = int(np.ceil(real("t_end", t_end) / h - STEP_MULTIPLE_TOLERANCE))
+    if steps < 0:
+        raise bad("t_end", "a time (s) not before the start, 0", repr(t_end))
+    result = _core.simulate_scene(model, q0, v0, steps, record_every, ctrl=ctrl,
+                                  controller=_controller_argument(model, controller),
+                                  progress=callback("progress", progress))
+    series = ("q", "v", "a", "tau", "tau_passive", "ctrl", "tau_constraint")
+    batch = result["q"].ndim == 3
+    runs = [
+        Trajectory(model, result["t"], integrator="mujoco",
+                   **{key: result[key][k] if batch else result[key] for key in series},
+                   **{key: result[key][k] for key in ("steps", "rejected_steps", "evaluations")})
+        for k in range(len(result["steps"]))
+    ]
+    return runs if batch else runs[0]
+
+
+def _scene_model(model: Any) -> _core.Model:
+    """The model a scene's step takes: a :class:`MimicModel` without mimic joints is its full model."""
+    if isinstance(model, MimicModel):
+        if model.mimic_joints:
+            raise bad("model", "a model without mimic joints with integrator='mujoco' (MuJoCo's soft couplings "
+                      "are not made yet)", f"mimic joints {[name for name, *_ in model.mimic_joints]}")
+        return model.full
+    robot_model("model", model)
+    return model
+
+
+def _scene_start(model: _core.Model, q0: Any, v0: Any, ctrl: Any) -> tuple[Any, Any, Any]:
+    """(q0, v0, ctrl) of a scene's run: a keyframe's name gives its q, v and ctrl (those given win)."""
+    if isinstance(q0, str):
+        key = _keyframe(model, q0)
+        q0, v0, ctrl = key.q, key.v if v0 is None else v0, key.ctrl if ctrl is None else ctrl
+    q0 = numbers("q0", q0)
+    v0 = np.zeros(q0.shape[:-1] + (model.nv,)) if v0 is None else numbers("v0", v0)
+    if ctrl is not None and not callable(ctrl):
+        ctrl = numbers("ctrl", ctrl)
+    return q0, v0, ctrl
+
+
+def _keyframe(model: _core.Model, name: str) -> Any:
+    """The keyframe ``q0`` names; a ValueError naming ``q0`` and the model's keyframes if none."""
+    names = [key.name for key in model.keyframes]
+    if name not in names:
+        known = f"one of {names}" if names else "the model has none"
+        raise bad("q0", f"a configuration or the name of one of the model's keyframes ({known})", repr(name))
+    return model.keyframe(name)
 
 
 def _report_accuracy(runs: list[Trajectory], accuracy: str, batch: bool) -> None:
@@ -504,6 +584,7 @@ def step(
     constraints: Any | None = "model",
     baumgarte: tuple[float, float] | None = None,
     damping: float = 0.0,
+    ctrl: Any = None,
 ) -> Any:
     """One step of size ``dt`` from (``q``, ``v``) with the torque ``tau`` held over it: the step
     :func:`simulate` takes (``integrator`` ``"euler"``, ``"semi_implicit_euler"`` or ``"rk4"``, on the
@@ -523,10 +604,14 @@ def step(
     :meth:`Model.constrained_forward_dynamics_derivatives` (those of the exact constraint
     equations, so ``derivatives=True`` takes ``baumgarte=None``).
     """
+    if integrator == "mujoco":
+        return _step_scene(model, q, v, tau, dt, derivatives, constraints, ctrl)
+    if ctrl is not None:
+        raise bad("ctrl", "None: controls drive a scene's actuators with integrator='mujoco'", "controls")
     if isinstance(model, MimicModel):
         return step_reduced(dict(locals()))
     robot_model("model", model)
-    choice("integrator", integrator, INTEGRATORS[:3], " (a single fixed step)")
+    choice("integrator", integrator, INTEGRATORS[:3] + ("mujoco",), " (a single fixed step)")
     _check_gains(baumgarte)
     choice("limits", limits, LIMIT_MODELS)
     derivatives = flag("derivatives", derivatives)
@@ -543,3 +628,20 @@ def step(
     a = flat[..., nx : nx + 4 * nv * nv].reshape(batch + (2 * nv, 2 * nv))
     b = flat[..., nx + 4 * nv * nv :].reshape(batch + (2 * nv, nv))
     return x1, a, b
+
+
+def _step_scene(model: Any, q: Any, v: Any, tau: Any, dt: float, derivatives: bool, constraints: Any,
+                ctrl: Any) -> Any:
+    """:func:`step` with ``integrator="mujoco"``: one ``mj_step`` of the scene."""
+    model = _scene_model(model)
+    if flag("derivatives", derivatives):
+        raise bad("derivatives", "False with integrator='mujoco' (the derivatives of MuJoCo's step are not made "
+                  "yet)", "True")
+    if not (isinstance(constraints, str) and constraints == "model") and constraints:
+        raise bad("constraints", "'model' with integrator='mujoco' (the scene's own equality constraints)",
+                  repr(constraints))
+    h = model.options.timestep
+    if abs(real("dt", dt) - h) > STEP_MULTIPLE_TOLERANCE * h:
+        raise bad("dt", f"the scene's time step ({h} s) with integrator='mujoco'", repr(dt))
+    ctrl = np.zeros(model.nu) if ctrl is None else ctrl
+    return _core.step_scene(model, q, v, tau, ctrl)

@@ -31,7 +31,7 @@ KEYED = (REPOSITORY / "testdata" / "mjcf" / "keyframes.xml").read_text()
 def keyed():
     """The model of KEYED, read without a warning but that its geoms do not collide yet."""
     model = robodyn.load_mjcf_string(KEYED)
-    assert all("robodyn's simulation does not use contact forces yet" in w for w in model.warnings), model.warnings
+    assert all("robodyn.simulate feels them only with integrator='mujoco'" in w for w in model.warnings), model.warnings
     return model
 
 

@@ -79,7 +79,7 @@ def test_published_model_loads_and_agrees_with_mujoco_or_names_what_is_missing(p
     # what is not read is said (a model read whole warns of nothing but that contacts are not
     # computed yet)
     said = [str(w.message) for w in caught if issubclass(w.category, robodyn.ModelWarning)]
-    assert all("not read" in message or "does not use contact forces yet" in message for message in said), said
+    assert all("not read" in message or "feels them only with integrator='mujoco'" in message for message in said), said
     # its active equality constraints are held
     assert len(model.constraints) == int(np.sum(mj.eq_active0))
     assert model.total_mass > 0

@@ -231,7 +231,7 @@ def test_disabled_gravity_and_equalities_are_followed_and_the_rest_named():
     assert not model.options.flag("gravity") and not model.options.flag("limit")
     messages = " ".join(model.warnings)
     assert "<flag> 'limit' not followed" in messages
-    assert "robodyn's simulation does not use contact forces yet" in messages
+    assert "robodyn.simulate feels them only with integrator='mujoco'" in messages
 
 
 @pytest.mark.parametrize(

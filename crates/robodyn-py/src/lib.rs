@@ -54,6 +54,8 @@ fn _core(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(model_from_bytes, module)?)?;
     module.add_function(wrap_pyfunction!(simulation::simulate, module)?)?;
     module.add_function(wrap_pyfunction!(simulation::step, module)?)?;
+    module.add_function(wrap_pyfunction!(simulation::simulate_scene, module)?)?;
+    module.add_function(wrap_pyfunction!(simulation::step_scene, module)?)?;
     module.add_function(wrap_pyfunction!(visuals::read_mesh_file, module)?)?;
     module.add_function(wrap_pyfunction!(
         properties::check_physical_parameters,

@@ -446,7 +446,7 @@ fn quaternion_of<S: Real>(q: &[S]) -> UnitQuaternion<S> {
 /// R = 1 − s [y²+z², ...] (the quaternion's rotation formula, written out so that it inlines
 /// into the batch kernels).
 #[inline(always)]
-fn rotation_of<S: Real>(q: &[S]) -> Matrix3<S> {
+pub(crate) fn rotation_of<S: Real>(q: &[S]) -> Matrix3<S> {
     let (x, y, z, w) = (q[0], q[1], q[2], q[3]);
     let s = S::splat(2.0) / (x * x + y * y + z * z + w * w);
     let one = S::one();

@@ -22,7 +22,9 @@
 pub mod dynamics;
 pub mod impedance;
 pub mod rows;
+pub mod simulate;
 pub mod solver;
+pub mod step;
 pub mod weights;
 
 use crate::model::{ContactPair, Geom, Model, SolverParameters};

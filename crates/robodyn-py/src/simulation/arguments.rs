@@ -137,29 +137,7 @@ impl<'a, 'py> Simulation<'a, 'py> {
         options.accuracy_rtol = arguments.accuracy_rtol;
         options.check().map_err(to_py_err)?;
 
-        let q0 = model.q_arg("q0", arguments.q0)?;
-        let v0 = model.v_arg("v0", arguments.v0)?;
-        let batch = q0.batch()?;
-        if v0.batch()? != batch {
-            return Err(PyValueError::new_err(format!(
-                "argument 'v0': expected as many states as 'q0' ({}), got shape {:?}",
-                batch.map_or("one".to_string(), |n| n.to_string()),
-                v0.array.shape()
-            )));
-        }
-        let law = match arguments.controller {
-            None => Some(ControlLaw::Constant(DVector::zeros(m.nv))),
-            Some(spec) => match spec.cast::<PyDict>() {
-                Ok(dict) => Some(control_law(m, dict)?),
-                Err(_) if spec.is_callable() => None,
-                Err(_) => {
-                    return Err(PyValueError::new_err(format!(
-                        "argument 'controller': expected None, a callable (t, q, v) -> tau or a robodyn controller, got {}",
-                        spec.repr()?
-                    )))
-                }
-            },
-        };
+        let (q0, v0, batch) = initial_states(model, arguments.q0, arguments.v0)?;
         let wrenches = match arguments.wrenches {
             None => Wrenches::None,
             Some(callable) if callable.is_callable() => Wrenches::Python(callable.clone()),
@@ -171,14 +149,8 @@ impl<'a, 'py> Simulation<'a, 'py> {
                 Wrenches::Constant(ConstantWrenches(forces))
             }
         };
-        let controller = match (law, arguments.controller) {
-            (Some(law), _) => Control::Native(Box::new(
-                NativeController::new(m, law, options.passive, arguments.t_end)
-                    .map_err(to_py_err)?,
-            )),
-            (None, Some(callable)) => Control::Python(callable.clone()),
-            (None, None) => unreachable!("no controller is read as a constant zero torque"),
-        };
+        let controller =
+            read_controller(m, arguments.controller, options.passive, arguments.t_end)?;
         Ok(Simulation {
             rollouts: Rollouts {
                 model: m,
@@ -193,6 +165,49 @@ impl<'a, 'py> Simulation<'a, 'py> {
             progress: arguments.progress,
         })
     }
+}
+
+/// The initial states `q0` (nq or N × nq) and `v0` (nv or N × nv) and N (`None` for one).
+pub(super) fn initial_states<'a, 'py>(
+    model: &PyModel,
+    q0: &'a Bound<'py, PyAny>,
+    v0: &'a Bound<'py, PyAny>,
+) -> PyResult<(Argument<'py>, Argument<'py>, Option<usize>)> {
+    let (q0, v0) = (model.q_arg("q0", q0)?, model.v_arg("v0", v0)?);
+    let batch = q0.batch()?;
+    if v0.batch()? != batch {
+        return Err(PyValueError::new_err(format!(
+            "argument 'v0': expected as many states as 'q0' ({}), got shape {:?}",
+            batch.map_or("one".to_string(), |n| n.to_string()),
+            v0.array.shape()
+        )));
+    }
+    Ok((q0, v0, batch))
+}
+
+/// The controller `spec`: None (no torque), a native controller's description, or a callable
+/// `(t, q, v) -> tau`.
+pub(super) fn read_controller<'py>(
+    m: &Model,
+    spec: Option<&Bound<'py, PyAny>>,
+    passive: PassiveForces,
+    t_end: f64,
+) -> PyResult<Control<'py>> {
+    let law = match spec {
+        None => ControlLaw::Constant(DVector::zeros(m.nv)),
+        Some(spec) => match spec.cast::<PyDict>() {
+            Ok(dict) => control_law(m, dict)?,
+            Err(_) if spec.is_callable() => return Ok(Control::Python(spec.clone())),
+            Err(_) => {
+                return Err(PyValueError::new_err(format!(
+                    "argument 'controller': expected None, a callable (t, q, v) -> tau or a robodyn controller, got {}",
+                    spec.repr()?
+                )))
+            }
+        },
+    };
+    let native = NativeController::new(m, law, passive, t_end).map_err(to_py_err)?;
+    Ok(Control::Native(Box::new(native)))
 }
 
 /// Reads the native controller description `{"kind": ..., ...}` that `robodyn.simulate` builds.

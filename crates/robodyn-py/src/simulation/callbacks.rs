@@ -82,7 +82,7 @@ impl ExternalWrenches for ConstantWrenches {
 }
 
 /// Calls `callable(t, q, v)` and copies its result, of one sample of `shape`, into `out`.
-fn call_back(
+pub(super) fn call_back(
     callable: &Bound<PyAny>,
     t: f64,
     q: &[f64],
@@ -93,10 +93,12 @@ fn call_back(
 ) -> PyResult<()> {
     let py = callable.py();
     let result = callable.call1((t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, v)))?;
-    let argument = Argument::new(name, &result, shape)
-        .map_err(|e| PyValueError::new_err(format!("{} (returned at t = {t})", e.value(py))))?;
-    out.copy_from_slice(&single_sample(&argument)?);
-    Ok(())
+    let mut read = || -> PyResult<()> {
+        let argument = Argument::new(name, &result, shape)?;
+        out.copy_from_slice(&single_sample(&argument)?);
+        Ok(())
+    };
+    read().map_err(|e| PyValueError::new_err(format!("{} (returned at t = {t})", e.value(py))))
 }
 
 /// Keeps a Python exception for re-raising and tells the loop to stop.

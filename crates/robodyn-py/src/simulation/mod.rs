@@ -10,6 +10,9 @@ mod arguments;
 mod callbacks;
 mod record;
 mod rollouts;
+mod scene;
+
+pub use scene::{simulate_scene, step_scene};
 
 use crate::constrained::made_for;
 use crate::model::{write_row_major, PyModel};

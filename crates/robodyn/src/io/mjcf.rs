@@ -295,8 +295,9 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         };
         model.warnings.push(format!(
             "{}: geoms read as collision shapes (m.geoms, m.collide; their forces: \
-             m.contact_forward_dynamics) but robodyn's simulation does not use contact forces \
-             yet: in simulation bodies pass through each other and the floor{unfound}",
+             m.contact_forward_dynamics); robodyn.simulate feels them only with \
+             integrator='mujoco' (the scene stepped as MuJoCo steps it): with its other \
+             integrators bodies pass through each other and the floor{unfound}",
             reader.location(root)
         ));
     }

@@ -24,7 +24,7 @@ use crate::integrate::forces::spring_displacement;
 use crate::joint::Joint;
 use crate::model::Model;
 use crate::Data;
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
 /// What [`ContactDynamics::forward`] finds.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -39,6 +39,10 @@ pub struct ContactForward {
     pub actuator: DVector<f64>,
     /// The constraints' generalised forces `Jᵀ f` (MuJoCo's `qfrc_constraint`).
     pub constraint: DVector<f64>,
+    /// The joints' springs and dampers (MuJoCo's `qfrc_passive`).
+    pub passive: DVector<f64>,
+    /// The mass matrix M at q.
+    pub mass: DMatrix<f64>,
 }
 
 /// A model's soft-constraint dynamics: its constant weights, pairs and scratch space.
@@ -87,9 +91,10 @@ impl ContactDynamics {
         // 2. q̈₀ = M⁻¹ (τ + τ_actuator + τ_passive − C q̇ − g), by the articulated-body algorithm
         out.actuator = DVector::zeros(nv);
         model.actuator_forces(q, v, ctrl, out.actuator.as_mut_slice())?;
-        let total = DVector::from_column_slice(tau) + &out.actuator + passive_forces(model, q, v);
+        out.passive = passive_forces(model, q, v);
+        let total = DVector::from_column_slice(tau) + &out.actuator + &out.passive;
         let free = aba(model, &mut self.data, q, v, total.as_slice(), None)?.clone();
-        let mass = crba(model, &mut self.data, q)?.clone();
+        out.mass.clone_from(crba(model, &mut self.data, q)?);
         // 3. the rows, their a_ref as robodyn's accelerations see it: a_ref − J w
         constraint_rows(
             model,
@@ -104,7 +109,7 @@ impl ContactDynamics {
             .map(|i| out.rows.reference[i] - dot(out.rows.row(i), w.as_slice()))
             .collect();
         // 4. the solution
-        out.solution = solve(&out.rows, &mass, &free, &reference)?;
+        out.solution = solve(&out.rows, &out.mass, &free, &reference)?;
         out.constraint = DVector::zeros(nv);
         for (i, force) in out.solution.forces.iter().enumerate() {
             for (c, j) in out.rows.row(i).iter().enumerate() {
@@ -132,7 +137,7 @@ fn passive_forces(model: &Model, q: &[f64], v: &[f64]) -> DVector<f64> {
 
 /// w = (ω × v, 0) on each free joint's coordinates, 0 elsewhere: MuJoCo's free-joint
 /// acceleration is `T (q̈ + w)`.
-fn free_joint_velocity_product(model: &Model, v: &[f64]) -> DVector<f64> {
+pub(super) fn free_joint_velocity_product(model: &Model, v: &[f64]) -> DVector<f64> {
     let mut w = DVector::zeros(model.nv);
     for i in 1..model.nbodies() {
         if matches!(model.joints[i], Joint::Free) {

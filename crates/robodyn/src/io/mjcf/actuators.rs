@@ -3,7 +3,8 @@
 //! Modelled, as MuJoCo compiles them: `motor`, `position` (`kp`, `kv`, `inheritrange`),
 //! `velocity` (`kv`) and `general` with `dyntype="none"` and a fixed or affine gain and bias
 //! (`gainprm`, `biasprm`), on a hinge or slide (`joint`, `gear`'s first entry), with `ctrlrange`
-//! and `forcerange` (`ctrllimited`, `forcelimited`: "auto" limits where a range is given).
+//! and `forcerange` (`ctrllimited`, `forcelimited`: "auto" limits where a range is given); an
+//! actuator's `damping` and `armature` join its joint's, times gear² (as MuJoCo adds them).
 //! Any other actuator (activation dynamics, `dampratio`, muscles, tendon, site or body
 //! transmissions, a ball or free joint) keeps its place in the controls but exerts no force,
 //! with a warning naming it. Defaults come from the element's class, per element name.
@@ -30,7 +31,10 @@ impl<'a> Reader<'a> {
             for element in self.children(*section)? {
                 let index = model.actuators.len();
                 let actuator = match self.actuator(element, model, index)? {
-                    Ok(actuator) => actuator,
+                    Ok(actuator) => {
+                        self.add_transmission_terms(element, &actuator, model)?;
+                        actuator
+                    }
                     Err((actuator, why)) => {
                         model.warnings.push(format!(
                             "{}: not read ({why}; {MODELLED}): it keeps its place in the \
@@ -159,6 +163,39 @@ impl<'a> Reader<'a> {
             actuator.ctrl_range = Some((middle - half, middle + half));
         }
         Ok(Ok(actuator))
+    }
+
+    /// The actuator's own `damping` and `armature` (MuJoCo ≥ 3.5), which MuJoCo adds to its
+    /// joint's, scaled by gear²: a passive damper −g² b q̇ and a rotor inertia g² I_a.
+    fn add_transmission_terms(
+        &self,
+        element: Node<'a, 'a>,
+        actuator: &Actuator,
+        model: &mut Model,
+    ) -> Result<()> {
+        let Some(c) = actuator.coordinate else {
+            return Ok(());
+        };
+        let scale = actuator.gear * actuator.gear;
+        for (name, values) in [
+            ("damping", &mut model.damping),
+            ("armature", &mut model.armature),
+        ] {
+            let Some(text) = self.attribute(element, "main", name) else {
+                continue;
+            };
+            let value = parse_number_list(&text, name)
+                .map_err(|m| self.error(element, m))?
+                .first()
+                .copied()
+                .unwrap_or(0.0);
+            if value < 0.0 {
+                let message = format!("attribute '{name}': expected a value ≥ 0, got {value}");
+                return Err(self.error(element, message));
+            }
+            values[c] += scale * value;
+        }
+        Ok(())
     }
 
     /// `<name>range` where `<name>limited` limits it ("auto": where the range is given); a

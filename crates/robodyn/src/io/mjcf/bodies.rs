@@ -163,6 +163,7 @@ impl<'a> Reader<'a> {
         )?;
         if joints.is_empty() {
             // no joint: merged into the parent, kept as a frame
+            self.record_source_mass(source_body, parent, &inertia, &to_body);
             builder.add_fixed_link(parent, to_body, inertia, &name);
             self.add_geoms(
                 builder,
@@ -333,17 +334,7 @@ impl<'a> Reader<'a> {
         if to_body != Transform::IDENTITY {
             builder.add_frame(&name, body, to_body);
         }
-        // its own mass and centre of mass, in the model body's frame (X_{B←body} = to_body)
-        let own = to_body.transpose_apply_inertia(&inertia);
-        let com = if inertia.mass > 0.0 {
-            own.first_moment / own.mass
-        } else {
-            to_body.translation
-        };
-        let mut bodies = self.source_bodies.borrow_mut();
-        (bodies[source_body].body, bodies[source_body].mass) = (body, inertia.mass);
-        bodies[source_body].com = com;
-        drop(bodies);
+        self.record_source_mass(source_body, body, &inertia, &to_body);
         self.add_geoms(
             builder,
             &elements,
@@ -352,6 +343,27 @@ impl<'a> Reader<'a> {
             to_body,
         )?;
         self.read_children(builder, node, (body, source_body), to_body, child_class)
+    }
+
+    /// The file body `source_body`'s own mass and centre of mass, in the frame of the model
+    /// body `body` it moves with (`to_body`: X_{its frame←body}); its frame's origin when
+    /// massless.
+    fn record_source_mass(
+        &self,
+        source_body: usize,
+        body: usize,
+        inertia: &Inertia,
+        to_body: &Transform,
+    ) {
+        let own = to_body.transpose_apply_inertia(inertia);
+        let com = if inertia.mass > 0.0 {
+            own.first_moment / own.mass
+        } else {
+            to_body.translation
+        };
+        let mut bodies = self.source_bodies.borrow_mut();
+        let source = &mut bodies[source_body];
+        (source.body, source.mass, source.com) = (body, inertia.mass, com);
     }
 
     /// A joint's limit and dry friction in MuJoCo's soft constraint model: `solreflimit`,

@@ -1,0 +1,471 @@
+//! One step of a scene as MuJoCo's `mj_step` takes it: the soft model's forward dynamics
+//! ([`super::dynamics`]) integrated by the `<option>`'s integrator over its `timestep` h.
+//!
+//! Reference: MuJoCo's documentation, "Computation", §Numerical integration. MuJoCo's velocity
+//! ν differs from robodyn's v on free joints only, whose linear velocity it measures in world
+//! axes: ν = T v, T = diag(R, 1) there, and its acceleration is ã = T (q̈ + w), w = (ω × v, 0).
+//! With q̈ the soft model's accelerations and M the mass matrix:
+//! ```text
+//!   Euler          ν₁ = ν₀ + h ã,  ã explicit, or with joint damping D implicit in it:
+//!                      (M + h D) ã = M ã_explicit
+//!   implicitfast   (M − h K) ã = M ã_explicit,  K = ∂f/∂ν of the dampers and the actuators
+//!                      (and, on a free body alone in its tree, of its gyroscopic forces)
+//!   RK4            the classical tableau on (q, ν) on the joints' groups (Runge–Kutta–
+//!                  Munthe-Kaas), the constraints found anew at each stage
+//!   then           q₁ = q₀ ⊞ h ν₁ joint by joint: q + h q̇ on hinges and slides, quat ⊗
+//!                  exp(h ω) on balls, p + h v_world and quat ⊗ exp(h ω) on free joints
+//! ```
+//! Written in robodyn's basis an implicit solve reads `(M − h Tᵀ K T) u = M (q̈ + w)` with
+//! ν₁ = T₀ (v₀ + h u), and v₁ = T₁ᵀ ν₁ at the new orientation. A free body's gyroscopic
+//! derivative, Tᵀ (∂f/∂ν) T = −(∂τ/∂v − M ∂w/∂v), comes from RNEA's derivatives
+//! (`crate::algo::rnea_derivatives`).
+
+use super::dynamics::{free_joint_velocity_product, ContactDynamics, ContactForward};
+use crate::algo::rnea_derivatives;
+use crate::algo::DerivativesInto;
+use crate::error::{check_vector, Error, Result};
+use crate::joint::{rotation_of, Joint};
+use crate::model::{Integrator, Model};
+use crate::spatial::{skew, Mat3, Vec3};
+use crate::Data;
+use nalgebra::{DMatrix, DVector, Quaternion, UnitQuaternion};
+
+/// RK4's tableau: a_{i,i−1} (the rest are 0) and the weights b.
+const RK4_A: [f64; 3] = [0.5, 0.5, 1.0];
+const RK4_B: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
+/// A state coordinate beyond this has diverged (MuJoCo's `mjMAXVAL`).
+pub const MAX_STATE: f64 = 1e10;
+/// Below this rotation angle (rad) dexp⁻¹'s coefficient is its Taylor series.
+const SMALL_ANGLE: f64 = 1e-4;
+/// Below this |ω| a quaternion is not turned (MuJoCo's `mjMINVAL`).
+const MIN_ANGULAR_SPEED: f64 = 1e-15;
+
+/// A scene's step: its soft-constraint dynamics and scratch space.
+#[derive(Debug, Clone)]
+pub struct SceneStep {
+    dynamics: ContactDynamics,
+    /// The forward dynamics at the start of the last step: its contacts, rows and forces,
+    /// q̈ (robodyn's basis) and the actuators' forces.
+    pub forward: ContactForward,
+    /// For RK4's later stages.
+    stage: ContactForward,
+    data: Data,
+    /// Forward dynamics evaluated so far.
+    evaluations: usize,
+}
+
+impl SceneStep {
+    /// The step of `model`'s scene; its integrator must be one robodyn steps as MuJoCo does.
+    pub fn new(model: &Model) -> Result<Self> {
+        let integrator = model.options.integrator;
+        if matches!(integrator, Integrator::Implicit | Integrator::Discrete) {
+            return Err(Error::InvalidValue {
+                argument: "integrator".into(),
+                message: format!(
+                    "the model's <option integrator=\"{}\"> is not made yet: robodyn steps \
+                     Euler, implicitfast and RK4 as MuJoCo does",
+                    integrator.keyword()
+                ),
+            });
+        }
+        if model.options.noslip_iterations > 0 {
+            return Err(Error::InvalidValue {
+                argument: "noslip_iterations".into(),
+                message: "MuJoCo's no-slip solver is not made yet: expected \
+                          <option noslip_iterations=\"0\">"
+                    .into(),
+            });
+        }
+        Ok(SceneStep {
+            dynamics: ContactDynamics::new(model)?,
+            forward: ContactForward::default(),
+            stage: ContactForward::default(),
+            data: Data::new(model),
+            evaluations: 0,
+        })
+    }
+
+    /// The forward dynamics at (q, v) into [`Self::forward`], without a step.
+    pub fn forward_only(
+        &mut self,
+        model: &Model,
+        (q, v): (&[f64], &[f64]),
+        tau: &[f64],
+        ctrl: &[f64],
+    ) -> Result<()> {
+        self.evaluations += 1;
+        self.dynamics
+            .forward(model, (q, v), tau, ctrl, &mut self.forward)
+    }
+
+    /// How many times the forward dynamics was evaluated (RK4: four per step).
+    pub fn evaluations(&self) -> usize {
+        self.evaluations
+    }
+
+    /// Advances (q, v) at time `time` (s; for its errors) by the scene's time step under the
+    /// applied forces `tau` (nv) and the controls `ctrl` (nu), both held over the step. A state
+    /// that is not finite or beyond [`MAX_STATE`] afterwards stops it (MuJoCo resets there).
+    pub fn step(
+        &mut self,
+        model: &Model,
+        time: f64,
+        (q, v): (&mut [f64], &mut [f64]),
+        tau: &[f64],
+        ctrl: &[f64],
+    ) -> Result<()> {
+        model.check_configuration(q)?;
+        check_vector("v", v, model.nv)?;
+        let h = model.options.timestep;
+        self.forward_only(model, (q, v), tau, ctrl)?;
+        let acceleration = mujoco_acceleration(model, v, &self.forward.solution.acceleration);
+        let u = match model.options.integrator {
+            Integrator::Rk4 => None,
+            Integrator::Euler => {
+                let damped = model.options.flag("eulerdamp")
+                    && model.options.flag("damper")
+                    && model.damping.iter().any(|d| *d > 0.0);
+                let k = -DMatrix::from_diagonal(&model.damping);
+                Some(match damped {
+                    true => {
+                        implicit_solve(model, q, &self.forward.mass, &k, None, h, &acceleration)
+                    }
+                    false => Some(acceleration),
+                })
+            }
+            Integrator::ImplicitFast => {
+                let k = velocity_derivative(model, q, v, ctrl)?;
+                let gyroscopic = self.free_body_gyroscopic(model, q, v)?;
+                let mass = &self.forward.mass;
+                Some(implicit_solve(
+                    model,
+                    q,
+                    mass,
+                    &k,
+                    gyroscopic,
+                    h,
+                    &acceleration,
+                ))
+            }
+            Integrator::Implicit | Integrator::Discrete => unreachable!("refused by new"),
+        };
+        match u {
+            None => self.runge_kutta(model, q, v, tau, ctrl)?,
+            Some(Some(u)) => advance(model, q, v, &u, h),
+            Some(None) => {
+                return Err(Error::Simulation {
+                    time,
+                    message: "the implicit step's matrix M − h ∂f/∂v is singular".into(),
+                })
+            }
+        }
+        let bad = |x: &f64| !x.is_finite() || x.abs() > MAX_STATE;
+        if q.iter().chain(v.iter()).any(bad) {
+            return Err(Error::Simulation {
+                time,
+                message: format!("the state diverged (beyond {MAX_STATE:e} or not finite)"),
+            });
+        }
+        Ok(())
+    }
+
+    /// RK4 on (q, ν) as a Runge–Kutta–Munthe-Kaas scheme (MuJoCo's): stage i at
+    /// q₀ ⊞ θ_i, ν₀ + h a_i ã_{i−1}, with θ_i = h a_i K_{i−1} and K_j = dexp⁻¹_{θ_j}(ν_j) the rate
+    /// of the tangent coordinates (ν itself but on the rotations); the step q₀ ⊞ h Σ b_j K_j,
+    /// ν₀ + h Σ b_j ã_j.
+    fn runge_kutta(
+        &mut self,
+        model: &Model,
+        q: &mut [f64],
+        v: &mut [f64],
+        tau: &[f64],
+        ctrl: &[f64],
+    ) -> Result<()> {
+        let h = model.options.timestep;
+        let (q0, nu0) = (q.to_vec(), to_mujoco(model, q, v));
+        let mut rates = vec![nu0.clone()];
+        let mut acceleration = vec![to_mujoco(
+            model,
+            q,
+            mujoco_acceleration(model, v, &self.forward.solution.acceleration).as_slice(),
+        )];
+        for a in RK4_A {
+            let (rate, last_acceleration) =
+                (&rates[rates.len() - 1], &acceleration[rates.len() - 1]);
+            let theta = rate * (h * a);
+            let mut stage_q = q0.clone();
+            integrate_positions(model, &mut stage_q, &theta, 1.0);
+            let stage_nu = &nu0 + last_acceleration * (h * a);
+            let stage_v = from_mujoco(model, &stage_q, stage_nu.as_slice());
+            self.evaluations += 1;
+            self.dynamics.forward(
+                model,
+                (&stage_q, stage_v.as_slice()),
+                tau,
+                ctrl,
+                &mut self.stage,
+            )?;
+            let stage_acceleration =
+                mujoco_acceleration(model, stage_v.as_slice(), &self.stage.solution.acceleration);
+            acceleration.push(to_mujoco(model, &stage_q, stage_acceleration.as_slice()));
+            rates.push(tangent_rate(model, &theta, stage_nu));
+        }
+        let weighted = |values: &[DVector<f64>]| -> DVector<f64> {
+            values.iter().zip(RK4_B).map(|(x, b)| x * b).sum()
+        };
+        q.copy_from_slice(&q0);
+        integrate_positions(model, q, &weighted(&rates), h);
+        let nu1 = nu0 + weighted(&acceleration) * h;
+        v.copy_from_slice(from_mujoco(model, q, nu1.as_slice()).as_slice());
+        Ok(())
+    }
+
+    /// Tᵀ (∂f/∂ν) T of the gyroscopic forces of each free body alone in its tree (MuJoCo's
+    /// implicitfast adds them), −(∂τ/∂v − M ∂w/∂v) on its block; `None` when the model has no
+    /// such body.
+    fn free_body_gyroscopic(
+        &mut self,
+        model: &Model,
+        q: &[f64],
+        v: &[f64],
+    ) -> Result<Option<DMatrix<f64>>> {
+        let bodies = lone_free_bodies(model);
+        if bodies.is_empty() {
+            return Ok(None);
+        }
+        let zero = vec![0.0; model.nv];
+        rnea_derivatives(
+            model,
+            &mut self.data,
+            q,
+            v,
+            &zero,
+            None,
+            DerivativesInto::Data,
+        )?;
+        let mut k = DMatrix::zeros(model.nv, model.nv);
+        for body in bodies {
+            let s = model.idx_v[body];
+            let (linear, angular) = (vec3(&v[s..s + 3]), vec3(&v[s + 3..s + 6]));
+            // ∂w/∂v: w = ω × v_linear on the linear rows
+            let mut dw = DMatrix::<f64>::zeros(6, 6);
+            dw.fixed_view_mut::<3, 3>(0, 0).copy_from(&skew(&angular));
+            dw.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-skew(&linear)));
+            let block = self.data.dtau_dv.view((s, s), (6, 6))
+                - self.data.mass_matrix.view((s, s), (6, 6)) * dw;
+            k.view_mut((s, s), (6, 6)).copy_from(&(-block));
+        }
+        Ok(Some(k))
+    }
+}
+
+/// The bodies MuJoCo calls standalone free bodies: a free joint, no child bodies, and no mass
+/// in the file's bodies welded to it but its own.
+fn lone_free_bodies(model: &Model) -> Vec<usize> {
+    (1..model.nbodies())
+        .filter(|&b| matches!(model.joints[b], Joint::Free))
+        .filter(|&b| !model.parent.contains(&b))
+        .filter(|&b| {
+            let welded = model.source_bodies.iter().filter(|s| s.body == b);
+            let mut masses = welded.map(|s| s.mass).filter(|m| *m != 0.0);
+            masses.next().is_some() && masses.next().is_none()
+        })
+        .collect()
+}
+
+/// K = ∂f/∂ν of the dampers (−D) and of the actuators whose force is not clamped
+/// (gear² (b₂ + a₂ u)), MuJoCo's `qDeriv` without the bias forces' terms; robodyn's actuators
+/// drive hinges and slides, where ν = v.
+fn velocity_derivative(model: &Model, q: &[f64], v: &[f64], ctrl: &[f64]) -> Result<DMatrix<f64>> {
+    let nv = model.nv;
+    let mut k = DMatrix::zeros(nv, nv);
+    if model.options.flag("damper") {
+        for c in 0..nv {
+            k[(c, c)] -= model.damping[c];
+        }
+    }
+    check_vector("ctrl", ctrl, model.nu())?;
+    if model.options.flag("actuation") {
+        for (actuator, &u) in model.actuators.iter().zip(ctrl) {
+            let Some(c) = actuator.coordinate else {
+                continue;
+            };
+            let force = actuator.force(q[actuator.position], v[c], u);
+            let clamped = actuator
+                .force_range
+                .is_some_and(|(low, high)| force <= low || force >= high);
+            if !clamped {
+                let slope = actuator.bias[2] + actuator.gain[2] * u;
+                k[(c, c)] += actuator.gear * actuator.gear * slope;
+            }
+        }
+    }
+    Ok(k)
+}
+
+/// u with (M − h Tᵀ K T − h G) u = M a: the implicit step's acceleration in robodyn's basis
+/// (G: the free bodies' gyroscopic Tᵀ(∂f/∂ν)T, already in that basis); `None` when singular.
+fn implicit_solve(
+    model: &Model,
+    q: &[f64],
+    mass: &DMatrix<f64>,
+    k: &DMatrix<f64>,
+    gyroscopic: Option<DMatrix<f64>>,
+    h: f64,
+    acceleration: &DVector<f64>,
+) -> Option<DVector<f64>> {
+    let t = basis_change(model, q);
+    let mut matrix = mass - (t.transpose() * k * &t) * h;
+    if let Some(g) = gyroscopic {
+        matrix -= g * h;
+    }
+    matrix.lu().solve(&(mass * acceleration))
+}
+
+/// ν₁ = T₀ (v₀ + h u), q₁ = q₀ ⊞ h ν₁, v₁ = T₁ᵀ ν₁ (the module's header).
+fn advance(model: &Model, q: &mut [f64], v: &mut [f64], u: &DVector<f64>, h: f64) {
+    let moved: Vec<f64> = v.iter().zip(u.iter()).map(|(v, u)| v + h * u).collect();
+    let nu = to_mujoco(model, q, &moved);
+    integrate_positions(model, q, &nu, h);
+    v.copy_from_slice(from_mujoco(model, q, nu.as_slice()).as_slice());
+}
+
+/// q̈ + w: the acceleration MuJoCo's basis sees, still in robodyn's axes (w = (ω × v, 0) on
+/// free joints).
+fn mujoco_acceleration(model: &Model, v: &[f64], qdd: &DVector<f64>) -> DVector<f64> {
+    qdd + free_joint_velocity_product(model, v)
+}
+
+/// T: the identity but for each free joint's linear block, its rotation R (ν = T v).
+fn basis_change(model: &Model, q: &[f64]) -> DMatrix<f64> {
+    let mut t = DMatrix::identity(model.nv, model.nv);
+    for (s, rotation) in free_rotations(model, q) {
+        t.fixed_view_mut::<3, 3>(s, s).copy_from(&rotation);
+    }
+    t
+}
+
+/// ν = T v.
+fn to_mujoco(model: &Model, q: &[f64], v: &[f64]) -> DVector<f64> {
+    let mut nu = DVector::from_column_slice(v);
+    for (s, rotation) in free_rotations(model, q) {
+        nu.fixed_rows_mut::<3>(s)
+            .copy_from(&(rotation * vec3(&v[s..s + 3])));
+    }
+    nu
+}
+
+/// v = Tᵀ ν.
+fn from_mujoco(model: &Model, q: &[f64], nu: &[f64]) -> DVector<f64> {
+    let mut v = DVector::from_column_slice(nu);
+    for (s, rotation) in free_rotations(model, q) {
+        v.fixed_rows_mut::<3>(s)
+            .copy_from(&(rotation.transpose() * vec3(&nu[s..s + 3])));
+    }
+    v
+}
+
+/// Each free joint's first velocity coordinate and its rotation R (child to world axes).
+fn free_rotations<'a>(model: &'a Model, q: &'a [f64]) -> impl Iterator<Item = (usize, Mat3)> + 'a {
+    (1..model.nbodies())
+        .filter(move |&b| matches!(model.joints[b], Joint::Free))
+        .map(move |b| {
+            let quaternion = &q[model.idx_q[b] + 3..model.idx_q[b] + 7];
+            (model.idx_v[b], rotation_of(quaternion))
+        })
+}
+
+/// K = dexp⁻¹_θ(ν): the rate of the tangent coordinates θ in q = q₀ ⊞ θ that moves with
+/// velocity ν; on each rotation (a ball's, a free joint's angular part)
+/// ```text
+///   K = ω + ½ θ × ω + c θ × (θ × ω),   c = 1/|θ|² − (1 + cos|θ|) / (2 |θ| sin|θ|)
+/// ```
+/// (c → 1/12 + |θ|²/720 as θ → 0), ν itself elsewhere.
+fn tangent_rate(model: &Model, theta: &DVector<f64>, mut nu: DVector<f64>) -> DVector<f64> {
+    for b in 1..model.nbodies() {
+        let angular = match model.joints[b] {
+            Joint::Spherical => model.idx_v[b],
+            Joint::Free => model.idx_v[b] + 3,
+            _ => continue,
+        };
+        let (t, omega) = (
+            vec3(&theta.as_slice()[angular..angular + 3]),
+            vec3(&nu.as_slice()[angular..angular + 3]),
+        );
+        let angle = t.norm();
+        let c = if angle < SMALL_ANGLE {
+            1.0 / 12.0 + angle * angle / 720.0
+        } else {
+            1.0 / (angle * angle) - (1.0 + angle.cos()) / (2.0 * angle * angle.sin())
+        };
+        let rate = omega + 0.5 * t.cross(&omega) + c * t.cross(&t.cross(&omega));
+        nu.fixed_rows_mut::<3>(angular).copy_from(&rate);
+    }
+    nu
+}
+
+/// q ⊞ h ν joint by joint as MuJoCo's `mj_integratePos`: hinges and slides q + h q̇, balls
+/// quat ⊗ exp(h ω), free joints p + h v_world with their quaternion as a ball's.
+fn integrate_positions(model: &Model, q: &mut [f64], nu: &DVector<f64>, h: f64) {
+    for b in 1..model.nbodies() {
+        let (iq, iv) = (model.idx_q[b], model.idx_v[b]);
+        match model.joints[b] {
+            Joint::Fixed => {}
+            Joint::Revolute { .. } | Joint::Prismatic { .. } => q[iq] += h * nu[iv],
+            Joint::Spherical => turn(&mut q[iq..iq + 4], &vec3(&nu.as_slice()[iv..iv + 3]), h),
+            Joint::Free => {
+                for k in 0..3 {
+                    q[iq + k] += h * nu[iv + k];
+                }
+                turn(
+                    &mut q[iq + 3..iq + 7],
+                    &vec3(&nu.as_slice()[iv + 3..iv + 6]),
+                    h,
+                );
+            }
+        }
+    }
+}
+
+/// quat ← quat/|quat| ⊗ exp(h ω) for a quaternion [x, y, z, w] and a body-axes ω (MuJoCo's
+/// `mju_quatIntegrate`).
+fn turn(quaternion: &mut [f64], omega: &Vec3, h: f64) {
+    let start = UnitQuaternion::from_quaternion(Quaternion::new(
+        quaternion[3],
+        quaternion[0],
+        quaternion[1],
+        quaternion[2],
+    ));
+    let speed = omega.norm();
+    let rotation = if speed < MIN_ANGULAR_SPEED {
+        UnitQuaternion::identity()
+    } else {
+        UnitQuaternion::from_axis_angle(&nalgebra::Unit::new_unchecked(omega / speed), h * speed)
+    };
+    let end = start.into_inner() * rotation.into_inner();
+    quaternion.copy_from_slice(&[end.i, end.j, end.k, end.w]);
+}
+
+fn vec3(v: &[f64]) -> Vec3 {
+    Vec3::new(v[0], v[1], v[2])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_turn_about_z_by_a_quarter_is_the_quaternion_of_a_quarter_turn() {
+        let mut quaternion = [0.0, 0.0, 0.0, 1.0];
+        turn(
+            &mut quaternion,
+            &Vec3::new(0.0, 0.0, std::f64::consts::PI),
+            0.5,
+        );
+        let half = std::f64::consts::FRAC_PI_4;
+        let expected = [0.0, 0.0, half.sin(), half.cos()];
+        for (a, b) in quaternion.iter().zip(expected) {
+            assert!((a - b).abs() < 1e-15, "{quaternion:?}");
+        }
+    }
+}
