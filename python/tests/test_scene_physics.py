@@ -1,0 +1,118 @@
+"""Physics a user can check on scenes stepped as MuJoCo steps them (`integrator="mujoco"`), without
+MuJoCo: a crate on an incline sticks below atan μ and slides above it with a = g (sin θ − μ cos θ),
+a ball rolls down without slipping (a = 5/7 g sin θ), and Menagerie's Go2 held at its `home`
+keyframe through its motors stands for 10 s.
+
+The incline is the floor with gravity turned by θ (the same physics in the incline's axes)."""
+
+import numpy as np
+import pytest
+from conftest import load_quietly
+
+from test_menagerie import MENAGERIE
+
+import robodyn
+
+G = 9.81
+MU = 0.5
+# MuJoCo's friction is soft: a sliding crate feels slightly less or more than μN (measured, both in
+# MuJoCo 4.0 and here, on this flat crate at 1.1 and 1.5 atan μ: within 3.8 % of Coulomb's a).
+SLIDING_AGREEMENT = 0.05
+# Below atan μ soft friction lets a crate creep: measured below 1e-9 m/s² after the first 0.5 s.
+STICKING_ACCELERATION = 1e-6
+# A rolling ball: a = 5/7 g sin θ (measured 0.10 % below), its contact point at rest but for a slip
+# of 0.1 % of its speed (measured): soft friction lets it creep.
+ROLLING_AGREEMENT = 2e-3
+
+
+def tilted(body, theta, cone="elliptic"):
+    """A floor of friction MU with gravity turned by `theta` about y (the incline's axes) and
+    `body` (an MJCF body) on it."""
+    gravity = f"{float(G * np.sin(theta))!r} 0 {float(-G * np.cos(theta))!r}"
+    return f"""<mujoco><option gravity="{gravity}" cone="{cone}"/>
+      <worldbody><geom name="incline" type="plane" size="0 0 1" friction="{MU} 0.005 0.0001"/>
+      {body}</worldbody></mujoco>"""
+
+
+CRATE = """<body name="crate" pos="0 0 0.0199"><freejoint/>
+  <geom name="crate" type="box" size="0.1 0.1 0.02" friction="0.5 0.005 0.0001"/></body>"""
+
+
+def down_the_slope(run, start=0.5):
+    """The crate's or ball's speed along the slope (world x; the body stays level), and its mean
+    acceleration from `start` to the end."""
+    speed = np.array([model_velocity(q, v) for q, v in zip(run.q, run.v)])
+    first = int(np.searchsorted(run.t, start))
+    return speed, (speed[-1] - speed[first]) / (run.t[-1] - run.t[first])
+
+
+def model_velocity(q, v):
+    """The world x velocity of a free joint's origin: R v_linear."""
+    x, y, z, w = q[3:7]
+    row = np.array([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)])
+    return row @ v[:3]
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+@pytest.mark.parametrize("fraction", [0.5, 0.9])
+def test_a_crate_sticks_below_the_friction_angle(cone, fraction):
+    theta = fraction * np.arctan(MU)
+    model = load_quietly(text=tilted(CRATE, theta, cone))
+    run = robodyn.simulate(model, model.neutral(), t_end=1.0, dt=0.01, integrator="mujoco")
+    _, acceleration = down_the_slope(run)
+    assert abs(acceleration) < STICKING_ACCELERATION
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+@pytest.mark.parametrize("fraction", [1.1, 1.5])
+def test_a_crate_slides_above_the_friction_angle_as_coulomb_says(cone, fraction):
+    theta = fraction * np.arctan(MU)
+    model = load_quietly(text=tilted(CRATE, theta, cone))
+    run = robodyn.simulate(model, model.neutral(), t_end=1.0, dt=0.01, integrator="mujoco")
+    _, acceleration = down_the_slope(run)
+    expected = G * (np.sin(theta) - MU * np.cos(theta))
+    assert acceleration == pytest.approx(expected, rel=SLIDING_AGREEMENT)
+
+
+def test_a_ball_rolls_down_without_slipping():
+    """A solid ball (condim 3: no rolling friction) on a 20° slope: a = 5/7 g sin θ, and its
+    contact point does not move (v + ω × (−r e_z) = 0) but for soft friction's creep."""
+    theta, radius = np.radians(20.0), 0.1
+    ball = f"""<body name="ball" pos="0 0 {radius - 1e-4}"><freejoint/>
+      <geom name="ball" type="sphere" size="{radius}" friction="{MU} 0.005 0.0001"/></body>"""
+    model = load_quietly(text=tilted(ball, theta))
+    run = robodyn.simulate(model, model.neutral(), t_end=1.0, dt=0.01, integrator="mujoco")
+    _, acceleration = down_the_slope(run)
+    assert acceleration == pytest.approx(5 / 7 * G * np.sin(theta), rel=ROLLING_AGREEMENT)
+    # the contact point's velocity: v + ω × (−r e_z), all in world axes
+    for q, v in zip(run.q[50:], run.v[50:]):
+        x, y, z, w = q[3:7]
+        rotation = np.array([
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ])
+        linear, angular = rotation @ v[:3], rotation @ v[3:]
+        slip = linear + np.cross(angular, [0.0, 0.0, -radius])
+        assert np.linalg.norm(slip[:2]) < ROLLING_AGREEMENT * np.linalg.norm(linear)
+
+
+def test_go2_held_at_home_by_its_motors_stands_for_ten_seconds():
+    """Menagerie's Go2 from `home`, its twelve motors driven by a PD law toward the keyframe's joint
+    angles (k_p = 200 N·m/rad, k_d = 5 N·m·s/rad, clamped to ctrlrange): the trunk stays within 1 cm
+    of where it started for 10 s (5000 steps), neither falling nor walking away."""
+    model = load_quietly(MENAGERIE / "unitree_go2" / "scene.xml")
+    home = model.keyframe("home")
+    joints, rates = slice(7, model.nq), slice(6, model.nv)
+    target = np.asarray(home.q)[joints]
+    low, high = model.ctrl_range[:, 0], model.ctrl_range[:, 1]
+
+    def hold(t, q, v):
+        return np.clip(200.0 * (target - q[joints]) - 5.0 * v[rates], low, high)
+
+    run = robodyn.simulate(model, "home", t_end=10.0, dt=0.1, integrator="mujoco", ctrl=hold)
+    assert run.t[-1] == pytest.approx(10.0)
+    trunk = run.q[:, :3]
+    assert np.max(np.linalg.norm(trunk - trunk[0], axis=1)) < 0.01
+    # its feet carry it: the constraint forces hold its weight up at the end
+    assert np.all(np.abs(run.v[-1]) < 1e-2)
