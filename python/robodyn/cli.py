@@ -324,7 +324,7 @@ def _check_outputs(plot: str | None, animate: str | None, csv: str | None, npz: 
             _arguments.writable_folder(option, path)
 
 
-def simulate(model: str, t_end: float, dt: float, integrator: str, q0: Sequence[float] | None, controller: str,
+def simulate(model: str, t_end: float, dt: float | None, integrator: str, q0: Sequence[float] | None, controller: str,
              target: Sequence[float] | None, plot: str | None, animate: str | None, csv: str | None,
              npz: str | None, show_progress: bool | None = None, html: str | None = None) -> int:
     """Simulate a model from rest and report the run; optionally save a plot, an animation, a page
@@ -342,6 +342,8 @@ def simulate(model: str, t_end: float, dt: float, integrator: str, q0: Sequence[
         "pd": robodyn.PD(kp=100.0 * gains, kd=20.0 * gains, q_ref=goal, gravity_compensation=True),
     }
     terminal = _is_terminal(sys.stderr)
+    if dt is None:
+        dt = m.options.timestep if integrator == "mujoco" else 1e-3
     if show_progress is None:
         show_progress = t_end / dt > PROGRESS_BAR_SAMPLES and terminal
     begin = time.perf_counter()
@@ -442,8 +444,9 @@ def _parser() -> _Parser:
     simulate_parser = commands.add_parser("simulate", help="simulate a model and plot or animate the motion")
     simulate_parser.add_argument("model", help=MODEL_HELP)
     simulate_parser.add_argument("--t", type=_positive_float, default=5.0, dest="t_end", help="duration in s (default 5)")
-    simulate_parser.add_argument("--dt", type=_positive_float, default=1e-3,
-                                 help="step (recording interval for rk45) in s (default 1e-3)")
+    simulate_parser.add_argument("--dt", type=_positive_float, default=None,
+                                 help="step (recording interval for rk45 and mujoco) in s (default 1e-3; "
+                                      "mujoco: the scene's time step)")
     simulate_parser.add_argument("--integrator", default="rk4", choices=INTEGRATORS)
     simulate_parser.add_argument("--q0", type=float, nargs="+", help="initial configuration, nq numbers (default: neutral)")
     simulate_parser.add_argument("--controller", default="none", choices=["none", "gravity", "pd"],

@@ -188,7 +188,9 @@ class Trajectory:
 
     Arrays: ``t`` (T,), ``q`` (T, nq), ``v``, ``a``, ``tau`` and ``tau_passive`` (T, nv). ``tau`` is
     the controller's torque, ``tau_passive`` the joints' own (springs, damping, friction, limit
-    penalty). Energies (J), per sample: ``kinetic_energy``, ``potential_energy`` (gravity),
+    penalty). A scene stepped with ``integrator="mujoco"`` also records ``ctrl`` (T, nu) and
+    ``tau_constraint`` (T, nv: Jᵀ f of its contacts, limits and dry friction), and its ``tau`` holds
+    the actuators' forces too; other runs leave them (T, 0). Energies (J), per sample: ``kinetic_energy``, ``potential_energy`` (gravity),
     ``spring_energy`` and their sum ``energy``. ``limit_violations`` lists the joints that left their
     position range. ``steps``, ``rejected_steps`` and ``evaluations`` tell the work done.
 
@@ -215,14 +217,19 @@ class Trajectory:
     error_estimate: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False)
     energy_drift: float | None = None
     accuracy_issue: dict[str, Any] | None = None
-    ctrl: np.ndarray | None = field(default=None, repr=False)
-    tau_constraint: np.ndarray | None = field(default=None, repr=False)
+    ctrl: np.ndarray = field(default_factory=lambda: np.empty((0, 0)), repr=False)
+    tau_constraint: np.ndarray = field(default_factory=lambda: np.empty((0, 0)), repr=False)
     kinetic_energy: np.ndarray = field(init=False, repr=False)
     potential_energy: np.ndarray = field(init=False, repr=False)
     spring_energy: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         m = self.model
+        # integrators other than "mujoco" record no controls and no constraint forces: (T, 0)
+        if self.ctrl.size == 0:
+            self.ctrl = np.empty((len(self.t), 0))
+        if self.tau_constraint.size == 0:
+            self.tau_constraint = np.empty((len(self.t), 0))
         self.kinetic_energy = np.asarray(m.kinetic_energy(self.q, self.v))
         self.potential_energy = np.asarray(m.potential_energy(self.q))
         reference = np.broadcast_to(m.spring_reference, self.q.shape)
@@ -390,7 +397,14 @@ def simulate(
     of them, simulated in parallel on all cores when everything is native (no Python callable).
     ``v0`` defaults to zeros.
 
-    ``integrator``: ``"euler"``, ``"semi_implicit_euler"`` or ``"rk4"`` step by ``dt``; ``"rk45"``
+    ``integrator="mujoco"`` steps a scene as MuJoCo's ``mj_step`` does (the file's ``<option>``
+    integrator and time step, its soft contacts, limits, dry friction and actuators; see the guide's
+    "Scenes stepped as MuJoCo"): ``q0`` may name a keyframe (its q, v and ctrl), ``ctrl`` gives the
+    actuators' controls (nu values, one row per rollout, or a callable ``(t, q, v) -> ctrl``),
+    ``controller`` forces on the joints, ``dt`` (default: the time step) a whole number of steps
+    between samples; the accuracy, passive-force and limit options below are the other integrators'.
+
+    ``integrator``: ``"euler"``, ``"semi_implicit_euler"`` or ``"rk4"`` step by ``dt`` (default 1 ms); ``"rk45"``
     chooses its steps to keep each one's error below ``atol + rtol·|x|`` (per component; ``max_step``
     bounds them; ``rtol`` defaults to 1e-6 there) and records every ``dt`` by dense output.
 
@@ -586,7 +600,8 @@ def step(
     damping: float = 0.0,
     ctrl: Any = None,
 ) -> Any:
-    """One step of size ``dt`` from (``q``, ``v``) with the torque ``tau`` held over it: the step
+    """One step of size ``dt`` from (``q``, ``v``) with the torque ``tau`` held over it (with
+    ``integrator="mujoco"``: one ``mj_step`` of the scene, ``dt`` its time step, ``ctrl`` the controls): the step
     :func:`simulate` takes (``integrator`` ``"euler"``, ``"semi_implicit_euler"`` or ``"rk4"``, on the
     joints' Lie groups, with the model's passive forces and the same ``friction_velocity`` and
     ``limits`` options).

@@ -21,7 +21,7 @@ import robodyn
 DOCUMENTS = [REPOSITORY / "README.md", REPOSITORY / "docs" / "getting-started.md",
              *sorted((REPOSITORY / "docs" / "guide").glob("*.md"))]
 #: the guide's topics, each a page (the documentation site's navigation names the same files)
-GUIDE_PAGES = {"loading-models", "kinematics", "dynamics", "derivatives", "constraints", "contacts", "mimic", "symbolic", "simulation",
+GUIDE_PAGES = {"loading-models", "kinematics", "dynamics", "derivatives", "constraints", "contacts", "mimic", "symbolic", "simulation", "scene-simulation",
                "viewer", "datasets", "conventions", "performance"}
 #: a clean environment's interpreter (scripts/test makes one), or this one
 PYTHON = os.environ.get("ROBODYN_CLEAN_PYTHON", sys.executable)
