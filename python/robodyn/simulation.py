@@ -189,8 +189,10 @@ class Trajectory:
     Arrays: ``t`` (T,), ``q`` (T, nq), ``v``, ``a``, ``tau`` and ``tau_passive`` (T, nv). ``tau`` is
     the controller's torque, ``tau_passive`` the joints' own (springs, damping, friction, limit
     penalty). A scene stepped with ``integrator="mujoco"`` also records ``ctrl`` (T, nu) and
-    ``tau_constraint`` (T, nv: Jᵀ f of its contacts, limits and dry friction), and its ``tau`` holds
-    the actuators' forces too; other runs leave them (T, 0). Energies (J), per sample: ``kinetic_energy``, ``potential_energy`` (gravity),
+    ``tau_constraint`` (T, nv: Jᵀ f of its contacts, limits and dry friction) and ``contacts`` (per
+    sample, its contacts as :meth:`Model.collide` lists them, each with ``force``: normal, tangents,
+    spin and rolls in its frame; :meth:`contact_force` sums them per geom), and its ``tau`` holds the
+    actuators' forces too; other runs leave them (T, 0) and empty. Energies (J), per sample: ``kinetic_energy``, ``potential_energy`` (gravity),
     ``spring_energy`` and their sum ``energy``. ``limit_violations`` lists the joints that left their
     position range. ``steps``, ``rejected_steps`` and ``evaluations`` tell the work done.
 
@@ -219,6 +221,7 @@ class Trajectory:
     accuracy_issue: dict[str, Any] | None = None
     ctrl: np.ndarray = field(default_factory=lambda: np.empty((0, 0)), repr=False)
     tau_constraint: np.ndarray = field(default_factory=lambda: np.empty((0, 0)), repr=False)
+    contacts: list[list[dict[str, Any]]] = field(default_factory=list, repr=False)
     kinetic_energy: np.ndarray = field(init=False, repr=False)
     potential_energy: np.ndarray = field(init=False, repr=False)
     spring_energy: np.ndarray = field(init=False, repr=False)
@@ -235,6 +238,21 @@ class Trajectory:
         reference = np.broadcast_to(m.spring_reference, self.q.shape)
         displacement = np.asarray(m.difference(reference, self.q)).reshape(len(self.t), m.nv)
         self.spring_energy = 0.5 * np.sum(m.stiffness * displacement**2, axis=1)
+
+    def contact_force(self, geom: str) -> np.ndarray:
+        """The contact force on the geom named ``geom`` per sample, (T, 3) in world axes (N): the sum
+        over its contacts of their normal and friction forces (``frame``ᵀ ``force[:3]``), as pushing
+        the contact's second geom and reversed on its first. Only runs with ``integrator="mujoco"``
+        record contacts (the others give zeros)."""
+        names = [g["name"] for g in self.model.geoms]
+        if geom not in names:
+            raise bad("geom", f"the name of one of the model's geoms ({len(names)})", repr(geom))
+        total = np.zeros((len(self.t), 3))
+        for k, sample in enumerate(self.contacts):
+            for contact in sample:
+                push = np.asarray(contact["frame"]).T @ np.asarray(contact["force"])[:3]
+                total[k] += push * ((contact["geom2"] == geom) - (contact["geom1"] == geom))
+        return total
 
     @property
     def energy(self) -> np.ndarray:
@@ -514,7 +532,7 @@ def _simulate_scene(model: Any, q0: Any, v0: Any, t_end: float, dt: float | None
     runs = [
         Trajectory(model, result["t"], integrator="mujoco",
                    **{key: result[key][k] if batch else result[key] for key in series},
-                   **{key: result[key][k] for key in ("steps", "rejected_steps", "evaluations")})
+                   **{key: result[key][k] for key in ("steps", "rejected_steps", "evaluations", "contacts")})
         for k in range(len(result["steps"]))
     ]
     return runs if batch else runs[0]

@@ -64,7 +64,13 @@ def mujoco_solution(mj_model, layout, qpos, qvel, tau=None, ctrl=None):
     mujoco.mj_forward(mj_model, d)
     nefc, nv = d.nefc, mj_model.nv
     name = lambda g: mj_model.geom(int(g)).name
+    contact_forces = []
+    for i in range(d.ncon):
+        force = np.zeros(6)
+        mujoco.mj_contactForce(mj_model, d, i, force)
+        contact_forces.append(force)
     return q, v, {
+        "contact_forces": np.array(contact_forces).reshape(d.ncon, 6),
         "qdd": layout.a_from_mujoco(q, v, d.qacc),
         "forces": d.efc_force.copy(),
         "row_types": [ROW_TYPES[int(t)] for t in d.efc_type],
@@ -104,6 +110,9 @@ def assert_matches_mujoco(model, mj_model, layout, qpos, qvel, tau=None, ctrl=No
     assert_close(ours["tau_actuator"], expected["tau_actuator"], ROW_AGREEMENT, f"{label} tau_actuator")
     for key in ("forces", "qdd", "tau_constraint"):
         assert_close(ours[key], expected[key], FORCE_AGREEMENT, f"{label} {key}")
+    # each contact's force in its frame: MuJoCo's mj_contactForce
+    forces = np.array([c["force"] for c in ours["contacts"]]).reshape(-1, 6)
+    assert_close(forces, expected["contact_forces"], FORCE_AGREEMENT, f"{label} contact forces")
     return ours, expected
 
 

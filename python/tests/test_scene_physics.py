@@ -114,5 +114,7 @@ def test_go2_held_at_home_by_its_motors_stands_for_ten_seconds():
     assert run.t[-1] == pytest.approx(10.0)
     trunk = run.q[:, :3]
     assert np.max(np.linalg.norm(trunk - trunk[0], axis=1)) < 0.01
-    # its feet carry it: the constraint forces hold its weight up at the end
+    # at rest at the end, its feet carry its weight: Σ contact forces = m g (N)
     assert np.all(np.abs(run.v[-1]) < 1e-2)
+    feet = sum(run.contact_force(foot)[-1] for foot in ("FL", "FR", "RL", "RR"))
+    assert feet == pytest.approx([0.0, 0.0, model.total_mass * G], abs=0.01 * model.total_mass * G)

@@ -189,6 +189,12 @@ def test_a_run_starts_from_a_keyframe_with_its_controls():
     run = robodyn.simulate(model, "home", t_end=10 * h, integrator="mujoco")
     assert np.array_equal(run.q[0], home.q) and np.array_equal(run.ctrl[0], home.ctrl)
     assert run.ctrl.shape == (11, model.nu) and run.tau_constraint.shape == (11, model.nv)
+    # each sample's contacts and forces are the forward dynamics' at its state
+    forward = model.contact_forward_dynamics(run.q[5], run.v[5], ctrl=home.ctrl)
+    assert [c["geom2"] for c in run.contacts[5]] == [c["geom2"] for c in forward["contacts"]]
+    for recorded, found in zip(run.contacts[5], forward["contacts"]):
+        assert np.array_equal(recorded["force"], found["force"])
+    assert np.array_equal(run.tau_constraint[5], forward["tau_constraint"])
     same = robodyn.simulate(model, home.q, home.v, t_end=10 * h, integrator="mujoco", ctrl=home.ctrl)
     assert np.array_equal(run.q, same.q)
     asked = []

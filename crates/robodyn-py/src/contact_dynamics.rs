@@ -22,7 +22,8 @@ impl PyModel {
     /// "contact_frictionless", "contact_pyramidal", "contact_elliptic"), `row_ids` (the degree of
     /// freedom, the joint or the contact of each row), `jacobian` (rows, nv), `R` and `aref`
     /// (each row's regulariser and reference acceleration), `contacts` (as `collide` lists them,
-    /// each with `dim`, its condim, and `first_row`, −1 when it has no rows), `tau_actuator` and
+    /// each with `dim`, its condim, `first_row`, −1 when it has no rows, and `force`: the normal,
+    /// tangent, spin and roll forces in its frame, MuJoCo's `mj_contactForce`), `tau_actuator` and
     /// `tau_constraint` (nv,: MuJoCo's `qfrc_actuator` and `qfrc_constraint`).
     #[pyo3(signature = (q, v, tau=None, ctrl=None))]
     fn contact_forward_dynamics<'py>(
@@ -71,8 +72,10 @@ impl PyModel {
                 robodyn::soft::contact_parameters(model, contact.geoms.0, contact.geoms.1).condim;
             item.set_item("dim", condim)?;
         }
-        for (first, item) in rows.contact_rows.iter().zip(&contacts) {
+        for (c, (first, item)) in rows.contact_rows.iter().zip(&contacts).enumerate() {
             item.set_item("first_row", first.map_or(-1, |f| f as i64))?;
+            let force = rows.contact_force(&out.solution.forces, c);
+            item.set_item("force", PyArray1::from_slice(py, &force))?;
         }
         result.set_item("contacts", contacts)?;
         result.set_item(

@@ -8,6 +8,7 @@ use super::callbacks::{call_back, keep_raised, PythonController, Raised};
 use super::record::stack;
 use crate::args::{Argument, SampleShape};
 use crate::model::PyModel;
+use crate::scene::contact_dicts;
 use crate::to_py_err;
 use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -130,6 +131,21 @@ pub fn simulate_scene<'py>(
         };
         out.set_item(name, PyArray1::from_vec(py, flat).reshape(shape)?)?;
     }
+    // per rollout, per sample: the contacts as `collide` lists them, each with its `force`
+    let mut contacts = Vec::with_capacity(runs.len());
+    for run in &runs {
+        let mut samples = Vec::with_capacity(run.contacts.len());
+        for sample in &run.contacts {
+            let found: Vec<_> = sample.iter().map(|(contact, _)| *contact).collect();
+            let items = contact_dicts(py, m, &found)?;
+            for ((_, force), item) in sample.iter().zip(&items) {
+                item.set_item("force", PyArray1::from_slice(py, force))?;
+            }
+            samples.push(items);
+        }
+        contacts.push(samples);
+    }
+    out.set_item("contacts", contacts)?;
     Ok(out)
 }
 

@@ -120,6 +120,34 @@ impl Rows {
         &self.jacobian[i * self.nv..(i + 1) * self.nv]
     }
 
+    /// Contact `contact`'s force in its frame from the rows' `forces` (MuJoCo's
+    /// `mj_contactForce`): the normal, the two tangents, the spin and the two rolls (condim of
+    /// them, the rest 0; all 0 for a contact without rows). An elliptic contact's rows are these;
+    /// a pyramidal one's edges n ± μ_k t_k (in pairs per direction k) give
+    /// ```text
+    ///   f_n = Σ edges,   f_k = μ_k (f_{k+} − f_{k−})
+    /// ```
+    pub fn contact_force(&self, forces: &[f64], contact: usize) -> [f64; 6] {
+        let mut force = [0.0; 6];
+        let Some(first) = self.contact_rows.get(contact).copied().flatten() else {
+            return force;
+        };
+        let Some(group) = self.groups.iter().find(|g| g.first == first) else {
+            return force;
+        };
+        let rows = &forces[first..first + group.len];
+        match group.kind {
+            RowKind::ContactPyramidal => {
+                force[0] = rows.iter().sum();
+                for (k, edges) in rows.chunks(2).enumerate() {
+                    force[k + 1] = group.friction[k] * (edges[0] - edges[1]);
+                }
+            }
+            _ => force[..rows.len()].copy_from_slice(rows),
+        }
+        force
+    }
+
     fn clear(&mut self, nv: usize) {
         self.nv = nv;
         self.jacobian.clear();

@@ -4,6 +4,7 @@
 //! `record_every`-th state recorded with what the forward dynamics found there.
 
 use super::step::SceneStep;
+use crate::collision::Contact;
 use crate::error::{check_vector, Error, Result};
 use crate::integrate::simulator::Progress;
 use crate::integrate::{Controller, Trajectory};
@@ -42,7 +43,8 @@ impl Controls for FixedControls {
 
 /// A recorded scene simulation: the [`Trajectory`] (`tau` the applied forces plus the actuators'
 /// `qfrc_actuator`, `tau_passive` the springs' and dampers', `a` the soft model's q̈) and, per
-/// sample, the controls (T × nu) and the constraints' forces Jᵀ f (T × nv).
+/// sample, the controls (T × nu), the constraints' forces Jᵀ f (T × nv) and the contacts with
+/// their forces.
 #[derive(Debug, Clone, Default)]
 pub struct SceneTrajectory {
     /// t, q, v, a, tau, tau_passive and the work done (steps, evaluations).
@@ -51,6 +53,9 @@ pub struct SceneTrajectory {
     pub ctrl: Vec<f64>,
     /// The constraints' generalised forces (MuJoCo's `qfrc_constraint`), row by row (T × nv).
     pub tau_constraint: Vec<f64>,
+    /// Per sample, its contacts and each one's force in its frame
+    /// ([`super::rows::Rows::contact_force`]).
+    pub contacts: Vec<Vec<(Contact, [f64; 6])>>,
 }
 
 /// How long a scene simulation runs and what it keeps.
@@ -133,4 +138,11 @@ fn record(out: &mut SceneTrajectory, stepper: &SceneStep, tau: &[f64], ctrl: &[f
     out.ctrl.extend_from_slice(ctrl);
     out.tau_constraint
         .extend_from_slice(forward.constraint.as_slice());
+    let forces = &forward.solution.forces;
+    let contacts = forward.contacts.iter().enumerate();
+    out.contacts.push(
+        contacts
+            .map(|(c, contact)| (*contact, forward.rows.contact_force(forces, c)))
+            .collect(),
+    );
 }
