@@ -7,11 +7,9 @@ The incline is the floor with gravity turned by θ (the same physics in the incl
 
 import numpy as np
 import pytest
-from conftest import load_quietly
-
-from test_menagerie import MENAGERIE
-
 import robodyn
+from conftest import load_quietly
+from test_menagerie import MENAGERIE
 
 G = 9.81
 MU = 0.5

@@ -9,14 +9,20 @@ MuJoCo solves to convergence here (`converged`: Newton, tolerance 1e-15)."""
 import mujoco
 import numpy as np
 import pytest
-from conftest import REPOSITORY, load_quietly
-
-from test_contact_dynamics import (ARM, FLAGGED, SUITE, box_scene, converged, load_both, random_suite_state,
-                                   without_fluid_forces)
-from test_menagerie import MENAGERIE, mujoco_model
-
 import robodyn
+from conftest import REPOSITORY, load_quietly
 from robodyn.convert import MujocoLayout
+from test_contact_dynamics import (
+    ARM,
+    FLAGGED,
+    SUITE,
+    box_scene,
+    converged,
+    load_both,
+    random_suite_state,
+    without_fluid_forces,
+)
+from test_menagerie import MENAGERIE, mujoco_model
 
 STEPS = 100
 # 100 steps without elliptic friction: the same arithmetic in another order; measured up to 1.1e-12
