@@ -189,10 +189,12 @@ pub fn step_scene<'py>(
     };
     let states: Vec<Vec<f64>> = py
         .detach(|| {
+            // the weights and pairs once; each state steps a copy
+            let template = SceneStep::new(m)?;
             (0..count)
                 .into_par_iter()
                 .map(|k| {
-                    let mut stepper = SceneStep::new(m)?;
+                    let mut stepper = template.clone();
                     let (mut q, mut v) = (row(0, k).to_vec(), row(1, k).to_vec());
                     stepper.step(m, 0.0, (&mut q, &mut v), row(2, k), row(3, k))?;
                     q.extend_from_slice(&v);

@@ -35,8 +35,6 @@ const RK4_A: [f64; 3] = [0.5, 0.5, 1.0];
 const RK4_B: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
 /// A state coordinate beyond this has diverged (MuJoCo's `mjMAXVAL`).
 pub const MAX_STATE: f64 = 1e10;
-/// Below this rotation angle (rad) dexp⁻¹'s coefficient is its Taylor series.
-const SMALL_ANGLE: f64 = 1e-4;
 /// Below this |ω| a quaternion is not turned (MuJoCo's `mjMINVAL`).
 const MIN_ANGULAR_SPEED: f64 = 1e-15;
 
@@ -52,6 +50,8 @@ pub struct SceneStep {
     data: Data,
     /// Forward dynamics evaluated so far.
     evaluations: usize,
+    /// The free bodies alone in their trees ([`lone_free_bodies`]).
+    lone_free_bodies: Vec<usize>,
 }
 
 impl SceneStep {
@@ -82,6 +82,7 @@ impl SceneStep {
             stage: ContactForward::default(),
             data: Data::new(model),
             evaluations: 0,
+            lone_free_bodies: lone_free_bodies(model),
         })
     }
 
@@ -125,12 +126,12 @@ impl SceneStep {
                 let damped = model.options.flag("eulerdamp")
                     && model.options.flag("damper")
                     && model.damping.iter().any(|d| *d > 0.0);
-                let k = -DMatrix::from_diagonal(&model.damping);
                 Some(match damped {
                     true => {
+                        let k = -DMatrix::from_diagonal(&model.damping);
                         implicit_solve(model, q, &self.forward.mass, &k, None, h, &acceleration)
                     }
-                    false => Some(acceleration),
+                    false => Some(acceleration.clone()),
                 })
             }
             Integrator::ImplicitFast => {
@@ -150,7 +151,7 @@ impl SceneStep {
             Integrator::Implicit | Integrator::Discrete => unreachable!("refused by new"),
         };
         match u {
-            None => self.runge_kutta(model, q, v, tau, ctrl)?,
+            None => self.runge_kutta(model, (q, v), &acceleration, tau, ctrl)?,
             Some(Some(u)) => advance(model, q, v, &u, h),
             Some(None) => {
                 return Err(Error::Simulation {
@@ -173,22 +174,19 @@ impl SceneStep {
     /// q₀ ⊞ θ_i, ν₀ + h a_i ã_{i−1}, with θ_i = h a_i K_{i−1} and K_j = dexp⁻¹_{θ_j}(ν_j) the rate
     /// of the tangent coordinates (ν itself but on the rotations); the step q₀ ⊞ h Σ b_j K_j,
     /// ν₀ + h Σ b_j ã_j.
+    /// `start`: q̈ + w at (q, v), from the step's first evaluation.
     fn runge_kutta(
         &mut self,
         model: &Model,
-        q: &mut [f64],
-        v: &mut [f64],
+        (q, v): (&mut [f64], &mut [f64]),
+        start: &DVector<f64>,
         tau: &[f64],
         ctrl: &[f64],
     ) -> Result<()> {
         let h = model.options.timestep;
         let (q0, nu0) = (q.to_vec(), to_mujoco(model, q, v));
         let mut rates = vec![nu0.clone()];
-        let mut acceleration = vec![to_mujoco(
-            model,
-            q,
-            mujoco_acceleration(model, v, &self.forward.solution.acceleration).as_slice(),
-        )];
+        let mut acceleration = vec![to_mujoco(model, q, start.as_slice())];
         for a in RK4_A {
             let (rate, last_acceleration) =
                 (&rates[rates.len() - 1], &acceleration[rates.len() - 1]);
@@ -229,8 +227,7 @@ impl SceneStep {
         q: &[f64],
         v: &[f64],
     ) -> Result<Option<DMatrix<f64>>> {
-        let bodies = lone_free_bodies(model);
-        if bodies.is_empty() {
+        if self.lone_free_bodies.is_empty() {
             return Ok(None);
         }
         let zero = vec![0.0; model.nv];
@@ -244,7 +241,7 @@ impl SceneStep {
             DerivativesInto::Data,
         )?;
         let mut k = DMatrix::zeros(model.nv, model.nv);
-        for body in bodies {
+        for &body in &self.lone_free_bodies {
             let s = model.idx_v[body];
             let (linear, angular) = (vec3(&v[s..s + 3]), vec3(&v[s + 3..s + 6]));
             // ∂w/∂v: w = ω × v_linear on the linear rows
@@ -376,11 +373,9 @@ fn free_rotations<'a>(model: &'a Model, q: &'a [f64]) -> impl Iterator<Item = (u
 }
 
 /// K = dexp⁻¹_θ(ν): the rate of the tangent coordinates θ in q = q₀ ⊞ θ that moves with
-/// velocity ν; on each rotation (a ball's, a free joint's angular part)
-/// ```text
-///   K = ω + ½ θ × ω + c θ × (θ × ω),   c = 1/|θ|² − (1 + cos|θ|) / (2 |θ| sin|θ|)
-/// ```
-/// (c → 1/12 + |θ|²/720 as θ → 0), ν itself elsewhere.
+/// velocity ν; on each rotation (a ball's, a free joint's angular part: MuJoCo integrates a free
+/// joint on R³ × SO(3)) the rotation group's, [`Joint::tangent_rate`] of a ball; ν itself
+/// elsewhere.
 fn tangent_rate(model: &Model, theta: &DVector<f64>, mut nu: DVector<f64>) -> DVector<f64> {
     for b in 1..model.nbodies() {
         let angular = match model.joints[b] {
@@ -388,18 +383,13 @@ fn tangent_rate(model: &Model, theta: &DVector<f64>, mut nu: DVector<f64>) -> DV
             Joint::Free => model.idx_v[b] + 3,
             _ => continue,
         };
-        let (t, omega) = (
-            vec3(&theta.as_slice()[angular..angular + 3]),
-            vec3(&nu.as_slice()[angular..angular + 3]),
+        let range = angular..angular + 3;
+        let omega = vec3(&nu.as_slice()[range.clone()]);
+        Joint::Spherical.tangent_rate(
+            &theta.as_slice()[range.clone()],
+            omega.as_slice(),
+            &mut nu.as_mut_slice()[range],
         );
-        let angle = t.norm();
-        let c = if angle < SMALL_ANGLE {
-            1.0 / 12.0 + angle * angle / 720.0
-        } else {
-            1.0 / (angle * angle) - (1.0 + angle.cos()) / (2.0 * angle * angle.sin())
-        };
-        let rate = omega + 0.5 * t.cross(&omega) + c * t.cross(&t.cross(&omega));
-        nu.fixed_rows_mut::<3>(angular).copy_from(&rate);
     }
     nu
 }
