@@ -32,6 +32,10 @@ STEP_AGREEMENT = 1e-10
 # FORCE_AGREEMENT: forces up to 1.7e-7 off); over 100 steps the states differ by up to 6e-9 (Go2 at
 # home, box). The issue's bound, 1e-6, holds them.
 ELLIPTIC_STEP_AGREEMENT = 1e-6
+# One state solved twice, from the last step's solution (a run's warm start) and from q̈₀: both end
+# where Newton's steps fall below 1e-10 of the accelerations; measured 4e-13 of the largest force
+# apart on a Go2 falling onto its floor.
+WARM_START_AGREEMENT = 1e-10
 
 INTEGRATORS = ["Euler", "implicitfast", "RK4"]
 
@@ -198,9 +202,11 @@ def test_a_run_starts_from_a_keyframe_with_its_controls():
     # each sample's contacts and forces are the forward dynamics' at its state
     forward = model.contact_forward_dynamics(run.q[5], run.v[5], ctrl=home.ctrl)
     assert [c["geom2"] for c in run.contacts[5]] == [c["geom2"] for c in forward["contacts"]]
+    scale = max(np.abs(c["force"]).max() for c in forward["contacts"])
     for recorded, found in zip(run.contacts[5], forward["contacts"]):
-        assert np.array_equal(recorded["force"], found["force"])
-    assert np.array_equal(run.tau_constraint[5], forward["tau_constraint"])
+        np.testing.assert_allclose(recorded["force"], found["force"], rtol=0, atol=WARM_START_AGREEMENT * scale)
+    np.testing.assert_allclose(run.tau_constraint[5], forward["tau_constraint"], rtol=0,
+                               atol=WARM_START_AGREEMENT * scale)
     same = robodyn.simulate(model, home.q, home.v, t_end=10 * h, integrator="mujoco", ctrl=home.ctrl)
     assert np.array_equal(run.q, same.q)
     asked = []

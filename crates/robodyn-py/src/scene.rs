@@ -328,8 +328,8 @@ impl PyModel {
         let mut data = robodyn::Data::new(model);
         let x_world = robodyn::algo::forward_kinematics(model, &mut data, &q).map_err(to_py_err)?;
         let pairs = robodyn::collision::checked_pairs(model);
-        let (mut touches, mut contacts) = (Vec::new(), Vec::new());
-        robodyn::collision::collide(model, x_world, &pairs, &mut touches, &mut contacts);
+        let (mut scratch, mut contacts) = (Default::default(), Vec::new());
+        robodyn::collision::collide(model, x_world, &pairs, &mut scratch, &mut contacts);
         contact_dicts(py, model, &contacts)
     }
 

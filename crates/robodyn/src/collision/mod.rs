@@ -173,12 +173,18 @@ pub struct Contact {
 }
 
 /// A pair of geoms checked for contact: the geoms (lower type first) and the explicit pair.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CheckedPair {
     /// The two geoms, the lower type first.
     pub geoms: (usize, usize),
     /// The explicit pair it is, if any.
     pub pair: Option<usize>,
+    /// The distance within which a contact counts (MuJoCo's margin: the contact's `margin`
+    /// and `gap` together).
+    pub margin: f64,
+    /// Geoms whose origins are farther apart than this cannot touch: their bounding spheres'
+    /// radii and the margin (infinite when one is unbounded, a plane or a mesh).
+    pub reach: f64,
 }
 
 /// Every pair of geoms checked for contact, in MuJoCo's order: by the two file bodies (the lower
@@ -222,25 +228,69 @@ fn lower_type_first(model: &Model, g1: usize, g2: usize, pair: Option<usize>) ->
     } else {
         (g1, g2)
     };
-    CheckedPair { geoms, pair }
+    let parameters = crate::soft::contact_parameters(model, g1, g2);
+    let margin = parameters.margin + parameters.gap;
+    let radius = |g: usize| bounding_radius(&model.geoms[g].shape);
+    CheckedPair {
+        geoms,
+        pair,
+        margin,
+        reach: radius(g1) + radius(g2) + margin,
+    }
+}
+
+/// The radius of the smallest sphere about the shape's origin that holds it (MuJoCo's
+/// `rbound`); infinite for a plane, and for a mesh (not collided yet).
+fn bounding_radius(shape: &Shape) -> f64 {
+    match shape {
+        Shape::Sphere { radius } => *radius,
+        Shape::Capsule {
+            radius,
+            half_length,
+        } => radius + half_length,
+        Shape::Cylinder {
+            radius,
+            half_length,
+        } => radius.hypot(*half_length),
+        Shape::Box { half_extents } => half_extents.norm(),
+        Shape::Ellipsoid { radii } => radii.max(),
+        Shape::Plane { .. } | Shape::Mesh { .. } => f64::INFINITY,
+    }
 }
 
 /// The contacts of the geom pairs `pairs` ([`checked_pairs`]) with the bodies placed at
 /// `x_world` (`X_{i←0}` of each body, as [`crate::algo::forward_kinematics`] leaves them), into
-/// `contacts` (cleared first); `touches` is scratch space. Allocates nothing once both have
-/// grown to their size.
+/// `contacts` (cleared first). Allocates nothing once `scratch` and `contacts` have grown to
+/// their size.
 pub fn collide(
     model: &Model,
     x_world: &[Transform],
     pairs: &[CheckedPair],
-    touches: &mut Vec<Touch>,
+    scratch: &mut CollisionScratch,
     contacts: &mut Vec<Contact>,
 ) {
-    let place = |g: usize| {
-        let geom = &model.geoms[g];
-        Placed::new(&geom.shape, &(geom.placement * x_world[geom.body]))
+    // each geom placed once: X_{geom←0} = X_{geom←body} X_{body←0}
+    let CollisionScratch { touches, poses } = scratch;
+    poses.clear();
+    poses.extend(model.geoms.iter().map(|geom| {
+        let x = geom.placement * x_world[geom.body];
+        (x.rotation.transpose(), x.translation)
+    }));
+    let place = |g: usize| Placed {
+        shape: &model.geoms[g].shape,
+        rotation: poses[g].0,
+        position: poses[g].1,
     };
     collide_placed(model, place, pairs, touches, contacts);
+}
+
+/// [`collide`]'s scratch space.
+#[derive(Debug, Clone, Default)]
+pub struct CollisionScratch {
+    /// One pair's contacts.
+    pub touches: Vec<Touch>,
+    /// Each geom's axes and origin in world coordinates.
+    poses: Vec<(Mat3, Vec3)>,
 }
 
 /// [`collide`] with each geom `g` placed in the world by `place(g)` instead of by its body.
@@ -258,14 +308,13 @@ pub fn collide_placed<'m>(
         let Some(function) = collider(&one.shape, &other.shape) else {
             continue;
         };
-        let parameters = crate::soft::contact_parameters(model, g1, g2);
+        // bounding spheres apart: no contact (MuJoCo's `rbound` test)
+        let (first, second) = (place(g1), place(g2));
+        if (first.position - second.position).norm() > checked.reach {
+            continue;
+        }
         touches.clear();
-        function(
-            &place(g1),
-            &place(g2),
-            parameters.margin + parameters.gap,
-            touches,
-        );
+        function(&first, &second, checked.margin, touches);
         contacts.extend(touches.iter().map(|touch| Contact {
             geoms: checked.geoms,
             pair: checked.pair,

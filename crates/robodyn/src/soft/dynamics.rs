@@ -15,10 +15,10 @@
 //! solution, and the forces of its rows.
 
 use super::rows::{constraint_rows, Rows};
-use super::solver::{solve, Solution};
+use super::solver::{Solution, Solver};
 use super::weights::{inverse_weights, InverseWeights};
 use crate::algo::{aba, crba, forward_kinematics};
-use crate::collision::{checked_pairs, collide, CheckedPair, Contact, Touch};
+use crate::collision::{checked_pairs, collide, CheckedPair, CollisionScratch, Contact};
 use crate::error::{check_vector, Result};
 use crate::integrate::forces::spring_displacement;
 use crate::joint::Joint;
@@ -51,7 +51,8 @@ pub struct ContactDynamics {
     weights: InverseWeights,
     pairs: Vec<CheckedPair>,
     data: Data,
-    touches: Vec<Touch>,
+    scratch: CollisionScratch,
+    solver: Solver,
 }
 
 impl ContactDynamics {
@@ -62,7 +63,8 @@ impl ContactDynamics {
             weights: inverse_weights(model, &mut data)?,
             pairs: checked_pairs(model),
             data,
-            touches: Vec::new(),
+            scratch: CollisionScratch::default(),
+            solver: Solver::default(),
         })
     }
 
@@ -85,7 +87,7 @@ impl ContactDynamics {
             model,
             &x_world,
             &self.pairs,
-            &mut self.touches,
+            &mut self.scratch,
             &mut out.contacts,
         );
         // 2. q̈₀ = M⁻¹ (τ + τ_actuator + τ_passive − C q̇ − g), by the articulated-body algorithm
@@ -109,7 +111,8 @@ impl ContactDynamics {
             .map(|i| out.rows.reference[i] - dot(out.rows.row(i), w.as_slice()))
             .collect();
         // 4. the solution
-        out.solution = solve(&out.rows, &out.mass, &free, &reference)?;
+        self.solver
+            .solve(&out.rows, &out.mass, &free, &reference, &mut out.solution)?;
         out.constraint = DVector::zeros(nv);
         for (i, force) in out.solution.forces.iter().enumerate() {
             for (c, j) in out.rows.row(i).iter().enumerate() {
