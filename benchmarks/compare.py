@@ -1,11 +1,12 @@
 """robodyn against Pinocchio and MuJoCo from Python, in one run: per-call time of each algorithm,
 a 10 000-state batch against a Python loop, forward dynamics under contacts (Solo12 on its feet,
 Talos on its soles) and impacts against Pinocchio's constraintDynamics and impulseDynamics, a 10 s
-UR5 rollout (RK4, PD) against mj_step and 64 rollouts of 1 s against mujoco.rollout, printed as
-ratios (< 1 means robodyn is faster).
+UR5 rollout (RK4, PD) against mj_step and 64 rollouts of 1 s against mujoco.rollout, and Menagerie's
+Go2 scene stepped as mj_step steps it (one step, a run, 64 rollouts), printed as ratios (< 1 means
+robodyn is faster).
 
 Run: .venv/bin/python benchmarks/compare.py [--batch 10000] [--robots ur5 panda talos]
-[--sections pinocchio constrained mujoco simulation] [--criterion target/criterion] [--json out.json]
+[--sections pinocchio constrained mujoco simulation scene] [--criterion target/criterion] [--json out.json]
 (--json also writes the tables as JSON, which scripts/benchmarks_page.py turns into docs/benchmarks.md;
 --criterion sets the Rust core's times of the constrained cases, from a `cargo bench -p robodyn
 --bench constrained` run before, beside the same calls from Python).
@@ -502,6 +503,96 @@ def compare_batched_rollouts(name: str) -> list[tuple[str, float, float]]:
     return [(f"{name} {BATCHED_ROLLOUTS} rollouts of {BATCHED_DURATION:g} s, RK4 + PD", *best_times(ours, theirs, 1, 3))]
 
 
+#: The scene section: Menagerie's Go2 on its floor (testdata; its meshes, which only draw, left out
+#: of MuJoCo's copy as of robodyn's), from its `home` keyframe with the keyframe's controls: one step,
+#: a run of SCENE_STEPS steps, and SCENE_ROLLOUTS rollouts of SCENE_ROLLOUT_STEPS steps, each
+#: recording its last state.
+GO2_SCENE = Path(__file__).resolve().parents[1] / "testdata" / "menagerie" / "unitree_go2" / "scene.xml"
+SCENE_STEPS, SCENE_ROLLOUTS, SCENE_ROLLOUT_STEPS = 500, 64, 1000
+
+
+def go2_mujoco() -> mujoco.MjModel:
+    """MuJoCo's Go2 scene without its mesh geoms (their files are not in testdata)."""
+    spec = mujoco.MjSpec.from_file(str(GO2_SCENE))
+    for geom in [g for g in spec.geoms if g.type == mujoco.mjtGeom.mjGEOM_MESH]:
+        spec.delete(geom)
+    for mesh in list(spec.meshes):
+        spec.delete(mesh)
+    return spec.compile()
+
+
+def compare_scene() -> list[tuple[str, float, float]]:
+    """The Go2 scene stepped as mj_step steps it (its own integrator, Euler; contacts, dry friction
+    and motors): robodyn.step against mj_step from the keyframe (MuJoCo's warm start cleared, as
+    robodyn.step has none), robodyn.simulate against mujoco.rollout with one MjData, and a batch of
+    rollouts against mujoco.rollout with one MjData per core."""
+    import warnings
+
+    from mujoco import rollout
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", robodyn.ModelWarning)
+        m = robodyn.load(GO2_SCENE)
+    mj = go2_mujoco()
+    home = m.keyframe("home")
+    h = m.options.timestep
+    q, v, tau = np.asarray(home.q), np.asarray(home.v), np.zeros(m.nv)
+    d = mujoco.MjData(mj)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    mujoco.mj_resetDataKeyframe(mj, d, 0)
+    start = np.empty(mujoco.mj_stateSize(mj, spec))
+    mujoco.mj_getState(mj, d, start, spec)
+
+    def our_step():
+        return robodyn.step(m, q, v, tau, h, integrator="mujoco", ctrl=home.ctrl)
+
+    def their_step():
+        mujoco.mj_resetDataKeyframe(mj, d, 0)
+        mujoco.mj_step(mj, d)
+
+    def their_reset():
+        mujoco.mj_resetDataKeyframe(mj, d, 0)
+
+    ours, theirs = best_times(our_step, their_step, 200)
+    reset, _ = best_times(their_reset, their_reset, 200)
+    rows = [("go2 scene, one step (Euler)", ours, theirs - reset)]
+    duration = SCENE_STEPS * h
+    control = np.tile(np.asarray(home.ctrl), (1, SCENE_STEPS, 1))
+    rows.append((f"go2 scene, {SCENE_STEPS} steps", *best_times(
+        lambda: robodyn.simulate(m, "home", t_end=duration, dt=duration, integrator="mujoco"),
+        lambda: rollout.rollout(mj, d, start[None], control), 1, 5)))
+    duration = SCENE_ROLLOUT_STEPS * h
+    starts, speeds = np.tile(q, (SCENE_ROLLOUTS, 1)), np.zeros((SCENE_ROLLOUTS, m.nv))
+    controls = np.tile(np.asarray(home.ctrl), (SCENE_ROLLOUTS, 1))
+    workers = [mujoco.MjData(mj) for _ in range(os.cpu_count() or 1)]
+    initial = np.tile(start, (SCENE_ROLLOUTS, 1))
+    every_step = np.tile(np.asarray(home.ctrl), (SCENE_ROLLOUTS, SCENE_ROLLOUT_STEPS, 1))
+    rows.append((f"go2 scene, {SCENE_ROLLOUTS} rollouts of {SCENE_ROLLOUT_STEPS} steps", *best_times(
+        lambda: robodyn.simulate(m, starts, speeds, t_end=duration, dt=duration, integrator="mujoco", ctrl=controls),
+        lambda: rollout.rollout(mj, workers, initial, every_step), 1, 3)))
+    final = robodyn.simulate(m, "home", t_end=SCENE_STEPS * h, dt=SCENE_STEPS * h, integrator="mujoco").q[-1]
+    states, _ = rollout.rollout(mj, d, start[None], control)
+    print(f"go2 scene: after {SCENE_STEPS} steps the base heights differ by {abs(final[2] - states[0, -1, 3]):.1e} m "
+          "(MuJoCo's solver stops at its tolerance, 1e-8; robodyn's converges)")
+    return rows
+
+
+def native_scene(criterion: Path, timed) -> list[tuple[str, float, float]]:
+    """The Rust core's time of the scene's one step and run (`cargo bench -p robodyn --bench scenes`,
+    its results in `criterion`; the fastest sample, as `native_constrained`), beside the call from
+    Python."""
+    from_python = {case: ours for case, ours, _ in timed}
+    rows = []
+    for case, bench, steps in (("go2 scene, one step (Euler)", "step_Euler", 1),
+                               (f"go2 scene, {SCENE_STEPS} steps", f"run{SCENE_STEPS}_Euler", SCENE_STEPS)):
+        samples = criterion / "scene" / f"go2_{bench}" / "new" / "sample.json"
+        if case in from_python and samples.is_file():
+            sample = json.loads(samples.read_text(encoding="utf-8"))
+            nanoseconds = min(t / n for t, n in zip(sample["times"], sample["iters"]))
+            rows.append((case, nanoseconds * 1e-9, from_python[case]))
+    return rows
+
+
 def print_table(title: str, other: str, rows) -> None:
     width = max(40, 2 + max((len(case) for case, _, _ in rows), default=0))
     print(f"\n{title}")
@@ -513,9 +604,11 @@ def print_table(title: str, other: str, rows) -> None:
 
 #: The sections of a run, in order: robodyn against Pinocchio, the constrained cases, against
 #: MuJoCo, the rollouts.
-SECTIONS = ("pinocchio", "constrained", "mujoco", "simulation")
+SECTIONS = ("pinocchio", "constrained", "mujoco", "simulation", "scene")
 #: The table of the Rust core's constrained times (`--criterion`), after the constrained section.
 NATIVE_TITLE = "Constrained dynamics, one call: the Rust core (criterion) beside the call from Python"
+#: The table of the Rust core's scene times (`--criterion`), after the scene section.
+NATIVE_SCENE_TITLE = "Go2 scene: the Rust core (criterion) beside the call from Python"
 
 
 def main() -> None:
@@ -524,7 +617,8 @@ def main() -> None:
     parser.add_argument("--robots", nargs="+", default=list(ROBOTS), choices=list(ROBOTS))
     parser.add_argument("--sections", nargs="+", default=list(SECTIONS), choices=list(SECTIONS), help="the sections run (default: all)")
     parser.add_argument("--criterion", type=Path, help="criterion's results (target/criterion) of `cargo bench -p robodyn --bench "
-                        "constrained`, set beside the constrained one-call rows in a table of their own")
+                        "constrained` and `--bench scenes`, set beside the constrained one-call rows and the scene rows in "
+                        "tables of their own")
     parser.add_argument("--json", type=Path, help="also write the tables to this file (times in seconds)")
     args = parser.parse_args()
     versions = {"robodyn": robodyn.__version__, "pinocchio": pin.__version__, "mujoco": mujoco.__version__,
@@ -540,6 +634,8 @@ def main() -> None:
         "mujoco": ("robodyn vs MuJoCo (fixed base)", "mujoco", lambda: [row for name in args.robots for row in compare_mujoco(name, args.batch)]),
         "simulation": ("Simulation: robodyn.simulate vs mj_step and mujoco.rollout", "mujoco",
                        lambda: compare_rollout("ur5") + compare_batched_rollouts("ur5")),
+        "scene": ("Scene (Go2 on its floor) stepped as mj_step: robodyn vs mj_step and mujoco.rollout", "mujoco",
+                  compare_scene),
     }
     tables = []
     for key in args.sections:
@@ -551,6 +647,10 @@ def main() -> None:
             native = native_constrained(args.criterion, rows)
             print_table(NATIVE_TITLE, "from Python", native)
             tables.append({"title": NATIVE_TITLE, "other": "from Python", "rows": [list(row) for row in native]})
+        if key == "scene" and args.criterion:
+            native = native_scene(args.criterion, rows)
+            print_table(NATIVE_SCENE_TITLE, "from Python", native)
+            tables.append({"title": NATIVE_SCENE_TITLE, "other": "from Python", "rows": [list(row) for row in native]})
     if args.json:
         # the one-minute load average at the start and at the end: other jobs sharing the machine
         machine["load_average"].append(os.getloadavg()[0])

@@ -190,6 +190,21 @@ def test_one_step_is_mj_step_and_batches_step_each_state():
         assert np.array_equal(single, x1[k])
 
 
+def test_a_property_set_between_steps_is_felt_by_the_next():
+    """`step` keeps the scene's weights per model: a property set afterwards makes them anew (the
+    armature changes M at qpos0, hence the contacts' regularisers), as a model loaded so would."""
+    model, _, layout = load_both(text=box_scene(3, "pyramidal"))
+    q = layout.q_from_mujoco(np.array([0.0, 0.0, 0.09, 1.0, 0.0, 0.0, 0.0]))
+    v, tau, h = np.array([0.3, 0.0, -0.2, 0.0, 0.0, 0.0]), np.zeros(6), model.options.timestep
+    before = robodyn.step(model, q, v, tau, h, integrator="mujoco")
+    model.armature = np.full(6, 0.5)
+    after = robodyn.step(model, q, v, tau, h, integrator="mujoco")
+    fresh, _, _ = load_both(text=box_scene(3, "pyramidal"))
+    fresh.armature = np.full(6, 0.5)
+    assert not np.allclose(before, after)
+    assert np.array_equal(after, robodyn.step(fresh, q, v, tau, h, integrator="mujoco"))
+
+
 def test_a_run_starts_from_a_keyframe_with_its_controls():
     """`q0` may name a keyframe: its q, v and ctrl; controls given win, a callable is asked at each
     step's start and gives the same run as the array it returns."""

@@ -98,6 +98,7 @@ impl PyModel {
 
     #[setter]
     fn set_gravity(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        self.forget_scene_step();
         let values = read_property("gravity", value, 3)?;
         self.model.gravity = nalgebra::Vector3::from_row_slice(&values);
         Ok(())
@@ -112,6 +113,7 @@ impl PyModel {
 
     #[setter]
     fn set_armature(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        self.forget_scene_step();
         let armature = read_non_negative("armature", value, self.model.nv)?;
         self.model
             .check_armature(armature.as_slice())
@@ -153,6 +155,7 @@ impl PyModel {
 
     #[setter]
     fn set_damping(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        self.forget_scene_step();
         self.model.damping = read_non_negative("damping", value, self.model.nv)?;
         Ok(())
     }
@@ -166,6 +169,7 @@ impl PyModel {
 
     #[setter]
     fn set_friction(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        self.forget_scene_step();
         self.model.friction = read_non_negative("friction", value, self.model.nv)?;
         Ok(())
     }
@@ -179,6 +183,7 @@ impl PyModel {
 
     #[setter]
     fn set_stiffness(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        self.forget_scene_step();
         self.model.stiffness = read_non_negative("stiffness", value, self.model.nv)?;
         Ok(())
     }
@@ -192,6 +197,7 @@ impl PyModel {
 
     #[setter]
     fn set_spring_reference(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        self.forget_scene_step();
         let values = read_property("spring_reference", value, self.model.nq)?;
         self.model
             .check_configuration(&values)
@@ -266,6 +272,7 @@ impl PyModel {
 
     #[setter]
     fn set_inertial_parameters(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        self.forget_scene_step();
         let rows = self.model.nbodies() - 1;
         let flat = read_sample("inertial_parameters", value, SampleShape::matrix(rows, 10))?;
         let parameters: Vec<[f64; 10]> = flat

@@ -24,6 +24,7 @@ use nalgebra::DMatrix;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyString;
+use robodyn::soft::step::SceneStep;
 use robodyn::{Data, Model};
 use rustc_hash::FxHashMap;
 use std::sync::Mutex;
@@ -56,6 +57,9 @@ pub(crate) struct PyModel {
     pub(crate) frame_indices: FxHashMap<String, usize>,
     /// The constraint set the last constrained call resolved (see `ResolvedConstraints`).
     pub(crate) last_constraints: Mutex<Option<ResolvedConstraints>>,
+    /// The scene's step as made for this model (its weights, geom pairs and scratch space), used
+    /// by each `step_scene` call; forgotten when a property changes.
+    pub(crate) scene_step: Mutex<Option<SceneStep>>,
 }
 
 impl PyModel {
@@ -72,7 +76,28 @@ impl PyModel {
             batch_workspaces: WorkspacePool::default(),
             frame_indices,
             last_constraints: Mutex::new(None),
+            scene_step: Mutex::new(None),
         }
+    }
+
+    /// `work` with the model's scene step (made the first time, kept between calls), its solver
+    /// starting from q̈₀ as a new one would.
+    pub(crate) fn with_scene_step<T>(
+        &self,
+        work: impl FnOnce(&mut SceneStep) -> robodyn::Result<T>,
+    ) -> robodyn::Result<T> {
+        let mut cached = self.scene_step.lock().unwrap_or_else(|e| e.into_inner());
+        if cached.is_none() {
+            *cached = Some(SceneStep::new(&self.model)?);
+        }
+        let stepper = cached.as_mut().expect("made above");
+        stepper.forget_warm_start();
+        work(stepper)
+    }
+
+    /// Forgets the scene step: the model's properties changed.
+    pub(crate) fn forget_scene_step(&mut self) {
+        *self.scene_step.get_mut().unwrap_or_else(|e| e.into_inner()) = None;
     }
 
     #[inline(always)]

@@ -189,18 +189,21 @@ pub fn step_scene<'py>(
     };
     let states: Vec<Vec<f64>> = py
         .detach(|| {
-            // the weights and pairs once; each state steps a copy
-            let template = SceneStep::new(m)?;
-            (0..count)
-                .into_par_iter()
-                .map(|k| {
-                    let mut stepper = template.clone();
-                    let (mut q, mut v) = (row(0, k).to_vec(), row(1, k).to_vec());
-                    stepper.step(m, 0.0, (&mut q, &mut v), row(2, k), row(3, k))?;
-                    q.extend_from_slice(&v);
-                    Ok(q)
-                })
-                .collect::<robodyn::Result<_>>()
+            let step = |stepper: &mut SceneStep, k: usize| {
+                stepper.forget_warm_start();
+                let (mut q, mut v) = (row(0, k).to_vec(), row(1, k).to_vec());
+                stepper.step(m, 0.0, (&mut q, &mut v), row(2, k), row(3, k))?;
+                q.extend_from_slice(&v);
+                Ok(q)
+            };
+            // one state with the model's own step; a batch with a copy per task
+            model.with_scene_step(|stepper| match count {
+                1 => Ok(vec![step(stepper, 0)?]),
+                _ => (0..count)
+                    .into_par_iter()
+                    .map_init(|| stepper.clone(), step)
+                    .collect(),
+            })
         })
         .map_err(to_py_err)?;
     let flat: Vec<f64> = states.concat();

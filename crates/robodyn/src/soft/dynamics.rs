@@ -68,6 +68,11 @@ impl ContactDynamics {
         })
     }
 
+    /// The next forward dynamics starts its solver from q̈₀ rather than the last solution.
+    pub fn forget_warm_start(&mut self) {
+        self.solver.forget_warm_start();
+    }
+
     /// The soft model's q̈ at (q, q̇) under applied forces `tau` (nv) and controls `ctrl` (nu),
     /// into `out` (see the module's header).
     pub fn forward(

@@ -336,6 +336,8 @@ impl Pattern {
 pub struct Solver {
     /// The last solution's q̈, where the next solve may start.
     warm_start: DVector<f64>,
+    /// Whether `warm_start` holds a solution (false: the next solve starts from q̈₀).
+    warm: bool,
     pattern: Pattern,
     curvature: Curvature,
     /// x = J q̈ − a_ref and the rows' forces there.
@@ -378,7 +380,8 @@ impl Solver {
             out.acceleration = free.clone();
         }
         let warm_start = std::mem::take(&mut self.warm_start);
-        if warm_start.len() == nv
+        if self.warm
+            && warm_start.len() == nv
             && self.cost(rows, mass, free, reference, &warm_start)
                 < self.cost(rows, mass, free, reference, free)
         {
@@ -425,7 +428,13 @@ impl Solver {
         } else {
             self.warm_start = out.acceleration.clone();
         }
+        self.warm = true;
         Ok(())
+    }
+
+    /// The next solve starts from q̈₀: its result no longer depends on the solves before.
+    pub fn forget_warm_start(&mut self) {
+        self.warm = false;
     }
 
     fn size(&mut self, nv: usize, count: usize) {

@@ -99,6 +99,12 @@ impl SceneStep {
             .forward(model, (q, v), tau, ctrl, &mut self.forward)
     }
 
+    /// The next step starts its solver from q̈₀ (as a new `SceneStep` would) rather than from
+    /// the last solution: its result no longer depends on the steps before.
+    pub fn forget_warm_start(&mut self) {
+        self.dynamics.forget_warm_start();
+    }
+
     /// How many times the forward dynamics was evaluated (RK4: four per step).
     pub fn evaluations(&self) -> usize {
         self.evaluations
