@@ -314,6 +314,14 @@ class Trajectory:
 
         return plot_trajectory(self, path, show)
 
+    def plot_contact_forces(self, geoms: Any = None, path: str | os.PathLike[str] | None = None,
+                            show: bool | None = None):
+        """The contact force on each geom over time, up and across (see
+        :func:`robodyn.plot.plot_contact_forces`)."""
+        from robodyn.plot import plot_contact_forces
+
+        return plot_contact_forces(self, geoms, path, show)
+
     def animate(self, path: str | os.PathLike[str], fps: int = 30, speed: float = 1.0,
                 progress: Callable[[float], Any] | None = None):
         """A 3-D stick figure of the robot, as a GIF or (with ffmpeg) MP4 (see

@@ -104,6 +104,14 @@ MADE: dict[str, Callable[[Path], Any]] = {
 }
 
 
+def _scene_run() -> Any:
+    """A box dropped on a plane, stepped as MuJoCo steps it: a run that records contacts."""
+    scene = robodyn.load_mjcf_string("""<mujoco><worldbody><geom name="floor" type="plane" size="1 1 1"/>
+      <body name="box" pos="0 0 0.1"><freejoint/><geom name="box" type="box" size="0.1 0.1 0.1"/></body>
+      </worldbody></mujoco>""")
+    return robodyn.simulate(scene, scene.neutral(), t_end=0.01, integrator="mujoco")
+
+
 def _dataset_file(folder: Path) -> str:
     path = str(folder / "read.zarr")
     robodyn.dataset(UR5, 4, chunk=4, out=path)
@@ -123,6 +131,8 @@ SPECIFIC: dict[str, dict[str, Callable[[Path], Any]]] = {
     "robodyn.plot.check_animation_path": {"path": lambda folder: str(folder / "motion.gif")},
     "robodyn.plot.check_figure_path": {"path": lambda folder: str(folder / "figure.png")},
     "robodyn.plot.plot_trajectory": {"path": lambda folder: str(folder / "figure.png")},
+    "robodyn.plot.plot_contact_forces": {"path": lambda folder: str(folder / "figure.png"),
+                                         "trajectory": lambda folder: _scene_run()},
     "robodyn.viewer.check_html_path": {"path": lambda folder: str(folder / "page.html")},
     "robodyn.viewer.model_html": {"path": lambda folder: str(folder / "model.html")},
     "robodyn.viewer.trajectory_html": {"path": lambda folder: str(folder / "motion.html")},

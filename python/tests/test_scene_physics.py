@@ -116,3 +116,24 @@ def test_go2_held_at_home_by_its_motors_stands_for_ten_seconds():
     assert np.all(np.abs(run.v[-1]) < 1e-2)
     feet = sum(run.contact_force(foot)[-1] for foot in ("FL", "FR", "RL", "RR"))
     assert feet == pytest.approx([0.0, 0.0, model.total_mass * G], abs=0.01 * model.total_mass * G)
+
+
+def test_the_contact_force_plot_shows_the_weight_carried(tmp_path):
+    """A crate resting on a level floor: the plot's "up" line is the floor's push on it, m g once
+    settled, its "across" line zero; a run without contacts recorded, or an unknown geom, is
+    refused."""
+    scene = load_quietly(text=tilted(CRATE, 0.0))
+    run = robodyn.simulate(scene, scene.neutral(), t_end=0.5, integrator="mujoco")
+    figure = run.plot_contact_forces(path=tmp_path / "forces.png")
+    assert (tmp_path / "forces.png").stat().st_size > 0
+    along, across = figure.axes[:2]
+    up = {line.get_label(): line.get_ydata() for line in along.get_lines()}
+    weight = scene.total_mass * G
+    assert set(up) == {"crate", f"m g = {weight:.4g} N"}
+    assert abs(up["crate"][-1] - weight) < 1e-6 * weight
+    assert np.allclose(up["crate"], run.contact_force("crate")[:, 2])
+    assert np.max(np.abs(across.get_lines()[0].get_ydata())) < 1e-9 * weight
+    with pytest.raises(ValueError, match="geoms"):
+        run.plot_contact_forces(["nothing"])
+    with pytest.raises(ValueError, match="integrator='mujoco'"):
+        robodyn.plot.plot_contact_forces(robodyn.simulate(scene, scene.neutral(), t_end=0.01))

@@ -14,7 +14,8 @@ import numpy as np
 
 from robodyn import _arguments
 
-__all__ = ["animate_trajectory", "check_animation_path", "check_figure_path", "plot_trajectory", "stick_figure_points"]
+__all__ = ["animate_trajectory", "check_animation_path", "check_figure_path", "plot_contact_forces", "plot_trajectory",
+           "stick_figure_points"]
 
 #: At most this many legend entries per panel; beyond it, the panel says how many it left out.
 MAX_LEGEND_ENTRIES = 12
@@ -105,6 +106,69 @@ def plot_trajectory(trajectory, path: str | os.PathLike[str] | None = None, show
         f"{model.name}: {trajectory.integrator}, {len(t)} samples over {t[-1]:g} s, "
         f"{trajectory.steps} steps"
     )
+    figure.tight_layout()
+    if path is not None:
+        figure.savefig(path, dpi=110)
+    if show:
+        import matplotlib.pyplot as plt
+
+        plt.show()
+    return figure
+
+
+def plot_contact_forces(trajectory, geoms=None, path: str | os.PathLike[str] | None = None,
+                        show: bool | None = None):
+    """The contact force on each geom over time (a run with ``integrator="mujoco"``): its part along
+    "up" (against gravity; world z without gravity) and the size of the rest, one panel each, with
+    their sum over the geoms and, on the first panel, the model's weight m g. ``geoms``: names
+    (default: every geom of a moving body that touched something). Saves to ``path`` as
+    :func:`plot_trajectory` does; returns the matplotlib figure."""
+    trajectory = _arguments.trajectory("trajectory", trajectory)
+    model = trajectory.model
+    if trajectory.integrator != "mujoco":
+        raise _arguments.bad("trajectory", "a run with integrator='mujoco' (the others record no contacts)",
+                             f"a run with integrator={trajectory.integrator!r}")
+    names = [g["name"] for g in model.geoms]
+    if geoms is None:
+        touched = {name for sample in trajectory.contacts for contact in sample
+                   for name in (contact["geom1"], contact["geom2"])}
+        geoms = [g["name"] for g in model.geoms if g["name"] in touched and g["body"] != 0]
+    elif isinstance(geoms, str):
+        geoms = [geoms]
+    elif not isinstance(geoms, (list, tuple)) or not all(isinstance(g, str) for g in geoms):
+        raise _arguments.bad("geoms", "None, a geom's name or a list of them", repr(geoms))
+    unknown = [g for g in geoms if g not in names]
+    if unknown:
+        raise _arguments.bad("geoms", f"names of the model's geoms ({len(names)})", repr(unknown))
+    if path is not None:
+        check_figure_path(path)
+    if show is None:
+        show = path is None and bool(os.environ.get("DISPLAY"))
+    show = _arguments.flag("show", show)
+    gravity = np.asarray(model.gravity, dtype=float)
+    up = -gravity / np.linalg.norm(gravity) if np.any(gravity) else np.array([0.0, 0.0, 1.0])
+    figure = _new_figure(2, show)
+    along, across = figure.subplots(2, 1, sharex=True)
+    t = trajectory.t
+    total = np.zeros((len(t), 3))
+    for name in geoms:
+        force = trajectory.contact_force(name)
+        total += force
+        along.plot(t, force @ up, label=name, linewidth=1.2)
+        across.plot(t, np.linalg.norm(force - np.outer(force @ up, up), axis=1), label=name, linewidth=1.2)
+    if len(geoms) > 1:
+        along.plot(t, total @ up, label="sum", color="black", linewidth=1.5)
+        across.plot(t, np.linalg.norm(total - np.outer(total @ up, up), axis=1), label="sum", color="black",
+                    linewidth=1.5)
+    weight = float(model.total_mass * np.linalg.norm(gravity))
+    along.axhline(weight, color="grey", linestyle=":", linewidth=1.0, label=f"m g = {weight:.4g} N")
+    along.set_ylabel("up [N]")
+    across.set_ylabel("across [N]")
+    across.set_xlabel("time [s]")
+    _legend(along, len(geoms) + 2)
+    for axis in (along, across):
+        axis.grid(True, alpha=0.3)
+    figure.suptitle(f"{model.name}: contact forces on {len(geoms)} geoms (up: against gravity)")
     figure.tight_layout()
     if path is not None:
         figure.savefig(path, dpi=110)
