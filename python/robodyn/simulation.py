@@ -332,16 +332,17 @@ class Trajectory:
 
     def view(self, **options: Any) -> TrajectoryViewer:
         """Plays the trajectory in a browser page served from this machine: play/pause, time
-        slider, speed, and the overlays (body frames, centre of mass, ground). Returns the
-        :class:`robodyn.viewer.TrajectoryViewer` (``close()`` stops it). Options: ``speed``,
-        ``frames``, ``com``, ``ground``, ``groups``, ``host``, ``port``, ``open_browser``."""
+        slider, speed, and the overlays (body frames, centre of mass, ground, and a scene run's
+        contact points and force arrows). Returns the :class:`robodyn.viewer.TrajectoryViewer`
+        (``close()`` stops it). Options: ``speed``, ``frames``, ``com``, ``ground``, ``contacts``,
+        ``groups``, ``host``, ``port``, ``open_browser``."""
         from robodyn.viewer import TrajectoryViewer
 
         return TrajectoryViewer(self, **options)
 
     def to_html(self, path: str | os.PathLike[str], **options: Any) -> Path:
         """Writes one self-contained HTML file that plays the trajectory offline, in any browser,
-        at 60 frames per second. Options: ``frames``, ``com``, ``ground``, ``groups``."""
+        at 60 frames per second. Options: ``frames``, ``com``, ``ground``, ``contacts``, ``groups``."""
         from robodyn.viewer import trajectory_html
 
         return trajectory_html(self, path, **options)

@@ -346,3 +346,50 @@ def test_the_shell_commands_write_pages_and_check_their_paths(tmp_path: Path, ca
     errors = capsys.readouterr().err
     assert "robodyn view: argument '--html': the folder" in errors
     assert "robodyn simulate: argument '--html': expected a file name ending in .html" in errors
+
+
+BOX_SCENE = """<mujoco><worldbody><geom name="floor" type="plane" size="1 1 1"/>
+  <body name="box" pos="0 0 0.1"><freejoint/><geom name="box" type="box" size="0.1 0.1 0.1" rgba="0.9 0.1 0.1 1"/></body>
+  </worldbody></mujoco>"""
+
+
+def test_a_scene_run_shows_its_contact_points_and_force_arrows(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A box at rest on a floor: the player draws a point at each corner's contact and an arrow
+    along the floor's push, the four together the box's weight m g at WEIGHT_ARROW_FRACTION of the
+    robot's size; unchecked, none; the offline page draws each frame's sample; a run without
+    contacts recorded has the box disabled."""
+    from robodyn.viewer.scene import WEIGHT_ARROW_FRACTION, RobotScene
+
+    scene = robodyn.load_mjcf_string(BOX_SCENE)
+    run = robodyn.simulate(scene, scene.neutral(), t_end=0.3, dt=0.01, integrator="mujoco")
+    viewer = run.view(open_browser=False, port=0)
+    try:
+        viewer.seek(run.t[-1])
+        time.sleep(0.2)
+        points, arrows = viewer.contacts[-1]
+        assert np.allclose(points, [c["position"] for c in run.contacts[-1]])
+        pushed = (arrows[:, 1] - arrows[:, 0]).sum(axis=0)
+        assert np.allclose(pushed, [0.0, 0.0, WEIGHT_ARROW_FRACTION * viewer.scene.size], rtol=1e-6, atol=1e-9)
+        cloud, lines = viewer.scene.contact_nodes
+        assert cloud.visible and lines.visible
+        viewer.contacts_box.value = False
+        time.sleep(0.2)
+        assert not viewer.scene.contact_nodes[1].visible
+    finally:
+        viewer.close()
+    drawn: list[np.ndarray] = []
+    original = RobotScene.show_contacts
+    monkeypatch.setattr(RobotScene, "show_contacts",
+                        lambda self, points, arrows, visible=True: (drawn.append(points), original(self, points, arrows, visible)))
+    run.to_html(tmp_path / "box.html")
+    assert len(drawn) == int(round(run.t[-1] * 60)) + 1
+    assert np.allclose(drawn[-1], points)
+    drawn.clear()
+    run.to_html(tmp_path / "plain.html", contacts=False)
+    assert drawn == []
+    free_fall = robodyn.simulate(scene, scene.neutral(), t_end=0.01)
+    player = free_fall.view(open_browser=False, port=0)
+    try:
+        assert player.contacts is None and player.contacts_box.disabled
+    finally:
+        player.close()

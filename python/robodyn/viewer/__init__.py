@@ -28,7 +28,7 @@ from numpy.typing import ArrayLike
 
 from robodyn import _arguments
 from robodyn.viewer.geometry import MUJOCO_VISIBLE_GROUPS, stick_pieces, visual_pieces
-from robodyn.viewer.scene import RobotScene
+from robodyn.viewer.scene import WEIGHT_ARROW_FRACTION, RobotScene, contact_arrows
 
 __all__ = ["PLAYBACK_RATE", "TrajectoryViewer", "Viewer", "check_html_path", "model_html", "trajectory_html"]
 
@@ -170,6 +170,21 @@ def _samples(trajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         np.asarray(model.center_of_mass(q)).reshape(len(q), 3)
 
 
+def _contact_samples(trajectory, size: float) -> list[tuple[np.ndarray, np.ndarray]] | None:
+    """Each sample's contact points and force arrows (:func:`robodyn.viewer.scene.contact_arrows`),
+    the model's weight m g drawn :data:`WEIGHT_ARROW_FRACTION` of the robot's size long (the
+    largest force, without gravity); None when the run records no contacts (integrators other
+    than ``"mujoco"``)."""
+    if trajectory.integrator != "mujoco":
+        return None
+    model = trajectory.model
+    weight = float(model.total_mass * np.linalg.norm(model.gravity))
+    if weight == 0.0:
+        largest = [np.linalg.norm(np.asarray(c["force"])[:3]) for sample in trajectory.contacts for c in sample]
+        weight = max(largest, default=1.0) or 1.0
+    return [contact_arrows(sample, WEIGHT_ARROW_FRACTION * size / weight) for sample in trajectory.contacts]
+
+
 def _spread(poses: np.ndarray) -> np.ndarray:
     """About :data:`EXTENT_SAMPLES` of a trajectory's poses, spread over it: what the first view
     frames."""
@@ -184,16 +199,21 @@ def _sample_at(times: np.ndarray, t: float) -> int:
 class TrajectoryViewer(Viewer):
     """A trajectory played in the browser at :data:`PLAYBACK_RATE` frames per second: play/pause,
     a time slider, the playback speed and the overlays in the page's panel. Arguments as
-    :class:`Viewer`; ``speed`` is the initial playback speed (one of :data:`SPEEDS`)."""
+    :class:`Viewer`; ``speed`` is the initial playback speed (one of :data:`SPEEDS`); ``contacts``
+    draws a scene run's contact points and force arrows (``integrator="mujoco"``: each arrow the
+    force on the contact's second geom, the model's weight half the robot's size long)."""
 
     def __init__(self, trajectory: Any, *, speed: str = "1x", frames: bool = False, com: bool = False, ground: bool = True,
                  groups: tuple[int, ...] | None = MUJOCO_VISIBLE_GROUPS, host: str = LOOPBACK,
-                 port: int = DEFAULT_PORT, open_browser: bool | None = None, camera: tuple[Any, Any] | None = None) -> None:
+                 port: int = DEFAULT_PORT, open_browser: bool | None = None, camera: tuple[Any, Any] | None = None,
+                 contacts: bool = True) -> None:
         if speed not in SPEEDS:
             raise ValueError(f"argument 'speed': expected one of {', '.join(SPEEDS)}, got {speed!r}")
         self.times, self.poses, self.coms = _samples(trajectory)
+        contacts = _arguments.flag("contacts", contacts)
         self._serve(trajectory.model, self.poses[0], self.coms[0], _spread(self.poses),
                     _options(frames, com, ground, camera), groups, host, port)
+        self.contacts = _contact_samples(trajectory, self.scene.size)
         gui = self.server.gui
         duration = float(self.times[-1] - self.times[0])
         self.playing = gui.add_checkbox("Play", True)
@@ -206,6 +226,8 @@ class TrajectoryViewer(Viewer):
         frames_box.on_update(lambda _: self.scene.overlays(frames=frames_box.value))
         com_box.on_update(lambda _: self.scene.overlays(com_marker=com_box.value))
         ground_box.on_update(lambda _: self.scene.overlays(ground=ground_box.value))
+        self.contacts_box = gui.add_checkbox("Contacts", contacts, disabled=self.contacts is None)
+        self.contacts_box.on_update(lambda _: self._draw(self.time.value))
         # the slider draws: moved in the page, or by the player below (viser calls back on both)
         self.time.on_update(lambda _: self._draw(self.time.value))
         self._stop = threading.Event()
@@ -218,6 +240,8 @@ class TrajectoryViewer(Viewer):
     def _draw(self, t: float) -> None:
         k = _sample_at(self.times, t)
         self.scene.show(self.poses[k], self.coms[k])
+        if self.contacts is not None:
+            self.scene.show_contacts(*self.contacts[k], visible=self.contacts_box.value)
 
     def _play(self) -> None:
         """Advances the time slider at the playback rate while playing, looping at the end."""
@@ -274,11 +298,13 @@ def model_html(model, path: str | os.PathLike[str], q=None, *, frames: bool = Fa
 
 def trajectory_html(trajectory, path: str | os.PathLike[str], *, frames: bool = False, com: bool = False,
                     ground: bool = True, groups: tuple[int, ...] | None = MUJOCO_VISIBLE_GROUPS,
-                    camera: tuple[Any, Any] | None = None) -> Path:
+                    camera: tuple[Any, Any] | None = None, contacts: bool = True) -> Path:
     """Writes one self-contained HTML file that plays ``trajectory`` at :data:`PLAYBACK_RATE`
-    frames per second (play/pause, time slider and speed in the page), offline in any browser.
-    Returns the path."""
+    frames per second (play/pause, time slider and speed in the page), offline in any browser;
+    with a scene run's contact points and force arrows unless ``contacts`` is False (see
+    :class:`TrajectoryViewer`). Returns the path."""
     target = check_html_path(path)
+    contacts = _arguments.flag("contacts", contacts)
     times, poses, coms = _samples(trajectory)
     options = _options(frames, com, ground, camera)
     pieces = _pieces(trajectory.model, groups)
@@ -286,11 +312,14 @@ def trajectory_html(trajectory, path: str | os.PathLike[str], *, frames: bool = 
     scene = RobotScene(server, pieces, poses[0], coms[0], extent_poses=_spread(poses), skybox=trajectory.model.skybox,
                        **options)
     frame_times = np.arange(times[0], times[-1] + 0.5 / PLAYBACK_RATE, 1.0 / PLAYBACK_RATE)
+    drawn = _contact_samples(trajectory, scene.size) if contacts else None
 
     def record(serializer) -> None:
         for k, t in enumerate(frame_times):
             sample = _sample_at(times, t)
             scene.show(poses[sample], coms[sample])
+            if drawn is not None:
+                scene.show_contacts(*drawn[sample])
             if k + 1 < len(frame_times):
                 serializer.insert_sleep(1.0 / PLAYBACK_RATE)
 

@@ -11,7 +11,7 @@ import numpy as np
 from robodyn.viewer.geometry import Piece, skybox_piece
 from robodyn.viewer.textures import unlit_glb
 
-__all__ = ["RobotScene", "camera_for", "poses_to_wxyz_position"]
+__all__ = ["RobotScene", "camera_for", "contact_arrows", "poses_to_wxyz_position"]
 
 #: Vertical field of view of the initial camera, radians.
 CAMERA_FOV = np.radians(50.0)
@@ -23,6 +23,12 @@ CAMERA_MARGIN = 1.15
 AXES_FRACTION = 0.08
 COM_FRACTION = 0.02
 COM_RGB = (230, 40, 40)
+#: Contact points and their force arrows: colour, point size and arrow thickness as fractions of
+#: the robot's size, and the length of an arrow carrying the model's weight m g, as one.
+CONTACT_RGB = (20, 170, 60)
+CONTACT_POINT_FRACTION = 0.02
+CONTACT_ARROW_FRACTION = 0.004
+WEIGHT_ARROW_FRACTION = 0.5
 #: Side of the ground grid's cells, metres, and how far the grid reaches beyond the robot.
 GRID_CELL = 0.1
 GRID_REACH = 2.0
@@ -33,6 +39,16 @@ def poses_to_wxyz_position(poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     from viser.transforms import SO3
 
     return SO3.from_matrix(poses[..., :3, :3]).wxyz, poses[..., :3, 3].copy()
+
+
+def contact_arrows(contacts: list[dict[str, Any]], metres_per_newton: float) -> tuple[np.ndarray, np.ndarray]:
+    """One sample's contacts (as ``Trajectory.contacts`` lists them): their points (K, 3) and force
+    arrows (K, 2, 3), from each point along the force pushing its second geom (``frame``ᵀ
+    ``force[:3]``, world axes), ``metres_per_newton`` long per newton."""
+    points = np.array([contact["position"] for contact in contacts], dtype=float).reshape(-1, 3)
+    forces = np.array([np.asarray(contact["frame"]).T @ np.asarray(contact["force"])[:3] for contact in contacts],
+                      dtype=float).reshape(-1, 3)
+    return points, np.stack([points, points + metres_per_newton * forces], axis=1)
 
 
 def _bounds(pieces: list[Piece], poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -103,6 +119,7 @@ class RobotScene:
         server.initial_camera.look_at = tuple(look_at)
         self.bounds = (low, high)
         self.camera = (position, look_at)
+        self.size = size
 
         grid_side = 2 * GRID_REACH + float(max(high[0] - low[0], high[1] - low[1]))
         self.ground = scene.add_grid("/ground", width=grid_side, height=grid_side, cell_size=GRID_CELL,
@@ -122,6 +139,7 @@ class RobotScene:
             scene.add_mesh_simple(name, vertices=piece.vertices.astype(np.float32), faces=piece.faces.astype(np.uint32),
                                   color=rgb, opacity=piece.rgba[3] if piece.rgba[3] < 1 else None, side="double")
         self.com = scene.add_icosphere("/com", radius=COM_FRACTION * size, color=COM_RGB, visible=com_marker)
+        self.contact_nodes: tuple[Any, Any] | None = None
         self.show(poses, com)
 
     def show(self, poses: np.ndarray, com: np.ndarray) -> None:
@@ -132,6 +150,23 @@ class RobotScene:
                 node.wxyz = w
                 node.position = p
             self.com.position = np.asarray(com, dtype=float)
+
+    def show_contacts(self, points: np.ndarray, arrows: np.ndarray, visible: bool = True) -> None:
+        """Draws contact points (K, 3) and force arrows (K, 2, 3) (:func:`contact_arrows`) in
+        place of the last ones; none drawn when K is 0 or not ``visible``."""
+        scene = self.server.scene
+        shown = visible and len(points) > 0
+        if not shown:
+            # one hidden point stands for none (viser draws no empty cloud)
+            points, arrows = np.zeros((1, 3)), np.zeros((1, 2, 3))
+        with self.server.atomic():
+            self.contact_nodes = (
+                scene.add_point_cloud("/contacts/points", points.astype(np.float32), CONTACT_RGB,
+                                      point_size=CONTACT_POINT_FRACTION * self.size, point_shape="circle",
+                                      visible=shown),
+                scene.add_line_segments("/contacts/forces", arrows.astype(np.float32), CONTACT_RGB,
+                                        thickness=CONTACT_ARROW_FRACTION * self.size, visible=shown),
+            )
 
     def overlays(self, *, frames: bool | None = None, com_marker: bool | None = None, ground: bool | None = None) -> None:
         """Switches the overlays given."""
