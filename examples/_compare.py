@@ -1,9 +1,26 @@
-"""Printing a textbook value next to robodyn's, shared by the examples."""
+"""Printing a textbook value next to robodyn's, and the Go2 scene, shared by the examples."""
 
 from __future__ import annotations
 
+import warnings
+from pathlib import Path
+from typing import Any
+
 import numpy as np
 from numpy.typing import ArrayLike
+
+#: The repository's Go2 scene: examples/ lies beside testdata/ (the Go2 without its visual meshes).
+GO2_SCENE = Path(__file__).resolve().parents[1] / "testdata" / "menagerie" / "unitree_go2" / "scene.xml"
+
+
+def go2_scene() -> Any:
+    """Menagerie's Unitree Go2 on its floor (:data:`GO2_SCENE`), loaded without its warnings (the
+    scene's <visual> is not read, and its contacts are felt only with integrator='mujoco')."""
+    import robodyn
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", robodyn.ModelWarning)
+        return robodyn.load(GO2_SCENE)
 
 
 def show(label: str, textbook: ArrayLike, robodyn_value: ArrayLike, tolerance: float = 1e-10) -> None:

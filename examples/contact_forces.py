@@ -10,23 +10,15 @@ every row's force and the accelerations are checked against `mj_forward` run to 
     python examples/contact_forces.py
 """
 
-import warnings
-from pathlib import Path
 
-import _compare
 import matplotlib.pyplot as plt
 import numpy as np
-from _compare import show
+from _compare import GO2_SCENE, go2_scene, show
 
 import robodyn
 from robodyn.plot import stick_figure_points
 
-# the repository's root: examples/ lies beside testdata/ (the Go2 without its visual meshes)
-SCENE = Path(_compare.__file__).resolve().parents[1] / "testdata" / "menagerie" / "unitree_go2" / "scene.xml"
-with warnings.catch_warnings():
-    # the scene's <visual> is not read, and its contacts are felt only with integrator='mujoco'
-    warnings.simplefilter("ignore", robodyn.ModelWarning)
-    go2 = robodyn.load(SCENE)
+go2 = go2_scene()
 home = go2.keyframe("home")
 q, ctrl = np.asarray(home.q), np.asarray(home.ctrl)
 v = np.zeros(go2.nv)
@@ -104,7 +96,7 @@ try:
 except ImportError:
     mujoco = None
 if mujoco is not None:
-    spec = mujoco.MjSpec.from_file(str(SCENE))
+    spec = mujoco.MjSpec.from_file(str(GO2_SCENE))
     for geom in [geom for geom in spec.geoms if geom.type == mujoco.mjtGeom.mjGEOM_MESH]:
         spec.delete(geom)
     for mesh in list(spec.meshes):

@@ -10,22 +10,14 @@ draws the force on each foot over time: the impact, then the feet sharing the ro
     python examples/go2_landing.py
 """
 
-import warnings
-from pathlib import Path
 from typing import Any
 
-import _compare
 import numpy as np
-from _compare import show
+from _compare import go2_scene, show
 
 import robodyn
 
-# the repository's root: examples/ lies beside testdata/ (the Go2 without its visual meshes)
-SCENE = Path(_compare.__file__).resolve().parents[1] / "testdata" / "menagerie" / "unitree_go2" / "scene.xml"
-with warnings.catch_warnings():
-    # the scene's <visual> is not read
-    warnings.simplefilter("ignore", robodyn.ModelWarning)
-    go2 = robodyn.load(SCENE)
+go2 = go2_scene()
 home = go2.keyframe("home")
 JOINTS, SPEEDS = slice(7, go2.nq), slice(6, go2.nv)
 KP, KD = 200.0, 5.0
