@@ -19,8 +19,10 @@
 //! `solref` (its friction rows' too), `solimp` and friction are the `<option>`'s `o_margin`,
 //! `o_solref`, `o_solimp` and `o_friction`. Every friction term is at least [`MIN_FRICTION`].
 
+mod cost;
 pub mod dynamics;
 pub mod impedance;
+mod pattern;
 pub mod rows;
 pub mod simulate;
 pub mod solver;
