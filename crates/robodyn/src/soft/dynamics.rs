@@ -15,7 +15,7 @@
 //! solution, and the forces of its rows.
 
 use super::rows::{constraint_rows, Rows};
-use super::solver::{Solution, Solver};
+use super::solver::{dot, Solution, Solver};
 use super::weights::{inverse_weights, InverseWeights};
 use crate::algo::{aba, crba, forward_kinematics};
 use crate::collision::{checked_pairs, collide, CheckedPair, CollisionScratch, Contact};
@@ -157,8 +157,4 @@ pub(super) fn free_joint_velocity_product(model: &Model, v: &[f64]) -> DVector<f
         }
     }
     w
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(a, b)| a * b).sum()
 }

@@ -282,7 +282,8 @@ impl Solver {
     }
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
+/// aᵀ b of two slices.
+pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(a, b)| a * b).sum()
 }
 
