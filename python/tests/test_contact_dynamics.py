@@ -5,7 +5,8 @@ reference accelerations, then the same solution (row forces, accelerations, cons
 MuJoCo is made to solve to convergence (Newton, tolerance 1e-15, 1000 iterations, 100 line-search
 steps) with a dense constraint Jacobian. Scenes: a box on a plane (every condim, both cones, two
 impratios), explicit contact pairs with their own solref/solreffriction/solimp/margin/gap, joint
-limits and dof friction loss with actuators, and dm_control's suite models."""
+limits and dof friction loss with actuators, equality constraints of every kind robodyn reads, and
+dm_control's suite models."""
 
 import mujoco
 import numpy as np
@@ -380,7 +381,75 @@ def test_go2_standing_at_home_as_in_mujoco(cone, tmp_path):
         assert sum(geom2 in ("FL", "FR", "RL", "RR") for _, geom2, *_ in expected["contacts"]) == 4
 
 
-# --- 6. what is refused ---------------------------------------------------------------------
+# --- 6. equality constraints ------------------------------------------------------------------
+
+# Every kind of MuJoCo equality robodyn reads: a weld between an arm and a free box (torquescale 2,
+# its own solref), a free ball's point connected to the world, two sites connected (their own
+# solimp), a site welded to a world site, a ball joint welded to the world at a relpose, a slide
+# following a hinge by a polynomial, a hinge held, and an inactive connect; the ball rests on the
+# floor.
+EQUALITIES = """<mujoco><option timestep="0.002" cone="{cone}"/>
+  <worldbody>
+    <geom name="floor" type="plane" size="0 0 1"/>
+    <site name="post" pos="0.5 -1 1.5"/>
+    <body name="arm" pos="0 0 1"><joint name="shoulder" axis="0 1 0"/>
+      <geom type="capsule" fromto="0 0 0 .5 0 0" size=".05"/>
+      <body name="fore" pos=".5 0 0" euler="10 20 30">
+        <joint name="elbow" axis="0 0 1"/><joint name="slide" type="slide" axis="1 0 0"/>
+        <geom type="box" size=".2 .05 .05" pos=".2 0 0"/></body></body>
+    <body name="box" pos="1 .3 1.2" euler="5 -10 40"><freejoint/>
+      <geom name="box" type="box" size=".1 .2 .3" mass="2"/>
+      <site name="corner" pos=".1 .2 .3"/></body>
+    <body name="ball" pos="-1 0 0.09"><freejoint/><geom name="ball" type="sphere" size=".1"/>
+      <site name="top" pos="0 0 .1"/></body>
+    <body name="pendulum" pos="0.5 -1 2"><joint name="swing" axis="1 0 0"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -.5" size=".03"/>
+      <body name="bob" pos="0 0 -.5"><joint name="twist" axis="0 0 1"/><geom type="sphere" size=".06"/>
+        <site name="tip" pos="0 0 0" euler="0 0 15"/></body></body>
+    <body name="lever" pos="-1 1 1"><joint name="lever" type="ball"/><geom type="box" size=".3 .02 .02" pos=".3 0 0"/></body>
+  </worldbody>
+  <equality>
+    <weld body1="fore" body2="box" torquescale="2" solref="0.03 0.8"/>
+    <connect body1="ball" anchor="0 0 .1"/>
+    <connect site1="top" site2="corner" solimp="0.8 0.95 0.01 0.4 3"/>
+    <weld site1="tip" site2="post"/>
+    <weld body1="lever" anchor="-1 1 1" relpose="0 0 0 0.9 0.1 0 0"/>
+    <joint joint1="slide" joint2="shoulder" polycoef="0.1 0.5 0.2 0 0"/>
+    <joint joint1="elbow" polycoef="0.2 0 0 0 0"/>
+    <connect body1="arm" body2="lever" anchor="0 0 0" active="false"/>
+  </equality></mujoco>"""
+EQUALITY_ROWS = 6 + 3 + 3 + 6 + 6 + 1 + 1
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+def test_equality_constraints_as_in_mujoco(cone):
+    """The equality rows (MuJoCo's first block: per equality, its rows' Jacobian, R from the bodies'
+    or joints' weights and the impedance of the norm of its error, a_ref with the weld's and
+    connect's J̇ q̇) and the solution with them, at random states away from qpos0."""
+    model, mj_model, layout = load_both(EQUALITIES.replace("{cone}", cone))
+    rng = np.random.default_rng(6)
+    ball_height = mj_model.jnt_qposadr[mj_model.body("ball").jntadr[0]] + 2
+    for case in range(4):
+        qpos = mj_model.qpos0.copy()
+        mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.1, 1.0)
+        qpos[ball_height] = 0.08
+        ours, expected = assert_matches_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv),
+                                               tau=rng.normal(size=mj_model.nv), label=f"{cone} case {case}")
+        kinds = list(ours["row_types"])
+        assert kinds[:EQUALITY_ROWS] == ["equality"] * EQUALITY_ROWS and "equality" not in kinds[EQUALITY_ROWS:]
+        assert 7 not in list(ours["row_ids"])[:EQUALITY_ROWS], "the inactive connect has no rows"
+        assert any(kind.startswith("contact") for kind in kinds), "the ball touches the floor"
+
+
+def test_a_disabled_equality_flag_drops_the_rows():
+    """<flag equality="disable">: no equality rows, as in MuJoCo."""
+    text = EQUALITIES.replace('cone="{cone}"/>', 'cone="pyramidal"><flag equality="disable"/></option>')
+    model, mj_model, layout = load_both(text)
+    ours, _ = assert_matches_mujoco(model, mj_model, layout, mj_model.qpos0, np.ones(mj_model.nv))
+    assert "equality" not in list(ours["row_types"])
+
+
+# --- 7. what is refused ---------------------------------------------------------------------
 
 
 def test_bad_input_is_refused_naming_it():
@@ -394,11 +463,6 @@ def test_bad_input_is_refused_naming_it():
         model.contact_forward_dynamics(q, v, ctrl=np.zeros(2))
     with pytest.raises(ValueError, match="argument 'v'"):
         model.contact_forward_dynamics(q, np.zeros(7))
-    welded = load_quietly(text="""<mujoco><worldbody>
-      <body name="a"><joint name="hinge" axis="0 1 0"/><geom size="0.1" mass="1"/></body>
-      </worldbody><equality><joint name="held" joint1="hinge"/></equality></mujoco>""")
-    with pytest.raises(ValueError, match="equality constraint 'held'.*not made yet"):
-        welded.contact_forward_dynamics(welded.neutral(), np.zeros(1))
 
 
 BALL = """<mujoco><compiler angle="degree"/>

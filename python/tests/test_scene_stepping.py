@@ -14,6 +14,7 @@ from conftest import REPOSITORY, load_quietly
 from robodyn.convert import MujocoLayout
 from test_contact_dynamics import (
     ARM,
+    EQUALITIES,
     FLAGGED,
     SUITE,
     box_scene,
@@ -133,6 +134,15 @@ def test_an_arm_with_limits_friction_and_actuators_steps_as_in_mujoco(integrator
     qvel = np.array([0.5, 2.0, -3.0, 1.0])
     assert_steps_like_mujoco(model, mj_model, layout, qpos, qvel, ctrl=[0.7, -0.4], tau=[0.0, 0.3, -0.2, 0.1],
                              label=integrator)
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+def test_equality_constraints_step_as_in_mujoco(integrator):
+    """test_contact_dynamics's equalities of every kind (welds, connects, joint couplings; the ball on
+    the floor), set moving: their rows' J̇ q̇ and softness through 100 steps."""
+    model, mj_model, layout = load_both(text=with_integrator(EQUALITIES.replace("{cone}", "pyramidal"), integrator))
+    qvel = np.random.default_rng(7).normal(size=mj_model.nv)
+    assert_steps_like_mujoco(model, mj_model, layout, mj_model.qpos0, qvel, label=integrator)
 
 
 # --- 3. a Menagerie quadruped, dm_control's suite ----------------------------------------------

@@ -210,6 +210,10 @@ pub struct ModelConstraint {
     pub solimp: [f64; 5],
     /// A weld's `torquescale` (the weight of its rotation rows in the soft form; 1 otherwise).
     pub torquescale: f64,
+    /// The file bodies ([`Model::source_bodies`] ids, the world 0) a connect or weld attaches,
+    /// whose weights soften its rows in MuJoCo's model (unused by the other kinds).
+    #[serde(default)]
+    pub bodies: [usize; 2],
 }
 
 pub use crate::model::{DEFAULT_SOLIMP, DEFAULT_SOLREF};
@@ -224,6 +228,7 @@ impl ModelConstraint {
             solref: DEFAULT_SOLREF,
             solimp: DEFAULT_SOLIMP,
             torquescale: 1.0,
+            bodies: [0, 0],
         }
     }
 }

@@ -21,6 +21,7 @@
 
 mod cost;
 pub mod dynamics;
+pub mod equality;
 pub mod impedance;
 mod pattern;
 pub mod rows;

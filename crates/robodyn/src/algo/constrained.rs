@@ -212,9 +212,7 @@ fn factor_inertia(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
     factor_mass_matrix(model, data)
 }
 
-/// J, γ and φ at (q, q̇): the bodies' placements, velocities and accelerations with q̈ = 0 (no
-/// gravity) by the outward pass of Table 5.1, then each constraint's rows. Writes `data.x_up`,
-/// `data.x_world`, `data.v`, `data.a`.
+/// J, γ and φ at (q, q̇) into `constraints` (see [`evaluate_rows`]).
 fn constraint_rows(
     model: &Model,
     data: &mut Data,
@@ -222,6 +220,24 @@ fn constraint_rows(
     set: &ConstraintSet,
     q: &[f64],
     v: &[f64],
+) -> Result<()> {
+    let rows = ConstraintRows {
+        jacobian: &mut constraints.jacobian,
+        drift: constraints.drift.as_mut_slice(),
+        error: constraints.error.as_mut_slice(),
+    };
+    evaluate_rows(model, data, set, (q, v), rows)
+}
+
+/// J, γ and φ of `set` at (q, q̇): the bodies' placements, velocities and accelerations with
+/// q̈ = 0 (no gravity) by the outward pass of Table 5.1, then each constraint's rows. Writes
+/// `data.x_up`, `data.x_world`, `data.v`, `data.a`.
+pub(crate) fn evaluate_rows(
+    model: &Model,
+    data: &mut Data,
+    set: &ConstraintSet,
+    (q, v): (&[f64], &[f64]),
+    rows: ConstraintRows,
 ) -> Result<()> {
     model.check_configuration(q)?;
     check_vector("v", v, model.nv)?;
@@ -240,11 +256,6 @@ fn constraint_rows(
         x_world: &data.x_world,
         v: &data.v,
         a: &data.a,
-    };
-    let rows = ConstraintRows {
-        jacobian: &mut constraints.jacobian,
-        drift: constraints.drift.as_mut_slice(),
-        error: constraints.error.as_mut_slice(),
     };
     evaluate(model, set, &bodies, (q, v), rows);
     Ok(())

@@ -208,6 +208,7 @@ fn load_sources(sources: &Sources) -> Result<Model> {
             mass: 0.0,
             com: crate::spatial::Vec3::zeros(),
         }]),
+        site_bodies: RefCell::new(HashMap::new()),
     };
     if !root.has_tag_name("mujoco") {
         return Err(reader.error(root, "expected the root element <mujoco>"));
@@ -336,6 +337,8 @@ struct Reader<'a> {
     warnings: RefCell<Vec<String>>,
     /// the file's bodies' names by MuJoCo body id (the world first), as they are read
     source_bodies: RefCell<Vec<SourceBody>>,
+    /// each site's file body (MuJoCo body id), by the site's name
+    site_bodies: RefCell<HashMap<String, usize>>,
 }
 
 impl<'a> Reader<'a> {

@@ -4,6 +4,7 @@
 //! analytically-invertible dynamics with contacts and constraints", ICRA 2014. Per group of
 //! rows, with `D = 1/R` and `x = J q̈ − a_ref`:
 //! ```text
+//!   equality rows                             s = ½ D x²                      f = −D x
 //!   limits, frictionless and pyramidal rows   s = ½ D x²  where x < 0          f = −D x  (or 0)
 //!   friction loss (largest force φ)           Huber: ½ D x² for |x| < R φ,     f = ∓φ beyond
 //!                                                    φ|x| − ½ R φ² beyond
@@ -64,6 +65,16 @@ pub(super) fn forces_at(
     for group in &rows.groups {
         let range = group.first..group.first + group.len;
         match group.kind {
+            RowKind::Equality => {
+                for i in range {
+                    let d = 1.0 / rows.regulariser[i];
+                    forces[i] = -d * x[i];
+                    cost += 0.5 * d * x[i] * x[i];
+                    if let Some(c) = curvature.as_deref_mut() {
+                        c.diagonal.push((i, d));
+                    }
+                }
+            }
             RowKind::FrictionDof => {
                 let i = group.first;
                 let (r, loss) = (rows.regulariser[i], rows.frictionloss[i]);
@@ -173,10 +184,11 @@ pub(super) mod tests {
     use crate::soft::rows::Group;
     use nalgebra::DMatrix;
 
-    /// Four degrees of freedom under a friction-loss row, a limit and an elliptic contact of
-    /// three rows (μ = 0.5), J with zeros in it as a robot's has.
+    /// Four degrees of freedom under an equality row, a friction-loss row, a limit and an
+    /// elliptic contact of three rows (μ = 0.5), J with zeros in it as a robot's has.
     pub(in crate::soft) fn mixed_rows() -> Rows {
         let jacobian = vec![
+            0.2, 0.0, 0.5, -0.7, // equality
             0.0, 1.0, 0.0, 0.0, // friction loss
             0.3, 0.0, -1.2, 0.0, // limit
             1.0, 0.5, 0.0, 0.2, // contact normal
@@ -195,37 +207,40 @@ pub(super) mod tests {
             nv: 4,
             jacobian,
             kind: vec![
+                Equality,
                 FrictionDof,
                 LimitJoint,
                 ContactElliptic,
                 ContactElliptic,
                 ContactElliptic,
             ],
-            id: vec![0; 5],
-            position: vec![0.0; 5],
-            margin: vec![0.0; 5],
-            frictionloss: vec![0.5, 0.0, 0.0, 0.0, 0.0],
-            regulariser: vec![1e-2, 1e-1, 2e-2, 4e-2, 5e-2],
-            reference: vec![0.1, 2.0, 3.0, -1.0, 0.5],
+            id: vec![0; 6],
+            position: vec![0.0; 6],
+            margin: vec![0.0; 6],
+            frictionloss: vec![0.0, 0.5, 0.0, 0.0, 0.0, 0.0],
+            regulariser: vec![3e-2, 1e-2, 1e-1, 2e-2, 4e-2, 5e-2],
+            reference: vec![0.4, 0.1, 2.0, 3.0, -1.0, 0.5],
             groups: vec![
-                group(0, 1, FrictionDof, 0.0),
-                group(1, 1, LimitJoint, 0.0),
-                group(2, 3, ContactElliptic, 0.5),
+                group(0, 1, Equality, 0.0),
+                group(1, 1, FrictionDof, 0.0),
+                group(2, 1, LimitJoint, 0.0),
+                group(3, 3, ContactElliptic, 0.5),
             ],
-            contact_rows: vec![Some(2)],
+            contact_rows: vec![Some(3)],
         }
     }
 
     #[test]
     fn the_curvature_is_minus_the_forces_derivative() {
-        // x on the elliptic cone's surface and the friction row inside its Huber zone
+        // x on the elliptic cone's surface, the friction row inside its Huber zone, the
+        // equality's x positive (it pulls both ways)
         let rows = mixed_rows();
-        let x = [1e-3, -0.2, -0.3, 0.4, -0.1];
+        let x = [0.3, 1e-3, -0.2, -0.3, 0.4, -0.1];
         let mut curvature = Curvature::default();
-        let mut forces = [0.0; 5];
+        let mut forces = [0.0; 6];
         forces_at(&rows, &x, &mut forces, Some(&mut curvature));
         assert_eq!(curvature.blocks.len(), 1, "on the cone's surface");
-        let mut dense = DMatrix::zeros(5, 5);
+        let mut dense = DMatrix::zeros(6, 6);
         for &(i, d) in &curvature.diagonal {
             dense[(i, i)] = d;
         }
@@ -238,14 +253,14 @@ pub(super) mod tests {
         }
         // H_s = −∂f/∂x, by central differences
         let step = 1e-6;
-        for k in 0..5 {
+        for k in 0..6 {
             let (mut up, mut down) = (x, x);
             up[k] += step;
             down[k] -= step;
-            let (mut f_up, mut f_down) = ([0.0; 5], [0.0; 5]);
+            let (mut f_up, mut f_down) = ([0.0; 6], [0.0; 6]);
             forces_at(&rows, &up, &mut f_up, None);
             forces_at(&rows, &down, &mut f_down, None);
-            for i in 0..5 {
+            for i in 0..6 {
                 let derivative = -(f_up[i] - f_down[i]) / (2.0 * step);
                 let scale = 1.0 + dense[(i, k)].abs();
                 assert!(

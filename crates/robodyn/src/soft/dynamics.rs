@@ -14,6 +14,7 @@
 //! `J (q̈ + w)` to follow a_ref. Solving for robodyn's q̈ with `a_ref − J w` gives its very
 //! solution, and the forces of its rows.
 
+use super::equality::Equalities;
 use super::rows::{constraint_rows, Rows};
 use super::solver::{dot, Solution, Solver};
 use super::weights::{inverse_weights, InverseWeights};
@@ -53,14 +54,17 @@ pub struct ContactDynamics {
     data: Data,
     scratch: CollisionScratch,
     solver: Solver,
+    equalities: Equalities,
 }
 
 impl ContactDynamics {
     /// The weights and pairs of `model`.
     pub fn new(model: &Model) -> Result<Self> {
         let mut data = Data::new(model);
+        let weights = inverse_weights(model, &mut data)?;
         Ok(ContactDynamics {
-            weights: inverse_weights(model, &mut data)?,
+            equalities: Equalities::new(model, &weights)?,
+            weights,
             pairs: checked_pairs(model),
             data,
             scratch: CollisionScratch::default(),
@@ -109,6 +113,7 @@ impl ContactDynamics {
             (q, v),
             &x_world,
             &out.contacts,
+            &mut self.equalities,
             &mut out.rows,
         )?;
         let w = free_joint_velocity_product(model, v);
@@ -147,6 +152,13 @@ fn passive_forces(model: &Model, q: &[f64], v: &[f64]) -> DVector<f64> {
 /// acceleration is `T (q̈ + w)`.
 pub(super) fn free_joint_velocity_product(model: &Model, v: &[f64]) -> DVector<f64> {
     let mut w = DVector::zeros(model.nv);
+    write_free_joint_product(model, v, &mut w);
+    w
+}
+
+/// [`free_joint_velocity_product`] into `w` (nv).
+pub(super) fn write_free_joint_product(model: &Model, v: &[f64], w: &mut DVector<f64>) {
+    w.fill(0.0);
     for i in 1..model.nbodies() {
         if matches!(model.joints[i], Joint::Free) {
             let s = model.idx_v[i];
@@ -156,5 +168,4 @@ pub(super) fn free_joint_velocity_product(model: &Model, v: &[f64]) -> DVector<f
             w.rows_mut(s, 3).copy_from(&product);
         }
     }
-    w
 }

@@ -4,6 +4,7 @@
 //! Reference: MuJoCo's documentation, "Computation", §Constraint model and §Soft constraints
 //! (read to understand, written anew here). The rows come in blocks:
 //! ```text
+//!   equalities      connect (3 rows), weld (6), joint (1): see super::equality
 //!   friction loss   one per degree of freedom with frictionloss > 0:  J = e_i,  pos = 0
 //!   limits          each side of a limited hinge or slide within its margin:
 //!                     lower  pos = q − lo,  J = +e_i      upper  pos = hi − q,  J = −e_i
@@ -23,10 +24,11 @@
 //! ```
 //! with (k, b) from `solref` ([`super::impedance::spring_and_damper`]).
 
+use super::equality::Equalities;
 use super::impedance::{impedance, spring_and_damper};
 use super::weights::{point_columns, InverseWeights};
 use crate::collision::Contact;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::joint::Joint;
 use crate::model::{FrictionCone, Model, SolverParameters};
 use crate::spatial::{Mat3, Transform, Vec3};
@@ -37,6 +39,8 @@ const TINY: f64 = 1e-15;
 /// What made a row (MuJoCo's `mjtConstraint`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RowKind {
+    /// An equality constraint's row.
+    Equality,
     /// Dry friction of one degree of freedom.
     FrictionDof,
     /// One side of a joint's limit.
@@ -53,6 +57,7 @@ impl RowKind {
     /// MuJoCo's name, lower case without its `mjCNSTR_` prefix.
     pub fn name(self) -> &'static str {
         match self {
+            RowKind::Equality => "equality",
             RowKind::FrictionDof => "friction_dof",
             RowKind::LimitJoint => "limit_joint",
             RowKind::ContactFrictionless => "contact_frictionless",
@@ -86,7 +91,8 @@ pub struct Rows {
     pub jacobian: Vec<f64>,
     /// Each row's kind.
     pub kind: Vec<RowKind>,
-    /// Each row's element: the degree of freedom, the joint (MuJoCo's joint id), the contact.
+    /// Each row's element: the model constraint, the degree of freedom, the joint (MuJoCo's
+    /// joint id), the contact.
     pub id: Vec<usize>,
     /// Position (m or rad): negative when violated.
     pub position: Vec<f64>,
@@ -163,7 +169,13 @@ impl Rows {
     }
 
     /// Adds a row; its Jacobian zero, to be written.
-    fn push(&mut self, kind: RowKind, id: usize, position: f64, margin: f64) -> &mut [f64] {
+    pub(super) fn push(
+        &mut self,
+        kind: RowKind,
+        id: usize,
+        position: f64,
+        margin: f64,
+    ) -> &mut [f64] {
         self.kind.push(kind);
         self.id.push(id);
         self.position.push(position);
@@ -192,6 +204,7 @@ pub fn constraint_rows(
     (q, v): (&[f64], &[f64]),
     x_world: &[Transform],
     contacts: &[Contact],
+    equalities: &mut Equalities,
     rows: &mut Rows,
 ) -> Result<()> {
     let options = &model.options;
@@ -202,24 +215,15 @@ pub fn constraint_rows(
         return Ok(());
     }
     let safe_after = options.flag("refsafe").then_some(2.0 * options.timestep);
-    // equality constraints are rows MuJoCo puts first: not made yet, so refused
-    if options.flag("equality") {
-        if let Some((index, held)) = model.constraints.iter().enumerate().find(|(_, c)| c.active) {
-            let name = if held.name.is_empty() {
-                format!("number {index}")
-            } else {
-                format!("'{}'", held.name)
-            };
-            return Err(Error::InvalidValue {
-                argument: "model".into(),
-                message: format!(
-                    "the model holds the equality constraint {name}: MuJoCo's soft equality \
-                     rows are not made yet (robodyn's exact constraints: \
-                     constrained_forward_dynamics)"
-                ),
-            });
-        }
-    }
+    // equality constraints, each a group of rows with its own softness
+    equalities.append(model, (q, v), rows, |rows, count, solver, diagonal| {
+        let softness = Softness {
+            solver,
+            friction_solref: [0.0; 2],
+            diagonal,
+        };
+        finish_group(rows, RowKind::Equality, count, &softness, safe_after, v);
+    })?;
     // friction loss, degree of freedom by degree of freedom: J = e_i in MuJoCo's velocities
     if options.flag("frictionloss") {
         for i in 1..model.nbodies() {
@@ -376,8 +380,16 @@ fn finish_group(
 ) {
     let first = rows.len() - count;
     let solimp = &softness.solver.solimp;
-    // d of the first row's |pos − margin|
-    let violation = rows.position[first] - rows.margin[first];
+    // d of the first row's |pos − margin|, of an equality's |pos| over its rows
+    let violation = if kind == RowKind::Equality {
+        rows.position[first..]
+            .iter()
+            .map(|p| p * p)
+            .sum::<f64>()
+            .sqrt()
+    } else {
+        rows.position[first] - rows.margin[first]
+    };
     let (d, _) = impedance(solimp, violation);
     for k in 0..count {
         let i = first + k;

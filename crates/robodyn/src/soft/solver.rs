@@ -374,11 +374,11 @@ mod tests {
         let mut solver = Solver::default();
         solver.size(4, rows.len());
         solver.pattern.find(&rows);
-        let x = [1e-3, -0.2, -0.3, 0.4, -0.1];
-        let mut forces = [0.0; 5];
+        let x = [0.3, 1e-3, -0.2, -0.3, 0.4, -0.1];
+        let mut forces = [0.0; 6];
         forces_at(&rows, &x, &mut forces, Some(&mut solver.curvature));
         solver.assemble_hessian(&rows, &mass);
-        let mut hs = DMatrix::zeros(5, 5);
+        let mut hs = DMatrix::zeros(6, 6);
         for &(i, d) in &solver.curvature.diagonal {
             hs[(i, i)] = d;
         }
@@ -389,7 +389,7 @@ mod tests {
                 }
             }
         }
-        let j = DMatrix::from_row_slice(5, 4, &rows.jacobian);
+        let j = DMatrix::from_row_slice(6, 4, &rows.jacobian);
         let expected = &mass + j.transpose() * hs * &j;
         assert!(
             (&solver.hessian - &expected).amax() < EXACT,

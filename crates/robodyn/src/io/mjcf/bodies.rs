@@ -92,6 +92,7 @@ impl<'a> Reader<'a> {
                         None => self.placement(child, site_class)?,
                     };
                     builder.add_frame(&name, body, placement * to_element);
+                    self.site_bodies.borrow_mut().insert(name, source_body);
                 }
                 "body" => self.read_body(builder, child, (body, source_body), to_element, class)?,
                 // a <frame> only places what it holds: its pose composes with theirs

@@ -69,7 +69,8 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
-    /// The constraint with the element's name, `active`, `solref`, `solimp`, `torquescale`.
+    /// The constraint with the element's name, `active`, `solref`, `solimp`, `torquescale` and
+    /// the bodies it attaches.
     fn declared(&self, element: Node<'a, 'a>, constraint: Constraint) -> Result<ModelConstraint> {
         let active = match self.equality_attribute(element, "active")?.as_deref() {
             None | Some("true") => true,
@@ -88,7 +89,23 @@ impl<'a> Reader<'a> {
             torquescale: self
                 .equality_numbers::<1>(element, "torquescale")?
                 .map_or(1.0, |[t]| t),
+            bodies: self.attached_bodies(element),
         })
+    }
+
+    /// The file bodies a connect or weld attaches (its sites' or its bodies', the world 0):
+    /// the names were checked when its constraint was made.
+    fn attached_bodies(&self, element: Node<'a, 'a>) -> [usize; 2] {
+        let sites = self.site_bodies.borrow();
+        let bodies = self.source_bodies.borrow();
+        let of = |site: &str, body: &str| {
+            if let Some(name) = element.attribute(site) {
+                return sites.get(name).copied().unwrap_or(0);
+            }
+            let name = element.attribute(body).unwrap_or("world");
+            bodies.iter().position(|b| b.name == name).unwrap_or(0)
+        };
+        [of("site1", "body1"), of("site2", "body2")]
     }
 
     /// An attribute of an equality element, else its class's `<equality>` default (MuJoCo's
