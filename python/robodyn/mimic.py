@@ -239,6 +239,10 @@ class MimicModel(ConstrainedMethods):
         """Gᵀ of the full model's actuator forces at the expanded state."""
         return self._generalized(self.full.actuator_forces(self._expand(q, "q"), self._expand_velocity(v, "v"), ctrl))
 
+    def tendon_lengths(self, q: Any) -> np.ndarray:
+        """The full model's tendon lengths at the expanded q."""
+        return self.full.tendon_lengths(self._expand(q, "q"))
+
     def _diagonal(self, values: np.ndarray, power: int) -> np.ndarray:
         """Σ_k |G_kj|^power values_k over each reduced coordinate's group (Gᵀ diag(x) G is
         diagonal: each full coordinate moves with one reduced coordinate)."""
@@ -581,7 +585,7 @@ class MimicModel(ConstrainedMethods):
 _SHARED = frozenset({
     "name", "body_names", "body_parents", "body_masses", "frame_names", "frame_bodies", "joint_names",
     "joint_types", "mimic_joints", "total_mass", "visuals", "skybox", "nu", "actuator_names", "ctrl_range",
-    "options", "geoms", "contact_pairs", "contact_excludes", "contact_candidates", "joint_softness",
+    "tendon_names", "options", "geoms", "contact_pairs", "contact_excludes", "contact_candidates", "joint_softness",
     "contact_parameters", "collide_placed",
 })
 

@@ -5,8 +5,8 @@ reference accelerations, then the same solution (row forces, accelerations, cons
 MuJoCo is made to solve to convergence (Newton, tolerance 1e-15, 1000 iterations, 100 line-search
 steps) with a dense constraint Jacobian. Scenes: a box on a plane (every condim, both cones, two
 impratios), explicit contact pairs with their own solref/solreffriction/solimp/margin/gap, joint
-limits and dof friction loss with actuators, equality constraints of every kind robodyn reads, and
-dm_control's suite models."""
+limits and dof friction loss with actuators, equality constraints of every kind robodyn reads, fixed
+tendons (limits, friction, springs, equalities, actuators), and dm_control's suite models."""
 
 import mujoco
 import numpy as np
@@ -286,14 +286,16 @@ def test_joint_limits_friction_loss_and_actuators_as_in_mujoco():
 
 # --- 4. dm_control's suite -------------------------------------------------------------------
 
-# Of the suite's 16 models (test_collision.py's SUITE), those without what the method leaves out:
-# ball_in_cup, fish, point_mass (tendons), manipulator, stacker (tendons, a tendon equality) and
-# quadruped (tendons, equalities, a height field) are left out; none has a limited ball joint.
-SUITE = ["cheetah", "finger", "hopper", "humanoid", "humanoid_CMU", "walker"]
-# The rest disable constraints (acrobot: <flag constraint="disable"/>) or contacts (cartpole,
+# Of the suite's 16 models (test_collision.py's SUITE), those without what the method leaves out
+# (ball_in_cup: a spatial tendon; quadruped: activation dynamics and a height field); manipulator,
+# point_mass and stacker drive fixed tendons, manipulator and stacker couple two fingers by a
+# tendon equality; none has a limited ball joint.
+SUITE = ["cheetah", "finger", "hopper", "humanoid", "humanoid_CMU", "manipulator", "point_mass", "stacker", "walker"]
+# The rest disable constraints (acrobot, fish: <flag constraint="disable"/>) or contacts (cartpole,
 # reacher, swimmer: contact="disable"): MuJoCo finds no contacts at all there (an empty
-# d.contact; cartpole and reacher would have 3–7 otherwise), nor limit rows in acrobot.
-FLAGGED = ["acrobot", "cartpole", "reacher", "swimmer"]
+# d.contact; cartpole and reacher would have 3–7 otherwise), nor limit rows in acrobot; fish's
+# tendon spring and tendon actuators still act.
+FLAGGED = ["acrobot", "cartpole", "fish", "reacher", "swimmer"]
 SUITE_STATES = 5
 
 
@@ -449,7 +451,78 @@ def test_a_disabled_equality_flag_drops_the_rows():
     assert "equality" not in list(ours["row_types"])
 
 
-# --- 7. what is refused ---------------------------------------------------------------------
+# --- 7. fixed tendons -------------------------------------------------------------------------
+
+# An arm whose fixed tendons carry every part robodyn reads: limits (one with a margin, one from a
+# class), dry friction with its own solreffriction, dampers, a spring with a dead band and one at
+# the joints' springref, two tendon equalities (one coupling two tendons by a polynomial) after an
+# inactive joint equality, and motor, position (inheritrange) and general (affine, forcerange,
+# damping) actuators on tendons.
+TENDONS = """<mujoco><option timestep="0.002" cone="{cone}"/>
+  <default><tendon solreflimit="0.03 0.9"/><default class="stiff"><tendon stiffness="40" springlength="0.1 0.3"/></default></default>
+  <worldbody>
+    <body name="upper" pos="0 0 1"><joint name="shoulder" axis="0 1 0" springref="20" damping="0.1"/>
+      <geom name="upper" type="capsule" fromto="0 0 0 .4 0 0" size=".04"/>
+      <body name="lower" pos=".4 0 0"><joint name="elbow" axis="0 1 0" ref="10"/>
+        <joint name="reach" type="slide" axis="1 0 0" range="-.1 .2"/>
+        <geom name="lower" type="capsule" fromto="0 0 0 .3 0 0" size=".03"/>
+        <body name="hand" pos=".3 0 0"><joint name="wrist" axis="0 0 1"/>
+          <geom name="hand" type="box" size=".05 .03 .02"/></body></body></body>
+  </worldbody>
+  <tendon>
+    <fixed name="flex" range="-0.4 0.5" margin="0.05" frictionloss="0.3" damping="0.7" solreffriction="0.05 1">
+      <joint joint="shoulder" coef="1"/><joint joint="elbow" coef="-0.5"/></fixed>
+    <fixed name="span" class="stiff" limited="true" range="-0.05 0.25">
+      <joint joint="elbow" coef="0.3"/><joint joint="reach" coef="2"/></fixed>
+    <fixed name="twist" damping="0.2"><joint joint="wrist" coef="1"/><joint joint="shoulder" coef="0.2"/></fixed>
+    <fixed name="rest" stiffness="5"><joint joint="wrist" coef="-1"/></fixed>
+  </tendon>
+  <equality>
+    <joint joint1="wrist" joint2="shoulder" polycoef="0 0.1 0 0 0" active="false"/>
+    <tendon name="pair" tendon1="twist" tendon2="flex" polycoef="0.05 0.4 -0.3 0 0" solref="0.02 0.7"/>
+    <tendon tendon1="rest" polycoef="0.1 0 0 0 0"/>
+  </equality>
+  <actuator>
+    <motor tendon="flex" gear="2" ctrlrange="-1 1"/>
+    <position tendon="span" kp="30" kv="2" inheritrange="1"/>
+    <general tendon="twist" gainprm="3 0.5 0.2" gaintype="affine" biasprm="0.1 -1 -0.5" biastype="affine" forcerange="-2 2" damping="0.3"/>
+    <velocity joint="shoulder" kv="0.5"/>
+  </actuator>
+</mujoco>"""
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+def test_fixed_tendons_as_in_mujoco(cone):
+    """Tendon friction and limit rows (after the dofs' and the joints'), tendon equality rows (ids in
+    the file's order), tendon springs and dampers in q̈₀, tendon actuators, against MuJoCo."""
+    model, mj_model, layout = load_both(TENDONS.replace("{cone}", cone))
+    assert model.tendon_names == ["flex", "span", "twist", "rest"]
+    rng, kinds = np.random.default_rng(3), set()
+    for case in range(12):
+        qpos = mj_model.qpos0 + rng.normal(size=mj_model.nq) * 0.4
+        qvel, tau = rng.normal(size=mj_model.nv), rng.normal(size=mj_model.nv)
+        ours, _ = assert_matches_mujoco(model, mj_model, layout, qpos, qvel, tau, rng.uniform(-1.5, 1.5, size=mj_model.nu),
+                                        label=f"{cone} case {case}")
+        kinds |= {(kind, int(i)) for kind, i in zip(ours["row_types"], ours["row_ids"])}
+    assert {("equality", 1), ("equality", 2), ("friction_tendon", 0), ("limit_tendon", 0), ("limit_tendon", 1)} <= kinds
+
+
+def test_tendon_lengths_as_in_mujoco():
+    """m.tendon_lengths(q) is MuJoCo's ten_length, one state and a batch."""
+    model, mj_model, layout = load_both(TENDONS.replace("{cone}", "pyramidal"))
+    rng, d = np.random.default_rng(8), mujoco.MjData(mj_model)
+    states = [mj_model.qpos0 + rng.normal(size=mj_model.nq) for _ in range(3)]
+    expected = []
+    for qpos in states:
+        d.qpos[:] = qpos
+        mujoco.mj_fwdPosition(mj_model, d)
+        expected.append(d.ten_length.copy())
+    batch = model.tendon_lengths(np.array([layout.q_from_mujoco(qpos) for qpos in states]))
+    assert_close(batch, np.array(expected), ROW_AGREEMENT, "batch")
+    assert_close(model.tendon_lengths(layout.q_from_mujoco(states[0])), expected[0], ROW_AGREEMENT, "one")
+
+
+# --- 8. what is refused ---------------------------------------------------------------------
 
 
 def test_bad_input_is_refused_naming_it():

@@ -340,3 +340,59 @@ def test_each_contact_takes_mujocos_parameters(override):
         model.contact_parameters("hand", "floor")
     with pytest.raises(ValueError, match="argument 'geom2': expected a geom other than geom1"):
         model.contact_parameters("floor", "floor")
+
+
+# --- fixed tendons ------------------------------------------------------------------------------
+
+TENDON_ARM = """<mujoco><worldbody>
+  <body name="a"><joint name="hinge" axis="0 1 0"/><geom size="0.1"/>
+    <body name="b" pos="0 0 -0.3"><joint name="slide" type="slide" axis="1 0 0"/><geom size="0.1"/>
+      <body name="c" pos="0 0 -0.3"><joint name="ball" type="ball"/><geom size="0.1"/></body></body></body>
+  </worldbody>
+  <tendon><fixed name="pull" range="0 1" springlength="0.2 0.4">
+    <joint joint="hinge" coef="1"/><joint joint="slide" coef="-2"/></fixed></tendon>
+  <actuator><motor name="drive" tendon="pull" gear="3"/></actuator></mujoco>"""
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (('joint="slide" coef="-2"', 'joint="slid" coef="-2"'), r"line \d+.*attribute 'joint': no joint is called 'slid'"),
+        (('joint="slide" coef="-2"', 'joint="hinge" coef="-2"'), r"line \d+.*joint 'hinge' is repeated"),
+        (('joint="slide" coef="-2"', 'joint="ball" coef="-2"'), r"line \d+.*must be a hinge or slide, got 'ball'"),
+        (('joint="slide" coef="-2"', 'joint="slide"'), r"line \d+.*expected attribute 'coef'"),
+        (('springlength="0.2 0.4"', 'springlength="0.4 0.2"'), r"line \d+.*attribute 'springlength'"),
+        (('range="0 1"', 'range="1 0" limited="true"'), r"line \d+.*a limited tendon needs lower < upper"),
+        (('tendon="pull"', 'tendon="push"'), r"line \d+.*attribute 'tendon': no tendon named 'push'"),
+    ],
+)
+def test_a_tendon_mujoco_refuses_is_refused_by_name_and_line(change, message):
+    broken = TENDON_ARM.replace(*change)
+    assert broken != TENDON_ARM
+    with pytest.raises(ValueError, match=message):
+        robodyn.load_mjcf_string(broken)
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_string(broken)
+
+
+def test_what_tendons_robodyn_does_not_model_are_named():
+    """A spatial tendon (and what uses it), a tendon's armature: a warning each; an invalid range
+    under limited="auto" leaves the tendon unlimited, as in MuJoCo; the actuator on the tendon
+    pulls with gear times its coefficients."""
+    text = TENDON_ARM.replace('range="0 1"', 'range="1 0" armature="0.1"').replace(
+        "</fixed></tendon>", '</fixed><spatial name="string"><site site="s1"/><site site="s2"/></spatial></tendon>'
+    ).replace('<geom size="0.1"/></body></body></body>', '<geom size="0.1"/><site name="s2"/></body></body><site name="s1"/></body>')
+    text = text.replace("</actuator>", '<motor name="reel" tendon="string"/></actuator>')
+    model = robodyn.load_mjcf_string(text)
+    messages = " ".join(model.warnings)
+    assert "<spatial name='string'> (line" in messages and "'armature' not modelled" in messages
+    assert "<motor name='reel'> (line" in messages and "spatial tendon 'string'" in messages
+    assert model.tendon_names == ["pull"]
+    q = model.neutral()
+    q[model.joint_idx_q[model.joint_names.index("hinge")]] = 0.3
+    assert_close(model.tendon_lengths(q), [0.3], 0.0, "L = q_hinge")
+    tau = model.actuator_forces(q, np.zeros(model.nv), [1.0, 1.0])
+    expected = np.zeros(model.nv)
+    expected[model.joint_idx_v[model.joint_names.index("hinge")]] = 3.0
+    expected[model.joint_idx_v[model.joint_names.index("slide")]] = -6.0
+    assert_close(tau, expected, 0.0, "gear × coefficients; the spatial tendon's actuator none")

@@ -15,6 +15,7 @@ from robodyn.convert import MujocoLayout
 from test_contact_dynamics import (
     ARM,
     EQUALITIES,
+    TENDONS,
     FLAGGED,
     SUITE,
     box_scene,
@@ -143,6 +144,15 @@ def test_equality_constraints_step_as_in_mujoco(integrator):
     model, mj_model, layout = load_both(text=with_integrator(EQUALITIES.replace("{cone}", "pyramidal"), integrator))
     qvel = np.random.default_rng(7).normal(size=mj_model.nv)
     assert_steps_like_mujoco(model, mj_model, layout, mj_model.qpos0, qvel, label=integrator)
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+def test_fixed_tendons_step_as_in_mujoco(integrator):
+    """test_contact_dynamics's tendon arm under steady controls: tendon dampers explicit in Euler (only
+    the joints' are implicit there), in implicitfast's K with the tendon actuators' velocity gains."""
+    model, mj_model, layout = load_both(text=with_integrator(TENDONS.replace("{cone}", "pyramidal"), integrator))
+    qvel = np.random.default_rng(7).normal(size=mj_model.nv)
+    assert_steps_like_mujoco(model, mj_model, layout, mj_model.qpos0, qvel, ctrl=[0.7, 0.1, -0.4, 0.3], label=integrator)
 
 
 # --- 3. a Menagerie quadruped, dm_control's suite ----------------------------------------------

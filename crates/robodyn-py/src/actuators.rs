@@ -46,8 +46,9 @@ impl PyModel {
 
     /// The generalised forces (nv,) the actuators exert under the controls `ctrl` (nu,) at
     /// (q, v): MuJoCo's `qfrc_actuator` — each control clamped to its range, its actuator's
-    /// force `(a₀ + a₁ l + a₂ l̇) u + (b₀ + b₁ l + b₂ l̇)` (l = gear q_j) clamped to its force
-    /// range, times the gear on its joint. A batch gives (N, nv).
+    /// force `(a₀ + a₁ l + a₂ l̇) u + (b₀ + b₁ l + b₂ l̇)` (l = gear q_j, or gear L on a fixed
+    /// tendon) clamped to its force range, times the gear on its joint (gear coef on each of
+    /// its tendon's joints). A batch gives (N, nv).
     fn actuator_forces<'py>(
         &self,
         py: Python<'py>,

@@ -24,6 +24,7 @@ mod properties;
 mod results;
 mod scene;
 mod simulation;
+mod tendons;
 mod visuals;
 
 use loaders::*;

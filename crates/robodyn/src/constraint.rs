@@ -23,7 +23,7 @@ mod rows;
 pub(crate) use derivatives::{
     add_body_forces, differentiate_rows, RowDerivatives, RowLevel, RowScratch,
 };
-pub(crate) use rows::{evaluate, BodyMotion, ConstraintRows};
+pub(crate) use rows::{evaluate, polynomial_at, BodyMotion, ConstraintRows};
 
 use crate::error::{Error, Result};
 use crate::model::Model;

@@ -8,6 +8,7 @@ mod geom;
 mod keyframe;
 mod options;
 mod physical;
+mod tendon;
 
 pub use actuator::Actuator;
 pub use builder::{ModelBuilder, NewBody};
@@ -26,6 +27,7 @@ pub use options::{
 pub use physical::{
     check_mass_and_inertia, check_physical_parameters, check_positive_semidefinite, Unphysical,
 };
+pub use tendon::{Tendon, TendonEquality};
 
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::joint::{Joint, MotionSubspace};
@@ -218,6 +220,12 @@ pub struct Model {
     /// The actuators (MJCF `<actuator>`), in the file's order: the controls' order.
     #[serde(default)]
     pub actuators: Vec<Actuator>,
+    /// The fixed tendons (MJCF `<tendon><fixed>`), in the file's order.
+    #[serde(default)]
+    pub tendons: Vec<Tendon>,
+    /// The equalities between tendon lengths (MJCF `<equality><tendon>`), in the file's order.
+    #[serde(default)]
+    pub tendon_equalities: Vec<TendonEquality>,
     /// The range each body's joint's total actuator force is clamped to (MJCF
     /// `actuatorfrcrange`), nbodies; read for hinges and slides only.
     #[serde(default)]

@@ -337,7 +337,7 @@ fn kept_indices(mask: &[bool; 6]) -> ([usize; 6], usize) {
 
 /// p(x) = Σ c_k x^k and its first three derivatives, by Horner's rule.
 #[inline(always)]
-pub(super) fn polynomial_at<S: Real>(c: &[f64; 5], x: S) -> [S; 4] {
+pub(crate) fn polynomial_at<S: Real>(c: &[f64; 5], x: S) -> [S; 4] {
     let [mut p, mut dp, mut ddp, mut dddp] = [S::zero(); 4];
     let (two, three) = (S::splat(2.0), S::splat(3.0));
     for &coefficient in c.iter().rev() {

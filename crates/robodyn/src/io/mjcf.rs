@@ -47,6 +47,7 @@ mod mass;
 mod meshes;
 mod options;
 mod schema_table;
+mod tendons;
 mod textures;
 mod visuals;
 
@@ -55,7 +56,7 @@ use mass::MassRules;
 use schema_table::MJCF_SCHEMA;
 
 /// Sections of an MJCF file that do not describe the tree.
-const IGNORED_SECTIONS: [&str; 4] = ["sensor", "tendon", "visual", "statistic"];
+const IGNORED_SECTIONS: [&str; 3] = ["sensor", "visual", "statistic"];
 
 /// Attributes of which an element may give only the first values, the others kept from its class
 /// or MuJoCo's defaults (MuJoCo reads `solimp="0.9 0.95"` as the first two of five).
@@ -209,6 +210,7 @@ fn load_sources(sources: &Sources) -> Result<Model> {
             com: crate::spatial::Vec3::zeros(),
         }]),
         site_bodies: RefCell::new(HashMap::new()),
+        unread_tendons: RefCell::new(Vec::new()),
     };
     if !root.has_tag_name("mujoco") {
         return Err(reader.error(root, "expected the root element <mujoco>"));
@@ -262,6 +264,7 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         builder.warn(message);
     }
     let mut model = builder.build();
+    reader.read_tendons(&sections, &mut model)?;
     reader.read_equalities(&sections, &mut model)?;
     reader.read_actuators(&sections, &mut model)?;
     reader.read_keyframes(&sections, &mut model)?;
@@ -339,6 +342,8 @@ struct Reader<'a> {
     source_bodies: RefCell<Vec<SourceBody>>,
     /// each site's file body (MuJoCo body id), by the site's name
     site_bodies: RefCell<HashMap<String, usize>>,
+    /// the names of the tendons not read (spatial ones)
+    unread_tendons: RefCell<Vec<String>>,
 }
 
 impl<'a> Reader<'a> {

@@ -25,6 +25,10 @@ pub struct Actuator {
     pub coordinate: Option<usize>,
     /// The coordinate of the same joint in q (its length is `gear q`).
     pub position: usize,
+    /// The fixed tendon ([`Model::tendons`]) it pulls on instead of a joint (its length is
+    /// `gear L`).
+    #[serde(default)]
+    pub tendon: Option<usize>,
     /// g: the moment arm, the length's scale (MJCF `gear[0]`).
     pub gear: f64,
     /// a: the gain's constant, length and velocity terms (MJCF `gainprm[0..3]`).
@@ -41,16 +45,52 @@ impl Actuator {
     /// f: the actuator's scalar force at joint position `q_j` and velocity `v_j` under control
     /// `u`.
     pub fn force(&self, q_j: f64, v_j: f64, u: f64) -> f64 {
-        let (a, b, g) = (&self.gain, &self.bias, self.gear);
+        // l = g q_j, l̇ = g q̇_j
+        self.force_at(self.gear * q_j, self.gear * v_j, u)
+    }
+
+    /// f at its length l and rate l̇ under control `u`.
+    pub fn force_at(&self, l: f64, l_dot: f64, u: f64) -> f64 {
+        let (a, b) = (&self.gain, &self.bias);
         let u = self.ctrl_range.map_or(u, |(low, high)| u.clamp(low, high));
-        // l = g q_j, l̇ = g q̇_j;  f = (a₀ + a₁ l + a₂ l̇) u + (b₀ + b₁ l + b₂ l̇)
-        let (l, l_dot) = (g * q_j, g * v_j);
+        // f = (a₀ + a₁ l + a₂ l̇) u + (b₀ + b₁ l + b₂ l̇)
         let f = (a[0] + a[1] * l + a[2] * l_dot) * u + (b[0] + b[1] * l + b[2] * l_dot);
         self.force_range.map_or(f, |(low, high)| f.clamp(low, high))
     }
 }
 
 impl Model {
+    /// The moment arms of `actuator`: (velocity coordinate, configuration coordinate, ∂l/∂q̇)
+    /// with its length `l = Σ arm q` and `τ = Σ arm f e_k`: `gear` on its joint, `gear c_k` on
+    /// each joint of its tendon; none for an actuator robodyn does not model.
+    pub fn actuator_arms<'a>(
+        &'a self,
+        actuator: &'a Actuator,
+    ) -> impl Iterator<Item = (usize, usize, f64)> + 'a {
+        let joint = actuator
+            .coordinate
+            .map(|c| (c, actuator.position, actuator.gear));
+        let tendon = actuator.tendon.map(|t| &self.tendons[t]);
+        let tendon_arms = tendon
+            .into_iter()
+            .flat_map(move |t| t.entries(self))
+            .map(move |(k, p, c)| (k, p, actuator.gear * c));
+        joint.into_iter().chain(tendon_arms)
+    }
+
+    /// `actuator`'s length l = Σ arm q and its rate l̇ = Σ arm q̇ at (q, q̇).
+    pub fn actuator_length_and_rate(
+        &self,
+        actuator: &Actuator,
+        q: &[f64],
+        v: &[f64],
+    ) -> (f64, f64) {
+        self.actuator_arms(actuator)
+            .fold((0.0, 0.0), |(l, rate), (k, p, arm)| {
+                (l + arm * q[p], rate + arm * v[k])
+            })
+    }
+
     /// nu: the number of actuators (of the controls).
     pub fn nu(&self) -> usize {
         self.actuators.len()
@@ -70,8 +110,11 @@ impl Model {
         check_vector("ctrl", ctrl, self.nu())?;
         tau.fill(0.0);
         for (actuator, &u) in self.actuators.iter().zip(ctrl) {
-            if let Some(c) = actuator.coordinate {
-                tau[c] += actuator.gear * actuator.force(q[actuator.position], v[c], u);
+            // τ += arm f(l, l̇, u)
+            let (length, rate) = self.actuator_length_and_rate(actuator, q, v);
+            let force = actuator.force_at(length, rate, u);
+            for (k, _, arm) in self.actuator_arms(actuator) {
+                tau[k] += arm * force;
             }
         }
         // a hinge's or slide's total actuator force is clamped to its range

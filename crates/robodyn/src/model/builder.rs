@@ -72,6 +72,8 @@ impl ModelBuilder {
                 constraints: Vec::new(),
                 keyframes: Vec::new(),
                 actuators: Vec::new(),
+                tendons: Vec::new(),
+                tendon_equalities: Vec::new(),
                 actuator_force_range: vec![None],
                 joint_softness: vec![JointSoftness::default()],
                 geoms: Vec::new(),

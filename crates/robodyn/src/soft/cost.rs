@@ -75,7 +75,7 @@ pub(super) fn forces_at(
                     }
                 }
             }
-            RowKind::FrictionDof => {
+            RowKind::FrictionDof | RowKind::FrictionTendon => {
                 let i = group.first;
                 let (r, loss) = (rows.regulariser[i], rows.frictionloss[i]);
                 if x[i] <= -r * loss {

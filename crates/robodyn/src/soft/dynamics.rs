@@ -133,8 +133,9 @@ impl ContactDynamics {
     }
 }
 
-/// τ_passive = −K (q ⊖ q_ref) − D q̇: the joints' springs and dampers (MuJoCo's `qfrc_passive`
-/// without gravity compensation and fluid forces; dry friction is a constraint row).
+/// τ_passive = −K (q ⊖ q_ref) − D q̇ + Σ Jᵀ f_tendon: the joints' and the tendons' springs and
+/// dampers (MuJoCo's `qfrc_passive` without gravity compensation and fluid forces; dry friction
+/// is a constraint row).
 fn passive_forces(model: &Model, q: &[f64], v: &[f64]) -> DVector<f64> {
     let options = &model.options;
     let mut tau = DVector::zeros(model.nv);
@@ -144,6 +145,15 @@ fn passive_forces(model: &Model, q: &[f64], v: &[f64]) -> DVector<f64> {
     }
     if options.flag("damper") {
         tau -= model.damping.component_mul(&DVector::from_column_slice(v));
+    }
+    // each tendon's spring and damper along its length: τ += Jᵀ f
+    for tendon in &model.tendons {
+        let (length, rate) = (tendon.length(model, q), tendon.rate(model, v));
+        let force =
+            tendon.passive_force(length, rate, options.flag("spring"), options.flag("damper"));
+        for (k, _, c) in tendon.entries(model) {
+            tau[k] += c * force;
+        }
     }
     tau
 }

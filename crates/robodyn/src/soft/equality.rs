@@ -10,6 +10,7 @@
 //!   weld     6 rows   the connect's, then
 //!                     pos = t vec(q̄₂ ⊗ q₁)            J = ½ t vec(q̄₂ ⊗ (0, J_ω₁ − J_ω₂) ⊗ q₁)
 //!   joint    1 row    pos = (q_f − q_f,0) − p(q_l − q_l,0)      J = e_f − p′ e_l
+//!   tendon   1 row    pos = (L₁ − L₁,₀) − p(L₂ − L₂,₀)          J = J_L₁ − p′ J_L₂
 //! ```
 //! The weld's rotation rows are the time derivative of its error: `vec(q̄₂ ⊗ (0, u) ⊗ q₁) =
 //! (e₀ I − [e_v]×) R₂ᵀ u` with `e = q̄₂ ⊗ q₁` (taken with e₀ ≥ 0). A group's impedance d is that
@@ -27,10 +28,11 @@ use super::rows::{RowKind, Rows};
 use super::weights::InverseWeights;
 use crate::algo::constrained::evaluate_rows;
 use crate::constraint::{
-    Attachment, Constraint, ConstraintKind, ConstraintReference, ConstraintRows, ConstraintSet,
+    polynomial_at, Attachment, Constraint, ConstraintKind, ConstraintReference, ConstraintRows,
+    ConstraintSet,
 };
 use crate::error::{Error, Result};
-use crate::model::{Model, SolverParameters};
+use crate::model::{Model, SolverParameters, TendonEquality};
 use crate::spatial::{Mat3, Vec3};
 use crate::Data;
 use nalgebra::{DMatrix, DVector, Quaternion, Rotation3, UnitQuaternion};
@@ -38,10 +40,12 @@ use nalgebra::{DMatrix, DVector, Quaternion, Rotation3, UnitQuaternion};
 /// One active equality: what MuJoCo's rows of it need beyond robodyn's rows.
 #[derive(Debug, Clone)]
 struct Held {
-    /// Its index among the model's constraints (MuJoCo's `efc_id`).
+    /// Its index among the file's equalities (MuJoCo's `efc_id`).
     index: usize,
-    /// Connect, weld or joint.
+    /// Connect, weld, joint or tendon.
     shape: Shape,
+    /// Its place in the constraint set (a tendon equality has none).
+    member: usize,
     /// Its `solref` and `solimp`.
     solver: SolverParameters,
     /// Each row's approximate inverse inertia Â.
@@ -55,6 +59,8 @@ enum Shape {
     /// With its torquescale.
     Weld(f64),
     Joint,
+    /// [`Model::tendon_equalities`] index.
+    Tendon(usize),
 }
 
 /// A model's active equalities and the scratch space their rows are made in.
@@ -79,7 +85,31 @@ impl Equalities {
         let mut held = Vec::new();
         let mut constraints = Vec::new();
         let enforced = model.options.flag("equality") && model.options.flag("constraint");
-        for (index, declared) in model.constraints.iter().enumerate() {
+        // MuJoCo numbers the file's equalities in order: the tendon ones among the others
+        let mut index = 0;
+        for (k, declared) in model.constraints.iter().map(Some).chain([None]).enumerate() {
+            for (j, equality) in model.tendon_equalities.iter().enumerate() {
+                if equality.before != k {
+                    continue;
+                }
+                if enforced && equality.active {
+                    let (t1, t2) = equality.tendons;
+                    let own = weights.tendons[t1] + t2.map_or(0.0, |t| weights.tendons[t]);
+                    held.push(Held {
+                        index,
+                        shape: Shape::Tendon(j),
+                        member: usize::MAX,
+                        solver: equality.solver,
+                        diagonal: [own; 6],
+                    });
+                }
+                index += 1;
+            }
+            let Some(declared) = declared else {
+                break;
+            };
+            let id = index;
+            index += 1;
             if !(enforced && declared.active) {
                 continue;
             }
@@ -107,11 +137,12 @@ impl Equalities {
                     let own = dof(*follower) + leader.map_or(0.0, dof);
                     (Shape::Joint, [own; 6])
                 }
-                _ => return Err(unstated(model, index, constraint)),
+                _ => return Err(unstated(model, k, constraint)),
             };
             held.push(Held {
-                index,
+                index: id,
                 shape,
+                member: constraints.len(),
                 solver: SolverParameters {
                     solref: declared.solref,
                     solimp: declared.solimp,
@@ -157,7 +188,13 @@ impl Equalities {
         evaluate_rows(model, &mut self.data, &self.set, (q, v), robodyn_rows)?;
         super::dynamics::write_free_joint_product(model, v, &mut self.free_product);
         let nv = model.nv;
-        for (k, held) in self.held.iter().enumerate() {
+        for held in &self.held {
+            if let Shape::Tendon(j) = held.shape {
+                tendon_row(model, &model.tendon_equalities[j], held.index, q, rows);
+                close(rows, 1, &held.solver, &held.diagonal[..1]);
+                continue;
+            }
+            let k = held.member;
             let offset = self.set.offset(k);
             let count = self.set.constraints()[k].rows();
             // one that moves nothing (between bodies welded to the world) has no rows
@@ -215,6 +252,29 @@ impl Equalities {
             }
         }
         Ok(())
+    }
+}
+
+/// The row of a tendon equality at q (see the module's header), its a_ref to be made.
+fn tendon_row(model: &Model, equality: &TendonEquality, index: usize, q: &[f64], rows: &mut Rows) {
+    let c = &equality.polynomial;
+    let tendons = &model.tendons;
+    let (first, second) = (
+        &tendons[equality.tendons.0],
+        equality.tendons.1.map(|t| &tendons[t]),
+    );
+    let follower = first.length(model, q) - first.length0;
+    // p(x) and p′(x) of the leader's x = L₂ − L₂,₀ (without one: c₀ and 0)
+    let [p, dp, _, _] = match second {
+        Some(leader) => polynomial_at(c, leader.length(model, q) - leader.length0),
+        None => [c[0], 0.0, 0.0, 0.0],
+    };
+    let row = rows.push(RowKind::Equality, index, follower - p, 0.0);
+    for (k, _, coefficient) in first.entries(model) {
+        row[k] += coefficient;
+    }
+    for (k, _, coefficient) in second.iter().flat_map(|leader| leader.entries(model)) {
+        row[k] -= dp * coefficient;
     }
 }
 

@@ -5,9 +5,11 @@
 //! (read to understand, written anew here). The rows come in blocks:
 //! ```text
 //!   equalities      connect (3 rows), weld (6), joint (1): see super::equality
-//!   friction loss   one per degree of freedom with frictionloss > 0:  J = e_i,  pos = 0
+//!   friction loss   one per degree of freedom with frictionloss > 0:  J = e_i,  pos = 0,
+//!                   then one per such tendon:  J = J_L (its length L = J q)
 //!   limits          each side of a limited hinge or slide within its margin:
 //!                     lower  pos = q − lo,  J = +e_i      upper  pos = hi − q,  J = −e_i
+//!                   then each side of a limited tendon, the same with L and J_L
 //!   contacts        per contact within its margin, c the rows of F (J(b₂, p) − J(b₁, p)):
 //!                     condim 1            c_n
 //!                     pyramidal           c_n ± μ_k c_k,  k = 1 … condim − 1
@@ -43,8 +45,12 @@ pub enum RowKind {
     Equality,
     /// Dry friction of one degree of freedom.
     FrictionDof,
+    /// Dry friction of a tendon.
+    FrictionTendon,
     /// One side of a joint's limit.
     LimitJoint,
+    /// One side of a tendon's limit.
+    LimitTendon,
     /// A contact without friction (condim 1).
     ContactFrictionless,
     /// A contact's pyramid edge.
@@ -59,7 +65,9 @@ impl RowKind {
         match self {
             RowKind::Equality => "equality",
             RowKind::FrictionDof => "friction_dof",
+            RowKind::FrictionTendon => "friction_tendon",
             RowKind::LimitJoint => "limit_joint",
+            RowKind::LimitTendon => "limit_tendon",
             RowKind::ContactFrictionless => "contact_frictionless",
             RowKind::ContactPyramidal => "contact_pyramidal",
             RowKind::ContactElliptic => "contact_elliptic",
@@ -91,8 +99,8 @@ pub struct Rows {
     pub jacobian: Vec<f64>,
     /// Each row's kind.
     pub kind: Vec<RowKind>,
-    /// Each row's element: the model constraint, the degree of freedom, the joint (MuJoCo's
-    /// joint id), the contact.
+    /// Each row's element: the model constraint, the degree of freedom or tendon, the joint
+    /// (MuJoCo's joint id) or tendon, the contact.
     pub id: Vec<usize>,
     /// Position (m or rad): negative when violated.
     pub position: Vec<f64>,
@@ -244,6 +252,24 @@ pub fn constraint_rows(
                 finish_group(rows, RowKind::FrictionDof, 1, &softness, safe_after, v);
             }
         }
+        // then tendon by tendon: J = J_tendon
+        for (t, tendon) in model.tendons.iter().enumerate() {
+            if tendon.frictionloss <= 0.0 {
+                continue;
+            }
+            let first = rows.len();
+            let row = rows.push(RowKind::FrictionTendon, t, 0.0, 0.0);
+            for (k, _, c) in tendon.entries(model) {
+                row[k] = c;
+            }
+            rows.frictionloss[first] = tendon.frictionloss;
+            let softness = Softness {
+                solver: &tendon.friction,
+                friction_solref: [0.0; 2],
+                diagonal: &[weights.tendons[t]],
+            };
+            finish_group(rows, RowKind::FrictionTendon, 1, &softness, safe_after, v);
+        }
     }
     // limits, joint by joint: each side within the margin, a ball's cone
     if options.flag("limit") {
@@ -285,6 +311,29 @@ pub fn constraint_rows(
                 let row = rows.push(RowKind::LimitJoint, i - 1, distance, softness.margin);
                 row[dof] = side;
                 finish_group(rows, RowKind::LimitJoint, 1, &group, safe_after, v);
+            }
+        }
+        // then tendon by tendon, the same with L and J_tendon
+        for (t, tendon) in model.tendons.iter().enumerate() {
+            let Some((lower, upper)) = tendon.range else {
+                continue;
+            };
+            let length = tendon.length(model, q);
+            let group = Softness {
+                solver: &tendon.limit,
+                friction_solref: [0.0; 2],
+                diagonal: &[weights.tendons[t]],
+            };
+            for (side, range_end) in [(1.0, lower), (-1.0, upper)] {
+                let distance = side * (length - range_end);
+                if distance >= tendon.margin || distance.is_nan() {
+                    continue;
+                }
+                let row = rows.push(RowKind::LimitTendon, t, distance, tendon.margin);
+                for (k, _, c) in tendon.entries(model) {
+                    row[k] = side * c;
+                }
+                finish_group(rows, RowKind::LimitTendon, 1, &group, safe_after, v);
             }
         }
     }
@@ -396,8 +445,8 @@ fn finish_group(
         rows.regulariser
             .push(((1.0 - d) / d * softness.diagonal[k]).max(TINY));
         // a friction row (dry friction, an elliptic cone's tangents) has no spring
-        let friction_row =
-            kind == RowKind::FrictionDof || (kind == RowKind::ContactElliptic && k > 0);
+        let friction_row = matches!(kind, RowKind::FrictionDof | RowKind::FrictionTendon)
+            || (kind == RowKind::ContactElliptic && k > 0);
         let solref = if kind == RowKind::ContactElliptic
             && k > 0
             && softness.friction_solref != [0.0, 0.0]

@@ -276,9 +276,10 @@ fn lone_free_bodies(model: &Model) -> Vec<usize> {
         .collect()
 }
 
-/// K = ∂f/∂ν of the dampers (−D) and of the actuators whose force is not clamped
-/// (gear² (b₂ + a₂ u)), MuJoCo's `qDeriv` without the bias forces' terms; robodyn's actuators
-/// drive hinges and slides, where ν = v.
+/// K = ∂f/∂ν of the dampers (−D, and −b JᵀJ of each tendon's) and of the actuators whose force
+/// is not clamped ((b₂ + a₂ u) m mᵀ, m the moment arms: gear on a joint, gear J on a tendon),
+/// MuJoCo's `qDeriv` without the bias forces' terms; robodyn's actuators and tendons act on
+/// hinges and slides, where ν = v.
 fn velocity_derivative(model: &Model, q: &[f64], v: &[f64], ctrl: &[f64]) -> Result<DMatrix<f64>> {
     let nv = model.nv;
     let mut k = DMatrix::zeros(nv, nv);
@@ -286,20 +287,29 @@ fn velocity_derivative(model: &Model, q: &[f64], v: &[f64], ctrl: &[f64]) -> Res
         for c in 0..nv {
             k[(c, c)] -= model.damping[c];
         }
+        for tendon in &model.tendons {
+            for (a, _, ca) in tendon.entries(model) {
+                for (b, _, cb) in tendon.entries(model) {
+                    k[(a, b)] -= tendon.damping * ca * cb;
+                }
+            }
+        }
     }
     check_vector("ctrl", ctrl, model.nu())?;
     if model.options.flag("actuation") {
         for (actuator, &u) in model.actuators.iter().zip(ctrl) {
-            let Some(c) = actuator.coordinate else {
-                continue;
-            };
-            let force = actuator.force(q[actuator.position], v[c], u);
+            let (length, rate) = model.actuator_length_and_rate(actuator, q, v);
+            let force = actuator.force_at(length, rate, u);
             let clamped = actuator
                 .force_range
                 .is_some_and(|(low, high)| force <= low || force >= high);
             if !clamped {
                 let slope = actuator.bias[2] + actuator.gain[2] * u;
-                k[(c, c)] += actuator.gear * actuator.gear * slope;
+                for (a, _, arm_a) in model.actuator_arms(actuator) {
+                    for (b, _, arm_b) in model.actuator_arms(actuator) {
+                        k[(a, b)] += slope * arm_a * arm_b;
+                    }
+                }
             }
         }
     }

@@ -11,7 +11,8 @@
 //! ```
 //! (0 for a body welded to the world), and a joint's block of `M⁻¹` gives its own:
 //! `(M⁻¹)_ii` for a hinge or slide, the mean of the block's diagonal for a ball, of the
-//! translation and rotation blocks apart for a free joint. Both traces are the same in any
+//! translation and rotation blocks apart for a free joint; a fixed tendon's is `J M⁻¹ Jᵀ`. Both
+//! traces are the same in any
 //! coordinates of the velocities, so robodyn's free-joint velocities (linear in the body's axes)
 //! give MuJoCo's numbers (linear in the world's).
 //!
@@ -33,6 +34,8 @@ pub struct InverseWeights {
     pub bodies: Vec<[f64; 2]>,
     /// Per velocity coordinate.
     pub dofs: Vec<f64>,
+    /// Per fixed tendon: `J M⁻¹ Jᵀ` (MuJoCo's `tendon_invweight0`).
+    pub tendons: Vec<f64>,
 }
 
 /// The weights of `model` at its neutral configuration (see the module's header).
@@ -93,7 +96,28 @@ pub fn inverse_weights(model: &Model, data: &mut Data) -> Result<InverseWeights>
             }
         }
     }
-    Ok(InverseWeights { bodies, dofs })
+    // the tendons: J M⁻¹ Jᵀ of their constant J
+    let inverse = &inverse;
+    let tendons = model
+        .tendons
+        .iter()
+        .map(|tendon| {
+            let entries: Vec<(usize, usize, f64)> = tendon.entries(model).collect();
+            entries
+                .iter()
+                .flat_map(|&(a, _, ca)| {
+                    entries
+                        .iter()
+                        .map(move |&(b, _, cb)| ca * cb * inverse[(a, b)])
+                })
+                .sum()
+        })
+        .collect();
+    Ok(InverseWeights {
+        bodies,
+        dofs,
+        tendons,
+    })
 }
 
 /// The columns of the Jacobian of the world point `point` moving with `body`, those of the

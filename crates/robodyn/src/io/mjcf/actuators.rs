@@ -2,10 +2,11 @@
 //!
 //! Modelled, as MuJoCo compiles them: `motor`, `position` (`kp`, `kv`, `inheritrange`),
 //! `velocity` (`kv`) and `general` with `dyntype="none"` and a fixed or affine gain and bias
-//! (`gainprm`, `biasprm`), on a hinge or slide (`joint`, `gear`'s first entry), with `ctrlrange`
+//! (`gainprm`, `biasprm`), on a hinge or slide (`joint`) or a fixed tendon (`tendon`), `gear`'s
+//! first entry its moment arm, with `ctrlrange`
 //! and `forcerange` (`ctrllimited`, `forcelimited`: "auto" limits where a range is given); an
 //! actuator's `damping` and `armature` join its joint's, times gear² (as MuJoCo adds them).
-//! Any other actuator (activation dynamics, `dampratio`, muscles, tendon, site or body
+//! Any other actuator (activation dynamics, `dampratio`, muscles, spatial tendon, site or body
 //! transmissions, a ball or free joint) keeps its place in the controls but exerts no force,
 //! with a warning naming it. Defaults come from the element's class, per element name.
 
@@ -17,7 +18,7 @@ use roxmltree::Node;
 
 /// What robodyn models, for the warning about an actuator it does not.
 const MODELLED: &str = "robodyn models motor, position, velocity and general actuators without \
-                        activation dynamics on a hinge or slide";
+                        activation dynamics on a hinge, a slide or a fixed tendon";
 
 impl<'a> Reader<'a> {
     /// The elements of the `<actuator>` sections among `sections`, in order, into
@@ -77,6 +78,7 @@ impl<'a> Reader<'a> {
                 .map_or_else(|| format!("actuator{index}"), str::to_string),
             coordinate: None,
             position: 0,
+            tendon: None,
             gear: scalar("gear", 1.0)?,
             gain: [1.0, 0.0, 0.0],
             bias: [0.0; 3],
@@ -130,9 +132,33 @@ impl<'a> Reader<'a> {
             other => return unmodelled(actuator, format!("<{other}>")),
         }
 
-        // the transmission: a hinge or slide
+        // the transmission: a fixed tendon, or a hinge or slide
+        if let Some(tendon_name) = element.attribute("tendon") {
+            let Some(t) = model.tendons.iter().position(|t| t.name == tendon_name) else {
+                if self
+                    .unread_tendons
+                    .borrow()
+                    .iter()
+                    .any(|n| n == tendon_name)
+                {
+                    return unmodelled(actuator, format!("spatial tendon '{tendon_name}'"));
+                }
+                let message = format!("attribute 'tendon': no tendon named '{tendon_name}'");
+                return Err(self.error(element, message));
+            };
+            actuator.tendon = Some(t);
+            if tag == "position" && scalar("inheritrange", 0.0)? > 0.0 {
+                let range = model.tendons[t].range.map(|(lower, upper)| [lower, upper]);
+                actuator.ctrl_range =
+                    Some(self.inherited_range(element, range, scalar("inheritrange", 0.0)?)?);
+            }
+            return Ok(Ok(actuator));
+        }
         let Some(joint_name) = element.attribute("joint") else {
-            return unmodelled(actuator, "a transmission other than 'joint'".into());
+            return unmodelled(
+                actuator,
+                "a transmission other than 'joint' or 'tendon'".into(),
+            );
         };
         let body = model.joint_names.iter().position(|n| n == joint_name);
         let body = body.ok_or_else(|| {
@@ -155,47 +181,77 @@ impl<'a> Reader<'a> {
                 model.lower_position_limit[actuator.position],
                 model.upper_position_limit[actuator.position],
             );
-            if !(lower.is_finite() && upper.is_finite()) {
-                let message = "attribute 'inheritrange': the joint has no range to inherit";
-                return Err(self.error(element, message));
-            }
-            let (middle, half) = ((lower + upper) / 2.0, inherit * (upper - lower) / 2.0);
-            actuator.ctrl_range = Some((middle - half, middle + half));
+            let range = (lower.is_finite() && upper.is_finite()).then_some([lower, upper]);
+            actuator.ctrl_range = Some(self.inherited_range(element, range, inherit)?);
         }
         Ok(Ok(actuator))
     }
 
+    /// `inheritrange`: the range of the joint or tendon (`None`: it has none, refused) scaled by
+    /// `inherit` about its middle.
+    fn inherited_range(
+        &self,
+        element: Node<'a, 'a>,
+        range: Option<[f64; 2]>,
+        inherit: f64,
+    ) -> Result<(f64, f64)> {
+        let Some([lower, upper]) = range else {
+            let message = "attribute 'inheritrange': the transmission has no range to inherit";
+            return Err(self.error(element, message));
+        };
+        let (middle, half) = ((lower + upper) / 2.0, inherit * (upper - lower) / 2.0);
+        Ok((middle - half, middle + half))
+    }
+
     /// The actuator's own `damping` and `armature` (MuJoCo ≥ 3.5), which MuJoCo adds to its
-    /// joint's, scaled by gear²: a passive damper −g² b q̇ and a rotor inertia g² I_a.
+    /// joint's (or its tendon's), scaled by gear²: a passive damper −g² b q̇ and a rotor
+    /// inertia g² I_a. A tendon's armature is not modelled (a warning).
     fn add_transmission_terms(
         &self,
         element: Node<'a, 'a>,
         actuator: &Actuator,
         model: &mut Model,
     ) -> Result<()> {
+        let scale = actuator.gear * actuator.gear;
+        if let Some(t) = actuator.tendon {
+            let damping = self.transmission_term(element, "damping")?;
+            model.tendons[t].damping += scale * damping;
+            if self.transmission_term(element, "armature")? != 0.0 {
+                model.warnings.push(format!(
+                    "{}: 'armature' on a tendon not modelled (the tendon's inertia JᵀJ)",
+                    self.location(element)
+                ));
+            }
+            return Ok(());
+        }
         let Some(c) = actuator.coordinate else {
             return Ok(());
         };
-        let scale = actuator.gear * actuator.gear;
         for (name, values) in [
             ("damping", &mut model.damping),
             ("armature", &mut model.armature),
         ] {
-            let Some(text) = self.attribute(element, "main", name) else {
-                continue;
-            };
-            let value = parse_number_list(&text, name)
-                .map_err(|m| self.error(element, m))?
-                .first()
-                .copied()
-                .unwrap_or(0.0);
-            if value < 0.0 {
-                let message = format!("attribute '{name}': expected a value ≥ 0, got {value}");
-                return Err(self.error(element, message));
-            }
-            values[c] += scale * value;
+            values[c] += scale * self.transmission_term(element, name)?;
         }
         Ok(())
+    }
+
+    /// An actuator's `damping` or `armature` (its first value; 0 when not given), refused when
+    /// negative.
+    fn transmission_term(&self, element: Node<'a, 'a>, name: &str) -> Result<f64> {
+        let Some(text) = self.attribute(element, "main", name) else {
+            return Ok(0.0);
+        };
+        let value = parse_number_list(&text, name)
+            .map_err(|m| self.error(element, m))?
+            .first()
+            .copied()
+            .unwrap_or(0.0);
+        if value < 0.0 {
+            let message = format!("attribute '{name}': expected a value ≥ 0, got {value}");
+            return Err(self.error(element, message));
+        }
+        Ok(value)
     }
 
     /// `<name>range` where `<name>limited` limits it ("auto": where the range is given); a

@@ -13,8 +13,12 @@
 //! - `joint` (`joint1`, `joint2`, `polycoef`): `q1 − q1,0 = Σ c_k (q2 − q2,0)^k` about the
 //!   joints' `qpos0` values; without joint2, joint1 is held at `q1,0 + c_0`.
 //!
+//! - `tendon` (`tendon1`, `tendon2`, `polycoef`): the same between fixed tendons' lengths about
+//!   their lengths at qpos0, a [`TendonEquality`] that MuJoCo's soft model holds (a warning
+//!   says robodyn's exact constraints do not).
+//!
 //! `active`, `solref`, `solimp` (and a weld's `torquescale`) are kept with each constraint, from
-//! the element or its class's `<equality>` default, with MuJoCo's defaults. `tendon`, `flex` and
+//! the element or its class's `<equality>` default, with MuJoCo's defaults. `flex` and
 //! `flexstrain` equalities are not read (a warning each).
 
 use super::Reader;
@@ -25,7 +29,7 @@ use crate::constraint::{
 };
 use crate::error::Result;
 use crate::io::xml::parse_numbers;
-use crate::model::Model;
+use crate::model::{Model, SolverParameters, TendonEquality};
 use crate::spatial::{Transform, Vec3};
 use crate::Data;
 use nalgebra::{Quaternion, UnitQuaternion};
@@ -46,6 +50,12 @@ impl<'a> Reader<'a> {
                     "connect" => self.connect(element, model, &mut data)?,
                     "weld" => self.weld(element, model, &mut data)?,
                     "joint" => self.joint_equality(element, model)?,
+                    "tendon" => {
+                        if let Some(equality) = self.tendon_equality(element, model)? {
+                            model.tendon_equalities.push(equality);
+                        }
+                        continue;
+                    }
                     _ => {
                         let message = format!(
                             "{}: not read (robodyn holds connect, weld and joint equalities)",
@@ -72,6 +82,22 @@ impl<'a> Reader<'a> {
     /// The constraint with the element's name, `active`, `solref`, `solimp`, `torquescale` and
     /// the bodies it attaches.
     fn declared(&self, element: Node<'a, 'a>, constraint: Constraint) -> Result<ModelConstraint> {
+        let (active, solver) = self.activity_and_softness(element)?;
+        Ok(ModelConstraint {
+            name: element.attribute("name").unwrap_or_default().to_string(),
+            constraint,
+            active,
+            solref: solver.solref,
+            solimp: solver.solimp,
+            torquescale: self
+                .equality_numbers::<1>(element, "torquescale")?
+                .map_or(1.0, |[t]| t),
+            bodies: self.attached_bodies(element),
+        })
+    }
+
+    /// An equality's `active`, `solref` and `solimp`.
+    fn activity_and_softness(&self, element: Node<'a, 'a>) -> Result<(bool, SolverParameters)> {
         let active = match self.equality_attribute(element, "active")?.as_deref() {
             None | Some("true") => true,
             Some("false") => false,
@@ -80,17 +106,11 @@ impl<'a> Reader<'a> {
                 return Err(self.error(element, message));
             }
         };
-        Ok(ModelConstraint {
-            name: element.attribute("name").unwrap_or_default().to_string(),
-            constraint,
-            active,
+        let solver = SolverParameters {
             solref: self.leading_numbers(element, "main", "equality", "solref", DEFAULT_SOLREF)?,
             solimp: self.leading_numbers(element, "main", "equality", "solimp", DEFAULT_SOLIMP)?,
-            torquescale: self
-                .equality_numbers::<1>(element, "torquescale")?
-                .map_or(1.0, |[t]| t),
-            bodies: self.attached_bodies(element),
-        })
+        };
+        Ok((active, solver))
     }
 
     /// The file bodies a connect or weld attaches (its sites' or its bodies', the world 0):
@@ -269,6 +289,61 @@ impl<'a> Reader<'a> {
         })
     }
 
+    /// A tendon equality: tendon1's length a polynomial of tendon2's about their lengths at
+    /// qpos0; `None` (warned) when it names a tendon that is not read.
+    fn tendon_equality(
+        &self,
+        element: Node<'a, 'a>,
+        model: &mut Model,
+    ) -> Result<Option<TendonEquality>> {
+        let tendon = |attribute: &str| -> Result<Option<std::result::Result<usize, String>>> {
+            let Some(name) = element.attribute(attribute) else {
+                return Ok(None);
+            };
+            if let Some(t) = model.tendons.iter().position(|t| t.name == name) {
+                return Ok(Some(Ok(t)));
+            }
+            if self.unread_tendons.borrow().iter().any(|n| n == name) {
+                return Ok(Some(Err(name.to_string())));
+            }
+            let message = format!("attribute '{attribute}': no tendon is called '{name}'");
+            Err(self.error(element, message))
+        };
+        let first = tendon("tendon1")?
+            .ok_or_else(|| self.error(element, "expected attribute 'tendon1'"))?;
+        let second = tendon("tendon2")?.transpose();
+        let (first, second) = match (first, second) {
+            (Ok(first), Ok(second)) => (first, second),
+            (Err(name), _) | (_, Err(name)) => {
+                model.warnings.push(format!(
+                    "{}: not read (spatial tendon '{name}' is not read)",
+                    self.location(element)
+                ));
+                return Ok(None);
+            }
+        };
+        let (active, solver) = self.activity_and_softness(element)?;
+        model.warnings.push(format!(
+            "{}: held by MuJoCo's soft model only (contact_forward_dynamics, step, simulate with \
+             integrator=\"mujoco\"), not by robodyn's exact constraints",
+            self.location(element)
+        ));
+        Ok(Some(TendonEquality {
+            name: element.attribute("name").unwrap_or_default().to_string(),
+            tendons: (first, second),
+            polynomial: self.polynomial(element)?,
+            active,
+            solver,
+            before: model.constraints.len(),
+        }))
+    }
+
+    /// A joint or tendon equality's `polycoef` (MuJoCo's default: the identity, 0 1 0 0 0).
+    fn polynomial(&self, element: Node<'a, 'a>) -> Result<[f64; 5]> {
+        let identity = [0.0, 1.0, 0.0, 0.0, 0.0];
+        self.leading_numbers(element, "main", "equality", "polycoef", identity)
+    }
+
     /// A joint equality: joint1 a polynomial of joint2 about their qpos0 values.
     fn joint_equality(&self, element: Node<'a, 'a>, model: &Model) -> Result<ConstraintKind> {
         let joint = |attribute: &str| -> Result<Option<usize>> {
@@ -290,13 +365,7 @@ impl<'a> Reader<'a> {
         Ok(ConstraintKind::Coupling {
             follower,
             leader,
-            polynomial: self.leading_numbers(
-                element,
-                "main",
-                "equality",
-                "polycoef",
-                [0.0, 1.0, 0.0, 0.0, 0.0],
-            )?,
+            polynomial: self.polynomial(element)?,
             references: (neutral(follower), leader.map_or(0.0, neutral)),
         })
     }

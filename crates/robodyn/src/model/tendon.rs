@@ -1,0 +1,130 @@
+//! Fixed tendons (MJCF `<tendon><fixed>`): a length that is a fixed linear combination of hinge
+//! and slide coordinates,
+//! ```text
+//!   L = Σ_k c_k q_k,   L̇ = J q̇,   J = Σ_k c_k e_k
+//! ```
+//! (MuJoCo's `ten_length`, `ten_J`). What MuJoCo hangs on it: a spring and a damper on L (its
+//! `stiffness` outside the dead band `springlength` and `damping`), dry friction and limits as
+//! constraint rows, equalities coupling two lengths, and actuators pulling on it.
+
+use super::{Model, SolverParameters};
+
+/// One fixed tendon.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Tendon {
+    /// Its name in the file (`tendon<k>` when it has none).
+    pub name: String,
+    /// Its joints: (the body whose hinge or slide it is, the coefficient c_k).
+    pub joints: Vec<(usize, f64)>,
+    /// L at the neutral configuration (MuJoCo's `tendon_length0`).
+    pub length0: f64,
+    /// The range of L where it is limited (`limited`, `range`).
+    pub range: Option<(f64, f64)>,
+    /// How far inside the range a limit's row starts (`margin`).
+    pub margin: f64,
+    /// The limit rows' softness (`solreflimit`, `solimplimit`).
+    pub limit: SolverParameters,
+    /// Dry friction's largest force on L (`frictionloss`).
+    pub frictionloss: f64,
+    /// The friction row's softness (`solreffriction`, `solimpfriction`).
+    pub friction: SolverParameters,
+    /// The spring's stiffness (`stiffness`), pulling L into `spring_length`.
+    pub stiffness: f64,
+    /// The dead band [low, high] of the spring (`springlength`; L₀ when not given).
+    pub spring_length: [f64; 2],
+    /// The damper on L̇ (`damping`).
+    pub damping: f64,
+}
+
+impl Tendon {
+    /// Its nonzero Jacobian entries, with each joint's coordinate in q: (velocity coordinate,
+    /// configuration coordinate, c_k).
+    pub fn entries<'a>(
+        &'a self,
+        model: &'a Model,
+    ) -> impl Iterator<Item = (usize, usize, f64)> + 'a {
+        self.joints
+            .iter()
+            .map(|&(body, c)| (model.idx_v[body], model.idx_q[body], c))
+    }
+
+    /// L at q.
+    pub fn length(&self, model: &Model, q: &[f64]) -> f64 {
+        self.entries(model).map(|(_, p, c)| c * q[p]).sum()
+    }
+
+    /// L̇ = J q̇.
+    pub fn rate(&self, model: &Model, v: &[f64]) -> f64 {
+        self.entries(model).map(|(k, _, c)| c * v[k]).sum()
+    }
+
+    /// The spring's and the damper's force along the tendon at (L, L̇):
+    /// `k (low − L)` below the dead band, `k (high − L)` above it, then `− b L̇`.
+    pub fn passive_force(&self, length: f64, rate: f64, spring: bool, damper: bool) -> f64 {
+        let [low, high] = self.spring_length;
+        let stretch = if length < low {
+            low - length
+        } else if length > high {
+            high - length
+        } else {
+            0.0
+        };
+        let spring_force = if spring {
+            self.stiffness * stretch
+        } else {
+            0.0
+        };
+        let damper_force = if damper { -self.damping * rate } else { 0.0 };
+        spring_force + damper_force
+    }
+}
+
+/// A tendon equality (MJCF `<equality><tendon>`): one tendon's length a polynomial of another's
+/// about their neutral lengths, `L₁ − L₁,₀ = Σ_k c_k (L₂ − L₂,₀)^k`, or, without a second,
+/// `L₁ − L₁,₀ = c₀`. Held by MuJoCo's soft model only (`soft`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TendonEquality {
+    /// Its name in the file (empty when it has none).
+    pub name: String,
+    /// The tendon that follows and the one it follows ([`Model::tendons`] indices).
+    pub tendons: (usize, Option<usize>),
+    /// `c₀ … c₄` (MuJoCo's `polycoef`).
+    pub polynomial: [f64; 5],
+    /// Whether it is enforced (`active`).
+    pub active: bool,
+    /// Its `solref` and `solimp`.
+    pub solver: SolverParameters,
+    /// Its place among the file's equalities: the number of [`Model::constraints`] read before
+    /// it (MuJoCo numbers them all in the file's order).
+    pub before: usize,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_spring_pulls_back_into_its_dead_band_and_the_damper_resists() {
+        let tendon = Tendon {
+            name: "t".into(),
+            joints: vec![],
+            length0: 0.0,
+            range: None,
+            margin: 0.0,
+            limit: SolverParameters::default(),
+            frictionloss: 0.0,
+            friction: SolverParameters::default(),
+            stiffness: 10.0,
+            spring_length: [0.2, 0.4],
+            damping: 2.0,
+        };
+        assert_eq!(tendon.passive_force(0.1, 0.0, true, true), 10.0 * 0.1);
+        assert_eq!(tendon.passive_force(0.3, 0.0, true, true), 0.0);
+        assert_eq!(
+            tendon.passive_force(0.5, 0.0, true, true),
+            -10.0 * (0.5 - 0.4)
+        );
+        assert_eq!(tendon.passive_force(0.3, 1.5, true, true), -3.0);
+        assert_eq!(tendon.passive_force(0.5, 1.5, false, false), 0.0);
+    }
+}
