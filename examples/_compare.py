@@ -13,14 +13,23 @@ from numpy.typing import ArrayLike
 GO2_SCENE = Path(__file__).resolve().parents[1] / "testdata" / "menagerie" / "unitree_go2" / "scene.xml"
 
 
+#: The repository's Franka Panda with a cube to pick up (its MJX scene, without its visual meshes).
+PANDA_CUBE = GO2_SCENE.parents[1] / "franka_emika_panda" / "mjx_single_cube.xml"
+
+
 def go2_scene() -> Any:
     """Menagerie's Unitree Go2 on its floor (:data:`GO2_SCENE`), loaded without its warnings (the
     scene's <visual> is not read, and its contacts are felt only with integrator='mujoco')."""
+    return quietly_loaded(GO2_SCENE)
+
+
+def quietly_loaded(path: Path) -> Any:
+    """The scene at ``path``, loaded without its ModelWarnings."""
     import robodyn
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", robodyn.ModelWarning)
-        return robodyn.load(GO2_SCENE)
+        return robodyn.load(path)
 
 
 def show(label: str, textbook: ArrayLike, robodyn_value: ArrayLike, tolerance: float = 1e-10) -> None:

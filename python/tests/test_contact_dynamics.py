@@ -20,6 +20,11 @@ from robodyn.convert import MujocoLayout
 # Jacobian, R and aref: the same formulas evaluated in another order (rounding only); entry by
 # entry, relative to max(1, |value|).
 ROW_AGREEMENT = 1e-12
+# A contact's distance is a difference of world coordinates of order 1 m, each rounded to ~1e-16 m:
+# its rounding is absolute, not relative to the distance (a Panda finger pad 6e-5 m into its cube:
+# distances 1.4e-17 m apart, 2e-13 of themselves). aref's spring term k d (pos − margin) carries it
+# times k d (1e4 /s² for solref 0.01): aref is also allowed k d POSITION_ROUNDING.
+POSITION_ROUNDING = 1e-15
 # Forces, accelerations and constraint forces, relative to max(1, max|value|). MuJoCo 4's Newton
 # solver at tolerance 1e-15 is not at the optimum: it also stops on its Newton decrement ½gᵀH⁻¹g
 # (the next step's predicted improvement; since MuJoCo 3.11), a step before the cost stops
@@ -79,6 +84,7 @@ def mujoco_solution(mj_model, layout, qpos, qvel, tau=None, ctrl=None):
         "jacobian": layout.jacobian_from_mujoco(q, d.efc_J[: nefc * nv].reshape(nefc, nv)),
         "R": d.efc_R.copy(),
         "aref": d.efc_aref.copy(),
+        "aref_rounding": d.efc_KBIP[:nefc, 0] * d.efc_KBIP[:nefc, 2] * POSITION_ROUNDING,
         "contacts": [(name(c.geom[0]), name(c.geom[1]), int(c.efc_address), int(c.dim)) for c in d.contact[: d.ncon]],
         "tau_actuator": layout.force_from_mujoco(q, d.qfrc_actuator),
         "tau_constraint": layout.force_from_mujoco(q, d.qfrc_constraint),
@@ -106,8 +112,12 @@ def assert_matches_mujoco(model, mj_model, layout, qpos, qvel, tau=None, ctrl=No
     assert list(ours["row_ids"]) == list(expected["row_ids"]), label
     found = [(c["geom1"], c["geom2"], c["first_row"], c["dim"]) for c in ours["contacts"]]
     assert found == expected["contacts"], label
-    for key in ("jacobian", "R", "aref"):
+    for key in ("jacobian", "R"):
         assert_entries_close(ours[key], expected[key], ROW_AGREEMENT, f"{label} {key}")
+    aref, expected_aref = np.asarray(ours["aref"]), expected["aref"]
+    assert aref.shape == expected_aref.shape, label
+    allowed = ROW_AGREEMENT * np.maximum(1.0, np.abs(expected_aref)) + expected["aref_rounding"]
+    assert np.all(np.abs(aref - expected_aref) <= allowed), f"{label} aref: off by up to {np.max(np.abs(aref - expected_aref)):.3e}"
     assert_close(ours["tau_actuator"], expected["tau_actuator"], ROW_AGREEMENT, f"{label} tau_actuator")
     for key in ("forces", "qdd", "tau_constraint"):
         assert_close(ours[key], expected[key], FORCE_AGREEMENT, f"{label} {key}")
@@ -383,6 +393,58 @@ def test_go2_standing_at_home_as_in_mujoco(cone, tmp_path):
         assert sum(geom2 in ("FL", "FR", "RL", "RR") for _, geom2, *_ in expected["contacts"]) == 4
 
 
+PANDA_CUBE = "franka_emika_panda/mjx_single_cube.xml"
+
+
+def panda_lift_ctrl(start, t):
+    """The Panda's controls at time t from its `pickup1` keyframe's (`start`): the gripper open, closed
+    from 0.1 s, then from 0.6 s the shoulder (joint 2) and elbow (joint 4) turned over 0.8 s to
+    raise the hand 30 cm."""
+    ctrl = np.array(start, dtype=float)
+    ctrl[7] = 0.0 if t > 0.1 else 0.04
+    if t > 0.6:
+        s = min(1.0, (t - 0.6) / 0.8)
+        ctrl[1] -= 0.35 * s
+        ctrl[3] += 0.2 * s
+    return ctrl
+
+
+def panda_holding_the_cube(mj_model):
+    """(qpos, qvel, ctrl) of the Panda with the cube lifted in its fingers: MuJoCo's own run of
+    `panda_lift_ctrl` from `pickup1` for 1.2 s (its file's solver settings)."""
+    d = mujoco.MjData(mj_model)
+    key = mj_model.key("pickup1")
+    mujoco.mj_resetDataKeyframe(mj_model, d, key.id)
+    while d.time < 1.2:
+        d.ctrl[:] = panda_lift_ctrl(key.ctrl, d.time)
+        mujoco.mj_step(mj_model, d)
+    return d.qpos.copy(), d.qvel.copy(), d.ctrl.copy()
+
+
+@pytest.mark.parametrize("cone", ["elliptic", "pyramidal"])
+def test_a_panda_holding_a_cube_as_in_mujoco(cone, tmp_path):
+    """Menagerie's Franka Panda (its MJX scene: box and capsule colliders, the fingers coupled by a
+    joint equality, position actuators) holding its cube 15 cm over the floor, only its finger pads
+    touching it; and at its three keyframes (the cube on the floor). Visual meshes left out
+    (testdata/menagerie/README.md)."""
+    folder = MENAGERIE / "franka_emika_panda"
+    for name in ("mjx_panda.xml", "mjx_scene.xml", "mjx_single_cube.xml"):
+        text = (folder / name).read_text()
+        (tmp_path / name).write_text(text.replace('<option timestep="0.005"', f'<option cone="{cone}" timestep="0.005"'))
+    path = tmp_path / "mjx_single_cube.xml"
+    model, mj_model = load_quietly(path), mujoco_model(path, PANDA_CUBE)
+    qpos, qvel, ctrl = panda_holding_the_cube(mj_model)
+    converged(mj_model)
+    layout = MujocoLayout(model, mj_model)
+    _, expected = assert_matches_mujoco(model, mj_model, layout, qpos, qvel, ctrl=ctrl, label="holding")
+    touching = {(geom1, geom2) for geom1, geom2, first, _ in expected["contacts"] if first >= 0}
+    assert touching == {("left_finger_pad", "box"), ("right_finger_pad", "box")}, touching
+    assert expected["row_types"][0] == "equality"
+    for key in range(mj_model.nkey):
+        assert_matches_mujoco(model, mj_model, layout, mj_model.key_qpos[key], mj_model.key_qvel[key],
+                              ctrl=mj_model.key_ctrl[key], label=f"keyframe {key}")
+
+
 # --- 6. equality constraints ------------------------------------------------------------------
 
 # Every kind of MuJoCo equality robodyn reads: a weld between an arm and a free box (torquescale 2,
@@ -435,8 +497,8 @@ def test_equality_constraints_as_in_mujoco(cone):
         qpos = mj_model.qpos0.copy()
         mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.1, 1.0)
         qpos[ball_height] = 0.08
-        ours, expected = assert_matches_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv),
-                                               tau=rng.normal(size=mj_model.nv), label=f"{cone} case {case}")
+        ours, _ = assert_matches_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv),
+                                        tau=rng.normal(size=mj_model.nv), label=f"{cone} case {case}")
         kinds = list(ours["row_types"])
         assert kinds[:EQUALITY_ROWS] == ["equality"] * EQUALITY_ROWS and "equality" not in kinds[EQUALITY_ROWS:]
         assert 7 not in list(ours["row_ids"])[:EQUALITY_ROWS], "the inactive connect has no rows"

@@ -25,7 +25,13 @@ from robodyn.crosscheck import DISAGREES, mujoco_agreement
 MENAGERIE = Path(__file__).resolve().parents[2] / "testdata" / "menagerie"
 #: The testdata files kept without their visual meshes: MuJoCo reads them with their mesh geoms
 #: removed, which every body's explicit <inertial> keeps out of the dynamics.
-WITHOUT_MESHES = {"universal_robots_ur5e/ur5e.xml", "unitree_go2/go2.xml", "unitree_go2/scene.xml"}
+WITHOUT_MESHES = {
+    "universal_robots_ur5e/ur5e.xml",
+    "unitree_go2/go2.xml",
+    "unitree_go2/scene.xml",
+    "franka_emika_panda/mjx_panda.xml",
+    "franka_emika_panda/mjx_single_cube.xml",
+}
 
 
 def package_folder(name: str) -> Path:
@@ -40,8 +46,10 @@ def mujoco_model(path: Path, file: str) -> mujoco.MjModel:
     if file not in WITHOUT_MESHES:
         return mujoco.MjModel.from_xml_path(str(path))
     spec = mujoco.MjSpec.from_file(str(path))
-    implicit = [body.name for body in spec.bodies[1:] if not body.explicitinertial]
-    assert not implicit, f"{file}: bodies {implicit} take their inertia from geoms, so their meshes are needed"
+    mesh = mujoco.mjtGeom.mjGEOM_MESH
+    implicit = [body.name for body in spec.bodies[1:]
+                if not body.explicitinertial and any(g.type == mesh for g in body.geoms)]
+    assert not implicit, f"{file}: bodies {implicit} take their inertia from mesh geoms, so their meshes are needed"
     for geom in [g for g in spec.geoms if g.type == mujoco.mjtGeom.mjGEOM_MESH]:
         spec.delete(geom)
     for mesh in list(spec.meshes):
@@ -55,6 +63,7 @@ MODELS = {
     # unmodified Menagerie files
     ("testdata", "universal_robots_ur5e/ur5e.xml"): None,
     ("testdata", "unitree_go2/go2.xml"): None,
+    ("testdata", "franka_emika_panda/mjx_panda.xml"): None,
     # bodies whose inertia comes from their mesh geoms
     ("testdata", "robotiq_2f85/2f85.xml"): None,
     # mjlab's versions of Menagerie's Unitree G1 humanoid and Go1 quadruped, and the i2rt YAM arm
