@@ -584,7 +584,42 @@ def test_tendon_lengths_as_in_mujoco():
     assert_close(model.tendon_lengths(layout.q_from_mujoco(states[0])), expected[0], ROW_AGREEMENT, "one")
 
 
-# --- 8. what is refused ---------------------------------------------------------------------
+# --- 8. MuJoCo's simple bodies -------------------------------------------------------------------
+
+# Bodies MuJoCo calls simple (body_simple 2: only axis-aligned slides at their origin, their inertia
+# frame their own, no child, under the world or a jointless child of it) weigh 1/m in R, for their
+# contacts and their slides' limits (with armature: not M⁻¹'s diagonal); and four that are not (a
+# box turned in its body, a slide off the origin, a parent, the fixed stand).
+SIMPLE_BODIES = """<mujoco><option cone="{cone}"/>
+  <worldbody>
+    <geom name="floor" type="plane" size="0 0 1"/>
+    <body name="puck" pos="0 0 0.049"><joint name="px" type="slide" axis="1 0 0" armature="0.3" range="-0.1 0.1" margin="0.2"/>
+      <joint name="py" type="slide" axis="0 1 0"/><geom name="puck" type="cylinder" size="0.1 0.05"/></body>
+    <body name="stand" pos="1 0 0"><geom type="box" size=".05 .05 .05" pos="0 0 .5"/>
+      <body name="slider" pos="0 0 0.039"><joint name="sz" type="slide" axis="0 0 1" range="-0.05 0.1" margin="0.2" armature="0.1"/>
+        <geom name="slider" type="box" size="0.04 0.04 0.04"/></body></body>
+    <body name="tilted" pos="2 0 0.039"><joint name="tx" type="slide" axis="1 0 0"/><joint name="ty" type="slide" axis="0 1 0"/>
+      <geom name="tilted" type="box" size="0.04 0.05 0.04" euler="0 0 30"/></body>
+    <body name="offset" pos="3 0 0.039"><joint name="ox" type="slide" axis="1 0 0" pos="0.1 0 0"/>
+      <geom name="offset" type="sphere" size="0.04"/></body>
+    <body name="parent" pos="4 0 0.039"><joint name="qx" type="slide" axis="1 0 0"/><geom name="parent" type="sphere" size="0.04"/>
+      <body name="child" pos="0 0.2 0"><geom name="child" type="sphere" size="0.04"/></body></body>
+  </worldbody></mujoco>"""
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+def test_simple_bodies_weigh_one_over_their_mass_as_in_mujoco(cone):
+    model, mj_model, layout = load_both(SIMPLE_BODIES.replace("{cone}", cone))
+    simple = {mj_model.body(i).name for i in range(1, mj_model.nbody) if mj_model.body_simple[i] == 2}
+    assert simple == {"puck", "slider"}
+    rng = np.random.default_rng(2)
+    for case in range(3):
+        qpos = mj_model.qpos0 + rng.normal(size=mj_model.nq) * 0.05
+        _, expected = assert_matches_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv), label=f"case {case}")
+        assert expected["row_types"].count("limit_joint") == 4
+
+
+# --- 9. what is refused ---------------------------------------------------------------------
 
 
 def test_bad_input_is_refused_naming_it():

@@ -208,6 +208,7 @@ fn load_sources(sources: &Sources) -> Result<Model> {
             body: 0,
             mass: 0.0,
             com: crate::spatial::Vec3::zeros(),
+            simple: false,
         }]),
         site_bodies: RefCell::new(HashMap::new()),
         unread_tendons: RefCell::new(Vec::new()),

@@ -91,6 +91,11 @@ pub struct SourceBody {
     /// Its own centre of mass (its frame's origin when massless) in the frame of `body`
     /// (MuJoCo's `xipos` there).
     pub com: Vec3,
+    /// Whether MuJoCo calls it a simple body without rotations (`body_simple == 2`): only
+    /// axis-aligned slides at its origin, its inertia frame its own, no child, and its parent the
+    /// world or a jointless child of it. Its weights are then 1/m.
+    #[serde(default)]
+    pub simple: bool,
 }
 
 /// Two of the file's bodies whose geoms never touch (`<contact><exclude>`), as

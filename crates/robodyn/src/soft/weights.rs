@@ -16,8 +16,9 @@
 //! coordinates of the velocities, so robodyn's free-joint velocities (linear in the body's axes)
 //! give MuJoCo's numbers (linear in the world's).
 //!
-//! MuJoCo takes 1/m instead for a "simple" body (a root body with only axis-aligned slides, its
-//! inertia frame its own): such bodies are not recognised here yet (see the guide's "Not yet").
+//! MuJoCo takes 1/m instead, for the body and for each of its slides, on a "simple" body (only
+//! axis-aligned slides at its origin, its inertia frame its own, no child, under the world or a
+//! jointless child of it: [`crate::model::SourceBody::simple`]).
 
 use crate::algo::{forward_kinematics, inverse_mass_matrix};
 use crate::error::Result;
@@ -25,6 +26,9 @@ use crate::joint::Joint;
 use crate::model::Model;
 use crate::spatial::{Transform, Vec3};
 use crate::Data;
+
+/// Below this a mass counts as zero (MuJoCo's `mjMINVAL`).
+const TINY: f64 = 1e-15;
 use nalgebra::DMatrix;
 
 /// The approximate inverse inertias of the file's bodies and of the degrees of freedom.
@@ -52,6 +56,10 @@ pub fn inverse_weights(model: &Model, data: &mut Data) -> Result<InverseWeights>
             bodies.push([0.0, 0.0]);
             continue;
         }
+        if source.simple {
+            bodies.push([1.0 / source.mass.max(TINY), 0.0]);
+            continue;
+        }
         let centre = world_point(&x_world[source.body], &source.com);
         jacobian.fill(0.0);
         point_columns(
@@ -72,9 +80,10 @@ pub fn inverse_weights(model: &Model, data: &mut Data) -> Result<InverseWeights>
         };
         bodies.push([trace(0), trace(3)]);
     }
-    // the joints: their blocks of M⁻¹
+    // the joints: their blocks of M⁻¹ (1/m on a simple body's slides)
     let mut dofs = vec![0.0; nv];
-    for i in 1..model.nbodies() {
+    let simple_mass = simple_body_masses(model);
+    for (i, simple_mass) in simple_mass.iter().enumerate().skip(1) {
         let range = model.v_range(i);
         let mean = |from: usize, count: usize| {
             (from..from + count).map(|k| inverse[(k, k)]).sum::<f64>() / count as f64
@@ -91,7 +100,10 @@ pub fn inverse_weights(model: &Model, data: &mut Data) -> Result<InverseWeights>
             }
             _ => {
                 for k in range {
-                    dofs[k] = inverse[(k, k)];
+                    dofs[k] = match simple_mass {
+                        Some(mass) => 1.0 / mass.max(TINY),
+                        None => inverse[(k, k)],
+                    };
                 }
             }
         }
@@ -118,6 +130,21 @@ pub fn inverse_weights(model: &Model, data: &mut Data) -> Result<InverseWeights>
         dofs,
         tendons,
     })
+}
+
+/// Per model body, the mass of the simple file body whose slide it carries (see
+/// [`crate::model::SourceBody::simple`]): the chain from that file body's model body to the
+/// world is its own.
+fn simple_body_masses(model: &Model) -> Vec<Option<f64>> {
+    let mut masses = vec![None; model.nbodies()];
+    for source in model.source_bodies.iter().filter(|s| s.simple) {
+        let mut j = source.body;
+        while j != 0 {
+            masses[j] = Some(source.mass);
+            j = model.parent[j];
+        }
+    }
+    masses
 }
 
 /// The columns of the Jacobian of the world point `point` moving with `body`, those of the

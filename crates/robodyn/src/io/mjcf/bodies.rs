@@ -136,12 +136,15 @@ impl<'a> Reader<'a> {
         // MuJoCo numbers the file's bodies in document order, the world 0
         let source_body = {
             let mut bodies = self.source_bodies.borrow_mut();
+            // a parent is no simple body
+            bodies[parent_source].simple = false;
             bodies.push(SourceBody {
                 name: name.clone(),
                 parent: parent_source,
                 body: parent,
                 mass: 0.0,
                 com: Vec3::zeros(),
+                simple: false,
             });
             bodies.len() - 1
         };
@@ -177,6 +180,8 @@ impl<'a> Reader<'a> {
         }
         let mut body = parent;
         let mut previous_position = Vec3::zeros();
+        // MuJoCo's simple body: only slides at its origin along a coordinate axis (so far)
+        let mut only_aligned_slides = true;
         for (k, (joint_node, to_frame, frame_class)) in joints.iter().enumerate() {
             let joint_class = self.declared_class(*joint_node, "class", frame_class)?;
             // a joint in a <frame> has its pos and axis in the frame's axes
@@ -223,6 +228,10 @@ impl<'a> Reader<'a> {
                     )
                     + to_frame.translation
             };
+            let aligned = axis.iter().filter(|x| x.abs() > SIMPLE_TOLERANCE).count() == 1;
+            only_aligned_slides &= matches!(joint, Joint::Prismatic { .. })
+                && aligned
+                && position.norm() <= SIMPLE_TOLERANCE;
             let scalar = |key: &str, default: f64| -> Result<f64> {
                 Ok(self
                     .numbers::<1>(*joint_node, joint_class, key)?
@@ -336,6 +345,8 @@ impl<'a> Reader<'a> {
             builder.add_frame(&name, body, to_body);
         }
         self.record_source_mass(source_body, body, &inertia, &to_body);
+        self.source_bodies.borrow_mut()[source_body].simple =
+            only_aligned_slides && self.placed_simply(parent_source, parent) && own_frame(&inertia);
         self.add_geoms(
             builder,
             &elements,
@@ -344,6 +355,13 @@ impl<'a> Reader<'a> {
             to_body,
         )?;
         self.read_children(builder, node, (body, source_body), to_body, child_class)
+    }
+
+    /// Whether a body under file body `parent_source` (model body `parent`) sits where MuJoCo's
+    /// simple bodies do: a child of the world, or of a jointless child of it.
+    fn placed_simply(&self, parent_source: usize, parent: usize) -> bool {
+        let bodies = self.source_bodies.borrow();
+        parent_source == 0 || (bodies[parent_source].parent == 0 && parent == 0)
     }
 
     /// The file body `source_body`'s own mass and centre of mass, in the frame of the model
@@ -419,4 +437,18 @@ impl<'a> Reader<'a> {
             )),
         }
     }
+}
+
+/// Below this a joint's offset (m) or an axis component counts as zero for MuJoCo's simple
+/// bodies (its `mjEPS`).
+const SIMPLE_TOLERANCE: f64 = 1e-14;
+
+/// Whether a body's inertia frame is its own (MuJoCo's `sameframe`): its centre of mass at its
+/// origin and its rotational inertia diagonal in its axes (to 1e-12 of its trace).
+fn own_frame(inertia: &Inertia) -> bool {
+    let r = &inertia.rotational;
+    let off_diagonal = [r[(0, 1)], r[(0, 2)], r[(1, 2)]];
+    let scale = 1e-12 * r.trace().abs().max(f64::MIN_POSITIVE);
+    inertia.first_moment.norm() <= SIMPLE_TOLERANCE * inertia.mass.max(1.0)
+        && off_diagonal.iter().all(|x| x.abs() <= scale)
 }
