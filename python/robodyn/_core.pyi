@@ -440,6 +440,7 @@ def simulate_scene(
     v0: ArrayLike,
     steps: int,
     record_every: int,
+    start: float = 0.0,
     ctrl: ArrayLike | Callable[[float, _FloatArray, _FloatArray], ArrayLike] | None = None,
     controller: dict | Callable[[float, _FloatArray, _FloatArray], ArrayLike] | None = None,
     progress: Callable[[float], object] | None = None,

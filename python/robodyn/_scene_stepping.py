@@ -27,16 +27,17 @@ def simulate_scene(model: Any, q0: Any, v0: Any, t_end: float, dt: float | None,
     if not (isinstance(constraints, str) and constraints == "model") and constraints:
         raise bad("constraints", "'model' with integrator='mujoco' (the scene's own equality constraints)",
                   repr(constraints))
+    start = keyframe(model, q0).time if isinstance(q0, str) else 0.0
     q0, v0, ctrl = scene_start(model, q0, v0, ctrl)
     h = model.options.timestep
     dt = h if dt is None else real("dt", dt)
     record_every = round(dt / h)
     if record_every < 1 or abs(record_every * h - dt) > STEP_MULTIPLE_TOLERANCE * dt:
         raise bad("dt", f"a whole number of the scene's time steps ({h} s) with integrator='mujoco'", repr(dt))
-    steps = int(np.ceil(real("t_end", t_end) / h - STEP_MULTIPLE_TOLERANCE))
+    steps = int(np.ceil((real("t_end", t_end) - start) / h - STEP_MULTIPLE_TOLERANCE))
     if steps < 0:
-        raise bad("t_end", "a time (s) not before the start, 0", repr(t_end))
-    result = _core.simulate_scene(model, q0, v0, steps, record_every, ctrl=ctrl,
+        raise bad("t_end", f"a time (s) not before the start, {start}", repr(t_end))
+    result = _core.simulate_scene(model, q0, v0, steps, record_every, start=start, ctrl=ctrl,
                                   controller=_controller_argument(model, controller),
                                   progress=callback("progress", progress))
     series = ("q", "v", "a", "tau", "tau_passive", "ctrl", "tau_constraint")

@@ -425,7 +425,8 @@ def simulate(
 
     ``integrator="mujoco"`` steps a scene as MuJoCo's ``mj_step`` does (the file's ``<option>``
     integrator and time step, its soft contacts, limits, dry friction and actuators; see the guide's
-    "Scenes stepped as MuJoCo"): ``q0`` may name a keyframe (its q, v and ctrl), ``ctrl`` gives the
+    "Scenes stepped as MuJoCo"): ``q0`` may name a keyframe (its q, v and ctrl; the run starts at its
+    time, from which ``t_end`` counts), ``ctrl`` gives the
     actuators' controls (nu values, one row per rollout, or a callable ``(t, q, v) -> ctrl``),
     ``controller`` forces on the joints, ``dt`` (default: the time step) a whole number of steps
     between samples; the accuracy, passive-force and limit options below are the other integrators'.

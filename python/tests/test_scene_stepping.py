@@ -260,6 +260,24 @@ def test_a_run_starts_from_a_keyframe_with_its_controls():
     assert np.array_equal(sparse.q, run.q[::5])
 
 
+def test_a_run_from_a_keyframe_starts_at_its_time():
+    """A keyframe's `time` is the run's first (MuJoCo's mj_resetDataKeyframe sets d.time): the samples,
+    the callbacks' t and t_end count from it; a t_end before it is refused naming it."""
+    text = SPINNER.format("Euler").replace("</mujoco>", '<keyframe><key name="late" time="0.3"/></keyframe></mujoco>')
+    model = load_quietly(text=text)
+    h, seen = model.options.timestep, []
+
+    def push(t, q, v):
+        seen.append(t)
+        return np.zeros(model.nv)
+
+    run = robodyn.simulate(model, "late", t_end=0.3 + 10 * h, integrator="mujoco", controller=push)
+    assert len(run.t) == 11 and np.allclose(run.t, 0.3 + h * np.arange(11), rtol=0, atol=1e-12)
+    assert seen[0] == 0.3 and np.allclose(seen, run.t[: len(seen)], rtol=0, atol=1e-12)
+    with pytest.raises(ValueError, match=r"argument 't_end': expected a time \(s\) not before the start, 0.3"):
+        robodyn.simulate(model, "late", t_end=0.2, integrator="mujoco")
+
+
 def test_rollouts_in_parallel_equal_their_own_runs():
     model = load_quietly(text=box_scene(3, "pyramidal"))
     rng = np.random.default_rng(3)

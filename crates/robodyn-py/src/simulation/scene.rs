@@ -22,11 +22,11 @@ use robodyn::soft::simulate::{
 use robodyn::soft::step::SceneStep;
 use robodyn::{Error, Model};
 
-/// Simulates `model`'s scene from `q0`, `v0` (one state, or N: shape (N, nq), (N, nv)) over
-/// `steps` of its time step, recording every `record_every`-th. `ctrl`: None (zeros), the
+/// Simulates `model`'s scene from `q0`, `v0` (one state, or N: shape (N, nq), (N, nv)) at time
+/// `start` over `steps` of its time step, recording every `record_every`-th. `ctrl`: None (zeros), the
 /// controls (nu, or (N, nu)) or a callable `(t, q, v) -> ctrl`; `controller` as in `simulate`.
 #[pyfunction]
-#[pyo3(signature = (model, q0, v0, steps, record_every, ctrl=None, controller=None, progress=None))]
+#[pyo3(signature = (model, q0, v0, steps, record_every, start=0.0, ctrl=None, controller=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_scene<'py>(
     py: Python<'py>,
@@ -35,6 +35,7 @@ pub fn simulate_scene<'py>(
     v0: &Bound<'py, PyAny>,
     steps: usize,
     record_every: usize,
+    start: f64,
     ctrl: Option<&Bound<'py, PyAny>>,
     controller: Option<&Bound<'py, PyAny>>,
     progress: Option<&Bound<'py, PyAny>>,
@@ -43,13 +44,14 @@ pub fn simulate_scene<'py>(
     let (q0, v0, batch) = initial_states(model, q0, v0)?;
     let count = batch.unwrap_or(1);
     let controls = read_controls(m, ctrl, count)?;
-    let t_end = steps as f64 * m.options.timestep;
+    let t_end = start + steps as f64 * m.options.timestep;
     let control = read_controller(m, controller, PassiveForces::default(), t_end)?;
     let (q0, v0) = (q0.values().into_owned(), v0.values().into_owned());
-    let start = |k: usize| (&q0[k * m.nq..(k + 1) * m.nq], &v0[k * m.nv..(k + 1) * m.nv]);
+    let initial = |k: usize| (&q0[k * m.nq..(k + 1) * m.nq], &v0[k * m.nv..(k + 1) * m.nv]);
     let scene = SceneRun {
         steps,
         record_every,
+        start,
     };
     let named = |k: usize, error: Error| match (batch, error) {
         (Some(_), Error::Simulation { time, message }) => Error::Simulation {
@@ -65,7 +67,7 @@ pub fn simulate_scene<'py>(
                     .into_par_iter()
                     .map(|k| {
                         let (mut native, mut fixed) = (native.as_ref().clone(), fixed[k].clone());
-                        run(m, start(k), scene, &mut native, &mut fixed, None)
+                        run(m, initial(k), scene, &mut native, &mut fixed, None)
                             .map_err(|e| named(k, e))
                     })
                     .collect::<robodyn::Result<_>>()
@@ -100,7 +102,7 @@ pub fn simulate_scene<'py>(
                     });
                     keep_raised(&mut progress_raised, result, fraction)
                 };
-                let result = run(m, start(k), scene, controller, inputs, Some(&mut report));
+                let result = run(m, initial(k), scene, controller, inputs, Some(&mut report));
                 let raised = python
                     .and_then(|p| p.raised)
                     .or(python_controls.and_then(|p| p.raised))

@@ -59,15 +59,17 @@ pub struct SceneTrajectory {
 }
 
 /// How long a scene simulation runs and what it keeps.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SceneRun {
     /// Steps of the scene's time step.
     pub steps: usize,
     /// A sample every this many steps (and the last state).
     pub record_every: usize,
+    /// The time of the first state (s): a keyframe's `time`, else 0.
+    pub start: f64,
 }
 
-/// Simulates `model`'s scene from (q₀, v₀) at t = 0 over `run.steps` steps under `controls`
+/// Simulates `model`'s scene from (q₀, v₀) at `run.start` over `run.steps` steps under `controls`
 /// and the applied forces of `controller`. `progress`, if given, is called with the fraction
 /// done about a hundred times; an error it returns stops the simulation with that error.
 pub fn simulate_scene(
@@ -93,7 +95,7 @@ pub fn simulate_scene(
     let mut out = SceneTrajectory::default();
     let report_every = (run.steps / 100).max(1);
     for k in 0..=run.steps {
-        let t = k as f64 * h;
+        let t = run.start + k as f64 * h;
         controls.controls(model, t, &q, &v, &mut ctrl)?;
         controller.torque(model, t, &q, &v, &mut tau)?;
         let recorded = k % run.record_every == 0 || k == run.steps;
