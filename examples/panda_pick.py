@@ -23,14 +23,11 @@ start = np.array(panda.keyframe("pickup1").ctrl)
 
 def pick(t: float, q: Any, v: Any) -> Any:
     """The controls: the fingers' target 0 (closed) after 0.1 s; from 0.6 s the shoulder (joint 2)
-    and the elbow (joint 4) turned by −0.35 and +0.2 rad over 0.8 s."""
-    ctrl = start.copy()
-    ctrl[7] = 0.0 if t > 0.1 else 0.04
-    if t > 0.6:
-        s = min(1.0, (t - 0.6) / 0.8)
-        ctrl[1] -= 0.35 * s
-        ctrl[3] += 0.2 * s
-    return ctrl
+    and the elbow (joint 4) turned by −0.35 and +0.2 rad along a half cosine over 0.8 s (no jerk
+    at either end)."""
+    closing = 0.0 if t > 0.1 else 0.04
+    raised = 0.5 * (1.0 - np.cos(np.pi * np.clip((t - 0.6) / 0.8, 0.0, 1.0)))
+    return start + np.array([0.0, -0.35 * raised, 0.0, 0.2 * raised, 0.0, 0.0, 0.0, closing - start[7]])
 
 
 # %%

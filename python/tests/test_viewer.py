@@ -393,3 +393,30 @@ def test_a_scene_run_shows_its_contact_points_and_force_arrows(tmp_path: Path, m
         assert player.contacts is None and player.contacts_box.disabled
     finally:
         player.close()
+
+
+def test_the_viewer_draws_a_poses_contacts_and_their_forces() -> None:
+    """A box resting on a floor, shown at rest: a point at each corner's contact and an arrow along
+    the floor's push (contact_forward_dynamics at v = 0), the four the box's weight m g at
+    WEIGHT_ARROW_FRACTION of the robot's size; hide_contacts draws none."""
+    from robodyn.viewer.scene import WEIGHT_ARROW_FRACTION
+
+    scene = robodyn.load_mjcf_string(BOX_SCENE)
+    q = scene.neutral()
+    q[2] = 0.099
+    viewer = Viewer(scene, open_browser=False, port=0)
+    try:
+        contacts = viewer.show_contacts(q)
+        assert len(contacts) == 4
+        cloud, lines = viewer.scene.contact_nodes
+        assert cloud.visible and lines.visible
+        # viser keeps the points in float16 (11 significant bits) and the lines in float32
+        assert np.allclose(cloud.points, [c["position"] for c in contacts], rtol=1e-3, atol=1e-6)
+        arrows = np.asarray(lines.points, dtype=float)
+        expected = sum(np.asarray(c["frame"]).T @ np.asarray(c["force"])[:3] for c in contacts)
+        scale = WEIGHT_ARROW_FRACTION * viewer.scene.size / (scene.total_mass * np.linalg.norm(scene.gravity))
+        assert np.allclose((arrows[:, 1] - arrows[:, 0]).sum(axis=0), scale * expected, rtol=1e-5, atol=1e-6)
+        viewer.hide_contacts()
+        assert not viewer.scene.contact_nodes[1].visible
+    finally:
+        viewer.close()

@@ -148,6 +148,23 @@ class Viewer:
         q = _configuration(self.model, q)
         self.scene.show(np.asarray(self.model.body_poses(q)), np.asarray(self.model.center_of_mass(q)))
 
+    def show_contacts(self, q: ArrayLike, v: ArrayLike | None = None, ctrl: ArrayLike | None = None) -> list[dict[str, Any]]:
+        """Poses the robot at ``q`` and draws its scene's contacts there: a point at each and an
+        arrow along the force pushing its second geom, of the soft model at (q, v) under controls
+        ``ctrl`` (``m.contact_forward_dynamics``; v and ctrl default to zeros), the model's weight
+        m g :data:`~robodyn.viewer.scene.WEIGHT_ARROW_FRACTION` of the robot's size long. Returns
+        the contacts drawn (as ``contact_forward_dynamics`` lists them)."""
+        q = _configuration(self.model, q)
+        v = np.zeros(self.model.nv) if v is None else v
+        contacts = self.model.contact_forward_dynamics(q, v, ctrl=ctrl)["contacts"]
+        self.show(q)
+        self.scene.show_contacts(*contact_arrows(contacts, _arrow_scale(self.model, self.scene.size, [contacts])))
+        return contacts
+
+    def hide_contacts(self) -> None:
+        """Draws no contacts."""
+        self.scene.show_contacts(np.zeros((0, 3)), np.zeros((0, 2, 3)))
+
     def close(self) -> None:
         """Stops the server; open pages stop updating."""
         _stop(self.server)
@@ -177,12 +194,19 @@ def _contact_samples(trajectory, size: float) -> list[tuple[np.ndarray, np.ndarr
     than ``"mujoco"``)."""
     if trajectory.integrator != "mujoco":
         return None
-    model = trajectory.model
+    scale = _arrow_scale(trajectory.model, size, trajectory.contacts)
+    return [contact_arrows(sample, scale) for sample in trajectory.contacts]
+
+
+def _arrow_scale(model: Any, size: float, samples: list[list[dict[str, Any]]]) -> float:
+    """Metres per newton of the force arrows: the model's weight m g drawn
+    :data:`WEIGHT_ARROW_FRACTION` of the robot's size long (the largest force of the samples'
+    contacts, without gravity)."""
     weight = float(model.total_mass * np.linalg.norm(model.gravity))
     if weight == 0.0:
-        largest = [np.linalg.norm(np.asarray(c["force"])[:3]) for sample in trajectory.contacts for c in sample]
+        largest = [np.linalg.norm(np.asarray(c["force"])[:3]) for sample in samples for c in sample]
         weight = max(largest, default=1.0) or 1.0
-    return [contact_arrows(sample, WEIGHT_ARROW_FRACTION * size / weight) for sample in trajectory.contacts]
+    return WEIGHT_ARROW_FRACTION * size / weight
 
 
 def _spread(poses: np.ndarray) -> np.ndarray:
