@@ -55,8 +55,8 @@ def scene_model(model: Any) -> _core.Model:
     """The model a scene's step takes: a :class:`MimicModel` without mimic joints is its full model."""
     if isinstance(model, MimicModel):
         if model.mimic_joints:
-            raise bad("model", "a model without mimic joints with integrator='mujoco' (MuJoCo's soft couplings "
-                      "are not made yet)", f"mimic joints {[name for name, *_ in model.mimic_joints]}")
+            raise bad("model", "a model without mimic joints with integrator='mujoco' (step its full model: "
+                      "MuJoCo's soft model holds the mimic relations there, as joint equalities)", f"mimic joints {[name for name, *_ in model.mimic_joints]}")
         return model.full
     robot_model("model", model)
     return model

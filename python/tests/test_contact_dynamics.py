@@ -619,6 +619,34 @@ def test_simple_bodies_weigh_one_over_their_mass_as_in_mujoco(cone):
         assert expected["row_types"].count("limit_joint") == 4
 
 
+# --- 8b. URDF mimic joints --------------------------------------------------------------------
+
+
+def test_urdf_mimic_joints_are_soft_joint_equalities(tmp_path):
+    """A URDF's mimic relations (held by m.constraints) are MuJoCo joint equalities in the soft model,
+    with MuJoCo's default solref and solimp: one equality row each, J = e_follower − multiplier
+    e_leader, its position the relation's violation; no file bodies are needed."""
+    from test_mimic import GRIPPER
+
+    path = tmp_path / "gripper.urdf"
+    path.write_text(GRIPPER)
+    model = load_quietly(path)
+    couplings = list(model.constraints)
+    assert len(couplings) >= 2
+    rng = np.random.default_rng(9)
+    q, v = rng.normal(size=model.nq), rng.normal(size=model.nv)
+    result = model.contact_forward_dynamics(q, v)
+    equality = [k for k, kind in enumerate(result["row_types"]) if kind == "equality"]
+    assert len(equality) == len(couplings)
+    jacobian = np.asarray(result["jacobian"])[equality]
+    names = model.joint_names
+    thumb, wrist = (model.joint_idx_v[names.index(n)] for n in ("thumb", "wrist"))
+    row = jacobian[0]
+    assert row[thumb] == 1.0 and row[wrist] == -0.5 and np.count_nonzero(row) == 2
+    # the relation's violation is the row's position: its force pulls it back (f = −(J q̈ − a_ref)/R)
+    assert np.all(np.isfinite(result["forces"])) and np.all(np.asarray(result["R"])[equality] > 0)
+
+
 # --- 9. what is refused ---------------------------------------------------------------------
 
 

@@ -16,12 +16,13 @@ impl PyModel {
     /// the applied generalised forces `tau` (nv, MuJoCo's `qfrc_applied`; None: zero) and the
     /// controls `ctrl` (nu; None: zero), as MuJoCo's `mj_forward` computes them with its solver
     /// run to convergence: the contacts (`collide`), the rows of every active constraint (the
-    /// model's equality constraints, dry friction of the joints, their limits, the contacts, in
-    /// MuJoCo's order), and the solution of the soft model. A dict: `qdd` (nv,), `forces` (one
-    /// per row: MuJoCo's `efc_force`), `row_types` (MuJoCo's constraint types: "equality",
-    /// "friction_dof", "limit_joint", "contact_frictionless", "contact_pyramidal",
-    /// "contact_elliptic"), `row_ids` (the model constraint, the degree of freedom, the joint or
-    /// the contact of each row), `jacobian` (rows, nv), `R` and `aref`
+    /// model's equality constraints, dry friction of the joints and the tendons, their limits,
+    /// the contacts, in MuJoCo's order), and the solution of the soft model. A dict: `qdd` (nv,),
+    /// `forces` (one per row: MuJoCo's `efc_force`), `row_types` (MuJoCo's constraint types:
+    /// "equality", "friction_dof", "friction_tendon", "limit_joint", "limit_tendon",
+    /// "contact_frictionless", "contact_pyramidal", "contact_elliptic"), `row_ids` (the equality's
+    /// place among the file's equalities, the degree of freedom, the tendon, the joint or the
+    /// contact of each row), `jacobian` (rows, nv), `R` and `aref`
     /// (each row's regulariser and reference acceleration), `contacts` (as `collide` lists them,
     /// each with `dim`, its condim, `first_row`, −1 when it has no rows, and `force`: the normal,
     /// tangent, spin and roll forces in its frame, MuJoCo's `mj_contactForce`), `tau_actuator` and

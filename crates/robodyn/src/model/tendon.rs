@@ -30,7 +30,8 @@ pub struct Tendon {
     pub friction: SolverParameters,
     /// The spring's stiffness (`stiffness`), pulling L into `spring_length`.
     pub stiffness: f64,
-    /// The dead band [low, high] of the spring (`springlength`; L₀ when not given).
+    /// The dead band [low, high] of the spring (`springlength`; when not given, the length at
+    /// the joints' `springref`, not at qpos0).
     pub spring_length: [f64; 2],
     /// The damper on L̇ (`damping`).
     pub damping: f64,

@@ -1,5 +1,5 @@
-//! Forward dynamics with MuJoCo's soft constraints: contacts, joint limits and dry friction as
-//! MuJoCo's `mj_forward` computes them, its solver run to convergence.
+//! Forward dynamics with MuJoCo's soft constraints: equalities, contacts, joint and tendon limits
+//! and dry friction as MuJoCo's `mj_forward` computes them, its solver run to convergence.
 //!
 //! Reference: MuJoCo's documentation, "Computation", §Forward dynamics. At (q, q̇) under applied
 //! forces τ and controls u:
@@ -40,7 +40,7 @@ pub struct ContactForward {
     pub actuator: DVector<f64>,
     /// The constraints' generalised forces `Jᵀ f` (MuJoCo's `qfrc_constraint`).
     pub constraint: DVector<f64>,
-    /// The joints' springs and dampers (MuJoCo's `qfrc_passive`).
+    /// The joints' and tendons' springs and dampers (MuJoCo's `qfrc_passive`).
     pub passive: DVector<f64>,
     /// The mass matrix M at q.
     pub mass: DMatrix<f64>,

@@ -1,5 +1,5 @@
-//! MuJoCo's equality rows: a model's connect, weld and joint equalities as soft constraints, the
-//! first block of rows.
+//! MuJoCo's equality rows: a model's connect, weld, joint and tendon equalities as soft
+//! constraints, the first block of rows.
 //!
 //! Reference: MuJoCo's documentation, "Computation", §Equality constraints (read to understand,
 //! written anew here). With p₁, p₂ the constrained point as body1 and body2 carry it, q₁, q₂ the
@@ -13,9 +13,10 @@
 //!   tendon   1 row    pos = (L₁ − L₁,₀) − p(L₂ − L₂,₀)          J = J_L₁ − p′ J_L₂
 //! ```
 //! The weld's rotation rows are the time derivative of its error: `vec(q̄₂ ⊗ (0, u) ⊗ q₁) =
-//! (e₀ I − [e_v]×) R₂ᵀ u` with `e = q̄₂ ⊗ q₁` (taken with e₀ ≥ 0). A group's impedance d is that
-//! of the norm of its positions (margin 0); its rows' Â are the two bodies' translation weights
-//! (a weld's rotation rows: their rotation weights) or the two joints' own. Connect and weld
+//! (e₀ I − [e_v]×) R₂ᵀ u` with `e = q̄₂ ⊗ q₁` (taken with e₀ ≥ 0: past a relative turn of π
+//! MuJoCo's rows are these negated, the same physics). A group's impedance d is that of the norm
+//! of its positions (margin 0); its rows' Â are the two bodies' translation weights (a weld's
+//! rotation rows: their rotation weights) or the two joints' or tendons' own. Connect and weld
 //! rows ask their acceleration `J q̈ + J̇ q̇` to follow `−b J q̇ − k d pos`: their a_ref carries
 //! `−J̇ q̇`, with, on the weld's rotation rows (q̇_k = ½ (0, ω_k) ⊗ q_k, Δω = ω₁ − ω₂),
 //! ```text
@@ -114,7 +115,24 @@ impl Equalities {
                 continue;
             }
             let constraint = &declared.constraint;
-            let body = |k: usize| weights.bodies[declared.bodies[k]];
+            // a connect's or weld's Â comes from its file bodies, which only an MJCF file names
+            let moves = constraint
+                .bodies(model)
+                .into_iter()
+                .flatten()
+                .any(|b| b != 0);
+            let weighed = declared.bodies != [0, 0] || !moves;
+            let point_or_frame = matches!(
+                constraint.kind,
+                ConstraintKind::Point { .. } | ConstraintKind::Frame { .. }
+            );
+            if point_or_frame && !weighed {
+                return Err(unweighed(model, k, constraint));
+            }
+            let body = |k: usize| {
+                let weight = weights.bodies.get(declared.bodies[k]);
+                weight.copied().unwrap_or_default()
+            };
             let translation = body(0)[0] + body(1)[0];
             let (shape, diagonal) = match &constraint.kind {
                 ConstraintKind::Point { .. } => (Shape::Connect, [translation; 6]),
@@ -361,6 +379,18 @@ impl WeldTurn {
     }
 }
 
+/// The error for a connect or weld without the file bodies whose weights soften it.
+fn unweighed(model: &Model, index: usize, constraint: &Constraint) -> Error {
+    Error::InvalidValue {
+        argument: "model".into(),
+        message: format!(
+            "model constraint {index} ({}) names no file bodies (ModelConstraint.bodies): MuJoCo's \
+             soft rows weigh a connect or weld by its bodies' body_invweight0",
+            constraint.describe(model)
+        ),
+    }
+}
+
 /// The error for a model constraint MuJoCo's equalities cannot state.
 fn unstated(model: &Model, index: usize, constraint: &Constraint) -> Error {
     Error::InvalidValue {
@@ -483,5 +513,19 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn a_connect_without_file_bodies_is_refused_naming_it() {
+        // a connect made elsewhere than in an MJCF file has no bodies to weigh it by
+        let mut model = load_mjcf_str(SCENE, "scene").unwrap();
+        let mut data = Data::new(&model);
+        let weights = inverse_weights(&model, &mut data).unwrap();
+        model.constraints[1].bodies = [0, 0];
+        let error = Equalities::new(&model, &weights).unwrap_err().to_string();
+        assert!(
+            error.contains("model constraint 1") && error.contains("names no file bodies"),
+            "{error}"
+        );
     }
 }

@@ -4,7 +4,7 @@
 //! Reference: MuJoCo's documentation, "Computation", §Constraint model and §Soft constraints
 //! (read to understand, written anew here). The rows come in blocks:
 //! ```text
-//!   equalities      connect (3 rows), weld (6), joint (1): see super::equality
+//!   equalities      connect (3 rows), weld (6), joint or tendon (1): see super::equality
 //!   friction loss   one per degree of freedom with frictionloss > 0:  J = e_i,  pos = 0,
 //!                   then one per such tendon:  J = J_L (its length L = J q)
 //!   limits          each side of a limited hinge or slide within its margin:
@@ -16,7 +16,8 @@
 //!                     elliptic            c_n, c_t₁, c_t₂ (, c_spin, c_roll₁, c_roll₂)
 //! ```
 //! F the contact frame (normal, tangents; spin and rolls about the same axes), p the contact
-//! point. One element's rows share its impedance d (of `|pos − margin|` of its first row). With
+//! point. One element's rows share its impedance d (of `|pos − margin|` of its first row; of the
+//! norm of an equality's positions). With
 //! `Â` a row's approximate inverse inertia ([`super::weights`]):
 //! ```text
 //!   R = max(1e-15, (1 − d)/d · Â)
@@ -99,8 +100,8 @@ pub struct Rows {
     pub jacobian: Vec<f64>,
     /// Each row's kind.
     pub kind: Vec<RowKind>,
-    /// Each row's element: the model constraint, the degree of freedom or tendon, the joint
-    /// (MuJoCo's joint id) or tendon, the contact.
+    /// Each row's element: the equality (its place among the file's equalities), the degree of
+    /// freedom or tendon, the joint (MuJoCo's joint id) or tendon, the contact.
     pub id: Vec<usize>,
     /// Position (m or rad): negative when violated.
     pub position: Vec<f64>,
