@@ -49,6 +49,13 @@ impl Tendon {
             .map(|&(body, c)| (model.idx_v[body], model.idx_q[body], c))
     }
 
+    /// Adds `scale J` (its Jacobian: c_k on each joint's velocity coordinate) to `row` (nv).
+    pub fn add_to_row(&self, model: &Model, scale: f64, row: &mut [f64]) {
+        for (k, _, c) in self.entries(model) {
+            row[k] += scale * c;
+        }
+    }
+
     /// L at q.
     pub fn length(&self, model: &Model, q: &[f64]) -> f64 {
         self.entries(model).map(|(_, p, c)| c * q[p]).sum()

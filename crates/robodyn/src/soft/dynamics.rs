@@ -147,13 +147,11 @@ fn passive_forces(model: &Model, q: &[f64], v: &[f64]) -> DVector<f64> {
         tau -= model.damping.component_mul(&DVector::from_column_slice(v));
     }
     // each tendon's spring and damper along its length: τ += Jᵀ f
+    let (spring, damper) = (options.flag("spring"), options.flag("damper"));
     for tendon in &model.tendons {
         let (length, rate) = (tendon.length(model, q), tendon.rate(model, v));
-        let force =
-            tendon.passive_force(length, rate, options.flag("spring"), options.flag("damper"));
-        for (k, _, c) in tendon.entries(model) {
-            tau[k] += c * force;
-        }
+        let force = tendon.passive_force(length, rate, spring, damper);
+        tendon.add_to_row(model, force, tau.as_mut_slice());
     }
     tau
 }

@@ -288,11 +288,9 @@ fn tendon_row(model: &Model, equality: &TendonEquality, index: usize, q: &[f64],
         None => [c[0], 0.0, 0.0, 0.0],
     };
     let row = rows.push(RowKind::Equality, index, follower - p, 0.0);
-    for (k, _, coefficient) in first.entries(model) {
-        row[k] += coefficient;
-    }
-    for (k, _, coefficient) in second.iter().flat_map(|leader| leader.entries(model)) {
-        row[k] -= dp * coefficient;
+    first.add_to_row(model, 1.0, row);
+    if let Some(leader) = second {
+        leader.add_to_row(model, -dp, row);
     }
 }
 

@@ -260,9 +260,7 @@ pub fn constraint_rows(
             }
             let first = rows.len();
             let row = rows.push(RowKind::FrictionTendon, t, 0.0, 0.0);
-            for (k, _, c) in tendon.entries(model) {
-                row[k] = c;
-            }
+            tendon.add_to_row(model, 1.0, row);
             rows.frictionloss[first] = tendon.frictionloss;
             let softness = Softness {
                 solver: &tendon.friction,
@@ -331,9 +329,7 @@ pub fn constraint_rows(
                     continue;
                 }
                 let row = rows.push(RowKind::LimitTendon, t, distance, tendon.margin);
-                for (k, _, c) in tendon.entries(model) {
-                    row[k] = side * c;
-                }
+                tendon.add_to_row(model, side, row);
                 finish_group(rows, RowKind::LimitTendon, 1, &group, safe_after, v);
             }
         }
