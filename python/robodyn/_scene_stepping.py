@@ -16,7 +16,7 @@ STEP_MULTIPLE_TOLERANCE = 1e-9
 
 
 def simulate_scene(model: Any, q0: Any, v0: Any, t_end: float, dt: float | None, controller: Any, wrenches: Any,
-                    progress: Any, constraints: Any, ctrl: Any) -> Any:
+                    progress: Any, constraints: Any, ctrl: Any, act0: Any) -> Any:
     """:func:`simulate` with ``integrator="mujoco"``: the scene stepped as ``mj_step`` steps it."""
     from robodyn.simulation import Trajectory, _controller_argument
 
@@ -28,6 +28,8 @@ def simulate_scene(model: Any, q0: Any, v0: Any, t_end: float, dt: float | None,
         raise bad("constraints", "'model' with integrator='mujoco' (the scene's own equality constraints)",
                   repr(constraints))
     start = keyframe(model, q0).time if isinstance(q0, str) else 0.0
+    if isinstance(q0, str) and act0 is None:
+        act0 = keyframe(model, q0).act
     q0, v0, ctrl = scene_start(model, q0, v0, ctrl)
     h = model.options.timestep
     dt = h if dt is None else real("dt", dt)
@@ -39,8 +41,9 @@ def simulate_scene(model: Any, q0: Any, v0: Any, t_end: float, dt: float | None,
         raise bad("t_end", f"a time (s) not before the start, {start}", repr(t_end))
     result = _core.simulate_scene(model, q0, v0, steps, record_every, start=start, ctrl=ctrl,
                                   controller=_controller_argument(model, controller),
-                                  progress=callback("progress", progress))
-    series = ("q", "v", "a", "tau", "tau_passive", "ctrl", "tau_constraint")
+                                  progress=callback("progress", progress),
+                                  act0=None if act0 is None else numbers("act0", act0))
+    series = ("q", "v", "a", "tau", "tau_passive", "ctrl", "tau_constraint", "act")
     batch = result["q"].ndim == 3
     runs = [
         Trajectory(model, result["t"], integrator="mujoco",
@@ -84,7 +87,7 @@ def keyframe(model: _core.Model, name: str) -> Any:
 
 
 def step_scene(model: Any, q: Any, v: Any, tau: Any, dt: float, derivatives: bool, constraints: Any,
-                ctrl: Any) -> Any:
+                ctrl: Any, act: Any) -> Any:
     """:func:`step` with ``integrator="mujoco"``: one ``mj_step`` of the scene."""
     model = scene_model(model)
     if flag("derivatives", derivatives):
@@ -97,4 +100,5 @@ def step_scene(model: Any, q: Any, v: Any, tau: Any, dt: float, derivatives: boo
     if abs(real("dt", dt) - h) > STEP_MULTIPLE_TOLERANCE * h:
         raise bad("dt", f"the scene's time step ({h} s) with integrator='mujoco'", repr(dt))
     ctrl = np.zeros(model.nu) if ctrl is None else ctrl
-    return _core.step_scene(model, q, v, tau, ctrl)
+    act = np.zeros(model.na) if act is None else act
+    return _core.step_scene(model, q, v, tau, ctrl, act)

@@ -233,11 +233,12 @@ class MimicModel(ConstrainedMethods):
         return self._reduced_keyframe(self.full.keyframe(key))
 
     def _reduced_keyframe(self, key: _core.Keyframe) -> _core.Keyframe:
-        return _core.Keyframe(key.name, key.time, self.reduce(key.q), key.v[self.independent_v], key.ctrl)
+        return _core.Keyframe(key.name, key.time, self.reduce(key.q), key.v[self.independent_v], key.ctrl, key.act)
 
-    def actuator_forces(self, q: Any, v: Any, ctrl: Any) -> np.ndarray:
+    def actuator_forces(self, q: Any, v: Any, ctrl: Any, act: Any = None) -> np.ndarray:
         """Gᵀ of the full model's actuator forces at the expanded state."""
-        return self._generalized(self.full.actuator_forces(self._expand(q, "q"), self._expand_velocity(v, "v"), ctrl))
+        full = self.full.actuator_forces(self._expand(q, "q"), self._expand_velocity(v, "v"), ctrl, act)
+        return self._generalized(full)
 
     def tendon_lengths(self, q: Any) -> np.ndarray:
         """The full model's tendon lengths at the expanded q."""
@@ -584,7 +585,7 @@ class MimicModel(ConstrainedMethods):
 #: What the reduced model takes unchanged from the full one.
 _SHARED = frozenset({
     "name", "body_names", "body_parents", "body_masses", "frame_names", "frame_bodies", "joint_names",
-    "joint_types", "mimic_joints", "total_mass", "visuals", "skybox", "nu", "actuator_names", "ctrl_range",
+    "joint_types", "mimic_joints", "total_mass", "visuals", "skybox", "nu", "na", "activation_rates", "actuator_names", "ctrl_range",
     "tendon_names", "options", "geoms", "contact_pairs", "contact_excludes", "contact_candidates", "joint_softness",
     "contact_parameters", "collide_placed",
 })

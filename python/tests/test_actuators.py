@@ -106,11 +106,11 @@ def test_a_position_actuator_holds_its_target():
 
 
 def test_what_is_not_modelled_warns_and_bad_input_is_refused():
-    unmodelled = ACTUATED.replace('<velocity joint="wrist"', '<intvelocity joint="wrist" actrange="-1 1"').replace(
-        'kv="3" forcerange="-1 1"/>', 'kp="3"/>')
+    unmodelled = ACTUATED.replace('<velocity joint="wrist"', '<muscle joint="wrist"').replace(
+        'kv="3" forcerange="-1 1"/>', '/>')
     model = robodyn.load_mjcf_string(unmodelled)
-    assert [w for w in model.warnings if "<intvelocity" in w and "not read" in w and "no force" in w]
-    assert model.nu == 7  # it keeps its place in the controls
+    assert [w for w in model.warnings if "<muscle" in w and "not read" in w and "no force" in w]
+    assert model.nu == 7 and model.na == 1  # it keeps its place in the controls and the activations
     text = ACTUATED.replace('joint="slide" gear="2"', 'joint="slid" gear="2"')
     with pytest.raises(ValueError, match=r"<motor name='push'> \(line \d+\): attribute 'joint': no joint named 'slid'"):
         robodyn.load_mjcf_string(text)

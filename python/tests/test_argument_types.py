@@ -75,7 +75,7 @@ VALID: dict[str, Any] = {
     "quantities": ("tau",), "chunk": 4, "per_task": 2, "progress": None, "client": None,
     "constraints": [robodyn.PointAnchor("tool0")], "joint": "elbow_joint", "leader": "shoulder_lift_joint",
     "frame1": "tool0", "frame2": "wrist_3_link", "q_full": MIMIC.full.neutral(),
-    "ctrl": np.zeros(UR5.nu), "key": "home", "geom1": "floor", "geom2": "upper_link",
+    "ctrl": np.zeros(UR5.nu), "act": np.zeros(UR5.na), "key": "home", "geom1": "floor", "geom2": "upper_link",
     "positions": np.zeros((8, 3)), "rotations": np.tile(np.eye(3).ravel(), (8, 1)),
 }
 #: Methods that need another model than UR5 to run (a keyframe): the method -> its model.

@@ -297,10 +297,13 @@ def test_joint_limits_friction_loss_and_actuators_as_in_mujoco():
 # --- 4. dm_control's suite -------------------------------------------------------------------
 
 # Of the suite's 16 models (test_collision.py's SUITE), those without what the method leaves out
-# (ball_in_cup: a spatial tendon; quadruped: activation dynamics and a height field); manipulator,
-# point_mass and stacker drive fixed tendons, manipulator and stacker couple two fingers by a
-# tendon equality; none has a limited ball joint.
-SUITE = ["cheetah", "finger", "hopper", "humanoid", "humanoid_CMU", "manipulator", "point_mass", "stacker", "walker"]
+# (ball_in_cup: a spatial tendon); manipulator, point_mass and stacker drive fixed tendons,
+# manipulator and stacker couple two fingers by a tendon equality; quadruped's twelve actuators
+# filter their controls (activation dynamics) and its height field, flat and 1 cm below its floor,
+# is switched off in MuJoCo (robodyn does not collide height fields: a warning); none has a limited
+# ball joint.
+SUITE = ["cheetah", "finger", "hopper", "humanoid", "humanoid_CMU", "manipulator", "point_mass", "quadruped",
+         "stacker", "walker"]
 # The rest disable constraints (acrobot, fish: <flag constraint="disable"/>) or contacts (cartpole,
 # reacher, swimmer: contact="disable"): MuJoCo finds no contacts at all there (an empty
 # d.contact; cartpole and reacher would have 3–7 otherwise), nor limit rows in acrobot; fish's
@@ -309,9 +312,12 @@ FLAGGED = ["acrobot", "cartpole", "fish", "reacher", "swimmer"]
 SUITE_STATES = 5
 
 
-def without_fluid_forces(mj_model):
-    """The medium's forces (swimmer's density) switched off in MuJoCo: robodyn models none."""
+def without_unmodelled(mj_model):
+    """What robodyn does not model, switched off in MuJoCo: the medium's forces (swimmer's density)
+    and height fields' contacts (quadruped's terrain)."""
     mj_model.opt.density = mj_model.opt.viscosity = 0.0
+    height_fields = mj_model.geom_type == mujoco.mjtGeom.mjGEOM_HFIELD
+    mj_model.geom_contype[height_fields] = mj_model.geom_conaffinity[height_fields] = 0
 
 
 def root_height_address(mj_model):
@@ -344,7 +350,7 @@ def check_suite_model(name):
     """SUITE_STATES random states of a suite model, with random tau and controls (past ±1: the
     clamped controls too), against MuJoCo; the largest number of rows seen."""
     model, mj_model, layout = load_both(path=REPOSITORY / "testdata" / "dm_control" / f"{name}.xml")
-    without_fluid_forces(mj_model)
+    without_unmodelled(mj_model)
     rng, rows = np.random.default_rng(4), 0
     for case in range(SUITE_STATES):
         qpos, qvel = random_suite_state(mj_model, rng)

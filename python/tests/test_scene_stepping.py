@@ -22,7 +22,7 @@ from test_contact_dynamics import (
     converged,
     load_both,
     random_suite_state,
-    without_fluid_forces,
+    without_unmodelled,
 )
 from test_menagerie import MENAGERIE, mujoco_model
 
@@ -184,7 +184,7 @@ def test_dm_control_models_step_as_in_mujoco(name):
     """Each suite model with its own integrator (acrobot and cartpole RK4, the rest Euler, most with
     joint damping) from a random state near its floor, under random controls."""
     model, mj_model, layout = load_both(path=REPOSITORY / "testdata" / "dm_control" / f"{name}.xml")
-    without_fluid_forces(mj_model)
+    without_unmodelled(mj_model)
     rng = np.random.default_rng(8)
     qpos, qvel = random_suite_state(mj_model, rng)
     ctrl = rng.uniform(-1.0, 1.0, size=mj_model.nu)

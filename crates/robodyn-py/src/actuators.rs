@@ -14,6 +14,13 @@ impl PyModel {
         self.model.nu()
     }
 
+    /// na: the number of activations (MuJoCo's `act`), one per actuator with activation dynamics
+    /// (`dyntype` integrator, filter, filterexact; a muscle's is held).
+    #[getter]
+    fn na(&self) -> usize {
+        self.model.na()
+    }
+
     /// The actuators' names, in the controls' order (MJCF's `name`, `actuator<k>` where the
     /// file gives none).
     #[getter]
@@ -44,24 +51,53 @@ impl PyModel {
         Ok(PyArray2::from_vec2(py, &rows)?)
     }
 
-    /// The generalised forces (nv,) the actuators exert under the controls `ctrl` (nu,) at
-    /// (q, v): MuJoCo's `qfrc_actuator` — each control clamped to its range, its actuator's
-    /// force `(a₀ + a₁ l + a₂ l̇) u + (b₀ + b₁ l + b₂ l̇)` (l = gear q_j, or gear L on a fixed
-    /// tendon) clamped to its force range, times the gear on its joint (gear coef on each of
-    /// its tendon's joints). A batch gives (N, nv).
+    /// The generalised forces (nv,) the actuators exert under the controls `ctrl` (nu,) and the
+    /// activations `act` (na,; None: zero) at (q, v): MuJoCo's `qfrc_actuator` — each control
+    /// clamped to its range, its actuator's force `(a₀ + a₁ l + a₂ l̇) u + (b₀ + b₁ l + b₂ l̇)`
+    /// (l = gear q_j, or gear L on a fixed tendon; its activation w, or with `actearly` the
+    /// next one, in place of u where it has one) clamped to its force range, times the gear on
+    /// its joint (gear coef on each of its tendon's joints). A batch gives (N, nv).
+    #[pyo3(signature = (q, v, ctrl, act=None))]
     fn actuator_forces<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
         v: &Bound<'py, PyAny>,
         ctrl: &Bound<'py, PyAny>,
+        act: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let controls = Argument::new("ctrl", ctrl, SampleShape::vector(self.model.nu()))?;
+        let mut arguments = vec![self.q_arg("q", q)?, self.v_arg("v", v)?, controls];
+        if let Some(act) = act {
+            let shape = SampleShape::vector(self.model.na());
+            arguments.push(Argument::new("act", act, shape)?);
+        }
+        // without `act`: zero activations
+        let zeros = vec![0.0; self.model.na()];
+        self.evaluate(py, &arguments, &[self.model.nv], &|m, _, i, out| {
+            let act = i.get(3).copied().unwrap_or(&zeros);
+            m.actuator_forces((i[0], i[1]), i[2], act, out)
+        })
+    }
+
+    /// ẇ (na,): the rates of the actuators' activations under the controls `ctrl` (nu,) at the
+    /// activations `act` (na,), MuJoCo's `act_dot`: u (clamped) for an integrator, (u − w)/τ for
+    /// a filter. A batch gives (N, na).
+    fn activation_rates<'py>(
+        &self,
+        py: Python<'py>,
+        ctrl: &Bound<'py, PyAny>,
+        act: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let m = &self.model;
         self.evaluate(
             py,
-            &[self.q_arg("q", q)?, self.v_arg("v", v)?, controls],
-            &[self.model.nv],
-            &|m, _, i, out| m.actuator_forces(i[0], i[1], i[2], out),
+            &[
+                Argument::new("ctrl", ctrl, SampleShape::vector(m.nu()))?,
+                Argument::new("act", act, SampleShape::vector(m.na()))?,
+            ],
+            &[m.na()],
+            &|m, _, i, out| m.activation_rates(i[0], i[1], out),
         )
     }
 }

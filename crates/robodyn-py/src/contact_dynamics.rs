@@ -12,9 +12,10 @@ use robodyn::soft::dynamics::{ContactDynamics, ContactForward};
 
 #[pymethods]
 impl PyModel {
-    /// The accelerations and constraint forces of MuJoCo's soft constraint model at (q, v) under
-    /// the applied generalised forces `tau` (nv, MuJoCo's `qfrc_applied`; None: zero) and the
-    /// controls `ctrl` (nu; None: zero), as MuJoCo's `mj_forward` computes them with its solver
+    /// The accelerations and constraint forces of MuJoCo's soft constraint model at (q, v) and
+    /// the actuators' activations `act` (na; None: zero) under the applied generalised forces
+    /// `tau` (nv, MuJoCo's `qfrc_applied`; None: zero) and the controls `ctrl` (nu; None:
+    /// zero), as MuJoCo's `mj_forward` computes them with its solver
     /// run to convergence: the contacts (`collide`), the rows of every active constraint (the
     /// model's equality constraints, dry friction of the joints and the tendons, their limits,
     /// the contacts, in MuJoCo's order), and the solution of the soft model. A dict: `qdd` (nv,),
@@ -26,8 +27,9 @@ impl PyModel {
     /// (each row's regulariser and reference acceleration), `contacts` (as `collide` lists them,
     /// each with `dim`, its condim, `first_row`, −1 when it has no rows, and `force`: the normal,
     /// tangent, spin and roll forces in its frame, MuJoCo's `mj_contactForce`), `tau_actuator` and
-    /// `tau_constraint` (nv,: MuJoCo's `qfrc_actuator` and `qfrc_constraint`).
-    #[pyo3(signature = (q, v, tau=None, ctrl=None))]
+    /// `tau_constraint` (nv,: MuJoCo's `qfrc_actuator` and `qfrc_constraint`), `act_dot` (na,:
+    /// the activations' rates).
+    #[pyo3(signature = (q, v, tau=None, ctrl=None, act=None))]
     fn contact_forward_dynamics<'py>(
         &self,
         py: Python<'py>,
@@ -35,9 +37,10 @@ impl PyModel {
         v: &Bound<'py, PyAny>,
         tau: Option<&Bound<'py, PyAny>>,
         ctrl: Option<&Bound<'py, PyAny>>,
+        act: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let model = &self.model;
-        let (nv, nu) = (model.nv, model.nu());
+        let (nv, nu, na) = (model.nv, model.nu(), model.na());
         let q = read_sample("q", q, SampleShape::vector(model.nq))?;
         let v = read_sample("v", v, SampleShape::vector(nv))?;
         let tau = match tau {
@@ -48,9 +51,15 @@ impl PyModel {
             Some(ctrl) => read_sample("ctrl", ctrl, SampleShape::vector(nu))?,
             None => vec![0.0; nu],
         };
+        let act = match act {
+            Some(act) => read_sample("act", act, SampleShape::vector(na))?,
+            None => vec![0.0; na],
+        };
         let mut out = ContactForward::default();
-        py.detach(|| ContactDynamics::new(model)?.forward(model, (&q, &v), &tau, &ctrl, &mut out))
-            .map_err(to_py_err)?;
+        py.detach(|| {
+            ContactDynamics::new(model)?.forward(model, (&q, &v, &act), &tau, &ctrl, &mut out)
+        })
+        .map_err(to_py_err)?;
         let rows = &out.rows;
         let result = PyDict::new(py);
         result.set_item(
@@ -87,6 +96,10 @@ impl PyModel {
         result.set_item(
             "tau_constraint",
             PyArray1::from_slice(py, out.constraint.as_slice()),
+        )?;
+        result.set_item(
+            "act_dot",
+            PyArray1::from_slice(py, out.activation_rate.as_slice()),
         )?;
         Ok(result)
     }

@@ -11,7 +11,8 @@ use robodyn::Keyframe;
 
 /// A state the model file names (MuJoCo's `<key>`), in robodyn's coordinates: `q` (nq,),
 /// quaternions scalar last; `v` (nv,), a free joint's linear velocity in its body's axes (MuJoCo's
-/// `qvel` has world axes); `ctrl`, one control per actuator of the file, in its order; `time` (s).
+/// `qvel` has world axes); `ctrl`, one control per actuator of the file, in its order; `act`, one
+/// activation per actuator with activation dynamics (MuJoCo's `act`); `time` (s).
 /// Start a simulation from it with `robodyn.simulate(m, key.q, v0=key.v, ...)`.
 #[pyclass(name = "Keyframe", module = "robodyn", frozen)]
 pub(crate) struct PyKeyframe {
@@ -24,6 +25,7 @@ pub(crate) struct PyKeyframe {
     q: Vec<f64>,
     v: Vec<f64>,
     ctrl: Vec<f64>,
+    act: Vec<f64>,
 }
 
 impl From<&Keyframe> for PyKeyframe {
@@ -34,6 +36,7 @@ impl From<&Keyframe> for PyKeyframe {
             q: key.q.as_slice().to_vec(),
             v: key.v.as_slice().to_vec(),
             ctrl: key.ctrl.as_slice().to_vec(),
+            act: key.act.as_slice().to_vec(),
         }
     }
 }
@@ -41,13 +44,14 @@ impl From<&Keyframe> for PyKeyframe {
 #[pymethods]
 impl PyKeyframe {
     #[new]
-    #[pyo3(text_signature = "(name, time, q, v, ctrl)")]
+    #[pyo3(signature = (name, time, q, v, ctrl, act=None))]
     fn new(
         name: &Bound<PyAny>,
         time: &Bound<PyAny>,
         q: &Bound<PyAny>,
         v: &Bound<PyAny>,
         ctrl: &Bound<PyAny>,
+        act: Option<&Bound<PyAny>>,
     ) -> PyResult<Self> {
         Ok(PyKeyframe {
             name: text("name", name)?,
@@ -55,6 +59,7 @@ impl PyKeyframe {
             q: finite_numbers("q", q)?,
             v: finite_numbers("v", v)?,
             ctrl: finite_numbers("ctrl", ctrl)?,
+            act: act.map_or(Ok(Vec::new()), |act| finite_numbers("act", act))?,
         })
     }
 
@@ -76,10 +81,17 @@ impl PyKeyframe {
         PyArray1::from_slice(py, &self.ctrl)
     }
 
+    /// The actuators' activations, one per actuator with activation dynamics (na,): a new array
+    /// each time.
+    #[getter]
+    fn act<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.act)
+    }
+
     fn __repr__(&self) -> String {
         format!(
-            "Keyframe({:?}, time={}, q={:?}, v={:?}, ctrl={:?})",
-            self.name, self.time, self.q, self.v, self.ctrl
+            "Keyframe({:?}, time={}, q={:?}, v={:?}, ctrl={:?}, act={:?})",
+            self.name, self.time, self.q, self.v, self.ctrl, self.act
         )
     }
 
@@ -91,6 +103,7 @@ impl PyKeyframe {
             this.q.clone(),
             this.v.clone(),
             this.ctrl.clone(),
+            this.act.clone(),
         );
         (slf.get_type(), args).into_pyobject(slf.py())
     }

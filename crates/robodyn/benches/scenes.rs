@@ -37,7 +37,12 @@ fn scenes(c: &mut Criterion) {
             group.bench_function("go2/forward", |b| {
                 b.iter(|| {
                     stepper
-                        .forward_only(&model, (home.q.as_slice(), home.v.as_slice()), &tau, ctrl)
+                        .forward_only(
+                            &model,
+                            (home.q.as_slice(), home.v.as_slice(), &[]),
+                            &tau,
+                            ctrl,
+                        )
                         .expect("forward");
                     black_box(&stepper.forward);
                 })
@@ -47,7 +52,7 @@ fn scenes(c: &mut Criterion) {
             b.iter(|| {
                 let (mut q, mut v) = (home.q.as_slice().to_vec(), home.v.as_slice().to_vec());
                 stepper
-                    .step(&model, 0.0, (&mut q, &mut v), &tau, ctrl)
+                    .step(&model, 0.0, (&mut q, &mut v, &mut []), &tau, ctrl)
                     .expect("step");
                 black_box(&q);
             })
@@ -58,7 +63,7 @@ fn scenes(c: &mut Criterion) {
                 for k in 0..RUN_STEPS {
                     let time = k as f64 * model.options.timestep;
                     stepper
-                        .step(&model, time, (&mut q, &mut v), &tau, ctrl)
+                        .step(&model, time, (&mut q, &mut v, &mut []), &tau, ctrl)
                         .expect("step");
                 }
                 black_box(&q);

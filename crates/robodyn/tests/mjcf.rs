@@ -283,7 +283,110 @@ fn a_short_key_is_completed_and_a_long_one_refused_by_name() {
             .iter()
             .any(|w| w.contains(&format!("'{name}' not read")))
     };
-    assert!(warned("act") && warned("mpos") && !warned("mquat"));
+    assert!(!warned("act") && warned("mpos") && !warned("mquat"));
+}
+
+#[test]
+fn activation_dynamics_as_mujoco_compiles_and_integrates_them() {
+    use robodyn::model::ActivationDynamics;
+    let text = r#"<mujoco>
+      <compiler angle="radian"/>
+      <worldbody><body><joint name="j" axis="0 1 0" range="-1 3"/><geom size="0.1"/></body></worldbody>
+      <actuator>
+        <general joint="j" dyntype="integrator" actrange="-0.5 0.5"/>
+        <motor joint="j"/>
+        <general joint="j" dyntype="filter" dynprm="0.2" gainprm="3" actearly="true"/>
+        <position joint="j" kp="4" timeconst="0.1"/>
+        <intvelocity joint="j" kp="2" inheritrange="0.5"/>
+        <cylinder joint="j" diameter="2" bias="1 2 3" timeconst="0.3"/>
+        <damper joint="j" kv="5" ctrlrange="0 1"/>
+      </actuator>
+      <keyframe><key name="home" act="0.1 0.2"/></keyframe>
+    </mujoco>"#;
+    let model = load_mjcf_str(text, "act.xml").unwrap();
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let dynamics: Vec<_> = model.actuators.iter().map(|a| a.dynamics).collect();
+    assert_eq!(
+        dynamics,
+        [
+            ActivationDynamics::Integrator,
+            ActivationDynamics::None,
+            ActivationDynamics::Filter { time_constant: 0.2 },
+            ActivationDynamics::FilterExact { time_constant: 0.1 },
+            ActivationDynamics::Integrator,
+            ActivationDynamics::Filter { time_constant: 0.3 },
+            ActivationDynamics::None,
+        ]
+    );
+    assert_eq!(model.na(), 5);
+    // intvelocity inherits its activation's range; a cylinder's gain is its area π d²/4
+    assert_eq!(model.actuators[4].act_range, Some((0.0, 2.0)));
+    assert_eq!(model.actuators[5].gain[0], std::f64::consts::PI);
+    assert_eq!(model.actuators[5].bias, [1.0, 2.0, 3.0]);
+    assert_eq!(model.actuators[6].gain, [0.0, 0.0, -5.0]);
+    let key = model.keyframe("home").unwrap();
+    assert_eq!(key.act.as_slice(), [0.1, 0.2, 0.0, 0.0, 0.0]);
+
+    // ẇ: u for an integrator, (u − w)/τ for a filter
+    let ctrl = [200.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0];
+    let act = [0.4, 0.5, 0.5, 0.0, 0.0];
+    let mut rates = [0.0; 5];
+    model.activation_rates(&ctrl, &act, &mut rates).unwrap();
+    assert_eq!(rates[..3], [200.0, (1.0 - 0.5) / 0.2, (1.0 - 0.5) / 0.1]);
+    // w₁: clamped to actrange; filterexact exactly
+    let h = model.options.timestep;
+    let mut next = act;
+    model.advance_activations(&mut next, &rates, h);
+    assert_eq!(next[0], 0.5);
+    assert_eq!(next[1], 0.5 + h * rates[1]);
+    let exact = 1.0 - 0.5 * (-h / 0.1f64).exp();
+    assert!((next[2] - exact).abs() < 1e-15);
+    // the force takes w₁ with actearly (the filter), else w (the position servo)
+    let (q, v) = ([0.25], [0.0]);
+    let force = |k: usize| {
+        let mut tau = [0.0];
+        let mut only = [0.0; 7];
+        only[k] = ctrl[k];
+        let mut w = [0.0; 5];
+        let slot = model.actuators[..k]
+            .iter()
+            .filter(|a| a.has_activation())
+            .count();
+        w[slot] = act[slot];
+        let mut without = model.clone();
+        without.actuators = vec![model.actuators[k].clone()];
+        let own = usize::from(model.actuators[k].has_activation());
+        without
+            .actuator_forces((&q, &v), &only[k..=k], &w[slot..slot + own], &mut tau)
+            .unwrap();
+        tau[0]
+    };
+    assert_eq!(force(2), 3.0 * next[1]);
+    assert_eq!(force(3), 4.0 * (0.5 - 0.25));
+    // what MuJoCo refuses
+    for (from, to, expected) in [
+        ("dynprm=\"0.2\"", "dynprm=\"0.2\" actdim=\"2\"", "'actdim'"),
+        ("kv=\"5\" ctrlrange=\"0 1\"", "kv=\"5\"", "a damper needs"),
+        (
+            "actrange=\"-0.5 0.5\"",
+            "actrange=\"0.5 -0.5\"",
+            "'actrange'",
+        ),
+        ("timeconst=\"0.1\"", "timeconst=\"-0.1\"", "'timeconst'"),
+    ] {
+        let message = load_mjcf_str(&text.replace(from, to), "act.xml")
+            .unwrap_err()
+            .to_string();
+        assert!(message.contains(expected), "{message}");
+    }
+    // a muscle keeps its activation's place, with a warning
+    let muscle = text.replace("dyntype=\"filter\"", "dyntype=\"muscle\"");
+    let model = load_mjcf_str(&muscle, "act.xml").unwrap();
+    assert_eq!(model.na(), 5);
+    assert!(model
+        .warnings
+        .iter()
+        .any(|w| w.contains("dyntype 'muscle'")));
 }
 
 #[test]
@@ -312,7 +415,9 @@ fn actuators_on_hinges_with_gears_and_ranges() {
         let mut ctrl = [0.0; 5];
         ctrl[k] = u;
         let mut tau = [0.0];
-        model.actuator_forces(&q, &v, &ctrl, &mut tau).unwrap();
+        model
+            .actuator_forces((&q, &v), &ctrl, &[], &mut tau)
+            .unwrap();
         tau[0]
     };
     // motor: g f with u clamped to 1
@@ -323,7 +428,9 @@ fn actuators_on_hinges_with_gears_and_ranges() {
     // general: (1 + 2 l + 3 l̇) u + (4 + 5 l + 6 l̇)
     let general = (1.0 + 2.0 * 0.5 + 3.0 * 0.25) * 2.0;
     assert!((one(3, 2.0) - one(3, 0.0) - general).abs() < 1e-14);
-    assert!(model.actuator_forces(&q, &v, &[0.0; 2], &mut tau).is_err());
+    assert!(model
+        .actuator_forces((&q, &v), &[0.0; 2], &[], &mut tau)
+        .is_err());
 }
 
 const SCENE: &str = r#"<mujoco model="scene">

@@ -22,11 +22,12 @@ use robodyn::soft::simulate::{
 use robodyn::soft::step::SceneStep;
 use robodyn::{Error, Model};
 
-/// Simulates `model`'s scene from `q0`, `v0` (one state, or N: shape (N, nq), (N, nv)) at time
-/// `start` over `steps` of its time step, recording every `record_every`-th. `ctrl`: None (zeros), the
-/// controls (nu, or (N, nu)) or a callable `(t, q, v) -> ctrl`; `controller` as in `simulate`.
+/// Simulates `model`'s scene from `q0`, `v0` (one state, or N: shape (N, nq), (N, nv)) and the
+/// activations `act0` (None: zeros; na, or (N, na)) at time `start` over `steps` of its time
+/// step, recording every `record_every`-th. `ctrl`: None (zeros), the controls (nu, or (N, nu))
+/// or a callable `(t, q, v) -> ctrl`; `controller` as in `simulate`.
 #[pyfunction]
-#[pyo3(signature = (model, q0, v0, steps, record_every, start=0.0, ctrl=None, controller=None, progress=None))]
+#[pyo3(signature = (model, q0, v0, steps, record_every, start=0.0, ctrl=None, controller=None, progress=None, act0=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_scene<'py>(
     py: Python<'py>,
@@ -39,15 +40,23 @@ pub fn simulate_scene<'py>(
     ctrl: Option<&Bound<'py, PyAny>>,
     controller: Option<&Bound<'py, PyAny>>,
     progress: Option<&Bound<'py, PyAny>>,
+    act0: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &model.model;
     let (q0, v0, batch) = initial_states(model, q0, v0)?;
     let count = batch.unwrap_or(1);
     let controls = read_controls(m, ctrl, count)?;
+    let act0 = per_rollout("act0", act0, m.na(), count)?;
     let t_end = start + steps as f64 * m.options.timestep;
     let control = read_controller(m, controller, PassiveForces::default(), t_end)?;
     let (q0, v0) = (q0.values().into_owned(), v0.values().into_owned());
-    let initial = |k: usize| (&q0[k * m.nq..(k + 1) * m.nq], &v0[k * m.nv..(k + 1) * m.nv]);
+    let initial = |k: usize| {
+        (
+            &q0[k * m.nq..(k + 1) * m.nq],
+            &v0[k * m.nv..(k + 1) * m.nv],
+            act0[k].as_slice(),
+        )
+    };
     let scene = SceneRun {
         steps,
         record_every,
@@ -125,6 +134,7 @@ pub fn simulate_scene<'py>(
             (|r| &r.ctrl) as fn(&SceneTrajectory) -> &Vec<f64>,
         ),
         ("tau_constraint", m.nv, |r| &r.tau_constraint),
+        ("act", m.na(), |r| &r.act),
     ] {
         let flat: Vec<f64> = runs.iter().flat_map(|r| field(r).iter().copied()).collect();
         let shape = match batch {
@@ -151,8 +161,8 @@ pub fn simulate_scene<'py>(
     Ok(out)
 }
 
-/// One step of each state (q, v) under applied forces `tau` and controls `ctrl`: per sample the
-/// flat [q₁, v₁].
+/// One step of each state (q, v, act) under applied forces `tau` and controls `ctrl`: per
+/// sample the flat [q₁, v₁, act₁] (act: the activations, na).
 #[pyfunction]
 pub fn step_scene<'py>(
     py: Python<'py>,
@@ -161,6 +171,7 @@ pub fn step_scene<'py>(
     v: &Bound<'py, PyAny>,
     tau: &Bound<'py, PyAny>,
     ctrl: &Bound<'py, PyAny>,
+    act: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let m = &model.model;
     let arguments = [
@@ -168,6 +179,7 @@ pub fn step_scene<'py>(
         model.v_arg("v", v)?,
         model.v_arg("tau", tau)?,
         Argument::new("ctrl", ctrl, SampleShape::vector(m.nu()))?,
+        Argument::new("act", act, SampleShape::vector(m.na()))?,
     ];
     let batch = arguments[0].batch()?;
     for argument in &arguments[1..] {
@@ -181,7 +193,7 @@ pub fn step_scene<'py>(
     }
     let count = batch.unwrap_or(1);
     let values: Vec<Vec<f64>> = arguments.iter().map(|a| a.values().into_owned()).collect();
-    let sizes = [m.nq, m.nv, m.nv, m.nu()];
+    let sizes = [m.nq, m.nv, m.nv, m.nu(), m.na()];
     let row = |i: usize, k: usize| -> &[f64] {
         let n = sizes[i];
         match values[i].len() == n {
@@ -193,9 +205,11 @@ pub fn step_scene<'py>(
         .detach(|| {
             let step = |stepper: &mut SceneStep, k: usize| {
                 stepper.forget_warm_start();
-                let (mut q, mut v) = (row(0, k).to_vec(), row(1, k).to_vec());
-                stepper.step(m, 0.0, (&mut q, &mut v), row(2, k), row(3, k))?;
+                let (mut q, mut v, mut act) =
+                    (row(0, k).to_vec(), row(1, k).to_vec(), row(4, k).to_vec());
+                stepper.step(m, 0.0, (&mut q, &mut v, &mut act), row(2, k), row(3, k))?;
                 q.extend_from_slice(&v);
+                q.extend_from_slice(&act);
                 Ok(q)
             };
             // one state with the model's own step; a batch with a copy per task
@@ -211,7 +225,7 @@ pub fn step_scene<'py>(
     let flat: Vec<f64> = states.concat();
     let array = PyArray1::from_vec(py, flat);
     Ok(match batch {
-        Some(n) => array.reshape([n, m.nq + m.nv])?.into_any(),
+        Some(n) => array.reshape([n, m.nq + m.nv + m.na()])?.into_any(),
         None => array.into_any(),
     })
 }
@@ -230,25 +244,35 @@ fn read_controls<'py>(
     ctrl: Option<&Bound<'py, PyAny>>,
     count: usize,
 ) -> PyResult<SceneControls<'py>> {
-    let nu = m.nu();
-    let Some(ctrl) = ctrl else {
-        return Ok(SceneControls::Fixed(vec![
-            FixedControls(vec![0.0; nu]);
-            count
-        ]));
-    };
-    if ctrl.is_callable() {
+    if let Some(ctrl) = ctrl.filter(|c| c.is_callable()) {
         return Ok(SceneControls::Python(ctrl.clone()));
     }
-    let argument = Argument::new("ctrl", ctrl, SampleShape::vector(nu))?;
+    let rows = per_rollout("ctrl", ctrl, m.nu(), count)?;
+    Ok(SceneControls::Fixed(
+        rows.into_iter().map(FixedControls).collect(),
+    ))
+}
+
+/// `value`: None (zeros), an array (width) for every rollout or (count, width), one row each.
+fn per_rollout(
+    name: &'static str,
+    value: Option<&Bound<'_, PyAny>>,
+    width: usize,
+    count: usize,
+) -> PyResult<Vec<Vec<f64>>> {
+    let Some(value) = value else {
+        return Ok(vec![vec![0.0; width]; count]);
+    };
+    let argument = Argument::new(name, value, SampleShape::vector(width))?;
     let values = argument.values();
     match argument.batch()? {
-        None => Ok(SceneControls::Fixed(vec![FixedControls(values.to_vec()); count])),
-        Some(n) if n == count => Ok(SceneControls::Fixed(
-            values.chunks(nu.max(1)).take(n).map(|c| FixedControls(c.to_vec())).collect(),
-        )),
+        None => Ok(vec![values.to_vec(); count]),
+        Some(n) if n == count => Ok((0..n)
+            .map(|k| values[k * width..(k + 1) * width].to_vec())
+            .collect()),
         Some(_) => Err(PyValueError::new_err(format!(
-            "argument 'ctrl': expected shape ({nu},) or ({count}, {nu}), one row per rollout, got {:?}",
+            "argument '{name}': expected shape ({width},) or ({count}, {width}), one row per \
+             rollout, got {:?}",
             argument.array.shape()
         ))),
     }

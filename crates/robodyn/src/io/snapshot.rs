@@ -141,6 +141,19 @@ fn check_structure(model: &Model) -> Result<()> {
             key.v.len()
         ));
     }
+    let (nu, na) = (model.nu(), model.na());
+    if let Some(key) = model
+        .keyframes
+        .iter()
+        .find(|k| (k.ctrl.len(), k.act.len()) != (nu, na))
+    {
+        return damaged(format!(
+            "keyframe '{}' has {} controls and {} activations, expected {nu} and {na}",
+            key.name,
+            key.ctrl.len(),
+            key.act.len()
+        ));
+    }
     let bodies_named = model
         .frames
         .iter()
@@ -203,6 +216,7 @@ mod tests {
             q: nalgebra::DVector::zeros(5),
             v: nalgebra::DVector::zeros(1),
             ctrl: nalgebra::DVector::zeros(0),
+            act: nalgebra::DVector::zeros(0),
         });
         assert!(message(&model_to_bytes(&model)).contains("keyframe 'home' has 5 + 1"));
     }

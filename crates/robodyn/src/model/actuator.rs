@@ -11,9 +11,47 @@
 //! total is clamped to the joint's `actuatorfrcrange` where it has one. A
 //! `motor` has a = (1, 0, 0), b = 0; a `position` a = (k_p, 0, 0), b = (0, −k_p, −k_v); a `velocity`
 //! a = (k_v, 0, 0), b = (0, 0, −k_v). Inputs: q, q̇, the controls (nu). Cost: O(nu).
+//!
+//! §Activation dynamics: an actuator with a `dyntype` other than none has a state w (MuJoCo's
+//! `act`, one per such actuator, in the actuators' order) that replaces u in the force, and
+//! evolves under the clamped control u:
+//! ```text
+//!   integrator     ẇ = u
+//!   filter         ẇ = (u − w) / τ                         (τ = dynprm[0], at least 1e-15)
+//!   filterexact    the same ẇ, integrated exactly over a step h:
+//!                  w₁ = w + ẇ τ (1 − e^(−h/τ))              (else w₁ = w + h ẇ)
+//! ```
+//! w₁ clamped to `actrange` when limited. With `actearly` the force takes w₁ instead of w (the
+//! force answers the control within the same step).
 
 use super::Model;
 use crate::error::{check_vector, Result};
+
+/// A below-this time constant is taken as this (MuJoCo's `mjMINVAL`).
+const MIN_TIME_CONSTANT: f64 = 1e-15;
+
+/// How an actuator's activation w evolves under its control u (MJCF `dyntype`, `dynprm`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum ActivationDynamics {
+    /// No activation: the force takes the control itself.
+    #[default]
+    None,
+    /// ẇ = u.
+    Integrator,
+    /// ẇ = (u − w)/τ, integrated as any state.
+    Filter {
+        /// τ (s).
+        time_constant: f64,
+    },
+    /// ẇ = (u − w)/τ, integrated exactly over each step.
+    FilterExact {
+        /// τ (s).
+        time_constant: f64,
+    },
+    /// An activation robodyn does not model (a muscle's, a user's): ẇ = 0, it keeps its place
+    /// among the activations.
+    Held,
+}
 
 /// One actuator: a joint transmission, an affine gain and bias, optional ranges.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -39,22 +77,84 @@ pub struct Actuator {
     pub ctrl_range: Option<(f64, f64)>,
     /// The force's range where it is limited (MJCF `forcerange` with `forcelimited`).
     pub force_range: Option<(f64, f64)>,
+    /// Its activation dynamics (MJCF `dyntype`, `dynprm`).
+    #[serde(default)]
+    pub dynamics: ActivationDynamics,
+    /// The activation's range where it is limited (MJCF `actrange` with `actlimited`).
+    #[serde(default)]
+    pub act_range: Option<(f64, f64)>,
+    /// The force takes the activation at the end of the step (MJCF `actearly`).
+    #[serde(default)]
+    pub act_early: bool,
+}
+
+impl ActivationDynamics {
+    /// Its MJCF `dyntype`.
+    pub fn keyword(&self) -> &'static str {
+        match self {
+            ActivationDynamics::None => "none",
+            ActivationDynamics::Integrator => "integrator",
+            ActivationDynamics::Filter { .. } => "filter",
+            ActivationDynamics::FilterExact { .. } => "filterexact",
+            ActivationDynamics::Held => "muscle or user",
+        }
+    }
 }
 
 impl Actuator {
-    /// f: the actuator's scalar force at joint position `q_j` and velocity `v_j` under control
-    /// `u`.
-    pub fn force(&self, q_j: f64, v_j: f64, u: f64) -> f64 {
-        // l = g q_j, l̇ = g q̇_j
-        self.force_at(self.gear * q_j, self.gear * v_j, u)
+    /// u clamped to the control's range where it is limited.
+    pub fn clamp_control(&self, u: f64) -> f64 {
+        self.ctrl_range.map_or(u, |(low, high)| u.clamp(low, high))
     }
 
-    /// f at its length l and rate l̇ under control `u`.
-    pub fn force_at(&self, l: f64, l_dot: f64, u: f64) -> f64 {
+    /// Whether it has an activation state w.
+    pub fn has_activation(&self) -> bool {
+        self.dynamics != ActivationDynamics::None
+    }
+
+    /// ẇ at activation `w` under the control `u` (already clamped); 0 without activation.
+    pub fn activation_rate(&self, u: f64, w: f64) -> f64 {
+        match self.dynamics {
+            ActivationDynamics::None | ActivationDynamics::Held => 0.0,
+            ActivationDynamics::Integrator => u,
+            // ẇ = (u − w)/τ
+            ActivationDynamics::Filter { time_constant }
+            | ActivationDynamics::FilterExact { time_constant } => {
+                (u - w) / time_constant.max(MIN_TIME_CONSTANT)
+            }
+        }
+    }
+
+    /// w₁: the activation after a step `h` from `w` at the rate `rate`, clamped to its range.
+    pub fn next_activation(&self, w: f64, rate: f64, h: f64) -> f64 {
+        let next = match self.dynamics {
+            // w₁ = w + ẇ τ (1 − e^(−h/τ))
+            ActivationDynamics::FilterExact { time_constant } => {
+                let tau = time_constant.max(MIN_TIME_CONSTANT);
+                w + rate * tau * (1.0 - (-h / tau).exp())
+            }
+            _ => w + rate * h,
+        };
+        self.act_range
+            .map_or(next, |(low, high)| next.clamp(low, high))
+    }
+
+    /// What the force's gain multiplies: the clamped control without activation, else the
+    /// activation `w` (or, with `actearly`, the next one, after a step `h`).
+    pub fn input(&self, u: f64, w: f64, h: f64) -> f64 {
+        let u = self.clamp_control(u);
+        match (self.has_activation(), self.act_early) {
+            (false, _) => u,
+            (true, false) => w,
+            (true, true) => self.next_activation(w, self.activation_rate(u, w), h),
+        }
+    }
+
+    /// f at its length l and rate l̇ for the gain's input `input` ([`Self::input`]).
+    pub fn force_at(&self, l: f64, l_dot: f64, input: f64) -> f64 {
         let (a, b) = (&self.gain, &self.bias);
-        let u = self.ctrl_range.map_or(u, |(low, high)| u.clamp(low, high));
-        // f = (a₀ + a₁ l + a₂ l̇) u + (b₀ + b₁ l + b₂ l̇)
-        let f = (a[0] + a[1] * l + a[2] * l_dot) * u + (b[0] + b[1] * l + b[2] * l_dot);
+        // f = (a₀ + a₁ l + a₂ l̇) input + (b₀ + b₁ l + b₂ l̇)
+        let f = (a[0] + a[1] * l + a[2] * l_dot) * input + (b[0] + b[1] * l + b[2] * l_dot);
         self.force_range.map_or(f, |(low, high)| f.clamp(low, high))
     }
 }
@@ -96,23 +196,72 @@ impl Model {
         self.actuators.len()
     }
 
+    /// na: the number of activations (MuJoCo's `act`), one per actuator with activation
+    /// dynamics.
+    pub fn na(&self) -> usize {
+        self.actuators.iter().filter(|a| a.has_activation()).count()
+    }
+
+    /// Each actuator with its control u and its activation w (0 for one without): the
+    /// actuators zipped with `ctrl` (nu) and `act` (na) in order.
+    pub fn actuator_states<'a>(
+        &'a self,
+        ctrl: &'a [f64],
+        act: &'a [f64],
+    ) -> impl Iterator<Item = (&'a Actuator, f64, f64)> + 'a {
+        let mut activations = act.iter();
+        self.actuators.iter().zip(ctrl).map(move |(actuator, &u)| {
+            let w = match actuator.has_activation() {
+                true => *activations.next().expect("act has na entries"),
+                false => 0.0,
+            };
+            (actuator, u, w)
+        })
+    }
+
+    /// ẇ (na) at the controls `ctrl` (nu) and activations `act` (na), into `rates`: MuJoCo's
+    /// `act_dot`.
+    pub fn activation_rates(&self, ctrl: &[f64], act: &[f64], rates: &mut [f64]) -> Result<()> {
+        check_vector("ctrl", ctrl, self.nu())?;
+        check_vector("act", act, self.na())?;
+        let stateful = self
+            .actuator_states(ctrl, act)
+            .filter(|(a, ..)| a.has_activation());
+        for (rate, (actuator, u, w)) in rates.iter_mut().zip(stateful) {
+            *rate = actuator.activation_rate(actuator.clamp_control(u), w);
+        }
+        Ok(())
+    }
+
+    /// w₁ = w ⊞ h ẇ for each activation in `act` at the rates `rates` (na), clamped to their
+    /// ranges (MuJoCo's `mj_advance` on `act`).
+    pub fn advance_activations(&self, act: &mut [f64], rates: &[f64], h: f64) {
+        let stateful = self.actuators.iter().filter(|a| a.has_activation());
+        for ((w, rate), actuator) in act.iter_mut().zip(rates).zip(stateful) {
+            *w = actuator.next_activation(*w, *rate, h);
+        }
+    }
+
     /// The generalised forces (nv) the actuators exert under controls `ctrl` (nu, in the
-    /// order of [`Model::actuators`]) at (q, q̇), into `tau`: MuJoCo's `qfrc_actuator`.
+    /// order of [`Model::actuators`]) and activations `act` (na) at (q, q̇), into `tau`:
+    /// MuJoCo's `qfrc_actuator`.
     pub fn actuator_forces(
         &self,
-        q: &[f64],
-        v: &[f64],
+        (q, v): (&[f64], &[f64]),
         ctrl: &[f64],
+        act: &[f64],
         tau: &mut [f64],
     ) -> Result<()> {
         self.check_configuration(q)?;
         check_vector("v", v, self.nv)?;
         check_vector("ctrl", ctrl, self.nu())?;
+        check_vector("act", act, self.na())?;
         tau.fill(0.0);
-        for (actuator, &u) in self.actuators.iter().zip(ctrl) {
-            // τ += arm f(l, l̇, u)
+        let h = self.options.timestep;
+        for (actuator, u, w) in self.actuator_states(ctrl, act) {
+            // τ += arm f(l, l̇, input)
             let (length, rate) = self.actuator_length_and_rate(actuator, q, v);
-            let force = actuator.force_at(length, rate, u);
+            let force = actuator.force_at(length, rate, actuator.input(u, w, h));
             for (k, _, arm) in self.actuator_arms(actuator) {
                 tau[k] += arm * force;
             }

@@ -20,6 +20,9 @@ pub struct Keyframe {
     pub v: DVector<f64>,
     /// The actuators' controls, one per actuator of the file in its order (MuJoCo's `ctrl`).
     pub ctrl: DVector<f64>,
+    /// The actuators' activations, one per actuator with activation dynamics (MuJoCo's `act`).
+    #[serde(default)]
+    pub act: DVector<f64>,
 }
 
 impl Model {

@@ -1,11 +1,11 @@
 //! Forward dynamics with MuJoCo's soft constraints: equalities, contacts, joint and tendon limits
 //! and dry friction as MuJoCo's `mj_forward` computes them, its solver run to convergence.
 //!
-//! Reference: MuJoCo's documentation, "Computation", §Forward dynamics. At (q, q̇) under applied
-//! forces τ and controls u:
+//! Reference: MuJoCo's documentation, "Computation", §Forward dynamics. At (q, q̇) and the
+//! actuators' activations w under applied forces τ and controls u:
 //! ```text
 //!   1. contacts   where the geoms touch (crate::collision)
-//!   2. q̈₀ = M⁻¹ (τ + τ_actuator(u) + τ_passive − C q̇ − g)      unconstrained
+//!   2. q̈₀ = M⁻¹ (τ + τ_actuator(u, w) + τ_passive − C q̇ − g)   unconstrained; ẇ(u, w)
 //!   3. rows       J, R, a_ref of every active constraint (super::rows)
 //!   4. q̈, f      the soft model's solution (super::solver)
 //! ```
@@ -38,6 +38,8 @@ pub struct ContactForward {
     pub solution: Solution,
     /// The actuators' generalised forces (MuJoCo's `qfrc_actuator`).
     pub actuator: DVector<f64>,
+    /// ẇ: the rates of the actuators' activations (MuJoCo's `act_dot`, na).
+    pub activation_rate: DVector<f64>,
     /// The constraints' generalised forces `Jᵀ f` (MuJoCo's `qfrc_constraint`).
     pub constraint: DVector<f64>,
     /// The joints' and tendons' springs and dampers (MuJoCo's `qfrc_passive`).
@@ -77,12 +79,12 @@ impl ContactDynamics {
         self.solver.forget_warm_start();
     }
 
-    /// The soft model's q̈ at (q, q̇) under applied forces `tau` (nv) and controls `ctrl` (nu),
-    /// into `out` (see the module's header).
+    /// The soft model's q̈ at (q, q̇) and activations `act` (na) under applied forces `tau`
+    /// (nv) and controls `ctrl` (nu), into `out` (see the module's header).
     pub fn forward(
         &mut self,
         model: &Model,
-        (q, v): (&[f64], &[f64]),
+        (q, v, act): (&[f64], &[f64], &[f64]),
         tau: &[f64],
         ctrl: &[f64],
         out: &mut ContactForward,
@@ -101,7 +103,9 @@ impl ContactDynamics {
         );
         // 2. q̈₀ = M⁻¹ (τ + τ_actuator + τ_passive − C q̇ − g), by the articulated-body algorithm
         out.actuator = DVector::zeros(nv);
-        model.actuator_forces(q, v, ctrl, out.actuator.as_mut_slice())?;
+        model.actuator_forces((q, v), ctrl, act, out.actuator.as_mut_slice())?;
+        out.activation_rate = DVector::zeros(act.len());
+        model.activation_rates(ctrl, act, out.activation_rate.as_mut_slice())?;
         out.passive = passive_forces(model, q, v);
         let total = DVector::from_column_slice(tau) + &out.actuator + &out.passive;
         let free = aba(model, &mut self.data, q, v, total.as_slice(), None)?.clone();

@@ -43,14 +43,16 @@ impl Controls for FixedControls {
 
 /// A recorded scene simulation: the [`Trajectory`] (`tau` the applied forces plus the actuators'
 /// `qfrc_actuator`, `tau_passive` the springs' and dampers', `a` the soft model's q̈) and, per
-/// sample, the controls (T × nu), the constraints' forces Jᵀ f (T × nv) and the contacts with
-/// their forces.
+/// sample, the controls (T × nu), the activations (T × na), the constraints' forces Jᵀ f (T × nv)
+/// and the contacts with their forces.
 #[derive(Debug, Clone, Default)]
 pub struct SceneTrajectory {
     /// t, q, v, a, tau, tau_passive and the work done (steps, evaluations).
     pub trajectory: Trajectory,
     /// The controls, row by row (T × nu).
     pub ctrl: Vec<f64>,
+    /// The actuators' activations (MuJoCo's `act`), row by row (T × na).
+    pub act: Vec<f64>,
     /// The constraints' generalised forces (MuJoCo's `qfrc_constraint`), row by row (T × nv).
     pub tau_constraint: Vec<f64>,
     /// Per sample, its contacts and each one's force in its frame
@@ -69,12 +71,13 @@ pub struct SceneRun {
     pub start: f64,
 }
 
-/// Simulates `model`'s scene from (q₀, v₀) at `run.start` over `run.steps` steps under `controls`
+/// Simulates `model`'s scene from (q₀, v₀) and the activations w₀ (na) at `run.start` over
+/// `run.steps` steps under `controls`
 /// and the applied forces of `controller`. `progress`, if given, is called with the fraction
 /// done about a hundred times; an error it returns stops the simulation with that error.
 pub fn simulate_scene(
     model: &Model,
-    (q0, v0): (&[f64], &[f64]),
+    (q0, v0, act0): (&[f64], &[f64], &[f64]),
     run: SceneRun,
     controller: &mut dyn Controller,
     controls: &mut dyn Controls,
@@ -82,6 +85,7 @@ pub fn simulate_scene(
 ) -> Result<SceneTrajectory> {
     model.check_configuration(q0)?;
     check_vector("v0", v0, model.nv)?;
+    check_vector("act0", act0, model.na())?;
     if run.record_every == 0 {
         return Err(Error::InvalidValue {
             argument: "record_every".into(),
@@ -90,7 +94,7 @@ pub fn simulate_scene(
     }
     let h = model.options.timestep;
     let mut stepper = SceneStep::new(model)?;
-    let (mut q, mut v) = (q0.to_vec(), v0.to_vec());
+    let (mut q, mut v, mut act) = (q0.to_vec(), v0.to_vec(), act0.to_vec());
     let (mut tau, mut ctrl) = (vec![0.0; model.nv], vec![0.0; model.nu()]);
     let mut out = SceneTrajectory::default();
     let report_every = (run.steps / 100).max(1);
@@ -103,11 +107,12 @@ pub fn simulate_scene(
             out.trajectory.t.push(t);
             out.trajectory.q.extend_from_slice(&q);
             out.trajectory.v.extend_from_slice(&v);
+            out.act.extend_from_slice(&act);
         }
         if k == run.steps {
-            stepper.forward_only(model, (&q, &v), &tau, &ctrl)?;
+            stepper.forward_only(model, (&q, &v, &act), &tau, &ctrl)?;
         } else {
-            stepper.step(model, t, (&mut q, &mut v), &tau, &ctrl)?;
+            stepper.step(model, t, (&mut q, &mut v, &mut act), &tau, &ctrl)?;
         }
         if recorded {
             record(&mut out, &stepper, &tau, &ctrl);

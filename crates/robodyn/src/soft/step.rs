@@ -13,7 +13,9 @@
 //!   RK4            the classical tableau on (q, ν) on the joints' groups (Runge–Kutta–
 //!                  Munthe-Kaas), the constraints found anew at each stage
 //!   then           q₁ = q₀ ⊞ h ν₁ joint by joint: q + h q̇ on hinges and slides, quat ⊗
-//!                  exp(h ω) on balls, p + h v_world and quat ⊗ exp(h ω) on free joints
+//!                  exp(h ω) on balls, p + h v_world and quat ⊗ exp(h ω) on free joints,
+//!                  and the activations w₁ = w₀ ⊞ h ẇ (crate::model::Actuator::next_activation;
+//!                  RK4: its stages take w₀ + h a_i ẇ_{i−1}, its step the weighted ẇ)
 //! ```
 //! Written in robodyn's basis an implicit solve reads `(M − h Tᵀ K T) u = M (q̈ + w)` with
 //! ν₁ = T₀ (v₀ + h u), and v₁ = T₁ᵀ ν₁ at the new orientation. A free body's gyroscopic
@@ -86,17 +88,18 @@ impl SceneStep {
         })
     }
 
-    /// The forward dynamics at (q, v) into [`Self::forward`], without a step.
+    /// The forward dynamics at (q, v) and the activations `act` into [`Self::forward`],
+    /// without a step.
     pub fn forward_only(
         &mut self,
         model: &Model,
-        (q, v): (&[f64], &[f64]),
+        state: (&[f64], &[f64], &[f64]),
         tau: &[f64],
         ctrl: &[f64],
     ) -> Result<()> {
         self.evaluations += 1;
         self.dynamics
-            .forward(model, (q, v), tau, ctrl, &mut self.forward)
+            .forward(model, state, tau, ctrl, &mut self.forward)
     }
 
     /// The next step starts its solver from q̈₀ (as a new `SceneStep` would) rather than from
@@ -110,21 +113,23 @@ impl SceneStep {
         self.evaluations
     }
 
-    /// Advances (q, v) at time `time` (s; for its errors) by the scene's time step under the
-    /// applied forces `tau` (nv) and the controls `ctrl` (nu), both held over the step. A state
-    /// that is not finite or beyond [`MAX_STATE`] afterwards stops it (MuJoCo resets there).
+    /// Advances (q, v) and the activations `act` (na) at time `time` (s; for its errors) by the
+    /// scene's time step under the applied forces `tau` (nv) and the controls `ctrl` (nu), both
+    /// held over the step. A state that is not finite or beyond [`MAX_STATE`] afterwards stops
+    /// it (MuJoCo resets there).
     pub fn step(
         &mut self,
         model: &Model,
         time: f64,
-        (q, v): (&mut [f64], &mut [f64]),
+        (q, v, act): (&mut [f64], &mut [f64], &mut [f64]),
         tau: &[f64],
         ctrl: &[f64],
     ) -> Result<()> {
         model.check_configuration(q)?;
         check_vector("v", v, model.nv)?;
+        check_vector("act", act, model.na())?;
         let h = model.options.timestep;
-        self.forward_only(model, (q, v), tau, ctrl)?;
+        self.forward_only(model, (q, v, act), tau, ctrl)?;
         let acceleration = mujoco_acceleration(model, v, &self.forward.solution.acceleration);
         let u = match model.options.integrator {
             Integrator::Rk4 => None,
@@ -141,7 +146,7 @@ impl SceneStep {
                 })
             }
             Integrator::ImplicitFast => {
-                let k = velocity_derivative(model, q, v, ctrl)?;
+                let k = velocity_derivative(model, (q, v, act), ctrl)?;
                 let gyroscopic = self.free_body_gyroscopic(model, q, v)?;
                 let mass = &self.forward.mass;
                 Some(implicit_solve(
@@ -157,8 +162,11 @@ impl SceneStep {
             Integrator::Implicit | Integrator::Discrete => unreachable!("refused by new"),
         };
         match u {
-            None => self.runge_kutta(model, (q, v), &acceleration, tau, ctrl)?,
-            Some(Some(u)) => advance(model, q, v, &u, h),
+            None => self.runge_kutta(model, (q, v, act), &acceleration, tau, ctrl)?,
+            Some(Some(u)) => {
+                advance(model, q, v, &u, h);
+                model.advance_activations(act, self.forward.activation_rate.as_slice(), h);
+            }
             Some(None) => {
                 return Err(Error::Simulation {
                     time,
@@ -179,32 +187,39 @@ impl SceneStep {
     /// RK4 on (q, ν) as a Runge–Kutta–Munthe-Kaas scheme (MuJoCo's): stage i at
     /// q₀ ⊞ θ_i, ν₀ + h a_i ã_{i−1}, with θ_i = h a_i K_{i−1} and K_j = dexp⁻¹_{θ_j}(ν_j) the rate
     /// of the tangent coordinates (ν itself but on the rotations); the step q₀ ⊞ h Σ b_j K_j,
-    /// ν₀ + h Σ b_j ã_j.
+    /// ν₀ + h Σ b_j ã_j; the activations likewise, w₀ + h a_i ẇ_{i−1} at the stages and
+    /// w₀ ⊞ h Σ b_j ẇ_j.
     /// `start`: q̈ + w at (q, v), from the step's first evaluation.
     fn runge_kutta(
         &mut self,
         model: &Model,
-        (q, v): (&mut [f64], &mut [f64]),
+        (q, v, act): (&mut [f64], &mut [f64], &mut [f64]),
         start: &DVector<f64>,
         tau: &[f64],
         ctrl: &[f64],
     ) -> Result<()> {
         let h = model.options.timestep;
-        let (q0, nu0) = (q.to_vec(), to_mujoco(model, q, v));
+        let (q0, nu0, w0) = (
+            q.to_vec(),
+            to_mujoco(model, q, v),
+            DVector::from_column_slice(act),
+        );
         let mut rates = vec![nu0.clone()];
         let mut acceleration = vec![to_mujoco(model, q, start.as_slice())];
+        let mut activation_rates = vec![self.forward.activation_rate.clone()];
         for a in RK4_A {
-            let (rate, last_acceleration) =
-                (&rates[rates.len() - 1], &acceleration[rates.len() - 1]);
+            let last = rates.len() - 1;
+            let (rate, last_acceleration) = (&rates[last], &acceleration[last]);
             let theta = rate * (h * a);
             let mut stage_q = q0.clone();
             integrate_positions(model, &mut stage_q, &theta, 1.0);
             let stage_nu = &nu0 + last_acceleration * (h * a);
             let stage_v = from_mujoco(model, &stage_q, stage_nu.as_slice());
+            let stage_w = &w0 + &activation_rates[last] * (h * a);
             self.evaluations += 1;
             self.dynamics.forward(
                 model,
-                (&stage_q, stage_v.as_slice()),
+                (&stage_q, stage_v.as_slice(), stage_w.as_slice()),
                 tau,
                 ctrl,
                 &mut self.stage,
@@ -213,6 +228,7 @@ impl SceneStep {
                 mujoco_acceleration(model, stage_v.as_slice(), &self.stage.solution.acceleration);
             acceleration.push(to_mujoco(model, &stage_q, stage_acceleration.as_slice()));
             rates.push(tangent_rate(model, &theta, stage_nu));
+            activation_rates.push(self.stage.activation_rate.clone());
         }
         let weighted = |values: &[DVector<f64>]| -> DVector<f64> {
             values.iter().zip(RK4_B).map(|(x, b)| x * b).sum()
@@ -221,6 +237,7 @@ impl SceneStep {
         integrate_positions(model, q, &weighted(&rates), h);
         let nu1 = nu0 + weighted(&acceleration) * h;
         v.copy_from_slice(from_mujoco(model, q, nu1.as_slice()).as_slice());
+        model.advance_activations(act, weighted(&activation_rates).as_slice(), h);
         Ok(())
     }
 
@@ -277,10 +294,15 @@ fn lone_free_bodies(model: &Model) -> Vec<usize> {
 }
 
 /// K = ∂f/∂ν of the dampers (−D, and −b JᵀJ of each tendon's) and of the actuators whose force
-/// is not clamped ((b₂ + a₂ u) m mᵀ, m the moment arms: gear on a joint, gear J on a tendon),
+/// is not clamped ((b₂ + a₂ u) m mᵀ, m the moment arms: gear on a joint, gear J on a tendon;
+/// the activation w, or with `actearly` the next one, in place of u where the actuator has one),
 /// MuJoCo's `qDeriv` without the bias forces' terms; robodyn's actuators and tendons act on
 /// hinges and slides, where ν = v.
-fn velocity_derivative(model: &Model, q: &[f64], v: &[f64], ctrl: &[f64]) -> Result<DMatrix<f64>> {
+fn velocity_derivative(
+    model: &Model,
+    (q, v, act): (&[f64], &[f64], &[f64]),
+    ctrl: &[f64],
+) -> Result<DMatrix<f64>> {
     let nv = model.nv;
     let mut k = DMatrix::zeros(nv, nv);
     if model.options.flag("damper") {
@@ -297,14 +319,18 @@ fn velocity_derivative(model: &Model, q: &[f64], v: &[f64], ctrl: &[f64]) -> Res
     }
     check_vector("ctrl", ctrl, model.nu())?;
     if model.options.flag("actuation") {
-        for (actuator, &u) in model.actuators.iter().zip(ctrl) {
+        let h = model.options.timestep;
+        for (actuator, u, w) in model.actuator_states(ctrl, act) {
             let (length, rate) = model.actuator_length_and_rate(actuator, q, v);
-            let force = actuator.force_at(length, rate, u);
+            let input = actuator.input(u, w, h);
+            let force = actuator.force_at(length, rate, input);
             let clamped = actuator
                 .force_range
                 .is_some_and(|(low, high)| force <= low || force >= high);
             if !clamped {
-                let slope = actuator.bias[2] + actuator.gain[2] * u;
+                // MuJoCo's derivative takes the control unclamped
+                let gained = if actuator.has_activation() { input } else { u };
+                let slope = actuator.bias[2] + actuator.gain[2] * gained;
                 for (a, _, arm_a) in model.actuator_arms(actuator) {
                     for (b, _, arm_b) in model.actuator_arms(actuator) {
                         k[(a, b)] += slope * arm_a * arm_b;

@@ -1,24 +1,30 @@
 //! `<actuator>`: each element an [`Actuator`], in the file's order (the controls' order).
 //!
-//! Modelled, as MuJoCo compiles them: `motor`, `position` (`kp`, `kv`, `inheritrange`),
-//! `velocity` (`kv`) and `general` with `dyntype="none"` and a fixed or affine gain and bias
-//! (`gainprm`, `biasprm`), on a hinge or slide (`joint`) or a fixed tendon (`tendon`), `gear`'s
-//! first entry its moment arm, with `ctrlrange`
+//! Modelled, as MuJoCo compiles them: `motor`, `position` (`kp`, `kv`, `inheritrange`,
+//! `timeconst`: a filterexact activation), `intvelocity` (an integrator activation, `inheritrange`
+//! its `actrange`), `velocity` (`kv`), `damper` (`kv`, a gain −kv l̇ on a control in its
+//! non-negative `ctrlrange`), `cylinder` (`timeconst`, `area` or `diameter`, `bias`: a filter
+//! activation) and `general` with `dyntype` none, integrator, filter or filterexact (`dynprm`)
+//! and a fixed or affine gain and bias (`gainprm`, `biasprm`), with `actrange`/`actlimited` and
+//! `actearly`; on a hinge or slide (`joint`) or a fixed tendon (`tendon`), `gear`'s first entry
+//! its moment arm, with `ctrlrange`
 //! and `forcerange` (`ctrllimited`, `forcelimited`: "auto" limits where a range is given); an
 //! actuator's `damping` and `armature` join its joint's, times gear² (as MuJoCo adds them).
-//! Any other actuator (activation dynamics, `dampratio`, muscles, spatial tendon, site or body
-//! transmissions, a ball or free joint) keeps its place in the controls but exerts no force,
-//! with a warning naming it. Defaults come from the element's class, per element name.
+//! Any other actuator (muscles, user dynamics, `dampratio`, spatial tendon, site or body
+//! transmissions, a ball or free joint) keeps its place in the controls (and its activation,
+//! if it has one) but exerts no force, with a warning naming it. Defaults come from the
+//! element's class, per element name.
 
 use super::Reader;
 use crate::error::Result;
 use crate::io::xml::parse_number_list;
-use crate::model::{Actuator, Model};
+use crate::model::{ActivationDynamics, Actuator, Model};
 use roxmltree::Node;
 
 /// What robodyn models, for the warning about an actuator it does not.
-const MODELLED: &str = "robodyn models motor, position, velocity and general actuators without \
-                        activation dynamics on a hinge, a slide or a fixed tendon";
+const MODELLED: &str = "robodyn models motor, position, intvelocity, velocity, damper, cylinder \
+                        and general actuators (dyntype none, integrator, filter, filterexact) on a \
+                        hinge, a slide or a fixed tendon";
 
 impl<'a> Reader<'a> {
     /// The elements of the `<actuator>` sections among `sections`, in order, into
@@ -84,32 +90,94 @@ impl<'a> Reader<'a> {
             bias: [0.0; 3],
             ctrl_range: self.range(element, "ctrl")?,
             force_range: self.range(element, "force")?,
+            dynamics: ActivationDynamics::None,
+            act_range: self.range(element, "act")?,
+            act_early: self.flag(element, "main", "actearly")?,
         };
         let unmodelled = |actuator: Actuator, why: String| Ok(Err((actuator, why)));
 
-        // the gain and bias of each kind
+        // the gain, bias and activation dynamics of each kind
+        let non_negative = |name: &str, default: f64| -> Result<f64> {
+            let value = scalar(name, default)?;
+            if value < 0.0 {
+                let message = format!("attribute '{name}': expected a value ≥ 0, got {value}");
+                return Err(self.error(element, message));
+            }
+            Ok(value)
+        };
+        let mut unmodelled_why = None;
         match tag {
             "motor" => {}
-            "position" => {
-                for name in ["dampratio", "timeconst"] {
-                    if scalar(name, 0.0)? != 0.0 {
-                        return unmodelled(actuator, format!("attribute '{name}'"));
-                    }
+            "position" | "intvelocity" => {
+                if scalar("dampratio", 0.0)? != 0.0 {
+                    unmodelled_why = Some("attribute 'dampratio'".to_string());
                 }
-                let (kp, kv) = (scalar("kp", 1.0)?, scalar("kv", 0.0)?);
+                let (kp, kv) = (scalar("kp", 1.0)?, non_negative("kv", 0.0)?);
                 actuator.gain = [kp, 0.0, 0.0];
                 actuator.bias = [0.0, -kp, -kv];
+                let time_constant = non_negative("timeconst", 0.0)?;
+                if time_constant > 0.0 {
+                    actuator.dynamics = ActivationDynamics::FilterExact { time_constant };
+                }
+                if tag == "intvelocity" {
+                    actuator.dynamics = ActivationDynamics::Integrator;
+                }
             }
             "velocity" => {
                 let kv = scalar("kv", 1.0)?;
                 actuator.gain = [kv, 0.0, 0.0];
                 actuator.bias = [0.0, 0.0, -kv];
             }
+            "damper" => {
+                // f = −k_v l̇ u, u in a non-negative range
+                actuator.gain = [0.0, 0.0, -non_negative("kv", 0.0)?];
+                match self.numbers::<2>(element, "main", "ctrlrange")? {
+                    Some([low, high]) if 0.0 <= low && low < high => {
+                        actuator.ctrl_range = Some((low, high));
+                    }
+                    _ => {
+                        let message = "attribute 'ctrlrange': a damper needs a range \
+                                       0 ≤ lower < upper";
+                        return Err(self.error(element, message));
+                    }
+                }
+            }
+            "cylinder" => {
+                // f = area u_act + b₀ + b₁ l + b₂ l̇
+                let time_constant = scalar("timeconst", 1.0)?;
+                actuator.dynamics = ActivationDynamics::Filter { time_constant };
+                let area = match scalar("diameter", -1.0)? {
+                    d if d >= 0.0 => std::f64::consts::PI / 4.0 * d * d,
+                    _ => scalar("area", 1.0)?,
+                };
+                actuator.gain = [area, 0.0, 0.0];
+                actuator.bias = [0.0; 3];
+                for (value, given) in actuator
+                    .bias
+                    .iter_mut()
+                    .zip(list("bias")?.unwrap_or_default())
+                {
+                    *value = given;
+                }
+            }
             "general" => {
                 let kinds = ["dyntype", "gaintype", "biastype"].map(text);
                 let [dynamics, gain, bias] = kinds.each_ref().map(|k| k.as_deref());
-                if !matches!(dynamics, None | Some("none")) {
-                    return unmodelled(actuator, "activation dynamics".into());
+                let time_constant = scalar("dynprm", 1.0)?;
+                match dynamics {
+                    None | Some("none") => {}
+                    Some("integrator") => actuator.dynamics = ActivationDynamics::Integrator,
+                    Some("filter") => {
+                        actuator.dynamics = ActivationDynamics::Filter { time_constant }
+                    }
+                    Some("filterexact") => {
+                        actuator.dynamics = ActivationDynamics::FilterExact { time_constant }
+                    }
+                    Some(other) => {
+                        // its activation keeps its place among the activations
+                        actuator.dynamics = ActivationDynamics::Held;
+                        return unmodelled(actuator, format!("dyntype '{other}'"));
+                    }
                 }
                 let prm = |name: &str, default: [f64; 3]| -> Result<[f64; 3]> {
                     let mut values = default;
@@ -129,7 +197,21 @@ impl<'a> Reader<'a> {
                     Some(other) => return unmodelled(actuator, format!("biastype '{other}'")),
                 };
             }
+            "muscle" => {
+                // its activation keeps its place among the activations
+                actuator.dynamics = ActivationDynamics::Held;
+                return unmodelled(actuator, "<muscle>".into());
+            }
+            "pid" | "dcmotor" | "plugin" => {
+                let why =
+                    format!("<{tag}>; its activation states, if any, are not in robodyn's act");
+                return unmodelled(actuator, why);
+            }
             other => return unmodelled(actuator, format!("<{other}>")),
+        }
+        self.check_activation_size(element, &actuator)?;
+        if let Some(why) = unmodelled_why {
+            return unmodelled(actuator, why);
         }
 
         // the transmission: a fixed tendon, or a hinge or slide
@@ -147,11 +229,8 @@ impl<'a> Reader<'a> {
                 return Err(self.error(element, message));
             };
             actuator.tendon = Some(t);
-            if tag == "position" && scalar("inheritrange", 0.0)? > 0.0 {
-                let range = model.tendons[t].range.map(|(lower, upper)| [lower, upper]);
-                actuator.ctrl_range =
-                    Some(self.inherited_range(element, range, scalar("inheritrange", 0.0)?)?);
-            }
+            let range = model.tendons[t].range.map(|(lower, upper)| [lower, upper]);
+            self.inherit_range(element, range, &mut actuator)?;
             return Ok(Ok(actuator));
         }
         let Some(joint_name) = element.attribute("joint") else {
@@ -174,17 +253,51 @@ impl<'a> Reader<'a> {
         actuator.coordinate = Some(model.v_range(body).start);
         actuator.position = model.q_range(body).start;
 
-        // `inheritrange`: the control range from the joint's, scaled about its middle
-        let inherit = scalar("inheritrange", 0.0)?;
-        if tag == "position" && inherit > 0.0 {
-            let (lower, upper) = (
-                model.lower_position_limit[actuator.position],
-                model.upper_position_limit[actuator.position],
-            );
-            let range = (lower.is_finite() && upper.is_finite()).then_some([lower, upper]);
-            actuator.ctrl_range = Some(self.inherited_range(element, range, inherit)?);
-        }
+        let (lower, upper) = (
+            model.lower_position_limit[actuator.position],
+            model.upper_position_limit[actuator.position],
+        );
+        let range = (lower.is_finite() && upper.is_finite()).then_some([lower, upper]);
+        self.inherit_range(element, range, &mut actuator)?;
         Ok(Ok(actuator))
+    }
+
+    /// `inheritrange` of a `position` (its control range) or an `intvelocity` (its activation
+    /// range): the transmission's `range` scaled about its middle.
+    fn inherit_range(
+        &self,
+        element: Node<'a, 'a>,
+        range: Option<[f64; 2]>,
+        actuator: &mut Actuator,
+    ) -> Result<()> {
+        let inherit = self
+            .numbers::<1>(element, "main", "inheritrange")?
+            .map_or(0.0, |[x]| x);
+        if inherit <= 0.0 {
+            return Ok(());
+        }
+        let inherited = Some(self.inherited_range(element, range, inherit)?);
+        match element.tag_name().name() {
+            "position" => actuator.ctrl_range = inherited,
+            "intvelocity" => actuator.act_range = inherited,
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// `actdim`: 1 for an actuator with activation dynamics, 0 without (MuJoCo refuses others).
+    fn check_activation_size(&self, element: Node<'a, 'a>, actuator: &Actuator) -> Result<()> {
+        let expected = usize::from(actuator.has_activation());
+        match self.numbers::<1>(element, "main", "actdim")? {
+            Some([given]) if given != expected as f64 => {
+                let message = format!(
+                    "attribute 'actdim': expected {expected} for dyntype {}, got {given}",
+                    actuator.dynamics.keyword()
+                );
+                Err(self.error(element, message))
+            }
+            _ => Ok(()),
+        }
     }
 
     /// `inheritrange`: the range of the joint or tendon (`None`: it has none, refused) scaled by

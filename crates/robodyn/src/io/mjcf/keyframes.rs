@@ -4,9 +4,9 @@
 //! quaternions scalar first (robodyn's: last), normalised here as MuJoCo normalises them before
 //! use; its `qvel` gives a free joint's linear velocity in world axes (robodyn's: in the body's).
 //! As in MuJoCo (4.0), a list may be shorter than the model's: it gives the first entries, and
-//! the rest are those of `qpos0` (the neutral configuration) for `qpos`, zeros for `qvel` and
-//! `ctrl`; a longer list is an error. A key without `time` is at 0.
-//! `act` (actuator activations) and `mpos`/`mquat` (mocap bodies) are not read: a warning each.
+//! the rest are those of `qpos0` (the neutral configuration) for `qpos`, zeros for `qvel`, `act`
+//! and `ctrl`; a longer list is an error. A key without `time` is at 0.
+//! `mpos`/`mquat` (mocap bodies) are not read: a warning each.
 
 use super::Reader;
 use crate::error::Result;
@@ -67,11 +67,11 @@ impl<'a> Reader<'a> {
         let qvel = list("qvel", vec![0.0; model.nv])?;
         let v = velocity_from_mujoco(model, &q, &qvel);
         let ctrl = list("ctrl", vec![0.0; actuators])?;
-        for name in ["act", "mpos", "mquat"] {
+        let act = list("act", vec![0.0; model.na()])?;
+        for name in ["mpos", "mquat"] {
             if key.attribute(name).is_some() {
                 model.warnings.push(format!(
-                    "{}: attribute '{name}' not read (robodyn models no actuator activations \
-                     or mocap bodies)",
+                    "{}: attribute '{name}' not read (robodyn models no mocap bodies)",
                     self.location(key)
                 ));
             }
@@ -82,6 +82,7 @@ impl<'a> Reader<'a> {
             q,
             v,
             ctrl: DVector::from_vec(ctrl),
+            act: DVector::from_vec(act),
         })
     }
 

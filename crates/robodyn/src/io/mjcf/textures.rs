@@ -221,7 +221,7 @@ impl<'a> Reader<'a> {
     }
 
     /// A true/false attribute (false when absent).
-    fn flag(&self, node: Node<'a, 'a>, class: &str, name: &str) -> Result<bool> {
+    pub(super) fn flag(&self, node: Node<'a, 'a>, class: &str, name: &str) -> Result<bool> {
         match self.attribute(node, class, name).as_deref() {
             None | Some("false") => Ok(false),
             Some("true") => Ok(true),
