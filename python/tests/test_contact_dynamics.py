@@ -610,19 +610,36 @@ SIMPLE_BODIES = """<mujoco><option cone="{cone}"/>
       <geom name="offset" type="sphere" size="0.04"/></body>
     <body name="parent" pos="4 0 0.039"><joint name="qx" type="slide" axis="1 0 0"/><geom name="parent" type="sphere" size="0.04"/>
       <body name="child" pos="0 0.2 0"><geom name="child" type="sphere" size="0.04"/></body></body>
+    <body name="turned" pos="5 0 0.5"><joint name="u" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
+      <geom type="box" size="0.04 0.05 0.04" euler="0 0 90"/></body>
+    <body name="rod" pos="6 0 0.5"><joint name="r" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
+      <geom type="capsule" fromto="-0.05 0 0 0.05 0 0" size="0.02"/></body>
+    <body name="decreasing" pos="7 0 0.5"><joint name="d" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
+      <geom type="box" size="0.02 0.04 0.06"/><geom type="box" size="0.02 0.04 0.03"/></body>
+    <body name="increasing" pos="8 0 0.5"><joint name="i" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
+      <geom type="box" size="0.06 0.04 0.02"/><geom type="box" size="0.03 0.04 0.02"/></body>
+    <body name="given" pos="9 0 0.5"><joint name="g" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
+      <inertial pos="0 0 0" mass="1" diaginertia="0.2 0.2 0.3" quat="0.7071068 0 0 0.7071068"/></body>
+    <body name="full" pos="10 0 0.5"><joint name="f" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
+      <inertial pos="0 0 0" mass="1" fullinertia="0.3 0.2 0.15 0 0 0"/></body>
   </worldbody></mujoco>"""
 
 
 @pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
 def test_simple_bodies_weigh_one_over_their_mass_as_in_mujoco(cone):
+    """MuJoCo's simple bodies need their principal axes of inertia to be their own, where its
+    compiler puts them: a single geom's axes (a box turned a quarter, a capsule along x: not simple
+    though diagonal), or by eigen-decomposition with the moments in decreasing order (two geoms,
+    `fullinertia`), or an `<inertial>`'s `quat`."""
     model, mj_model, layout = load_both(SIMPLE_BODIES.replace("{cone}", cone))
     simple = {mj_model.body(i).name for i in range(1, mj_model.nbody) if mj_model.body_simple[i] == 2}
-    assert simple == {"puck", "slider"}
+    assert simple == {"puck", "slider", "decreasing", "full"}
     rng = np.random.default_rng(2)
     for case in range(3):
         qpos = mj_model.qpos0 + rng.normal(size=mj_model.nq) * 0.05
         _, expected = assert_matches_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv), label=f"case {case}")
-        assert expected["row_types"].count("limit_joint") == 4
+        # each new slide has a limit row at least (its weight 1/m when simple, else 1/(m + armature))
+        assert expected["row_types"].count("limit_joint") >= 4 + 6
 
 
 # --- 8b. URDF mimic joints --------------------------------------------------------------------

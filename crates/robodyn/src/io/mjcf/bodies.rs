@@ -1,13 +1,14 @@
 //! The body tree of an MJCF file: bodies, their joints (those in `<frame>`s too), sites and
 //! frames, into the model builder.
 
+use super::inertia::InertiaAxes;
 use super::Reader;
 use crate::error::Result;
 use crate::joint::Joint;
 use crate::model::{
     JointProperties, JointSoftness, ModelBuilder, NewBody, SolverParameters, SourceBody,
 };
-use crate::spatial::{Inertia, Transform, Vec3};
+use crate::spatial::{Inertia, Mat3, Transform, Vec3};
 use nalgebra::{Rotation3, Unit, UnitQuaternion};
 use roxmltree::Node;
 
@@ -151,9 +152,10 @@ impl<'a> Reader<'a> {
         // X_{B←parent body}
         let mut to_body = self.placement(node, class)? * parent_element;
         let elements = self.children(node)?;
+        let (inertia, axes) = self.body_inertia(&elements, child_class)?;
         let inertia = self
             .mass_rules
-            .apply_to_body(self.body_inertia(&elements, child_class)?)
+            .apply_to_body(inertia)
             .map_err(|m| self.error(node, m))?;
         self.total_mass.set(self.total_mass.get() + inertia.mass);
         // the body's joints, those in its <frame>s too, with X_{frame←body}
@@ -345,8 +347,9 @@ impl<'a> Reader<'a> {
             builder.add_frame(&name, body, to_body);
         }
         self.record_source_mass(source_body, body, &inertia, &to_body);
-        self.source_bodies.borrow_mut()[source_body].simple =
-            only_aligned_slides && self.placed_simply(parent_source, parent) && own_frame(&inertia);
+        self.source_bodies.borrow_mut()[source_body].simple = only_aligned_slides
+            && self.placed_simply(parent_source, parent)
+            && own_frame(&inertia, axes);
         self.add_geoms(
             builder,
             &elements,
@@ -444,11 +447,24 @@ impl<'a> Reader<'a> {
 const SIMPLE_TOLERANCE: f64 = 1e-14;
 
 /// Whether a body's inertia frame is its own (MuJoCo's `sameframe`): its centre of mass at its
-/// origin and its rotational inertia diagonal in its axes (to 1e-12 of its trace).
-fn own_frame(inertia: &Inertia) -> bool {
+/// origin and its principal axes, where MuJoCo's compiler puts them (`axes`), its own: the axes
+/// given turned by nothing (a quarter turn that keeps the tensor diagonal still turns them), or,
+/// found by eigen-decomposition, the tensor diagonal in its axes (to 1e-12 of its trace) with the
+/// moments in decreasing order (else MuJoCo's axes are a permutation of the body's).
+fn own_frame(inertia: &Inertia, axes: InertiaAxes) -> bool {
     let r = &inertia.rotational;
-    let off_diagonal = [r[(0, 1)], r[(0, 2)], r[(1, 2)]];
     let scale = 1e-12 * r.trace().abs().max(f64::MIN_POSITIVE);
-    inertia.first_moment.norm() <= SIMPLE_TOLERANCE * inertia.mass.max(1.0)
-        && off_diagonal.iter().all(|x| x.abs() <= scale)
+    let centred = inertia.first_moment.norm() <= SIMPLE_TOLERANCE * inertia.mass.max(1.0);
+    let aligned = match axes {
+        InertiaAxes::Given(rotation) => {
+            (rotation - Mat3::identity()).abs().max() <= SIMPLE_TOLERANCE
+        }
+        InertiaAxes::Principal => {
+            let off_diagonal = [r[(0, 1)], r[(0, 2)], r[(1, 2)]];
+            off_diagonal.iter().all(|x| x.abs() <= scale)
+                && r[(0, 0)] >= r[(1, 1)] - scale
+                && r[(1, 1)] >= r[(2, 2)] - scale
+        }
+    };
+    centred && aligned
 }

@@ -25,6 +25,20 @@ use std::f64::consts::PI;
 /// MuJoCo's default geom density, kg/m³ (water).
 const DEFAULT_DENSITY: f64 = 1000.0;
 
+/// Below this a geom's mass does not count among a body's geoms (MuJoCo's `mjEPS`).
+const MASSLESS: f64 = 1e-14;
+
+/// Where MuJoCo's compiler puts a body's principal axes of inertia (its `iquat`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum InertiaAxes {
+    /// The axes given: an `<inertial>`'s with `diaginertia`, or the one massive geom's own
+    /// (rotation from them to the body's axes).
+    Given(Mat3),
+    /// Found by an eigen-decomposition of the total (several geoms, a mesh, `fullinertia`):
+    /// the moments in decreasing order.
+    Principal,
+}
+
 /// `<compiler inertiafromgeom>`: where a body's inertia comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum InertiaFromGeoms {
@@ -108,8 +122,12 @@ impl<'a> Reader<'a> {
     }
 
     /// The spatial inertia of a body, in its frame: from `<inertial>` or from its geoms, as
-    /// `<compiler inertiafromgeom>` says.
-    pub(super) fn body_inertia(&self, elements: &[Node<'a, 'a>], class: &str) -> Result<Inertia> {
+    /// `<compiler inertiafromgeom>` says; and where MuJoCo's compiler puts its principal axes.
+    pub(super) fn body_inertia(
+        &self,
+        elements: &[Node<'a, 'a>],
+        class: &str,
+    ) -> Result<(Inertia, InertiaAxes)> {
         let mut inertials = Vec::new();
         self.framed_elements(
             elements,
@@ -119,34 +137,77 @@ impl<'a> Reader<'a> {
             &mut inertials,
         )?;
         match (self.inertia_from_geoms, inertials.first()) {
-            (InertiaFromGeoms::Never, None) => Ok(Inertia::ZERO),
+            (InertiaFromGeoms::Never, None) => {
+                Ok((Inertia::ZERO, InertiaAxes::Given(Mat3::identity())))
+            }
             (
                 InertiaFromGeoms::Auto | InertiaFromGeoms::Never,
                 Some((inertial, to_frame, class)),
-            ) => Ok(to_frame.transpose_apply_inertia(&self.inertial(*inertial, class)?)),
+            ) => {
+                let inertia = to_frame.transpose_apply_inertia(&self.inertial(*inertial, class)?);
+                let rotation = to_frame.rotation.transpose()
+                    * self.placement(*inertial, class)?.rotation.transpose();
+                let axes = match self.numbers::<6>(*inertial, class, "fullinertia")? {
+                    Some(_) => InertiaAxes::Principal,
+                    None => InertiaAxes::Given(rotation),
+                };
+                Ok((inertia, axes))
+            }
             // each geom's mass and inertia is checked where it is read
             (InertiaFromGeoms::Always, _) | (InertiaFromGeoms::Auto, None) => {
-                self.geoms_inertia(elements, class)
+                let mut parts = Vec::new();
+                self.geom_parts(elements, class, &Mat3::identity(), &mut parts)?;
+                let total = parts
+                    .iter()
+                    .fold(Inertia::ZERO, |sum, (inertia, _)| sum + *inertia);
+                let massive: Vec<_> = parts.iter().filter(|(i, _)| i.mass > MASSLESS).collect();
+                let axes = match massive.as_slice() {
+                    [] => InertiaAxes::Given(Mat3::identity()),
+                    [(_, Some(rotation))] => InertiaAxes::Given(*rotation),
+                    _ => InertiaAxes::Principal,
+                };
+                Ok((total, axes))
             }
         }
     }
 
-    /// The inertia of the geoms among `elements` and inside their `<frame>`s, in the frame the
-    /// elements are written in.
-    pub(super) fn geoms_inertia(&self, elements: &[Node<'a, 'a>], class: &str) -> Result<Inertia> {
-        let mut total = Inertia::ZERO;
+    /// The inertia of each geom among `elements` and inside their `<frame>`s, in the frame the
+    /// elements are written in (turned by `rotation` from the body's), with its axes' rotation
+    /// in the body's frame (`None` for a mesh, whose axes are its principal ones).
+    fn geom_parts(
+        &self,
+        elements: &[Node<'a, 'a>],
+        class: &str,
+        rotation: &Mat3,
+        parts: &mut Vec<(Inertia, Option<Mat3>)>,
+    ) -> Result<()> {
         for element in elements {
             if element.has_tag_name("geom") {
-                total += self.geom_inertia(*element, class)?;
+                let inertia = self.geom_inertia(*element, class)?;
+                let geom_class = self.declared_class(*element, "class", class)?;
+                let kind = self.geom_type(*element, geom_class);
+                let axes = match kind.as_str() {
+                    "mesh" => None,
+                    _ => {
+                        let (_, frame) = self.geom_size_and_frame(*element, geom_class, &kind)?;
+                        Some(rotation * frame.rotation.transpose())
+                    }
+                };
+                parts.push((inertia, axes));
             } else if element.has_tag_name("frame") {
                 let inner_class = self.declared_class(*element, "childclass", class)?;
-                let inside = self.geoms_inertia(&self.children(*element)?, inner_class)?;
-                total += self
-                    .placement(*element, class)?
-                    .transpose_apply_inertia(&inside);
+                let placement = self.placement(*element, class)?;
+                let mut inside = Vec::new();
+                let turned = rotation * placement.rotation.transpose();
+                self.geom_parts(&self.children(*element)?, inner_class, &turned, &mut inside)?;
+                parts.extend(
+                    inside
+                        .into_iter()
+                        .map(|(inertia, axes)| (placement.transpose_apply_inertia(&inertia), axes)),
+                );
             }
         }
-        Ok(total)
+        Ok(())
     }
 
     /// `<inertial>`: mass, centre of mass and the inertia about it, in the body's frame.
