@@ -590,6 +590,36 @@ def test_tendon_lengths_as_in_mujoco():
     assert_close(model.tendon_lengths(layout.q_from_mujoco(states[0])), expected[0], ROW_AGREEMENT, "one")
 
 
+SKIPPED_ELEMENTS = """<mujoco><option timestep="0.002"/>
+  <worldbody>
+    <site name="s0" pos="0 0 1.5"/>
+    <body name="a" pos="0 0 1"><joint name="j1" axis="0 1 0" range="-1 1"/>
+      <geom type="capsule" fromto="0 0 0 .3 0 0" size=".03"/>
+      <body name="b" pos=".3 0 0"><joint name="j2" axis="0 1 0"/>
+        <geom type="capsule" fromto="0 0 0 .3 0 0" size=".03"/><site name="s2" pos=".3 0 0"/></body></body>
+  </worldbody>
+  <tendon>
+    <spatial name="rope"><site site="s0"/><site site="s2"/></spatial>
+    <fixed name="idle" frictionloss="0.5" range="-0.1 0.1" margin="0.5"><joint joint="j1" coef="0"/></fixed>
+    <fixed name="pair" frictionloss="0.2" range="-0.1 0.1"><joint joint="j1" coef="1"/><joint joint="j2" coef="0.5"/></fixed>
+  </tendon>
+  <equality>
+    <tendon tendon1="rope" active="false"/>
+    <joint joint1="j2" joint2="j1" polycoef="0 0.5 0 0 0"/>
+  </equality>
+</mujoco>"""
+
+
+def test_rows_carry_mujocos_ids_past_what_robodyn_does_not_read():
+    """A spatial tendon (not read) before the fixed ones, and its equality before a joint equality:
+    the rows' ids are still MuJoCo's (tendon 2, equality 1); a tendon whose Jacobian is zero has no
+    rows, as in MuJoCo (its friction and its limit within the margin)."""
+    model, mj_model, layout = load_both(SKIPPED_ELEMENTS)
+    _, expected = assert_matches_mujoco(model, mj_model, layout, np.array([0.3, -0.2]), np.array([0.4, -1.0]))
+    assert expected["row_types"] == ["equality", "friction_tendon", "limit_joint", "limit_tendon"]
+    assert list(expected["row_ids"]) == [1, 2, 0, 2]
+
+
 # --- 8. MuJoCo's simple bodies -------------------------------------------------------------------
 
 # Bodies MuJoCo calls simple (body_simple 2: only axis-aligned slides at their origin, their inertia

@@ -27,7 +27,7 @@ pub use options::{
 pub use physical::{
     check_mass_and_inertia, check_physical_parameters, check_positive_semidefinite, Unphysical,
 };
-pub use tendon::{Tendon, TendonEquality};
+pub use tendon::{Tendon, TendonEquality, UnreadElements};
 
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::joint::{Joint, MotionSubspace};
@@ -226,6 +226,10 @@ pub struct Model {
     /// The equalities between tendon lengths (MJCF `<equality><tendon>`), in the file's order.
     #[serde(default)]
     pub tendon_equalities: Vec<TendonEquality>,
+    /// Where the file's tendons and equalities that robodyn does not read sit among those it
+    /// reads, so that rows carry MuJoCo's ids ([`UnreadElements::mujoco_id`]).
+    #[serde(default)]
+    pub unread: UnreadElements,
     /// The range each body's joint's total actuator force is clamped to (MJCF
     /// `actuatorfrcrange`), nbodies; read for hinges and slides only.
     #[serde(default)]

@@ -74,6 +74,7 @@ impl ModelBuilder {
                 actuators: Vec::new(),
                 tendons: Vec::new(),
                 tendon_equalities: Vec::new(),
+                unread: Default::default(),
                 actuator_force_range: vec![None],
                 joint_softness: vec![JointSoftness::default()],
                 geoms: Vec::new(),

@@ -107,6 +107,25 @@ pub struct TendonEquality {
     pub before: usize,
 }
 
+/// The file's elements robodyn does not read, by where they sit: for each, how many elements of
+/// its kind that robodyn reads come before it in the file.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct UnreadElements {
+    /// Tendons (spatial ones) among [`Model::tendons`].
+    pub tendons: Vec<usize>,
+    /// Equalities (flex ones, those of unread tendons) among the file's read equalities
+    /// ([`Model::constraints`] and [`Model::tendon_equalities`] together, in the file's order).
+    pub equalities: Vec<usize>,
+}
+
+impl UnreadElements {
+    /// MuJoCo's id of the `read`-th element robodyn reads of a kind, `unread` that kind's list:
+    /// its place counting the unread elements before it too.
+    pub fn mujoco_id(unread: &[usize], read: usize) -> usize {
+        read + unread.iter().filter(|&&before| before <= read).count()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

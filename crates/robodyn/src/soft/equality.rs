@@ -33,7 +33,7 @@ use crate::constraint::{
     ConstraintSet,
 };
 use crate::error::{Error, Result};
-use crate::model::{Model, SolverParameters, TendonEquality};
+use crate::model::{Model, SolverParameters, TendonEquality, UnreadElements};
 use crate::spatial::{Mat3, Vec3};
 use crate::Data;
 use nalgebra::{DMatrix, DVector, Quaternion, Rotation3, UnitQuaternion};
@@ -97,7 +97,7 @@ impl Equalities {
                     let (t1, t2) = equality.tendons;
                     let own = weights.tendons[t1] + t2.map_or(0.0, |t| weights.tendons[t]);
                     held.push(Held {
-                        index,
+                        index: UnreadElements::mujoco_id(&model.unread.equalities, index),
                         shape: Shape::Tendon(j),
                         member: usize::MAX,
                         solver: equality.solver,
@@ -109,7 +109,7 @@ impl Equalities {
             let Some(declared) = declared else {
                 break;
             };
-            let id = index;
+            let id = UnreadElements::mujoco_id(&model.unread.equalities, index);
             index += 1;
             if !(enforced && declared.active) {
                 continue;

@@ -33,7 +33,7 @@ use super::weights::{point_columns, InverseWeights};
 use crate::collision::Contact;
 use crate::error::Result;
 use crate::joint::Joint;
-use crate::model::{FrictionCone, Model, SolverParameters};
+use crate::model::{FrictionCone, Model, SolverParameters, UnreadElements};
 use crate::spatial::{Mat3, Transform, Vec3};
 
 /// Below this a regulariser or an impratio counts as zero (MuJoCo's `mjMINVAL`).
@@ -194,6 +194,17 @@ impl Rows {
         self.jacobian.resize(start + self.nv, 0.0);
         &mut self.jacobian[start..]
     }
+
+    /// Removes the last `count` rows pushed (before their group is finished).
+    fn discard_last(&mut self, count: usize) {
+        let kept = self.len() - count;
+        self.kind.truncate(kept);
+        self.id.truncate(kept);
+        self.position.truncate(kept);
+        self.margin.truncate(kept);
+        self.frictionloss.truncate(kept);
+        self.jacobian.truncate(kept * self.nv);
+    }
 }
 
 /// What the rows of one element need beyond their Jacobians.
@@ -259,7 +270,8 @@ pub fn constraint_rows(
                 continue;
             }
             let first = rows.len();
-            let row = rows.push(RowKind::FrictionTendon, t, 0.0, 0.0);
+            let id = UnreadElements::mujoco_id(&model.unread.tendons, t);
+            let row = rows.push(RowKind::FrictionTendon, id, 0.0, 0.0);
             tendon.add_to_row(model, 1.0, row);
             rows.frictionloss[first] = tendon.frictionloss;
             let softness = Softness {
@@ -328,7 +340,8 @@ pub fn constraint_rows(
                 if distance >= tendon.margin || distance.is_nan() {
                     continue;
                 }
-                let row = rows.push(RowKind::LimitTendon, t, distance, tendon.margin);
+                let id = UnreadElements::mujoco_id(&model.unread.tendons, t);
+                let row = rows.push(RowKind::LimitTendon, id, distance, tendon.margin);
                 tendon.add_to_row(model, side, row);
                 finish_group(rows, RowKind::LimitTendon, 1, &group, safe_after, v);
             }
@@ -425,6 +438,15 @@ fn finish_group(
     v: &[f64],
 ) {
     let first = rows.len() - count;
+    // MuJoCo leaves out a group that moves nothing (a tendon whose Jacobian cancels), but a contact
+    let contact = matches!(
+        kind,
+        RowKind::ContactFrictionless | RowKind::ContactPyramidal | RowKind::ContactElliptic
+    );
+    if !contact && rows.jacobian[first * rows.nv..].iter().all(|j| *j == 0.0) {
+        rows.discard_last(count);
+        return;
+    }
     let solimp = &softness.solver.solimp;
     // d of the first row's |pos − margin|, of an equality's |pos| over its rows
     let violation = if kind == RowKind::Equality {

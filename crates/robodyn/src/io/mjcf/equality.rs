@@ -44,6 +44,11 @@ impl<'a> Reader<'a> {
         model: &mut Model,
     ) -> Result<()> {
         let mut data = Data::new(model);
+        // an equality left out keeps its place in MuJoCo's numbering
+        let read_none = |model: &mut Model| {
+            let read = model.constraints.len() + model.tendon_equalities.len();
+            model.unread.equalities.push(read);
+        };
         for section in sections.iter().filter(|c| c.has_tag_name("equality")) {
             for element in self.children(*section)? {
                 let kind = match element.tag_name().name() {
@@ -51,12 +56,14 @@ impl<'a> Reader<'a> {
                     "weld" => self.weld(element, model, &mut data)?,
                     "joint" => self.joint_equality(element, model)?,
                     "tendon" => {
-                        if let Some(equality) = self.tendon_equality(element, model)? {
-                            model.tendon_equalities.push(equality);
+                        match self.tendon_equality(element, model)? {
+                            Some(equality) => model.tendon_equalities.push(equality),
+                            None => read_none(model),
                         }
                         continue;
                     }
                     _ => {
+                        read_none(model);
                         let message = format!(
                             "{}: not read (robodyn holds connect, weld and joint equalities)",
                             self.location(element)

@@ -27,6 +27,7 @@ impl<'a> Reader<'a> {
                 if element.tag_name().name() != "fixed" {
                     let name = element.attribute("name").unwrap_or_default().to_string();
                     self.unread_tendons.borrow_mut().push(name);
+                    model.unread.tendons.push(model.tendons.len());
                     model.warnings.push(format!(
                         "{}: not read ({MODELLED}): its limits, friction, equalities and \
                          actuators are left out",
