@@ -28,9 +28,7 @@ def simulate_scene(model: Any, q0: Any, v0: Any, t_end: float, dt: float | None,
         raise bad("constraints", "'model' with integrator='mujoco' (the scene's own equality constraints)",
                   repr(constraints))
     start = keyframe(model, q0).time if isinstance(q0, str) else 0.0
-    if isinstance(q0, str) and act0 is None:
-        act0 = keyframe(model, q0).act
-    q0, v0, ctrl = scene_start(model, q0, v0, ctrl)
+    q0, v0, ctrl, act0 = scene_start(model, q0, v0, ctrl, act0)
     h = model.options.timestep
     dt = h if dt is None else real("dt", dt)
     record_every = round(dt / h)
@@ -41,8 +39,7 @@ def simulate_scene(model: Any, q0: Any, v0: Any, t_end: float, dt: float | None,
         raise bad("t_end", f"a time (s) not before the start, {start}", repr(t_end))
     result = _core.simulate_scene(model, q0, v0, steps, record_every, start=start, ctrl=ctrl,
                                   controller=_controller_argument(model, controller),
-                                  progress=callback("progress", progress),
-                                  act0=None if act0 is None else numbers("act0", act0))
+                                  progress=callback("progress", progress), act0=act0)
     series = ("q", "v", "a", "tau", "tau_passive", "ctrl", "tau_constraint", "act")
     batch = result["q"].ndim == 3
     runs = [
@@ -65,16 +62,18 @@ def scene_model(model: Any) -> _core.Model:
     return model
 
 
-def scene_start(model: _core.Model, q0: Any, v0: Any, ctrl: Any) -> tuple[Any, Any, Any]:
-    """(q0, v0, ctrl) of a scene's run: a keyframe's name gives its q, v and ctrl (those given win)."""
+def scene_start(model: _core.Model, q0: Any, v0: Any, ctrl: Any, act0: Any) -> tuple[Any, Any, Any, Any]:
+    """(q0, v0, ctrl, act0) of a scene's run: a keyframe's name gives its q, v, ctrl and act (those
+    given win)."""
     if isinstance(q0, str):
         key = keyframe(model, q0)
-        q0, v0, ctrl = key.q, key.v if v0 is None else v0, key.ctrl if ctrl is None else ctrl
+        q0, v0 = key.q, key.v if v0 is None else v0
+        ctrl, act0 = key.ctrl if ctrl is None else ctrl, key.act if act0 is None else act0
     q0 = numbers("q0", q0)
     v0 = np.zeros(q0.shape[:-1] + (model.nv,)) if v0 is None else numbers("v0", v0)
     if ctrl is not None and not callable(ctrl):
         ctrl = numbers("ctrl", ctrl)
-    return q0, v0, ctrl
+    return q0, v0, ctrl, None if act0 is None else numbers("act0", act0)
 
 
 def keyframe(model: _core.Model, name: str) -> Any:

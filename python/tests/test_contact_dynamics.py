@@ -534,7 +534,7 @@ TENDONS = """<mujoco><option timestep="0.002" cone="{cone}"/>
       <body name="lower" pos=".4 0 0"><joint name="elbow" axis="0 1 0" ref="10"/>
         <joint name="reach" type="slide" axis="1 0 0" range="-.1 .2"/>
         <geom name="lower" type="capsule" fromto="0 0 0 .3 0 0" size=".03"/>
-        <body name="hand" pos=".3 0 0"><joint name="wrist" axis="0 0 1"/>
+        <body name="hand" pos=".3 0 0"><joint name="wrist" axis="0 0 1" springref="25"/>
           <geom name="hand" type="box" size=".05 .03 .02"/></body></body></body>
   </worldbody>
   <tendon>

@@ -21,6 +21,11 @@
 
 mod cost;
 pub mod dynamics;
+
+/// Below this a width, a mass, a regulariser, an impratio or a speed counts as zero (MuJoCo's
+/// `mjMINVAL`).
+pub(crate) const TINY: f64 = 1e-15;
+
 pub mod equality;
 pub mod impedance;
 mod pattern;

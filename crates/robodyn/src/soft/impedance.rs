@@ -27,8 +27,7 @@ use crate::model::SolverParameters;
 pub const MIN_IMPEDANCE: f64 = 1e-4;
 /// See [`MIN_IMPEDANCE`].
 pub const MAX_IMPEDANCE: f64 = 0.9999;
-/// Below this a width, a product or a regulariser counts as zero (MuJoCo's `mjMINVAL`).
-const TINY: f64 = 1e-15;
+use super::TINY;
 
 /// The impedance `d(r)` of a row violated by `r = pos − margin`, and its derivative `∂d/∂r`.
 /// `solimp` is clamped as MuJoCo clamps it: d₀, d_max and the midpoint into

@@ -36,8 +36,7 @@ use crate::joint::Joint;
 use crate::model::{FrictionCone, Model, SolverParameters, UnreadElements};
 use crate::spatial::{Mat3, Transform, Vec3};
 
-/// Below this a regulariser or an impratio counts as zero (MuJoCo's `mjMINVAL`).
-const TINY: f64 = 1e-15;
+use super::TINY;
 
 /// What made a row (MuJoCo's `mjtConstraint`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

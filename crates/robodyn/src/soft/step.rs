@@ -23,6 +23,7 @@
 //! (`crate::algo::rnea_derivatives`).
 
 use super::dynamics::{free_joint_velocity_product, ContactDynamics, ContactForward};
+use super::TINY;
 use crate::algo::rnea_derivatives;
 use crate::algo::DerivativesInto;
 use crate::error::{check_vector, Error, Result};
@@ -37,8 +38,6 @@ const RK4_A: [f64; 3] = [0.5, 0.5, 1.0];
 const RK4_B: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
 /// A state coordinate beyond this has diverged (MuJoCo's `mjMAXVAL`).
 pub const MAX_STATE: f64 = 1e10;
-/// Below this |ω| a quaternion is not turned (MuJoCo's `mjMINVAL`).
-const MIN_ANGULAR_SPEED: f64 = 1e-15;
 
 /// A scene's step: its soft-constraint dynamics and scratch space.
 #[derive(Debug, Clone)]
@@ -485,7 +484,7 @@ fn turn(quaternion: &mut [f64], omega: &Vec3, h: f64) {
         quaternion[2],
     ));
     let speed = omega.norm();
-    let rotation = if speed < MIN_ANGULAR_SPEED {
+    let rotation = if speed < TINY {
         UnitQuaternion::identity()
     } else {
         UnitQuaternion::from_axis_angle(&nalgebra::Unit::new_unchecked(omega / speed), h * speed)

@@ -27,8 +27,7 @@ use crate::model::Model;
 use crate::spatial::{Transform, Vec3};
 use crate::Data;
 
-/// Below this a mass counts as zero (MuJoCo's `mjMINVAL`).
-const TINY: f64 = 1e-15;
+use super::TINY;
 use nalgebra::DMatrix;
 
 /// The approximate inverse inertias of the file's bodies and of the degrees of freedom.
