@@ -472,13 +472,15 @@ class MimicModel(ConstrainedMethods):
     def collide(self, q: Any) -> list[dict[str, Any]]:
         return self.full.collide(self.expand(q))
 
-    def contact_forward_dynamics(self, q: Any, v: Any, tau: Any = None, ctrl: Any = None) -> dict[str, Any]:
+    def contact_forward_dynamics(
+        self, q: Any, v: Any, tau: Any = None, ctrl: Any = None, act: Any = None
+    ) -> dict[str, Any]:
         """The full model's, where no joint mimics another; MuJoCo's soft model of a coupled
         joint (an equality row) is not made yet."""
         if self.mimic_joints:
             raise bad("model", "a model without mimic joints (MuJoCo's soft couplings are not made yet)",
                       f"mimic joints {[name for name, *_ in self.mimic_joints]}")
-        return self.full.contact_forward_dynamics(q, v, tau, ctrl)
+        return self.full.contact_forward_dynamics(q, v, tau, ctrl, act)
 
     def jacobian(self, q: Any, frame: Any, reference: str = "world", out: Any = None) -> np.ndarray:
         """J_red = J G."""

@@ -56,7 +56,7 @@ ACTIVATED = """<mujoco><compiler angle="radian"/><option timestep="0.005"/>
   </actuator>
   <keyframe>
     <key name="primed" qpos="0.05 0.2 -0.3 0.1" qvel="0.1 -0.5 0.8 2" act="0.1 -0.5 0.2 0.3 0.4 0.5"
-         ctrl="0.5 3 0.1 -0.8 0.3 1 0.4 0.5"/>
+         ctrl="0.5 3 0.1 -0.8 0.3 1 0.4 1.5"/>
   </keyframe>
 </mujoco>"""
 
@@ -102,7 +102,8 @@ def test_activations_drive_the_forces_as_in_mujoco():
 @pytest.mark.parametrize("integrator", INTEGRATORS)
 def test_activations_step_as_in_mujoco(integrator):
     """From the keyframe (its q, v, ctrl and act), 100 steps of each integrator: q, v and act as
-    mj_step's, the activations clamped to their ranges as they go (the integrator's slide saturates)."""
+    mj_step's, the activations clamped to their ranges as they go (the integrator's slide saturates);
+    the filter's and the damper's controls past their ranges (implicitfast's K takes them clamped)."""
     text = with_integrator(ACTIVATED, integrator)
     model, mj_model, layout = load_both(text)
     h = model.options.timestep
@@ -140,6 +141,23 @@ def test_a_filter_and_an_integrator_follow_their_closed_forms():
     t = run.t
     assert np.allclose(run.act[:, 0], 2.0 * (1 - np.exp(-t / 0.2)), rtol=0, atol=CLOSED_FORM)
     assert np.allclose(run.act[:, 1], np.minimum(0.75 * t, 0.5), rtol=0, atol=CLOSED_FORM)
+
+
+def test_activations_robodyn_does_not_model_keep_their_places():
+    """A PID's states (one per `ki`, `slewmax`), a user's `actdim`, a muscle's: counted as MuJoCo
+    counts them, held (warned), so that a keyframe's `act` and the modelled ones line up."""
+    text = ACTIVATED.replace("<actuator>", """<actuator>
+    <pid name="pid" joint="slide" kp="1" ki="1" slewmax="2"/>
+    <general name="user" joint="slide" dyntype="user" actdim="3"/>
+    <muscle name="muscle" joint="shoulder"/>""").replace('act="0.1 ', 'act="0 0 0 0 0 0 0.1 ').replace(
+        'ctrl="0.5 ', 'ctrl="0 0 0 0.5 ')
+    model, mj_model, _ = load_both(text)
+    assert model.na == mj_model.na == 12
+    assert [w for w in model.warnings if "<pid" in w or "'user'" in w or "<muscle" in w]
+    key, mj_key = model.keyframe("primed"), mj_model.key("primed")
+    assert np.array_equal(key.act, mj_key.act)
+    rates = model.activation_rates(key.ctrl, key.act)
+    assert np.all(rates[:6] == 0.0) and rates[6] == 0.5  # the integrator: ẇ = u
 
 
 def test_bad_activations_are_refused():

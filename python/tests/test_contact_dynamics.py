@@ -652,6 +652,10 @@ SIMPLE_BODIES = """<mujoco><option cone="{cone}"/>
       <inertial pos="0 0 0" mass="1" diaginertia="0.2 0.2 0.3" quat="0.7071068 0 0 0.7071068"/></body>
     <body name="full" pos="10 0 0.5"><joint name="f" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
       <inertial pos="0 0 0" mass="1" fullinertia="0.3 0.2 0.15 0 0 0"/></body>
+    <body name="nudged" pos="11 0 0.5"><joint name="n" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
+      <geom type="box" size="0.04 0.05 0.03" pos="5e-7 0 0" quat="1 5e-7 0 0"/></body>
+    <body name="opted" pos="12 0 0.5" simple="false"><joint name="o" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
+      <geom type="sphere" size="0.04"/></body>
   </worldbody></mujoco>"""
 
 
@@ -660,16 +664,17 @@ def test_simple_bodies_weigh_one_over_their_mass_as_in_mujoco(cone):
     """MuJoCo's simple bodies need their principal axes of inertia to be their own, where its
     compiler puts them: a single geom's axes (a box turned a quarter, a capsule along x: not simple
     though diagonal), or by eigen-decomposition with the moments in decreasing order (two geoms,
-    `fullinertia`), or an `<inertial>`'s `quat`."""
+    `fullinertia`), or an `<inertial>`'s `quat`; each to MuJoCo's 1e-6 (a geom 5e-7 off and turned by
+    1e-6 rad still is); `simple="false"` turns it off."""
     model, mj_model, layout = load_both(SIMPLE_BODIES.replace("{cone}", cone))
     simple = {mj_model.body(i).name for i in range(1, mj_model.nbody) if mj_model.body_simple[i] == 2}
-    assert simple == {"puck", "slider", "decreasing", "full"}
+    assert simple == {"puck", "slider", "decreasing", "full", "nudged"}
     rng = np.random.default_rng(2)
     for case in range(3):
         qpos = mj_model.qpos0 + rng.normal(size=mj_model.nq) * 0.05
         _, expected = assert_matches_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv), label=f"case {case}")
         # each new slide has a limit row at least (its weight 1/m when simple, else 1/(m + armature))
-        assert expected["row_types"].count("limit_joint") >= 4 + 6
+        assert expected["row_types"].count("limit_joint") >= 4 + 8
 
 
 # --- 8b. URDF mimic joints --------------------------------------------------------------------

@@ -10,7 +10,8 @@
 //! clamped to `forcerange` when limited, and it adds `g f` to the joint's generalised force, whose
 //! total is clamped to the joint's `actuatorfrcrange` where it has one. A
 //! `motor` has a = (1, 0, 0), b = 0; a `position` a = (k_p, 0, 0), b = (0, −k_p, −k_v); a `velocity`
-//! a = (k_v, 0, 0), b = (0, 0, −k_v). Inputs: q, q̇, the controls (nu). Cost: O(nu).
+//! a = (k_v, 0, 0), b = (0, 0, −k_v). Inputs: q, q̇, the controls (nu), the activations (na).
+//! Cost: O(nu).
 //!
 //! §Activation dynamics: an actuator with a `dyntype` other than none has a state w (MuJoCo's
 //! `act`, one per such actuator, in the actuators' order) that replaces u in the force, and
@@ -48,9 +49,12 @@ pub enum ActivationDynamics {
         /// τ (s).
         time_constant: f64,
     },
-    /// An activation robodyn does not model (a muscle's, a user's): ẇ = 0, it keeps its place
-    /// among the activations.
-    Held,
+    /// Activations robodyn does not model (a muscle's, a user's, a PID's): ẇ = 0, they keep
+    /// their places among the activations.
+    Held {
+        /// How many (MuJoCo's `actdim`).
+        states: usize,
+    },
 }
 
 /// One actuator: a joint transmission, an affine gain and bias, optional ranges.
@@ -96,7 +100,7 @@ impl ActivationDynamics {
             ActivationDynamics::Integrator => "integrator",
             ActivationDynamics::Filter { .. } => "filter",
             ActivationDynamics::FilterExact { .. } => "filterexact",
-            ActivationDynamics::Held => "muscle or user",
+            ActivationDynamics::Held { .. } => "muscle, user or pid",
         }
     }
 }
@@ -112,10 +116,19 @@ impl Actuator {
         self.dynamics != ActivationDynamics::None
     }
 
+    /// How many activations it has (MuJoCo's `actuator_actnum`): 1 with modelled dynamics.
+    pub fn activation_count(&self) -> usize {
+        match self.dynamics {
+            ActivationDynamics::None => 0,
+            ActivationDynamics::Held { states } => states,
+            _ => 1,
+        }
+    }
+
     /// ẇ at activation `w` under the control `u` (already clamped); 0 without activation.
     pub fn activation_rate(&self, u: f64, w: f64) -> f64 {
         match self.dynamics {
-            ActivationDynamics::None | ActivationDynamics::Held => 0.0,
+            ActivationDynamics::None | ActivationDynamics::Held { .. } => 0.0,
             ActivationDynamics::Integrator => u,
             // ẇ = (u − w)/τ
             ActivationDynamics::Filter { time_constant }
@@ -125,9 +138,11 @@ impl Actuator {
         }
     }
 
-    /// w₁: the activation after a step `h` from `w` at the rate `rate`, clamped to its range.
+    /// w₁: the activation after a step `h` from `w` at the rate `rate`, clamped to its range
+    /// (held where robodyn does not model it).
     pub fn next_activation(&self, w: f64, rate: f64, h: f64) -> f64 {
         let next = match self.dynamics {
+            ActivationDynamics::Held { .. } => return w,
             // w₁ = w + ẇ τ (1 − e^(−h/τ))
             ActivationDynamics::FilterExact { time_constant } => {
                 let tau = time_constant.max(MIN_TIME_CONSTANT);
@@ -196,39 +211,48 @@ impl Model {
         self.actuators.len()
     }
 
-    /// na: the number of activations (MuJoCo's `act`), one per actuator with activation
-    /// dynamics.
+    /// na: the number of activations (MuJoCo's `act`), in the actuators' order.
     pub fn na(&self) -> usize {
-        self.actuators.iter().filter(|a| a.has_activation()).count()
+        self.actuators.iter().map(Actuator::activation_count).sum()
     }
 
-    /// Each actuator with its control u and its activation w (0 for one without): the
-    /// actuators zipped with `ctrl` (nu) and `act` (na) in order.
+    /// Each actuator with the first of its activations in `act` (na).
+    fn activation_slots(&self) -> impl Iterator<Item = (&Actuator, usize)> + '_ {
+        self.actuators.iter().scan(0, |first, actuator| {
+            let slot = *first;
+            *first += actuator.activation_count();
+            Some((actuator, slot))
+        })
+    }
+
+    /// Each actuator with its control u and its activation w (its last; 0 for one without):
+    /// the actuators zipped with `ctrl` (nu) and `act` (na) in order.
     pub fn actuator_states<'a>(
         &'a self,
         ctrl: &'a [f64],
         act: &'a [f64],
     ) -> impl Iterator<Item = (&'a Actuator, f64, f64)> + 'a {
-        let mut activations = act.iter();
-        self.actuators.iter().zip(ctrl).map(move |(actuator, &u)| {
-            let w = match actuator.has_activation() {
-                true => *activations.next().expect("act has na entries"),
-                false => 0.0,
-            };
-            (actuator, u, w)
-        })
+        self.activation_slots()
+            .zip(ctrl)
+            .map(move |((actuator, slot), &u)| {
+                let w = match actuator.activation_count() {
+                    0 => 0.0,
+                    count => act[slot + count - 1],
+                };
+                (actuator, u, w)
+            })
     }
 
     /// ẇ (na) at the controls `ctrl` (nu) and activations `act` (na), into `rates`: MuJoCo's
-    /// `act_dot`.
+    /// `act_dot` (0 for the activations robodyn holds).
     pub fn activation_rates(&self, ctrl: &[f64], act: &[f64], rates: &mut [f64]) -> Result<()> {
         check_vector("ctrl", ctrl, self.nu())?;
         check_vector("act", act, self.na())?;
-        let stateful = self
-            .actuator_states(ctrl, act)
-            .filter(|(a, ..)| a.has_activation());
-        for (rate, (actuator, u, w)) in rates.iter_mut().zip(stateful) {
-            *rate = actuator.activation_rate(actuator.clamp_control(u), w);
+        rates.fill(0.0);
+        for ((actuator, slot), &u) in self.activation_slots().zip(ctrl) {
+            if actuator.activation_count() == 1 {
+                rates[slot] = actuator.activation_rate(actuator.clamp_control(u), act[slot]);
+            }
         }
         Ok(())
     }
@@ -236,9 +260,10 @@ impl Model {
     /// w₁ = w ⊞ h ẇ for each activation in `act` at the rates `rates` (na), clamped to their
     /// ranges (MuJoCo's `mj_advance` on `act`).
     pub fn advance_activations(&self, act: &mut [f64], rates: &[f64], h: f64) {
-        let stateful = self.actuators.iter().filter(|a| a.has_activation());
-        for ((w, rate), actuator) in act.iter_mut().zip(rates).zip(stateful) {
-            *w = actuator.next_activation(*w, *rate, h);
+        for (actuator, slot) in self.activation_slots() {
+            for k in slot..slot + actuator.activation_count() {
+                act[k] = actuator.next_activation(act[k], rates[k], h);
+            }
         }
     }
 

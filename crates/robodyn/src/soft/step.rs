@@ -327,9 +327,7 @@ fn velocity_derivative(
                 .force_range
                 .is_some_and(|(low, high)| force <= low || force >= high);
             if !clamped {
-                // MuJoCo's derivative takes the control unclamped
-                let gained = if actuator.has_activation() { input } else { u };
-                let slope = actuator.bias[2] + actuator.gain[2] * gained;
+                let slope = actuator.bias[2] + actuator.gain[2] * input;
                 for (a, _, arm_a) in model.actuator_arms(actuator) {
                     for (b, _, arm_b) in model.actuator_arms(actuator) {
                         k[(a, b)] += slope * arm_a * arm_b;

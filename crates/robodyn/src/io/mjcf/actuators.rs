@@ -175,7 +175,9 @@ impl<'a> Reader<'a> {
                     }
                     Some(other) => {
                         // its activation keeps its place among the activations
-                        actuator.dynamics = ActivationDynamics::Held;
+                        let states = self.numbers::<1>(element, "main", "actdim")?;
+                        let states = states.map_or(1, |[n]| n.max(0.0) as usize);
+                        actuator.dynamics = ActivationDynamics::Held { states };
                         return unmodelled(actuator, format!("dyntype '{other}'"));
                     }
                 }
@@ -199,10 +201,21 @@ impl<'a> Reader<'a> {
             }
             "muscle" => {
                 // its activation keeps its place among the activations
-                actuator.dynamics = ActivationDynamics::Held;
+                actuator.dynamics = ActivationDynamics::Held { states: 1 };
                 return unmodelled(actuator, "<muscle>".into());
             }
-            "pid" | "dcmotor" | "plugin" => {
+            "pid" => {
+                // an integral state with `ki`, a slew state with `slewmax`
+                let states = ["ki", "slewmax"]
+                    .iter()
+                    .map(|name| scalar(name, 0.0).map(|x| usize::from(x != 0.0)))
+                    .sum::<Result<usize>>()?;
+                if states > 0 {
+                    actuator.dynamics = ActivationDynamics::Held { states };
+                }
+                return unmodelled(actuator, "<pid>".into());
+            }
+            "dcmotor" | "plugin" => {
                 let why =
                     format!("<{tag}>; its activation states, if any, are not in robodyn's act");
                 return unmodelled(actuator, why);

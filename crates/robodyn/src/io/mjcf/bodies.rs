@@ -230,10 +230,10 @@ impl<'a> Reader<'a> {
                     )
                     + to_frame.translation
             };
-            let aligned = axis.iter().filter(|x| x.abs() > SIMPLE_TOLERANCE).count() == 1;
+            let aligned = axis.iter().filter(|x| x.abs() > AXIS_TOLERANCE).count() == 1;
             only_aligned_slides &= matches!(joint, Joint::Prismatic { .. })
                 && aligned
-                && position.norm() <= SIMPLE_TOLERANCE;
+                && position.abs().max() < FRAME_TOLERANCE;
             let scalar = |key: &str, default: f64| -> Result<f64> {
                 Ok(self
                     .numbers::<1>(*joint_node, joint_class, key)?
@@ -347,9 +347,11 @@ impl<'a> Reader<'a> {
             builder.add_frame(&name, body, to_body);
         }
         self.record_source_mass(source_body, body, &inertia, &to_body);
+        // `simple="false"`: the file turns MuJoCo's simple-body shortcut off
         self.source_bodies.borrow_mut()[source_body].simple = only_aligned_slides
             && self.placed_simply(parent_source, parent)
-            && own_frame(&inertia, axes);
+            && own_frame(&inertia, axes)
+            && node.attribute("simple") != Some("false");
         self.add_geoms(
             builder,
             &elements,
@@ -442,29 +444,48 @@ impl<'a> Reader<'a> {
     }
 }
 
-/// Below this a joint's offset (m) or an axis component counts as zero for MuJoCo's simple
-/// bodies (its `mjEPS`).
-const SIMPLE_TOLERANCE: f64 = 1e-14;
+/// Below this an axis component counts as zero for MuJoCo's simple bodies (its `mjEPS`).
+const AXIS_TOLERANCE: f64 = 1e-14;
+/// Below this, entry by entry, a position (m) or a quaternion is the null pose for MuJoCo's simple
+/// bodies (its compiler's `kFrameEps`).
+const FRAME_TOLERANCE: f64 = 1e-6;
+/// At most this many sweeps find a body's principal axes (a 3 × 3 tensor takes a handful).
+const EIGEN_ITERATIONS: usize = 100;
 
 /// Whether a body's inertia frame is its own (MuJoCo's `sameframe`): its centre of mass at its
 /// origin and its principal axes, where MuJoCo's compiler puts them (`axes`), its own: the axes
 /// given turned by nothing (a quarter turn that keeps the tensor diagonal still turns them), or,
-/// found by eigen-decomposition, the tensor diagonal in its axes (to 1e-12 of its trace) with the
-/// moments in decreasing order (else MuJoCo's axes are a permutation of the body's).
+/// found by eigen-decomposition, the moments in decreasing order along the body's axes (else
+/// MuJoCo's axes are a permutation of the body's); each to [`FRAME_TOLERANCE`] entry by entry.
 fn own_frame(inertia: &Inertia, axes: InertiaAxes) -> bool {
-    let r = &inertia.rotational;
-    let scale = 1e-12 * r.trace().abs().max(f64::MIN_POSITIVE);
-    let centred = inertia.first_moment.norm() <= SIMPLE_TOLERANCE * inertia.mass.max(1.0);
-    let aligned = match axes {
-        InertiaAxes::Given(rotation) => {
-            (rotation - Mat3::identity()).abs().max() <= SIMPLE_TOLERANCE
-        }
+    let centre = inertia.first_moment / inertia.mass.max(f64::MIN_POSITIVE);
+    if centre.abs().max() >= FRAME_TOLERANCE {
+        return false;
+    }
+    let rotation = match axes {
+        InertiaAxes::Given(rotation) => rotation,
         InertiaAxes::Principal => {
-            let off_diagonal = [r[(0, 1)], r[(0, 2)], r[(1, 2)]];
-            off_diagonal.iter().all(|x| x.abs() <= scale)
-                && r[(0, 0)] >= r[(1, 1)] - scale
-                && r[(1, 1)] >= r[(2, 2)] - scale
+            // the eigenvectors by decreasing moment, each turned towards its body axis
+            let Some(eigen) = inertia
+                .rotational
+                .try_symmetric_eigen(f64::EPSILON, EIGEN_ITERATIONS)
+            else {
+                return false;
+            };
+            let mut order = [0, 1, 2];
+            order.sort_by(|&a, &b| eigen.eigenvalues[b].total_cmp(&eigen.eigenvalues[a]));
+            Mat3::from_fn(|r, c| {
+                let column = eigen.eigenvectors.column(order[c]);
+                column[r] * column[c].signum()
+            })
         }
     };
-    centred && aligned
+    // a permutation of the axes may be a reflection, which no quaternion is; q and −q are one turn
+    let q = UnitQuaternion::from_matrix(&rotation);
+    let null = |w: f64| {
+        [q.w - w, q.i, q.j, q.k]
+            .iter()
+            .all(|x| x.abs() < FRAME_TOLERANCE)
+    };
+    rotation.determinant() > 0.0 && (null(1.0) || null(-1.0))
 }
