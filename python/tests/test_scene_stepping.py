@@ -14,8 +14,6 @@ from conftest import REPOSITORY, load_quietly
 from robodyn.convert import MujocoLayout
 from test_contact_dynamics import (
     ARM,
-    EQUALITIES,
-    TENDONS,
     FLAGGED,
     SUITE,
     box_scene,
@@ -25,6 +23,7 @@ from test_contact_dynamics import (
     without_unmodelled,
 )
 from test_menagerie import MENAGERIE, mujoco_model
+from test_soft_elements import EQUALITIES, TENDONS
 
 STEPS = 100
 # 100 steps without elliptic friction: the same arithmetic in another order; measured up to 1.1e-12
@@ -139,7 +138,7 @@ def test_an_arm_with_limits_friction_and_actuators_steps_as_in_mujoco(integrator
 
 @pytest.mark.parametrize("integrator", INTEGRATORS)
 def test_equality_constraints_step_as_in_mujoco(integrator):
-    """test_contact_dynamics's equalities of every kind (welds, connects, joint couplings; the ball on
+    """test_soft_elements's equalities of every kind (welds, connects, joint couplings; the ball on
     the floor), set moving: their rows' J̇ q̇ and softness through 100 steps."""
     model, mj_model, layout = load_both(text=with_integrator(EQUALITIES.replace("{cone}", "pyramidal"), integrator))
     qvel = np.random.default_rng(7).normal(size=mj_model.nv)
@@ -148,7 +147,7 @@ def test_equality_constraints_step_as_in_mujoco(integrator):
 
 @pytest.mark.parametrize("integrator", INTEGRATORS)
 def test_fixed_tendons_step_as_in_mujoco(integrator):
-    """test_contact_dynamics's tendon arm under steady controls: tendon dampers explicit in Euler (only
+    """test_soft_elements's tendon arm under steady controls: tendon dampers explicit in Euler (only
     the joints' are implicit there), in implicitfast's K with the tendon actuators' velocity gains."""
     model, mj_model, layout = load_both(text=with_integrator(TENDONS.replace("{cone}", "pyramidal"), integrator))
     qvel = np.random.default_rng(7).normal(size=mj_model.nv)

@@ -1,0 +1,265 @@
+"""MuJoCo's soft model beyond contacts and joints (`m.contact_forward_dynamics` against `mj_forward`,
+as in test_contact_dynamics.py): equality constraints of every kind robodyn reads, fixed tendons
+(limits, friction, springs, equalities, actuators), rows' ids past what robodyn does not read,
+MuJoCo's simple bodies, and a URDF's mimic joints as joint equalities.
+
+MuJoCo solves to convergence here (`converged`: Newton, tolerance 1e-15)."""
+
+import mujoco
+import numpy as np
+import pytest
+from conftest import assert_close, load_quietly
+from test_contact_dynamics import ROW_AGREEMENT, assert_matches_mujoco, load_both
+
+# --- 6. equality constraints ------------------------------------------------------------------
+
+# Every kind of MuJoCo equality robodyn reads: a weld between an arm and a free box (torquescale 2,
+# its own solref), a free ball's point connected to the world, two sites connected (their own
+# solimp), a site welded to a world site, a ball joint welded to the world at a relpose, a slide
+# following a hinge by a polynomial, a hinge held, and an inactive connect; the ball rests on the
+# floor.
+EQUALITIES = """<mujoco><option timestep="0.002" cone="{cone}"/>
+  <worldbody>
+    <geom name="floor" type="plane" size="0 0 1"/>
+    <site name="post" pos="0.5 -1 1.5"/>
+    <body name="arm" pos="0 0 1"><joint name="shoulder" axis="0 1 0"/>
+      <geom type="capsule" fromto="0 0 0 .5 0 0" size=".05"/>
+      <body name="fore" pos=".5 0 0" euler="10 20 30">
+        <joint name="elbow" axis="0 0 1"/><joint name="slide" type="slide" axis="1 0 0"/>
+        <geom type="box" size=".2 .05 .05" pos=".2 0 0"/></body></body>
+    <body name="box" pos="1 .3 1.2" euler="5 -10 40"><freejoint/>
+      <geom name="box" type="box" size=".1 .2 .3" mass="2"/>
+      <site name="corner" pos=".1 .2 .3"/></body>
+    <body name="ball" pos="-1 0 0.09"><freejoint/><geom name="ball" type="sphere" size=".1"/>
+      <site name="top" pos="0 0 .1"/></body>
+    <body name="pendulum" pos="0.5 -1 2"><joint name="swing" axis="1 0 0"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -.5" size=".03"/>
+      <body name="bob" pos="0 0 -.5"><joint name="twist" axis="0 0 1"/><geom type="sphere" size=".06"/>
+        <site name="tip" pos="0 0 0" euler="0 0 15"/></body></body>
+    <body name="lever" pos="-1 1 1"><joint name="lever" type="ball"/><geom type="box" size=".3 .02 .02" pos=".3 0 0"/></body>
+  </worldbody>
+  <equality>
+    <weld body1="fore" body2="box" torquescale="2" solref="0.03 0.8"/>
+    <connect body1="ball" anchor="0 0 .1"/>
+    <connect site1="top" site2="corner" solimp="0.8 0.95 0.01 0.4 3"/>
+    <weld site1="tip" site2="post"/>
+    <weld body1="lever" anchor="-1 1 1" relpose="0 0 0 0.9 0.1 0 0"/>
+    <joint joint1="slide" joint2="shoulder" polycoef="0.1 0.5 0.2 0 0"/>
+    <joint joint1="elbow" polycoef="0.2 0 0 0 0"/>
+    <connect body1="arm" body2="lever" anchor="0 0 0" active="false"/>
+  </equality></mujoco>"""
+EQUALITY_ROWS = 6 + 3 + 3 + 6 + 6 + 1 + 1
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+def test_equality_constraints_as_in_mujoco(cone):
+    """The equality rows (MuJoCo's first block: per equality, its rows' Jacobian, R from the bodies'
+    or joints' weights and the impedance of the norm of its error, a_ref with the weld's and
+    connect's J̇ q̇) and the solution with them, at random states away from qpos0."""
+    model, mj_model, layout = load_both(EQUALITIES.replace("{cone}", cone))
+    rng = np.random.default_rng(6)
+    ball_height = mj_model.jnt_qposadr[mj_model.body("ball").jntadr[0]] + 2
+    for case in range(4):
+        qpos = mj_model.qpos0.copy()
+        mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.1, 1.0)
+        qpos[ball_height] = 0.08
+        ours, _ = assert_matches_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv),
+                                        tau=rng.normal(size=mj_model.nv), label=f"{cone} case {case}")
+        kinds = list(ours["row_types"])
+        assert kinds[:EQUALITY_ROWS] == ["equality"] * EQUALITY_ROWS and "equality" not in kinds[EQUALITY_ROWS:]
+        assert 7 not in list(ours["row_ids"])[:EQUALITY_ROWS], "the inactive connect has no rows"
+        assert any(kind.startswith("contact") for kind in kinds), "the ball touches the floor"
+
+
+def test_a_disabled_equality_flag_drops_the_rows():
+    """<flag equality="disable">: no equality rows, as in MuJoCo."""
+    text = EQUALITIES.replace('cone="{cone}"/>', 'cone="pyramidal"><flag equality="disable"/></option>')
+    model, mj_model, layout = load_both(text)
+    ours, _ = assert_matches_mujoco(model, mj_model, layout, mj_model.qpos0, np.ones(mj_model.nv))
+    assert "equality" not in list(ours["row_types"])
+
+
+# --- 7. fixed tendons -------------------------------------------------------------------------
+
+# An arm whose fixed tendons carry every part robodyn reads: limits (one with a margin, one from a
+# class), dry friction with its own solreffriction, dampers, a spring with a dead band and one at
+# the joints' springref, two tendon equalities (one coupling two tendons by a polynomial) after an
+# inactive joint equality, and motor, position (inheritrange) and general (affine, forcerange,
+# damping) actuators on tendons.
+TENDONS = """<mujoco><option timestep="0.002" cone="{cone}"/>
+  <default><tendon solreflimit="0.03 0.9"/><default class="stiff"><tendon stiffness="40" springlength="0.1 0.3"/></default></default>
+  <worldbody>
+    <body name="upper" pos="0 0 1"><joint name="shoulder" axis="0 1 0" springref="20" damping="0.1"/>
+      <geom name="upper" type="capsule" fromto="0 0 0 .4 0 0" size=".04"/>
+      <body name="lower" pos=".4 0 0"><joint name="elbow" axis="0 1 0" ref="10"/>
+        <joint name="reach" type="slide" axis="1 0 0" range="-.1 .2"/>
+        <geom name="lower" type="capsule" fromto="0 0 0 .3 0 0" size=".03"/>
+        <body name="hand" pos=".3 0 0"><joint name="wrist" axis="0 0 1" springref="25"/>
+          <geom name="hand" type="box" size=".05 .03 .02"/></body></body></body>
+  </worldbody>
+  <tendon>
+    <fixed name="flex" range="-0.4 0.5" margin="0.05" frictionloss="0.3" damping="0.7" solreffriction="0.05 1">
+      <joint joint="shoulder" coef="1"/><joint joint="elbow" coef="-0.5"/></fixed>
+    <fixed name="span" class="stiff" limited="true" range="-0.05 0.25">
+      <joint joint="elbow" coef="0.3"/><joint joint="reach" coef="2"/></fixed>
+    <fixed name="twist" damping="0.2"><joint joint="wrist" coef="1"/><joint joint="shoulder" coef="0.2"/></fixed>
+    <fixed name="rest" stiffness="5"><joint joint="wrist" coef="-1"/></fixed>
+  </tendon>
+  <equality>
+    <joint joint1="wrist" joint2="shoulder" polycoef="0 0.1 0 0 0" active="false"/>
+    <tendon name="pair" tendon1="twist" tendon2="flex" polycoef="0.05 0.4 -0.3 0 0" solref="0.02 0.7"/>
+    <tendon tendon1="rest" polycoef="0.1 0 0 0 0"/>
+  </equality>
+  <actuator>
+    <motor tendon="flex" gear="2" ctrlrange="-1 1"/>
+    <position tendon="span" kp="30" kv="2" inheritrange="1"/>
+    <general tendon="twist" gainprm="3 0.5 0.2" gaintype="affine" biasprm="0.1 -1 -0.5" biastype="affine" forcerange="-2 2" damping="0.3"/>
+    <velocity joint="shoulder" kv="0.5"/>
+  </actuator>
+</mujoco>"""
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+def test_fixed_tendons_as_in_mujoco(cone):
+    """Tendon friction and limit rows (after the dofs' and the joints'), tendon equality rows (ids in
+    the file's order), tendon springs and dampers in q̈₀, tendon actuators, against MuJoCo."""
+    model, mj_model, layout = load_both(TENDONS.replace("{cone}", cone))
+    assert model.tendon_names == ["flex", "span", "twist", "rest"]
+    rng, kinds = np.random.default_rng(3), set()
+    for case in range(12):
+        qpos = mj_model.qpos0 + rng.normal(size=mj_model.nq) * 0.4
+        qvel, tau = rng.normal(size=mj_model.nv), rng.normal(size=mj_model.nv)
+        ours, _ = assert_matches_mujoco(model, mj_model, layout, qpos, qvel, tau, rng.uniform(-1.5, 1.5, size=mj_model.nu),
+                                        label=f"{cone} case {case}")
+        kinds |= {(kind, int(i)) for kind, i in zip(ours["row_types"], ours["row_ids"])}
+    assert {("equality", 1), ("equality", 2), ("friction_tendon", 0), ("limit_tendon", 0), ("limit_tendon", 1)} <= kinds
+
+
+def test_tendon_lengths_as_in_mujoco():
+    """m.tendon_lengths(q) is MuJoCo's ten_length, one state and a batch."""
+    model, mj_model, layout = load_both(TENDONS.replace("{cone}", "pyramidal"))
+    rng, d = np.random.default_rng(8), mujoco.MjData(mj_model)
+    states = [mj_model.qpos0 + rng.normal(size=mj_model.nq) for _ in range(3)]
+    expected = []
+    for qpos in states:
+        d.qpos[:] = qpos
+        mujoco.mj_fwdPosition(mj_model, d)
+        expected.append(d.ten_length.copy())
+    batch = model.tendon_lengths(np.array([layout.q_from_mujoco(qpos) for qpos in states]))
+    assert_close(batch, np.array(expected), ROW_AGREEMENT, "batch")
+    assert_close(model.tendon_lengths(layout.q_from_mujoco(states[0])), expected[0], ROW_AGREEMENT, "one")
+
+
+SKIPPED_ELEMENTS = """<mujoco><option timestep="0.002"/>
+  <worldbody>
+    <site name="s0" pos="0 0 1.5"/>
+    <body name="a" pos="0 0 1"><joint name="j1" axis="0 1 0" range="-1 1"/>
+      <geom type="capsule" fromto="0 0 0 .3 0 0" size=".03"/>
+      <body name="b" pos=".3 0 0"><joint name="j2" axis="0 1 0"/>
+        <geom type="capsule" fromto="0 0 0 .3 0 0" size=".03"/><site name="s2" pos=".3 0 0"/></body></body>
+  </worldbody>
+  <tendon>
+    <spatial name="rope"><site site="s0"/><site site="s2"/></spatial>
+    <fixed name="idle" frictionloss="0.5" range="-0.1 0.1" margin="0.5"><joint joint="j1" coef="0"/></fixed>
+    <fixed name="pair" frictionloss="0.2" range="-0.1 0.1"><joint joint="j1" coef="1"/><joint joint="j2" coef="0.5"/></fixed>
+  </tendon>
+  <equality>
+    <tendon tendon1="rope" active="false"/>
+    <joint joint1="j2" joint2="j1" polycoef="0 0.5 0 0 0"/>
+  </equality>
+</mujoco>"""
+
+
+def test_rows_carry_mujocos_ids_past_what_robodyn_does_not_read():
+    """A spatial tendon (not read) before the fixed ones, and its equality before a joint equality:
+    the rows' ids are still MuJoCo's (tendon 2, equality 1); a tendon whose Jacobian is zero has no
+    rows, as in MuJoCo (its friction and its limit within the margin)."""
+    model, mj_model, layout = load_both(SKIPPED_ELEMENTS)
+    _, expected = assert_matches_mujoco(model, mj_model, layout, np.array([0.3, -0.2]), np.array([0.4, -1.0]))
+    assert expected["row_types"] == ["equality", "friction_tendon", "limit_joint", "limit_tendon"]
+    assert list(expected["row_ids"]) == [1, 2, 0, 2]
+
+
+# --- 8. MuJoCo's simple bodies -------------------------------------------------------------------
+
+# Bodies MuJoCo calls simple (body_simple 2: only axis-aligned slides at their origin, their inertia
+# frame their own, no child, under the world or a jointless child of it) weigh 1/m in R, for their
+# contacts and their slides' limits (with armature: not M⁻¹'s diagonal); and four that are not (a
+# box turned in its body, a slide off the origin, a parent, the fixed stand).
+SIMPLE_BODIES = """<mujoco><option cone="{cone}"/>
+  <worldbody>
+    <geom name="floor" type="plane" size="0 0 1"/>
+    <body name="puck" pos="0 0 0.049"><joint name="px" type="slide" axis="1 0 0" armature="0.3" range="-0.1 0.1" margin="0.2"/>
+      <joint name="py" type="slide" axis="0 1 0"/><geom name="puck" type="cylinder" size="0.1 0.05"/></body>
+    <body name="stand" pos="1 0 0"><geom type="box" size=".05 .05 .05" pos="0 0 .5"/>
+      <body name="slider" pos="0 0 0.039"><joint name="sz" type="slide" axis="0 0 1" range="-0.05 0.1" margin="0.2" armature="0.1"/>
+        <geom name="slider" type="box" size="0.04 0.04 0.04"/></body></body>
+    <body name="tilted" pos="2 0 0.039"><joint name="tx" type="slide" axis="1 0 0"/><joint name="ty" type="slide" axis="0 1 0"/>
+      <geom name="tilted" type="box" size="0.04 0.05 0.04" euler="0 0 30"/></body>
+    <body name="offset" pos="3 0 0.039"><joint name="ox" type="slide" axis="1 0 0" pos="0.1 0 0"/>
+      <geom name="offset" type="sphere" size="0.04"/></body>
+    <body name="parent" pos="4 0 0.039"><joint name="qx" type="slide" axis="1 0 0"/><geom name="parent" type="sphere" size="0.04"/>
+      <body name="child" pos="0 0.2 0"><geom name="child" type="sphere" size="0.04"/></body></body>
+    <body name="turned" pos="5 0 0.5"><joint name="u" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
+      <geom type="box" size="0.04 0.05 0.04" euler="0 0 90"/></body>
+    <body name="rod" pos="6 0 0.5"><joint name="r" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
+      <geom type="capsule" fromto="-0.05 0 0 0.05 0 0" size="0.02"/></body>
+    <body name="decreasing" pos="7 0 0.5"><joint name="d" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
+      <geom type="box" size="0.02 0.04 0.06"/><geom type="box" size="0.02 0.04 0.03"/></body>
+    <body name="increasing" pos="8 0 0.5"><joint name="i" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
+      <geom type="box" size="0.06 0.04 0.02"/><geom type="box" size="0.03 0.04 0.02"/></body>
+    <body name="given" pos="9 0 0.5"><joint name="g" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
+      <inertial pos="0 0 0" mass="1" diaginertia="0.2 0.2 0.3" quat="0.7071068 0 0 0.7071068"/></body>
+    <body name="full" pos="10 0 0.5"><joint name="f" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
+      <inertial pos="0 0 0" mass="1" fullinertia="0.3 0.2 0.15 0 0 0"/></body>
+    <body name="nudged" pos="11 0 0.5"><joint name="n" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
+      <geom type="box" size="0.04 0.05 0.03" pos="5e-7 0 0" quat="1 5e-7 0 0"/></body>
+    <body name="opted" pos="12 0 0.5" simple="false"><joint name="o" type="slide" axis="1 0 0" range="-0.1 0.1" margin="0.2" armature="0.1"/>
+      <geom type="sphere" size="0.04"/></body>
+  </worldbody></mujoco>"""
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+def test_simple_bodies_weigh_one_over_their_mass_as_in_mujoco(cone):
+    """MuJoCo's simple bodies need their principal axes of inertia to be their own, where its
+    compiler puts them: a single geom's axes (a box turned a quarter, a capsule along x: not simple
+    though diagonal), or by eigen-decomposition with the moments in decreasing order (two geoms,
+    `fullinertia`), or an `<inertial>`'s `quat`; each to MuJoCo's 1e-6 (a geom 5e-7 off and turned by
+    1e-6 rad still is); `simple="false"` turns it off."""
+    model, mj_model, layout = load_both(SIMPLE_BODIES.replace("{cone}", cone))
+    simple = {mj_model.body(i).name for i in range(1, mj_model.nbody) if mj_model.body_simple[i] == 2}
+    assert simple == {"puck", "slider", "decreasing", "full", "nudged"}
+    rng = np.random.default_rng(2)
+    for case in range(3):
+        qpos = mj_model.qpos0 + rng.normal(size=mj_model.nq) * 0.05
+        _, expected = assert_matches_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv), label=f"case {case}")
+        # each new slide has a limit row at least (its weight 1/m when simple, else 1/(m + armature))
+        assert expected["row_types"].count("limit_joint") >= 4 + 8
+
+
+# --- 8b. URDF mimic joints --------------------------------------------------------------------
+
+
+def test_urdf_mimic_joints_are_soft_joint_equalities(tmp_path):
+    """A URDF's mimic relations (held by m.constraints) are MuJoCo joint equalities in the soft model,
+    with MuJoCo's default solref and solimp: one equality row each, J = e_follower − multiplier
+    e_leader, its position the relation's violation; no file bodies are needed."""
+    from test_mimic import GRIPPER
+
+    path = tmp_path / "gripper.urdf"
+    path.write_text(GRIPPER)
+    model = load_quietly(path)
+    couplings = list(model.constraints)
+    assert len(couplings) >= 2
+    rng = np.random.default_rng(9)
+    q, v = rng.normal(size=model.nq), rng.normal(size=model.nv)
+    result = model.contact_forward_dynamics(q, v)
+    equality = [k for k, kind in enumerate(result["row_types"]) if kind == "equality"]
+    assert len(equality) == len(couplings)
+    jacobian = np.asarray(result["jacobian"])[equality]
+    names = model.joint_names
+    thumb, wrist = (model.joint_idx_v[names.index(n)] for n in ("thumb", "wrist"))
+    row = jacobian[0]
+    assert row[thumb] == 1.0 and row[wrist] == -0.5 and np.count_nonzero(row) == 2
+    # the relation's violation is the row's position: its force pulls it back (f = −(J q̈ − a_ref)/R)
+    assert np.all(np.isfinite(result["forces"])) and np.all(np.asarray(result["R"])[equality] > 0)
