@@ -127,3 +127,108 @@ def test_what_is_not_modelled_warns_and_bad_input_is_refused():
     with pytest.raises(ValueError):
         mujoco.MjModel.from_xml_string(text)
     assert robodyn.load("ur5").nu == 0
+
+
+#: Two hinges under gravity (one limited, with armature), a fixed tendon across both; `{defaults}`
+#: and `{actuator}` filled in by each case of ACTUATOR_DEFAULTS.
+DEFAULTS_ARM = """<mujoco><compiler angle="radian"/>
+  <default>{defaults}</default>
+  <worldbody>
+    <body name="upper">
+      <joint name="j" axis="0 1 0" range="-1 2" armature="0.1"/>
+      <geom type="capsule" fromto="0 0 0 0.4 0 0" size="0.03"/>
+      <body name="fore" pos="0.4 0 0">
+        <joint name="j2" axis="0 1 0"/>
+        <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.025"/>
+      </body>
+    </body>
+  </worldbody>
+  <tendon><fixed name="t"><joint joint="j" coef="1"/><joint joint="j2" coef="0.5"/></fixed></tendon>
+  <actuator>{actuator}</actuator>
+</mujoco>"""
+
+#: (a class's actuator defaults, an actuator): what MuJoCo's rule passes on. A class has one
+#: actuator default; a shortcut takes its parameters only from a default written with the same
+#: shortcut or a `general` of its gain type (nearest class first), mechanical ones (ranges, gear)
+#: from any; a `general` takes the raw parameters whatever wrote them; damping ratios.
+ACTUATOR_DEFAULTS = [
+    ('<position kp="10"/>', '<velocity joint="j"/>'),
+    ('<position kp="10"/>', '<motor joint="j"/>'),
+    ('<position kp="10" kv="2"/>', '<general joint="j"/>'),
+    ('<position kp="3" timeconst="0.2"/>', '<general joint="j"/>'),
+    ('<position kp="3"/><velocity kv="5"/>', '<position joint="j"/>'),
+    ('<velocity kv="5"/><position kp="3"/>', '<position joint="j"/>'),
+    ('<position kp="3"/><default class="c"><velocity kv="5"/></default>', '<position joint="j" class="c"/>'),
+    ('<position kp="3" kv="2"/><default class="c"><position timeconst="0.5"/></default>',
+     '<position joint="j" class="c"/>'),
+    ('<position kp="3"/><general dyntype="filter"/>', '<velocity joint="j"/>'),
+    ('<general gaintype="affine"/><default class="c"><general gainprm="5"/></default>',
+     '<position joint="j" class="c"/>'),
+    ('<position kp="3"/><default class="c"><general gaintype="affine" gainprm="5"/></default>',
+     '<position joint="j" class="c"/>'),
+    ('<general gainprm="400" biastype="affine" biasprm="0 -400 -10"/>', '<position joint="j"/>'),
+    ('<general gainprm="400" biastype="affine" biasprm="0 -400 -10"/>', '<velocity joint="j"/>'),
+    ('<general gainprm="40" dyntype="integrator" biastype="affine" biasprm="0 -40 -2"/>', '<position joint="j"/>'),
+    ('<general dyntype="filterexact" dynprm="0.3" gainprm="5"/>', '<position joint="j"/>'),
+    ('<general dyntype="filter" dynprm="0.3"/>', '<cylinder joint="j"/>'),
+    ('<general gainprm="4" biastype="affine" biasprm="1 2 3" dynprm="0.4"/>', '<cylinder joint="j"/>'),
+    ('<general gaintype="affine" gainprm="7 2 3" dyntype="filter" dynprm="0.3"/>', '<cylinder joint="j"/>'),
+    ('<cylinder area="3" timeconst="0.4" bias="1 2 3"/>', '<cylinder joint="j" area="2"/>'),
+    ('<general gaintype="affine" gainprm="0 0 -3"/>', '<damper joint="j" ctrlrange="0 1"/>'),
+    ('<damper kv="3" ctrlrange="0 1"/>', '<position joint="j"/>'),
+    ('<damper kv="3" ctrlrange="0 1"/>', '<general joint="j"/>'),
+    ('<position kp="3" ctrlrange="-1 1" gear="2" forcerange="-4 4"/>', '<motor joint="j"/>'),
+    ('<position kp="3" inheritrange="0.5"/>', '<general joint="j"/>'),
+    ('<position kp="3" inheritrange="0.5"/>', '<intvelocity joint="j"/>'),
+    ('<position kp="3" inheritrange="0.5"/>', '<position joint="j" ctrlrange="-3 3"/>'),
+    ('<position kp="3" ctrlrange="-3 3"/>', '<position joint="j" inheritrange="0.5"/>'),
+    ('<general gainprm="40" dyntype="integrator" biastype="affine" biasprm="0 -40 0" inheritrange="0.5"/>',
+     '<general joint="j"/>'),
+    ('<intvelocity kp="3" actrange="-1 1"/>', '<intvelocity joint="j"/>'),
+    ('<position kp="3" dampratio="1"/>', '<position joint="j" kv="1"/>'),
+    ('<position kp="3" dampratio="0.7"/>', '<general joint="j" armature="0.05" gear="1.5"/>'),
+    ('<position kp="30" dampratio="1.2"/>', '<position tendon="t" gear="2"/>'),
+    ('', '<position joint="j2" kp="8" dampratio="1" timeconst="0.05"/>'),
+]
+
+
+@pytest.mark.parametrize("defaults, actuator", ACTUATOR_DEFAULTS)
+def test_actuator_defaults_pass_on_as_in_mujoco(defaults, actuator):
+    """Forces, activation rates, control and activation ranges as MuJoCo compiles the case."""
+    text = DEFAULTS_ARM.format(defaults=defaults, actuator=actuator)
+    model, compiled = robodyn.load_mjcf_string(text), mujoco.MjModel.from_xml_string(text)
+    assert model.warnings == []
+    assert (model.nu, model.na) == (compiled.nu, compiled.na) == (1, compiled.na)
+    limited = bool(compiled.actuator_ctrllimited[0])
+    expected_range = compiled.actuator_ctrlrange[0] if limited else [-np.inf, np.inf]
+    np.testing.assert_array_equal(model.ctrl_range[0], expected_range)
+    layout, data = MujocoLayout(model, compiled), mujoco.MjData(compiled)
+    rng = np.random.default_rng(5)
+    for _ in range(5):
+        q = rng.uniform(-1, 1, model.nq)
+        v, ctrl, act = rng.normal(size=model.nv), rng.uniform(-4, 4, 1), rng.uniform(-2, 2, model.na)
+        data.qpos[:], data.qvel[:], data.ctrl[:], data.act[:] = q, v, ctrl, act
+        mujoco.mj_forward(compiled, data)
+        tau = layout.force_from_mujoco(q, data.qfrc_actuator)
+        scale = max(1.0, np.max(np.abs(tau)))
+        np.testing.assert_allclose(model.actuator_forces(q, v, ctrl, act if model.na else None), tau,
+                                   rtol=0, atol=FORCE_TOLERANCE * scale)
+        if model.na:
+            np.testing.assert_allclose(model.activation_rates(ctrl, act), data.act_dot, rtol=0, atol=1e-12)
+
+
+def test_actuator_defaults_mujoco_refuses_are_refused():
+    for defaults, actuator, message in [
+        ("", '<position joint="j" kv="1" dampratio="1"/>', "'kv' and 'dampratio'"),
+        ("", '<position joint="j" ctrlrange="-1 1" inheritrange="1"/>', "'ctrlrange' and 'inheritrange'"),
+        ("", '<intvelocity joint="j" actrange="-1 1" inheritrange="1"/>', "'actrange' and 'inheritrange'"),
+        ("", '<cylinder joint="j" bias="1"/>', "attribute 'bias': expected 3 numbers"),
+        ('<position kv="-1"/>', '<position joint="j"/>', "attribute 'kv': expected a value ≥ 0"),
+        ("", '<general joint="j" dyntype="filter" biastype="affine" biasprm="0 -1 0" inheritrange="1"/>',
+         "attribute 'inheritrange': only for position and intvelocity"),
+    ]:
+        text = DEFAULTS_ARM.format(defaults=defaults, actuator=actuator)
+        with pytest.raises(ValueError, match=message):
+            robodyn.load_mjcf_string(text)
+        with pytest.raises(ValueError):
+            mujoco.MjModel.from_xml_string(text)

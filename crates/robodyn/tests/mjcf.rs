@@ -406,9 +406,11 @@ fn actuators_on_hinges_with_gears_and_ranges() {
     assert_eq!(model.nu(), 5);
     // inheritrange 0.5 of [−1, 3]: [0, 2] about the middle
     assert_eq!(model.actuators[1].ctrl_range, Some((0.0, 2.0)));
-    // a position actuator with dampratio is not modelled: a warning, no force
-    assert!(model.warnings.iter().any(|w| w.contains("'dampratio'")));
-    assert_eq!(model.actuators[4].coordinate, None);
+    // dampratio 1 on kp 1: k_v = 2 √(k_p I), I = 2/5 m r² of the sphere about its centre
+    let mass = 1000.0 * 4.0 / 3.0 * std::f64::consts::PI * 0.1f64.powi(3);
+    let kv = 2.0 * (0.4 * mass * 0.01f64).sqrt();
+    assert!((model.actuators[4].bias[2] + kv).abs() < 1e-14);
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
     let (q, v) = ([0.5], [0.25]);
     let mut tau = [0.0];
     let one = |k: usize, u: f64| {

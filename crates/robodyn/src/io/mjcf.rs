@@ -36,6 +36,7 @@ use std::cell::{Cell, RefCell};
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
+mod actuator_defaults;
 mod actuators;
 mod bodies;
 mod contacts;
@@ -51,12 +52,23 @@ mod tendons;
 mod textures;
 mod visuals;
 
+use actuator_defaults::{ClassActuator, ACTUATOR_KINDS};
 use inertia::InertiaFromGeoms;
 use mass::MassRules;
 use schema_table::MJCF_SCHEMA;
 
 /// Sections of an MJCF file that do not describe the tree.
 const IGNORED_SECTIONS: [&str; 3] = ["sensor", "visual", "statistic"];
+
+/// The tag under which a class keeps an element's defaults: every actuator element's under
+/// `actuator` (a class has one actuator default, [`actuator_defaults`]).
+fn defaults_tag(tag: &str) -> &str {
+    if ACTUATOR_KINDS.contains(&tag) {
+        "actuator"
+    } else {
+        tag
+    }
+}
 
 /// Attributes of which an element may give only the first values, the others kept from its class
 /// or MuJoCo's defaults (MuJoCo reads `solimp="0.9 0.95"` as the first two of five).
@@ -191,6 +203,7 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         inertia_from_geoms: InertiaFromGeoms::Auto,
         inertia_groups: (0, 5),
         defaults: HashMap::new(),
+        actuator_defaults: HashMap::new(),
         mass_rules: MassRules::default(),
         total_mass: Cell::new(0.0),
         meshes: HashMap::new(),
@@ -318,7 +331,10 @@ struct Reader<'a> {
     /// geoms whose `group` lies outside this range give no inertia (`inertiagrouprange`)
     inertia_groups: (i64, i64),
     /// class -> element tag -> attribute -> value, each class holding its parents' values too
+    /// (the actuator elements' under one tag, [`defaults_tag`])
     defaults: HashMap<String, HashMap<String, HashMap<String, String>>>,
+    /// class -> its actuator default's gain, bias and dynamics ([`actuator_defaults`])
+    actuator_defaults: HashMap<String, ClassActuator>,
     /// `boundmass`, `boundinertia`, `balanceinertia`, `settotalmass`
     mass_rules: MassRules,
     /// the mass of every body read so far, those welded to the world included
@@ -479,10 +495,17 @@ impl<'a> Reader<'a> {
             .cloned()
             .unwrap_or_default();
         let elements = self.children(node)?;
+        let mut actuator = self
+            .class_actuators(parent)
+            .next()
+            .cloned()
+            .unwrap_or_default();
         for element in elements.iter().filter(|c| !c.has_tag_name("default")) {
-            let entry = values
-                .entry(element.tag_name().name().to_string())
-                .or_default();
+            let tag = element.tag_name().name();
+            if ACTUATOR_KINDS.contains(&tag) {
+                actuator = self.raw_actuator(*element, &actuator, self.class_actuators(parent))?;
+            }
+            let entry = values.entry(defaults_tag(tag).to_string()).or_default();
             for attribute in element.attributes() {
                 let (name, mut value) = (attribute.name(), attribute.value().to_string());
                 // a leading attribute keeps the inherited values it does not give
@@ -498,6 +521,12 @@ impl<'a> Reader<'a> {
             }
         }
         self.defaults.insert(class.clone(), values);
+        let parent = parent.map(str::to_string);
+        let class_actuator = ClassActuator {
+            raw: actuator,
+            parent,
+        };
+        self.actuator_defaults.insert(class.clone(), class_actuator);
         for child in elements.iter().filter(|c| c.has_tag_name("default")) {
             self.read_defaults(*child, Some(&class))?;
         }
@@ -512,7 +541,7 @@ impl<'a> Reader<'a> {
         let class = node.attribute("class").unwrap_or(class);
         self.defaults
             .get(class)?
-            .get(node.tag_name().name())?
+            .get(defaults_tag(node.tag_name().name()))?
             .get(name)
             .cloned()
     }

@@ -1,24 +1,32 @@
 //! `<actuator>`: each element an [`Actuator`], in the file's order (the controls' order).
 //!
-//! Modelled, as MuJoCo compiles them: `motor`, `position` (`kp`, `kv`, `inheritrange`,
-//! `timeconst`: a filterexact activation), `intvelocity` (an integrator activation, `inheritrange`
-//! its `actrange`), `velocity` (`kv`), `damper` (`kv`, a gain −kv l̇ on a control in its
-//! non-negative `ctrlrange`), `cylinder` (`timeconst`, `area` or `diameter`, `bias`: a filter
-//! activation) and `general` with `dyntype` none, integrator, filter or filterexact (`dynprm`)
-//! and a fixed or affine gain and bias (`gainprm`, `biasprm`), with `actrange`/`actlimited` and
-//! `actearly`; on a hinge or slide (`joint`) or a fixed tendon (`tendon`), `gear`'s first entry
-//! its moment arm, with `ctrlrange`
-//! and `forcerange` (`ctrllimited`, `forcelimited`: "auto" limits where a range is given); an
-//! actuator's `damping` and `armature` join its joint's, times gear² (as MuJoCo adds them).
-//! Any other actuator (muscles, user dynamics, `dampratio`, spatial tendon, site or body
-//! transmissions, a ball or free joint) keeps its place in the controls (and its activation,
-//! if it has one) but exerts no force, with a warning naming it. Defaults come from the
-//! element's class, per element name.
+//! Modelled, as MuJoCo compiles them: `motor`, `position` (`kp`, `kv` or `dampratio`,
+//! `inheritrange`, `timeconst`: a filterexact activation), `intvelocity` (an integrator
+//! activation, `inheritrange` its `actrange`), `velocity` (`kv`), `damper` (`kv`, a gain −kv l̇ on
+//! a control in its non-negative `ctrlrange`), `cylinder` (`timeconst`, `area` or `diameter`,
+//! `bias`: a filter activation) and `general` with `dyntype` none, integrator, filter or
+//! filterexact (`dynprm`) and a fixed or affine gain and bias (`gainprm`, `biasprm`,
+//! `inheritrange`), with `actrange`/`actlimited` and `actearly`; on a hinge or slide (`joint`) or
+//! a fixed tendon (`tendon`), `gear`'s first entry its moment arm, with `ctrlrange` and
+//! `forcerange` (`ctrllimited`, `forcelimited`: "auto" limits where a range is given); an
+//! actuator's `damping` and `armature` join its joint's, times gear² (as MuJoCo adds them). A
+//! damping ratio becomes kv as MuJoCo's compiler makes it, from the inertia the transmission
+//! sees at qpos0.
+//!
+//! Any other actuator (muscles, user dynamics, spatial tendon, site or body transmissions, a ball
+//! or free joint) keeps its place in the controls (and its activation, if it has one) but exerts
+//! no force, with a warning naming it. Defaults: a class has one actuator default, whichever
+//! element wrote it; what a shortcut inherits from it is in [`super::actuator_defaults`].
 
+use super::actuator_defaults::RawActuator;
 use super::Reader;
+use crate::algo::inverse_mass_matrix;
 use crate::error::Result;
 use crate::io::xml::parse_number_list;
 use crate::model::{ActivationDynamics, Actuator, Model};
+use crate::soft::TINY;
+use crate::Data;
+use nalgebra::DVector;
 use roxmltree::Node;
 
 /// What robodyn models, for the warning about an actuator it does not.
@@ -34,9 +42,11 @@ impl<'a> Reader<'a> {
         sections: &[Node<'a, 'a>],
         model: &mut Model,
     ) -> Result<()> {
+        let mut elements = Vec::new();
         for section in sections.iter().filter(|c| c.has_tag_name("actuator")) {
             for element in self.children(*section)? {
                 let index = model.actuators.len();
+                elements.push(element);
                 let actuator = match self.actuator(element, model, index)? {
                     Ok(actuator) => {
                         self.add_transmission_terms(element, &actuator, model)?;
@@ -54,6 +64,50 @@ impl<'a> Reader<'a> {
                 model.actuators.push(actuator);
             }
         }
+        self.resolve_damping_ratios(&elements, model)
+    }
+
+    /// A position-like actuator (gain kp, bias −kp l + r l̇) with r > 0 holds a damping ratio
+    /// (`dampratio`), which MuJoCo's compiler turns into kv = 2 r √(kp m): m = 1 / (g M⁻¹ gᵀ) is
+    /// the inertia the transmission reflects at qpos0 (g its moment arms, the row of ∂l/∂q̇; M the
+    /// mass matrix with every armature, those of actuators too). Measured against MuJoCo 4.0.0.
+    fn resolve_damping_ratios(&self, elements: &[Node<'a, 'a>], model: &mut Model) -> Result<()> {
+        let has_ratio = |a: &Actuator| {
+            (a.coordinate.is_some() || a.tendon.is_some())
+                && a.gain[0] == -a.bias[1]
+                && a.bias[2] > 0.0
+        };
+        if !model.actuators.iter().any(has_ratio) {
+            return Ok(());
+        }
+        let mut data = Data::new(model);
+        let q = model.neutral_configuration.clone();
+        let inverse = inverse_mass_matrix(model, &mut data, q.as_slice())?.clone();
+        let mut moment = DVector::zeros(model.nv);
+        for (k, element) in elements.iter().enumerate() {
+            let actuator = &model.actuators[k];
+            if !has_ratio(actuator) {
+                continue;
+            }
+            // the moment arms g
+            moment.fill(0.0);
+            match (actuator.coordinate, actuator.tendon) {
+                (Some(c), _) => moment[c] = actuator.gear,
+                (None, Some(t)) => {
+                    model.tendons[t].add_to_row(model, actuator.gear, moment.as_mut_slice())
+                }
+                (None, None) => continue,
+            }
+            // m = 1 / (g M⁻¹ gᵀ)
+            let inertia = 1.0 / moment.dot(&(&inverse * &moment)).max(TINY);
+            let kp = actuator.gain[0];
+            if kp < 0.0 {
+                let message = format!("attribute 'dampratio': needs kp ≥ 0, got kp = {kp}");
+                return Err(self.error(*element, message));
+            }
+            let ratio = actuator.bias[2];
+            model.actuators[k].bias[2] = -2.0 * ratio * (kp * inertia).sqrt();
+        }
         Ok(())
     }
 
@@ -67,17 +121,7 @@ impl<'a> Reader<'a> {
         index: usize,
     ) -> Result<std::result::Result<Actuator, (Actuator, String)>> {
         let tag = element.tag_name().name();
-        let text = |name: &str| self.attribute(element, "main", name);
-        let list = |name: &str| -> Result<Option<Vec<f64>>> {
-            text(name)
-                .map(|t| parse_number_list(&t, name).map_err(|m| self.error(element, m)))
-                .transpose()
-        };
-        let scalar = |name: &str, default: f64| -> Result<f64> {
-            Ok(list(name)?
-                .and_then(|v| v.first().copied())
-                .unwrap_or(default))
-        };
+        let class = self.declared_class(element, "class", "main")?;
         let mut actuator = Actuator {
             name: element
                 .attribute("name")
@@ -85,7 +129,7 @@ impl<'a> Reader<'a> {
             coordinate: None,
             position: 0,
             tendon: None,
-            gear: scalar("gear", 1.0)?,
+            gear: self.transmission_term(element, "gear")?.unwrap_or(1.0),
             gain: [1.0, 0.0, 0.0],
             bias: [0.0; 3],
             ctrl_range: self.range(element, "ctrl")?,
@@ -96,120 +140,21 @@ impl<'a> Reader<'a> {
         };
         let unmodelled = |actuator: Actuator, why: String| Ok(Err((actuator, why)));
 
-        // the gain, bias and activation dynamics of each kind
-        let non_negative = |name: &str, default: f64| -> Result<f64> {
-            let value = scalar(name, default)?;
-            if value < 0.0 {
-                let message = format!("attribute '{name}': expected a value ≥ 0, got {value}");
-                return Err(self.error(element, message));
-            }
-            Ok(value)
-        };
-        let mut unmodelled_why = None;
+        // the kinds robodyn does not model keep their activations' places
+        let own = |name: &str| self.numbers::<1>(element, "main", name);
         match tag {
-            "motor" => {}
-            "position" | "intvelocity" => {
-                if scalar("dampratio", 0.0)? != 0.0 {
-                    unmodelled_why = Some("attribute 'dampratio'".to_string());
-                }
-                let (kp, kv) = (scalar("kp", 1.0)?, non_negative("kv", 0.0)?);
-                actuator.gain = [kp, 0.0, 0.0];
-                actuator.bias = [0.0, -kp, -kv];
-                let time_constant = non_negative("timeconst", 0.0)?;
-                if time_constant > 0.0 {
-                    actuator.dynamics = ActivationDynamics::FilterExact { time_constant };
-                }
-                if tag == "intvelocity" {
-                    actuator.dynamics = ActivationDynamics::Integrator;
-                }
-            }
-            "velocity" => {
-                let kv = scalar("kv", 1.0)?;
-                actuator.gain = [kv, 0.0, 0.0];
-                actuator.bias = [0.0, 0.0, -kv];
-            }
-            "damper" => {
-                // f = −k_v l̇ u, u in a non-negative range
-                actuator.gain = [0.0, 0.0, -non_negative("kv", 0.0)?];
-                match self.numbers::<2>(element, "main", "ctrlrange")? {
-                    Some([low, high]) if 0.0 <= low && low < high => {
-                        actuator.ctrl_range = Some((low, high));
-                    }
-                    _ => {
-                        let message = "attribute 'ctrlrange': a damper needs a range \
-                                       0 ≤ lower < upper";
-                        return Err(self.error(element, message));
-                    }
-                }
-            }
-            "cylinder" => {
-                // f = area u_act + b₀ + b₁ l + b₂ l̇
-                let time_constant = scalar("timeconst", 1.0)?;
-                actuator.dynamics = ActivationDynamics::Filter { time_constant };
-                let area = match scalar("diameter", -1.0)? {
-                    d if d >= 0.0 => std::f64::consts::PI / 4.0 * d * d,
-                    _ => scalar("area", 1.0)?,
-                };
-                actuator.gain = [area, 0.0, 0.0];
-                actuator.bias = [0.0; 3];
-                for (value, given) in actuator
-                    .bias
-                    .iter_mut()
-                    .zip(list("bias")?.unwrap_or_default())
-                {
-                    *value = given;
-                }
-            }
-            "general" => {
-                let kinds = ["dyntype", "gaintype", "biastype"].map(text);
-                let [dynamics, gain, bias] = kinds.each_ref().map(|k| k.as_deref());
-                let time_constant = scalar("dynprm", 1.0)?;
-                match dynamics {
-                    None | Some("none") => {}
-                    Some("integrator") => actuator.dynamics = ActivationDynamics::Integrator,
-                    Some("filter") => {
-                        actuator.dynamics = ActivationDynamics::Filter { time_constant }
-                    }
-                    Some("filterexact") => {
-                        actuator.dynamics = ActivationDynamics::FilterExact { time_constant }
-                    }
-                    Some(other) => {
-                        // its activation keeps its place among the activations
-                        let states = self.numbers::<1>(element, "main", "actdim")?;
-                        let states = states.map_or(1, |[n]| n.max(0.0) as usize);
-                        actuator.dynamics = ActivationDynamics::Held { states };
-                        return unmodelled(actuator, format!("dyntype '{other}'"));
-                    }
-                }
-                let prm = |name: &str, default: [f64; 3]| -> Result<[f64; 3]> {
-                    let mut values = default;
-                    for (value, given) in values.iter_mut().zip(list(name)?.unwrap_or_default()) {
-                        *value = given;
-                    }
-                    Ok(values)
-                };
-                actuator.gain = match gain {
-                    None | Some("fixed") => [prm("gainprm", [1.0, 0.0, 0.0])?[0], 0.0, 0.0],
-                    Some("affine") => prm("gainprm", [1.0, 0.0, 0.0])?,
-                    Some(other) => return unmodelled(actuator, format!("gaintype '{other}'")),
-                };
-                actuator.bias = match bias {
-                    None | Some("none") => [0.0; 3],
-                    Some("affine") => prm("biasprm", [0.0; 3])?,
-                    Some(other) => return unmodelled(actuator, format!("biastype '{other}'")),
-                };
-            }
+            "general" | "motor" | "position" | "intvelocity" | "velocity" | "damper"
+            | "cylinder" => {}
             "muscle" => {
-                // its activation keeps its place among the activations
                 actuator.dynamics = ActivationDynamics::Held { states: 1 };
                 return unmodelled(actuator, "<muscle>".into());
             }
             "pid" => {
                 // an integral state with `ki`, a slew state with `slewmax`
-                let states = ["ki", "slewmax"]
-                    .iter()
-                    .map(|name| scalar(name, 0.0).map(|x| usize::from(x != 0.0)))
-                    .sum::<Result<usize>>()?;
+                let mut states = 0;
+                for name in ["ki", "slewmax"] {
+                    states += usize::from(own(name)?.is_some_and(|[x]| x != 0.0));
+                }
                 if states > 0 {
                     actuator.dynamics = ActivationDynamics::Held { states };
                 }
@@ -222,13 +167,44 @@ impl<'a> Reader<'a> {
             }
             other => return unmodelled(actuator, format!("<{other}>")),
         }
-        self.check_activation_size(element, &actuator)?;
-        if let Some(why) = unmodelled_why {
-            return unmodelled(actuator, why);
+
+        // the gain, bias and activation dynamics MuJoCo compiles the element to
+        let raw = self.element_raw_actuator(element, class)?;
+        let time_constant = raw.dynamics[0];
+        actuator.dynamics = match raw.dyn_type.as_str() {
+            "none" => ActivationDynamics::None,
+            "integrator" => ActivationDynamics::Integrator,
+            "filter" => ActivationDynamics::Filter { time_constant },
+            "filterexact" => ActivationDynamics::FilterExact { time_constant },
+            other => {
+                // its activation keeps its place among the activations
+                let states = raw.act_dim.map_or(1, |n| n.max(0.0) as usize);
+                actuator.dynamics = ActivationDynamics::Held { states };
+                return unmodelled(actuator, format!("dyntype '{other}'"));
+            }
+        };
+        let [a, b] = [&raw.gain, &raw.bias].map(|p| [p[0], p[1], p[2]]);
+        actuator.gain = match raw.gain_type.as_str() {
+            "fixed" => [a[0], 0.0, 0.0],
+            "affine" => a,
+            other => return unmodelled(actuator, format!("gaintype '{other}'")),
+        };
+        actuator.bias = match raw.bias_type.as_str() {
+            "none" => [0.0; 3],
+            "affine" => b,
+            other => return unmodelled(actuator, format!("biastype '{other}'")),
+        };
+        self.check_activation_size(element, &actuator, raw.act_dim)?;
+        if tag == "damper" {
+            // f = −k_v l̇ u, u in a non-negative range
+            if !matches!(actuator.ctrl_range, Some((low, high)) if 0.0 <= low && low < high) {
+                let message = "attribute 'ctrlrange': a damper needs a range 0 ≤ lower < upper";
+                return Err(self.error(element, message));
+            }
         }
 
         // the transmission: a fixed tendon, or a hinge or slide
-        if let Some(tendon_name) = element.attribute("tendon") {
+        let range = if let Some(tendon_name) = element.attribute("tendon") {
             let Some(t) = model.tendons.iter().position(|t| t.name == tendon_name) else {
                 if self
                     .unread_tendons
@@ -242,67 +218,109 @@ impl<'a> Reader<'a> {
                 return Err(self.error(element, message));
             };
             actuator.tendon = Some(t);
-            let range = model.tendons[t].range.map(|(lower, upper)| [lower, upper]);
-            self.inherit_range(element, range, &mut actuator)?;
-            return Ok(Ok(actuator));
-        }
-        let Some(joint_name) = element.attribute("joint") else {
-            return unmodelled(
-                actuator,
-                "a transmission other than 'joint' or 'tendon'".into(),
+            model.tendons[t].range.map(|(lower, upper)| [lower, upper])
+        } else {
+            let Some(joint_name) = element.attribute("joint") else {
+                return unmodelled(
+                    actuator,
+                    "a transmission other than 'joint' or 'tendon'".into(),
+                );
+            };
+            let body = model.joint_names.iter().position(|n| n == joint_name);
+            let body = body.ok_or_else(|| {
+                self.error(
+                    element,
+                    format!("attribute 'joint': no joint named '{joint_name}'"),
+                )
+            })?;
+            if model.joints()[body].nv() != 1 {
+                let kind = model.joints()[body].kind();
+                return unmodelled(actuator, format!("a {kind} joint's transmission"));
+            }
+            actuator.coordinate = Some(model.v_range(body).start);
+            actuator.position = model.q_range(body).start;
+            let (lower, upper) = (
+                model.lower_position_limit[actuator.position],
+                model.upper_position_limit[actuator.position],
             );
+            (lower.is_finite() && upper.is_finite()).then_some([lower, upper])
         };
-        let body = model.joint_names.iter().position(|n| n == joint_name);
-        let body = body.ok_or_else(|| {
-            self.error(
-                element,
-                format!("attribute 'joint': no joint named '{joint_name}'"),
-            )
-        })?;
-        if model.joints()[body].nv() != 1 {
-            let kind = model.joints()[body].kind();
-            return unmodelled(actuator, format!("a {kind} joint's transmission"));
-        }
-        actuator.coordinate = Some(model.v_range(body).start);
-        actuator.position = model.q_range(body).start;
-
-        let (lower, upper) = (
-            model.lower_position_limit[actuator.position],
-            model.upper_position_limit[actuator.position],
-        );
-        let range = (lower.is_finite() && upper.is_finite()).then_some([lower, upper]);
-        self.inherit_range(element, range, &mut actuator)?;
+        self.inherit_range(element, &raw, range, &mut actuator)?;
         Ok(Ok(actuator))
     }
 
-    /// `inheritrange` of a `position` (its control range) or an `intvelocity` (its activation
-    /// range): the transmission's `range` scaled about its middle.
+    /// `inheritrange` (MuJoCo's compiler rule): on a position-like actuator (a fixed gain kp
+    /// with an affine bias −kp l), the transmission's `range` scaled about its middle becomes
+    /// the control's range (no dynamics or filterexact: a position servo) or the activation's
+    /// (an integrator: `intvelocity`). A range the element gives itself wins over an
+    /// `inheritrange` of its class; an element gives one or the other.
     fn inherit_range(
         &self,
         element: Node<'a, 'a>,
+        raw: &RawActuator,
         range: Option<[f64; 2]>,
         actuator: &mut Actuator,
     ) -> Result<()> {
-        let inherit = self
-            .numbers::<1>(element, "main", "inheritrange")?
-            .map_or(0.0, |[x]| x);
-        if inherit <= 0.0 {
+        let integrated = actuator.dynamics == ActivationDynamics::Integrator;
+        let (target, limited) = if integrated {
+            ("actrange", "actlimited")
+        } else {
+            ("ctrlrange", "ctrllimited")
+        };
+        let own_inherit = element.attribute("inheritrange").is_some();
+        let own_range = element.attribute(target).is_some();
+        let shortcut = element.tag_name().name() != "general";
+        if own_inherit && own_range && shortcut {
+            let message = format!("attributes '{target}' and 'inheritrange': give one, not both");
+            return Err(self.error(element, message));
+        }
+        let inherit = if own_range && !own_inherit {
+            0.0
+        } else {
+            raw.inherit_range
+        };
+        let position_like =
+            raw.gain_type == "fixed" && raw.bias_type == "affine" && raw.gain[0] == -raw.bias[1];
+        if inherit <= 0.0 || !position_like {
             return Ok(());
         }
-        let inherited = Some(self.inherited_range(element, range, inherit)?);
-        match element.tag_name().name() {
-            "position" => actuator.ctrl_range = inherited,
-            "intvelocity" => actuator.act_range = inherited,
-            _ => {}
+        if !matches!(
+            actuator.dynamics,
+            ActivationDynamics::None
+                | ActivationDynamics::FilterExact { .. }
+                | ActivationDynamics::Integrator
+        ) {
+            let message = "attribute 'inheritrange': only for position and intvelocity actuators \
+                           (dyntype none, filterexact or integrator)";
+            return Err(self.error(element, message));
+        }
+        let Some([lower, upper]) = range else {
+            let message = "attribute 'inheritrange': the transmission has no range to inherit";
+            return Err(self.error(element, message));
+        };
+        if self.attribute(element, "main", limited).as_deref() == Some("false") {
+            return Ok(());
+        }
+        let (middle, half) = ((lower + upper) / 2.0, inherit * (upper - lower) / 2.0);
+        let inherited = Some((middle - half, middle + half));
+        if integrated {
+            actuator.act_range = inherited;
+        } else {
+            actuator.ctrl_range = inherited;
         }
         Ok(())
     }
 
     /// `actdim`: 1 for an actuator with activation dynamics, 0 without (MuJoCo refuses others).
-    fn check_activation_size(&self, element: Node<'a, 'a>, actuator: &Actuator) -> Result<()> {
+    fn check_activation_size(
+        &self,
+        element: Node<'a, 'a>,
+        actuator: &Actuator,
+        given: Option<f64>,
+    ) -> Result<()> {
         let expected = usize::from(actuator.has_activation());
-        match self.numbers::<1>(element, "main", "actdim")? {
-            Some([given]) if given != expected as f64 => {
+        match given {
+            Some(given) if given != expected as f64 => {
                 let message = format!(
                     "attribute 'actdim': expected {expected} for dyntype {}, got {given}",
                     actuator.dynamics.keyword()
@@ -311,22 +329,6 @@ impl<'a> Reader<'a> {
             }
             _ => Ok(()),
         }
-    }
-
-    /// `inheritrange`: the range of the joint or tendon (`None`: it has none, refused) scaled by
-    /// `inherit` about its middle.
-    fn inherited_range(
-        &self,
-        element: Node<'a, 'a>,
-        range: Option<[f64; 2]>,
-        inherit: f64,
-    ) -> Result<(f64, f64)> {
-        let Some([lower, upper]) = range else {
-            let message = "attribute 'inheritrange': the transmission has no range to inherit";
-            return Err(self.error(element, message));
-        };
-        let (middle, half) = ((lower + upper) / 2.0, inherit * (upper - lower) / 2.0);
-        Ok((middle - half, middle + half))
     }
 
     /// The actuator's own `damping` and `armature` (MuJoCo ≥ 3.5), which MuJoCo adds to its
@@ -340,9 +342,9 @@ impl<'a> Reader<'a> {
     ) -> Result<()> {
         let scale = actuator.gear * actuator.gear;
         if let Some(t) = actuator.tendon {
-            let damping = self.transmission_term(element, "damping")?;
+            let damping = self.non_negative_term(element, "damping")?;
             model.tendons[t].damping += scale * damping;
-            if self.transmission_term(element, "armature")? != 0.0 {
+            if self.non_negative_term(element, "armature")? != 0.0 {
                 model.warnings.push(format!(
                     "{}: 'armature' on a tendon not modelled (the tendon's inertia JᵀJ)",
                     self.location(element)
@@ -357,22 +359,23 @@ impl<'a> Reader<'a> {
             ("damping", &mut model.damping),
             ("armature", &mut model.armature),
         ] {
-            values[c] += scale * self.transmission_term(element, name)?;
+            values[c] += scale * self.non_negative_term(element, name)?;
         }
         Ok(())
     }
 
-    /// An actuator's `damping` or `armature` (its first value; 0 when not given), refused when
-    /// negative.
-    fn transmission_term(&self, element: Node<'a, 'a>, name: &str) -> Result<f64> {
+    /// The first number of an actuator's `gear`, `damping` or `armature`, where given.
+    fn transmission_term(&self, element: Node<'a, 'a>, name: &str) -> Result<Option<f64>> {
         let Some(text) = self.attribute(element, "main", name) else {
-            return Ok(0.0);
+            return Ok(None);
         };
-        let value = parse_number_list(&text, name)
-            .map_err(|m| self.error(element, m))?
-            .first()
-            .copied()
-            .unwrap_or(0.0);
+        let values = parse_number_list(&text, name).map_err(|m| self.error(element, m))?;
+        Ok(values.first().copied())
+    }
+
+    /// An actuator's `damping` or `armature` (0 when not given), refused when negative.
+    fn non_negative_term(&self, element: Node<'a, 'a>, name: &str) -> Result<f64> {
+        let value = self.transmission_term(element, name)?.unwrap_or(0.0);
         if value < 0.0 {
             let message = format!("attribute '{name}': expected a value ≥ 0, got {value}");
             return Err(self.error(element, message));
