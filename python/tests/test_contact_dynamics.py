@@ -296,13 +296,13 @@ def test_joint_limits_friction_loss_and_actuators_as_in_mujoco():
 
 # --- 4. dm_control's suite -------------------------------------------------------------------
 
-# Of the suite's 16 models (test_collision.py's SUITE), those without what the method leaves out
-# (ball_in_cup: a spatial tendon); manipulator, point_mass and stacker drive fixed tendons,
-# manipulator and stacker couple two fingers by a tendon equality; quadruped's twelve actuators
+# Of the suite's 16 models (test_collision.py's SUITE), those with contacts and constraints:
+# ball_in_cup's string is a spatial tendon with a limit; manipulator, point_mass and stacker drive
+# fixed tendons, manipulator and stacker couple two fingers by a tendon equality; quadruped's twelve actuators
 # filter their controls (activation dynamics) and its height field, flat and 1 cm below its floor,
 # is switched off in MuJoCo (robodyn does not collide height fields: a warning); none has a limited
 # ball joint.
-SUITE = ["cheetah", "finger", "hopper", "humanoid", "humanoid_CMU", "manipulator", "point_mass", "quadruped",
+SUITE = ["ball_in_cup", "cheetah", "finger", "hopper", "humanoid", "humanoid_CMU", "manipulator", "point_mass", "quadruped",
          "stacker", "walker"]
 # The rest disable constraints (acrobot, fish: <flag constraint="disable"/>) or contacts (cartpole,
 # reacher, swimmer: contact="disable"): MuJoCo finds no contacts at all there (an empty

@@ -23,7 +23,7 @@ from test_contact_dynamics import (
     without_unmodelled,
 )
 from test_menagerie import MENAGERIE, mujoco_model
-from test_soft_elements import EQUALITIES, TENDONS
+from test_soft_elements import EQUALITIES, SPATIAL, TENDONS
 
 STEPS = 100
 # 100 steps without elliptic friction: the same arithmetic in another order; measured up to 1.1e-12
@@ -152,6 +152,18 @@ def test_fixed_tendons_step_as_in_mujoco(integrator):
     model, mj_model, layout = load_both(text=with_integrator(TENDONS.replace("{cone}", "pyramidal"), integrator))
     qvel = np.random.default_rng(7).normal(size=mj_model.nv)
     assert_steps_like_mujoco(model, mj_model, layout, mj_model.qpos0, qvel, ctrl=[0.7, 0.1, -0.4, 0.3], label=integrator)
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+def test_spatial_tendons_step_as_in_mujoco(integrator):
+    """test_soft_elements's spatial tendons from a turned state: their rows, springs and dampers
+    (implicitfast: in K, through the free body's turned velocities) through 100 steps."""
+    text = with_integrator(SPATIAL.replace("{cone}", "pyramidal"), integrator)
+    model, mj_model, layout = load_both(text=text)
+    rng = np.random.default_rng(2)
+    qpos = mj_model.qpos0.copy()
+    mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.3, 1.0)
+    assert_steps_like_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv), label=integrator)
 
 
 # --- 3. a Menagerie quadruped, dm_control's suite ----------------------------------------------

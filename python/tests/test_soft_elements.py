@@ -1,6 +1,6 @@
 """MuJoCo's soft model beyond contacts and joints (`m.contact_forward_dynamics` against `mj_forward`,
 as in test_contact_dynamics.py): equality constraints of every kind robodyn reads, fixed tendons
-(limits, friction, springs, equalities, actuators), rows' ids past what robodyn does not read,
+(limits, friction, springs, equalities, actuators), spatial tendons through sites and pulleys, rows' ids past what robodyn does not read,
 MuJoCo's simple bodies, and a URDF's mimic joints as joint equalities.
 
 MuJoCo solves to convergence here (`converged`: Newton, tolerance 1e-15)."""
@@ -153,13 +153,14 @@ def test_tendon_lengths_as_in_mujoco():
 SKIPPED_ELEMENTS = """<mujoco><option timestep="0.002"/>
   <worldbody>
     <site name="s0" pos="0 0 1.5"/>
+    <geom name="pin" type="cylinder" size=".02 .05" pos=".15 0 1.3" contype="0" conaffinity="0"/>
     <body name="a" pos="0 0 1"><joint name="j1" axis="0 1 0" range="-1 1"/>
       <geom type="capsule" fromto="0 0 0 .3 0 0" size=".03"/>
       <body name="b" pos=".3 0 0"><joint name="j2" axis="0 1 0"/>
         <geom type="capsule" fromto="0 0 0 .3 0 0" size=".03"/><site name="s2" pos=".3 0 0"/></body></body>
   </worldbody>
   <tendon>
-    <spatial name="rope"><site site="s0"/><site site="s2"/></spatial>
+    <spatial name="rope"><site site="s0"/><geom geom="pin"/><site site="s2"/></spatial>
     <fixed name="idle" frictionloss="0.5" range="-0.1 0.1" margin="0.5"><joint joint="j1" coef="0"/></fixed>
     <fixed name="pair" frictionloss="0.2" range="-0.1 0.1"><joint joint="j1" coef="1"/><joint joint="j2" coef="0.5"/></fixed>
   </tendon>
@@ -171,13 +172,85 @@ SKIPPED_ELEMENTS = """<mujoco><option timestep="0.002"/>
 
 
 def test_rows_carry_mujocos_ids_past_what_robodyn_does_not_read():
-    """A spatial tendon (not read) before the fixed ones, and its equality before a joint equality:
+    """A spatial tendon wrapping a geom (not read) before the fixed ones, and its equality before a joint equality:
     the rows' ids are still MuJoCo's (tendon 2, equality 1); a tendon whose Jacobian is zero has no
     rows, as in MuJoCo (its friction and its limit within the margin)."""
     model, mj_model, layout = load_both(SKIPPED_ELEMENTS)
     _, expected = assert_matches_mujoco(model, mj_model, layout, np.array([0.3, -0.2]), np.array([0.4, -1.0]))
     assert expected["row_types"] == ["equality", "friction_tendon", "limit_joint", "limit_tendon"]
     assert list(expected["row_ids"]) == [1, 2, 0, 2]
+
+
+# --- 7b. spatial tendons ----------------------------------------------------------------------
+
+# Sites on an arm, on the world and on a free-floating box (whose velocities robodyn measures in
+# its own axes): a cord through three bodies with a limit, friction, a spring's dead band and a
+# damper; a block and tackle (a pulley halves the second branch); two sites on one body; a
+# tendon equality between spatial tendons. No contacts: the tendons alone.
+SPATIAL = """<mujoco><option timestep="0.002" cone="{cone}"/>
+  <default><geom contype="0" conaffinity="0"/></default>
+  <worldbody>
+    <site name="anchor" pos="0 0.2 1.6"/><site name="hook" pos="0.5 0 1.8"/>
+    <body name="upper" pos="0 0 1"><joint name="shoulder" axis="0 1 0" damping="0.05"/>
+      <geom type="capsule" fromto="0 0 0 .4 0 0" size=".04"/><site name="elbow_in" pos=".2 0 .05"/>
+      <body name="lower" pos=".4 0 0"><joint name="elbow" axis="0 1 0"/>
+        <joint name="reach" type="slide" axis="1 0 0" range="-.1 .2"/>
+        <geom type="capsule" fromto="0 0 0 .3 0 0" size=".03"/>
+        <site name="mid" pos=".1 0 .03"/><site name="tip" pos=".3 0 0"/></body></body>
+    <body name="float" pos="0.6 0.1 1.2" euler="0.3 0.2 0.1"><joint type="free" stiffness="3" damping="0.02"/><geom type="box" size=".05 .04 .03"/>
+      <site name="eye" pos="0 0 .03"/><site name="eye2" pos=".05 0 0"/></body>
+  </worldbody>
+  <tendon>
+    <spatial name="cord" range="0.2 0.95" margin="0.05" frictionloss="0.2" damping="0.4" stiffness="30"
+             springlength="0.5 0.6"><site site="anchor"/><site site="elbow_in"/><site site="tip"/><site site="eye"/></spatial>
+    <spatial name="tackle" damping="0.3" stiffness="10"><site site="hook"/><site site="eye2"/>
+      <pulley divisor="2"/><site site="eye2"/><site site="mid"/></spatial>
+    <spatial name="inner" limited="true" range="0 0.5"><site site="mid"/><site site="tip"/><site site="eye"/></spatial>
+  </tendon>
+  <equality><tendon tendon1="inner" tendon2="tackle" polycoef="0 0.3 0 0 0" solref="0.05 1"/></equality>
+</mujoco>"""
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+def test_spatial_tendons_as_in_mujoco(cone):
+    """Spatial tendons' limit, friction and equality rows, springs and dampers, against mj_forward
+    at random states; their lengths (one state and a batch) as MuJoCo's ten_length."""
+    model, mj_model, layout = load_both(SPATIAL.replace("{cone}", cone))
+    assert not [w for w in model.warnings if "not read" in w or "not modelled" in w], model.warnings
+    assert model.tendon_names == ["cord", "tackle", "inner"]
+    rng, kinds, d = np.random.default_rng(6), set(), mujoco.MjData(mj_model)
+    for case in range(12):
+        qpos = mj_model.qpos0.copy()
+        mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.4, 1.0)
+        qvel, tau = rng.normal(size=mj_model.nv), rng.normal(size=mj_model.nv)
+        ours, _ = assert_matches_mujoco(model, mj_model, layout, qpos, qvel, tau, label=f"{cone} case {case}")
+        kinds |= {(kind, int(i)) for kind, i in zip(ours["row_types"], ours["row_ids"])}
+        d.qpos[:] = qpos
+        mujoco.mj_fwdPosition(mj_model, d)
+        assert_close(model.tendon_lengths(layout.q_from_mujoco(qpos)), d.ten_length, ROW_AGREEMENT, f"case {case}")
+    assert {("equality", 0), ("friction_tendon", 0), ("limit_tendon", 0), ("limit_tendon", 2)} <= kinds
+
+
+def test_spatial_tendon_paths_mujoco_refuses_are_refused():
+    sites = '<site site="anchor"/>', '<site site="tip"/>'
+    for path, message in [
+        (sites[0], "two stops or more"),
+        (f'{sites[0]}{sites[1]}<pulley divisor="2"/><pulley divisor="2"/>{sites[1]}{sites[0]}', "consecutive pulleys"),
+        (f'{sites[0]}{sites[1]}<pulley divisor="2"/>', "ends with a pulley"),
+        (f'{sites[0]}<pulley divisor="2"/>{sites[1]}', "needs a neighbour that is not a pulley"),
+        (f'{sites[0]}{sites[0]}{sites[1]}', "repeated next to itself"),
+        ('<site site="nowhere"/><site site="tip"/>', "no site named 'nowhere'"),
+        (f'{sites[0]}<pulley divisor="0"/>{sites[1]}{sites[0]}', "'divisor': expected > 0"),
+    ]:
+        text = SPATIAL.replace("{cone}", "pyramidal").replace("</tendon>", f'<spatial name="bad">{path}</spatial></tendon>')
+        with pytest.raises(ValueError, match=message):
+            load_quietly(None, text)
+        with pytest.raises(ValueError):
+            mujoco.MjModel.from_xml_string(text)
+    # an actuator on a spatial tendon is not modelled: a warning, no force
+    text = SPATIAL.replace("{cone}", "pyramidal").replace("</mujoco>", '<actuator><motor tendon="cord"/></actuator></mujoco>')
+    model = load_quietly(None, text)
+    assert [w for w in model.warnings if "spatial tendon 'cord'" in w]
 
 
 # --- 8. MuJoCo's simple bodies -------------------------------------------------------------------

@@ -1,18 +1,21 @@
-//! The model file's fixed tendons (MJCF `<tendon><fixed>`): their names and lengths.
+//! The model file's tendons (MJCF `<tendon>`: fixed, and spatial through sites and pulleys):
+//! their names and lengths.
 
 use crate::model::*;
 use pyo3::prelude::*;
+use robodyn::soft::tendons::TendonKinematics;
 
 #[pymethods]
 impl PyModel {
-    /// The fixed tendons' names, in the file's order (`tendon<k>` where the file gives none).
+    /// The tendons' names, in the file's order (`tendon<k>` where the file gives none).
     #[getter]
     fn tendon_names(&self) -> Vec<String> {
         self.model.tendons.iter().map(|t| t.name.clone()).collect()
     }
 
-    /// The fixed tendons' lengths (ntendon,) at q: `L = Σ coef q_j` over each one's joints
-    /// (MuJoCo's `ten_length`). A batch gives (N, ntendon).
+    /// The tendons' lengths (ntendon,) at q (MuJoCo's `ten_length`): `L = Σ coef q_j` over a
+    /// fixed tendon's joints, the length of its path through its sites for a spatial one (each
+    /// branch after a pulley divided by its divisor). A batch gives (N, ntendon).
     fn tendon_lengths<'py>(
         &self,
         py: Python<'py>,
@@ -22,11 +25,9 @@ impl PyModel {
             py,
             &[self.q_arg("q", q)?],
             &[self.model.tendons.len()],
-            &|m, _, i, out| {
-                m.check_configuration(i[0])?;
-                for (length, tendon) in out.iter_mut().zip(&m.tendons) {
-                    *length = tendon.length(m, i[0]);
-                }
+            &|m, workspace, i, out| {
+                let kinematics = TendonKinematics::at(m, &mut workspace.data, i[0])?;
+                out.copy_from_slice(&kinematics.lengths);
                 Ok(())
             },
         )

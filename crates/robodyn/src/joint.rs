@@ -438,7 +438,7 @@ fn inertia_times_axis<S: Real>(inertia: &Matrix6<S>, first: usize, axis: &Vec3) 
 }
 
 /// The unit quaternion of `[qx, qy, qz, qw]` (normalised).
-fn quaternion_of<S: Real>(q: &[S]) -> UnitQuaternion<S> {
+pub(crate) fn quaternion_of<S: Real>(q: &[S]) -> UnitQuaternion<S> {
     UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]))
 }
 

@@ -27,7 +27,7 @@ pub use options::{
 pub use physical::{
     check_mass_and_inertia, check_physical_parameters, check_positive_semidefinite, Unphysical,
 };
-pub use tendon::{Tendon, TendonEquality, UnreadElements};
+pub use tendon::{PathPoint, Tendon, TendonEquality, UnreadElements};
 
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::joint::{Joint, MotionSubspace};
@@ -220,7 +220,7 @@ pub struct Model {
     /// The actuators (MJCF `<actuator>`), in the file's order: the controls' order.
     #[serde(default)]
     pub actuators: Vec<Actuator>,
-    /// The fixed tendons (MJCF `<tendon><fixed>`), in the file's order.
+    /// The tendons (MJCF `<tendon>`: fixed, and spatial ones through sites), in the file's order.
     #[serde(default)]
     pub tendons: Vec<Tendon>,
     /// The equalities between tendon lengths (MJCF `<equality><tendon>`), in the file's order.

@@ -33,6 +33,7 @@ pub mod rows;
 pub mod simulate;
 pub mod solver;
 pub mod step;
+pub mod tendons;
 pub mod weights;
 
 use crate::model::{ContactPair, Geom, Model, SolverParameters};

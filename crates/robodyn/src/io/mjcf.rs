@@ -224,6 +224,7 @@ fn load_sources(sources: &Sources) -> Result<Model> {
             simple: false,
         }]),
         site_bodies: RefCell::new(HashMap::new()),
+        site_points: RefCell::new(HashMap::new()),
         unread_tendons: RefCell::new(Vec::new()),
     };
     if !root.has_tag_name("mujoco") {
@@ -359,6 +360,8 @@ struct Reader<'a> {
     source_bodies: RefCell<Vec<SourceBody>>,
     /// each site's file body (MuJoCo body id), by the site's name
     site_bodies: RefCell<HashMap<String, usize>>,
+    /// each site's body in the model and its position in that body's frame
+    site_points: RefCell<HashMap<String, (usize, Vec3)>>,
     /// the names of the tendons not read (spatial ones)
     unread_tendons: RefCell<Vec<String>>,
 }

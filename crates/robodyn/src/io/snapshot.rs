@@ -159,14 +159,23 @@ fn check_structure(model: &Model) -> Result<()> {
         .iter()
         .map(|f| f.body)
         .chain(model.visuals.iter().map(|v| v.body))
-        .chain(model.mimics.iter().flat_map(|m| [m.joint, m.mimicked]));
+        .chain(model.mimics.iter().flat_map(|m| [m.joint, m.mimicked]))
+        .chain(model.tendons.iter().flat_map(|t| {
+            let sites = t.path.iter().filter_map(|p| match p {
+                crate::model::PathPoint::Site { body, .. } => Some(*body),
+                crate::model::PathPoint::Pulley { .. } => None,
+            });
+            t.joints.iter().map(|(body, _)| *body).chain(sites)
+        }));
     let dof_parents_before = model
         .dof_parent
         .iter()
         .enumerate()
         .all(|(k, parent)| parent.is_none_or(|p| p < k));
     if bodies_named.into_iter().any(|body| body >= bodies) || !dof_parents_before {
-        return damaged("a frame, visual, mimic or coordinate refers to a missing one".into());
+        return damaged(
+            "a frame, visual, mimic, tendon or coordinate refers to a missing one".into(),
+        );
     }
     let declared = model.constraints.iter().map(|c| c.constraint.clone());
     if let Err(error) = crate::constraint::ConstraintSet::new(model, declared.collect()) {

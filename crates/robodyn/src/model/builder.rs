@@ -227,7 +227,8 @@ impl ModelBuilder {
     }
 
     /// Sets body `body`'s joint coordinates in the neutral configuration (the pose the file
-    /// draws, [`Model::neutral`]); a quaternion among them must have unit norm.
+    /// draws, [`Model::neutral`]); a quaternion among them must have unit norm. A free joint's
+    /// spring relaxes there too (MuJoCo's `qpos_spring` is `qpos0` for a free joint).
     pub fn set_neutral(&mut self, body: usize, q: &[f64]) -> Result<()> {
         let m = &mut self.model;
         let joint_name = m.joint_names.get(body).cloned().unwrap_or_default();
@@ -252,6 +253,9 @@ impl ModelBuilder {
         }
         let start = m.idx_q[body];
         m.neutral_configuration.as_mut_slice()[start..start + q.len()].copy_from_slice(q);
+        if joint == Joint::Free {
+            m.spring_reference.as_mut_slice()[start..start + q.len()].copy_from_slice(q);
+        }
         Ok(())
     }
 

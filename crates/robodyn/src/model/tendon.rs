@@ -1,21 +1,44 @@
-//! Fixed tendons (MJCF `<tendon><fixed>`): a length that is a fixed linear combination of hinge
-//! and slide coordinates,
+//! Tendons: a length L(q) that MuJoCo hangs forces and constraints on. A fixed tendon
+//! (MJCF `<tendon><fixed>`) is a fixed linear combination of hinge and slide coordinates,
 //! ```text
 //!   L = Σ_k c_k q_k,   L̇ = J q̇,   J = Σ_k c_k e_k
 //! ```
-//! (MuJoCo's `ten_length`, `ten_J`). What MuJoCo hangs on it: a spring and a damper on L (its
+//! a spatial one (`<tendon><spatial>` through sites, and pulleys) the length of its path through
+//! the sites, which moves with the bodies ([`crate::soft::tendons`] computes both at a state:
+//! MuJoCo's `ten_length`, `ten_J`). What MuJoCo hangs on it: a spring and a damper on L (its
 //! `stiffness` outside the dead band `springlength` and `damping`), dry friction and limits as
 //! constraint rows, equalities coupling two lengths, and actuators pulling on it.
 
 use super::{Model, SolverParameters};
+use crate::spatial::Vec3;
 
-/// One fixed tendon.
+/// One stop of a spatial tendon's path.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum PathPoint {
+    /// A site.
+    Site {
+        /// The body it moves with.
+        body: usize,
+        /// Its position in that body's frame.
+        point: Vec3,
+    },
+    /// A pulley: the branch after it counts its length divided by `divisor`.
+    Pulley {
+        /// The branch's divisor (MJCF `divisor`).
+        divisor: f64,
+    },
+}
+
+/// One tendon.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Tendon {
     /// Its name in the file (`tendon<k>` when it has none).
     pub name: String,
-    /// Its joints: (the body whose hinge or slide it is, the coefficient c_k).
+    /// A fixed tendon's joints: (the body whose hinge or slide it is, the coefficient c_k).
     pub joints: Vec<(usize, f64)>,
+    /// A spatial tendon's path, in order (empty for a fixed tendon).
+    #[serde(default)]
+    pub path: Vec<PathPoint>,
     /// L at the neutral configuration (MuJoCo's `tendon_length0`).
     pub length0: f64,
     /// The range of L where it is limited (`limited`, `range`).
@@ -38,7 +61,12 @@ pub struct Tendon {
 }
 
 impl Tendon {
-    /// Its nonzero Jacobian entries, with each joint's coordinate in q: (velocity coordinate,
+    /// Whether it is a spatial tendon (a path through sites) rather than a fixed one.
+    pub fn is_spatial(&self) -> bool {
+        !self.path.is_empty()
+    }
+
+    /// A fixed tendon's nonzero Jacobian entries, with each joint's coordinate in q: (velocity coordinate,
     /// configuration coordinate, c_k).
     pub fn entries<'a>(
         &'a self,
@@ -47,23 +75,6 @@ impl Tendon {
         self.joints
             .iter()
             .map(|&(body, c)| (model.idx_v[body], model.idx_q[body], c))
-    }
-
-    /// Adds `scale J` (its Jacobian: c_k on each joint's velocity coordinate) to `row` (nv).
-    pub fn add_to_row(&self, model: &Model, scale: f64, row: &mut [f64]) {
-        for (k, _, c) in self.entries(model) {
-            row[k] += scale * c;
-        }
-    }
-
-    /// L at q.
-    pub fn length(&self, model: &Model, q: &[f64]) -> f64 {
-        self.entries(model).map(|(_, p, c)| c * q[p]).sum()
-    }
-
-    /// L̇ = J q̇.
-    pub fn rate(&self, model: &Model, v: &[f64]) -> f64 {
-        self.entries(model).map(|(k, _, c)| c * v[k]).sum()
     }
 
     /// The spring's and the damper's force along the tendon at (L, L̇):
@@ -135,6 +146,7 @@ mod tests {
         let tendon = Tendon {
             name: "t".into(),
             joints: vec![],
+            path: vec![],
             length0: 0.0,
             range: None,
             margin: 0.0,

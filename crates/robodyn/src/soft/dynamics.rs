@@ -17,13 +17,15 @@
 use super::equality::Equalities;
 use super::rows::{constraint_rows, Rows};
 use super::solver::{dot, Solution, Solver};
+use super::tendons::TendonKinematics;
 use super::weights::{inverse_weights, InverseWeights};
 use crate::algo::{aba, crba, forward_kinematics};
 use crate::collision::{checked_pairs, collide, CheckedPair, CollisionScratch, Contact};
 use crate::error::{check_vector, Result};
 use crate::integrate::forces::spring_displacement;
-use crate::joint::Joint;
+use crate::joint::{quaternion_of, Joint};
 use crate::model::Model;
+use crate::spatial::Vec3;
 use crate::Data;
 use nalgebra::{DMatrix, DVector};
 
@@ -46,6 +48,8 @@ pub struct ContactForward {
     pub passive: DVector<f64>,
     /// The mass matrix M at q.
     pub mass: DMatrix<f64>,
+    /// The tendons' lengths and Jacobians at q (MuJoCo's `ten_length`, `ten_J`).
+    pub tendons: TendonKinematics,
 }
 
 /// A model's soft-constraint dynamics: its constant weights, pairs and scratch space.
@@ -101,12 +105,13 @@ impl ContactDynamics {
             &mut self.scratch,
             &mut out.contacts,
         );
+        out.tendons.update(model, q, &x_world);
         // 2. q̈₀ = M⁻¹ (τ + τ_actuator + τ_passive − C q̇ − g), by the articulated-body algorithm
         out.actuator = DVector::zeros(nv);
         model.actuator_forces((q, v), ctrl, act, out.actuator.as_mut_slice())?;
         out.activation_rate = DVector::zeros(act.len());
         model.activation_rates(ctrl, act, out.activation_rate.as_mut_slice())?;
-        out.passive = passive_forces(model, q, v);
+        out.passive = passive_forces(model, q, v, &out.tendons);
         let total = DVector::from_column_slice(tau) + &out.actuator + &out.passive;
         let free = aba(model, &mut self.data, q, v, total.as_slice(), None)?.clone();
         out.mass.clone_from(crba(model, &mut self.data, q)?);
@@ -115,7 +120,7 @@ impl ContactDynamics {
             model,
             &self.weights,
             (q, v),
-            &x_world,
+            (&x_world, &out.tendons),
             &out.contacts,
             &mut self.equalities,
             &mut out.rows,
@@ -140,11 +145,11 @@ impl ContactDynamics {
 /// τ_passive = −K (q ⊖ q_ref) − D q̇ + Σ Jᵀ f_tendon: the joints' and the tendons' springs and
 /// dampers (MuJoCo's `qfrc_passive` without gravity compensation and fluid forces; dry friction
 /// is a constraint row).
-fn passive_forces(model: &Model, q: &[f64], v: &[f64]) -> DVector<f64> {
+fn passive_forces(model: &Model, q: &[f64], v: &[f64], tendons: &TendonKinematics) -> DVector<f64> {
     let options = &model.options;
     let mut tau = DVector::zeros(model.nv);
     if options.flag("spring") && model.stiffness.iter().any(|k| *k != 0.0) {
-        spring_displacement(model, q, tau.as_mut_slice());
+        mujoco_spring_displacement(model, q, tau.as_mut_slice());
         tau.component_mul_assign(&(-&model.stiffness));
     }
     if options.flag("damper") {
@@ -152,12 +157,31 @@ fn passive_forces(model: &Model, q: &[f64], v: &[f64]) -> DVector<f64> {
     }
     // each tendon's spring and damper along its length: τ += Jᵀ f
     let (spring, damper) = (options.flag("spring"), options.flag("damper"));
-    for tendon in &model.tendons {
-        let (length, rate) = (tendon.length(model, q), tendon.rate(model, v));
+    for (t, tendon) in model.tendons.iter().enumerate() {
+        let (length, rate) = (tendons.lengths[t], tendons.rate(t, v));
         let force = tendon.passive_force(length, rate, spring, damper);
-        tendon.add_to_row(model, force, tau.as_mut_slice());
+        tendons.add_to_row(t, force, tau.as_mut_slice());
     }
     tau
+}
+
+/// q ⊖ q_ref as MuJoCo's springs measure it, as robodyn's generalised coordinates see it
+/// (MuJoCo's `mj_passive`): a free joint's translation and rotation apart, Rᵀ (p − p_ref) (the
+/// world-axes displacement MuJoCo pulls back, turned into the body's axes of robodyn's linear
+/// velocity) and log(q_ref⁻¹ ⊗ q); every other joint as [`spring_displacement`] (a ball's is the
+/// same log).
+fn mujoco_spring_displacement(model: &Model, q: &[f64], out: &mut [f64]) {
+    spring_displacement(model, q, out);
+    for i in (1..model.nbodies()).filter(|&i| matches!(model.joints[i], Joint::Free)) {
+        let (s, v) = (model.idx_q[i], model.idx_v[i]);
+        let reference = &model.spring_reference.as_slice()[s..s + 7];
+        let rotation = quaternion_of(&q[s + 3..s + 7]);
+        let moved = Vec3::new(q[s], q[s + 1], q[s + 2])
+            - Vec3::new(reference[0], reference[1], reference[2]);
+        let turned = (quaternion_of(&reference[3..7]).inverse() * rotation).scaled_axis();
+        out[v..v + 3].copy_from_slice(rotation.inverse_transform_vector(&moved).as_slice());
+        out[v + 3..v + 6].copy_from_slice(turned.as_slice());
+    }
 }
 
 /// w = (ω × v, 0) on each free joint's coordinates, 0 elsewhere: MuJoCo's free-joint

@@ -26,6 +26,7 @@
 //! constraints in world axes ([`crate::constraint`]).
 
 use super::rows::{RowKind, Rows};
+use super::tendons::TendonKinematics;
 use super::weights::InverseWeights;
 use crate::algo::constrained::evaluate_rows;
 use crate::constraint::{
@@ -192,6 +193,7 @@ impl Equalities {
         &mut self,
         model: &Model,
         (q, v): (&[f64], &[f64]),
+        tendons: &TendonKinematics,
         rows: &mut Rows,
         mut close: impl FnMut(&mut Rows, usize, &SolverParameters, &[f64]),
     ) -> Result<()> {
@@ -208,7 +210,13 @@ impl Equalities {
         let nv = model.nv;
         for held in &self.held {
             if let Shape::Tendon(j) = held.shape {
-                tendon_row(model, &model.tendon_equalities[j], held.index, q, rows);
+                tendon_row(
+                    model,
+                    &model.tendon_equalities[j],
+                    held.index,
+                    tendons,
+                    rows,
+                );
                 close(rows, 1, &held.solver, &held.diagonal[..1]);
                 continue;
             }
@@ -273,24 +281,28 @@ impl Equalities {
     }
 }
 
-/// The row of a tendon equality at q (see the module's header), its a_ref to be made.
-fn tendon_row(model: &Model, equality: &TendonEquality, index: usize, q: &[f64], rows: &mut Rows) {
+/// The row of a tendon equality at the tendons' lengths and Jacobians `tendons` (see the
+/// module's header), its a_ref to be made.
+fn tendon_row(
+    model: &Model,
+    equality: &TendonEquality,
+    index: usize,
+    tendons: &TendonKinematics,
+    rows: &mut Rows,
+) {
     let c = &equality.polynomial;
-    let tendons = &model.tendons;
-    let (first, second) = (
-        &tendons[equality.tendons.0],
-        equality.tendons.1.map(|t| &tendons[t]),
-    );
-    let follower = first.length(model, q) - first.length0;
+    let (first, second) = equality.tendons;
+    let displacement = |t: usize| tendons.lengths[t] - model.tendons[t].length0;
+    let follower = displacement(first);
     // p(x) and p′(x) of the leader's x = L₂ − L₂,₀ (without one: c₀ and 0)
     let [p, dp, _, _] = match second {
-        Some(leader) => polynomial_at(c, leader.length(model, q) - leader.length0),
+        Some(leader) => polynomial_at(c, displacement(leader)),
         None => [c[0], 0.0, 0.0, 0.0],
     };
     let row = rows.push(RowKind::Equality, index, follower - p, 0.0);
-    first.add_to_row(model, 1.0, row);
+    tendons.add_to_row(first, 1.0, row);
     if let Some(leader) = second {
-        leader.add_to_row(model, -dp, row);
+        tendons.add_to_row(leader, -dp, row);
     }
 }
 
@@ -435,12 +447,13 @@ mod tests {
         let weights = inverse_weights(model, &mut data).unwrap();
         let mut equalities = Equalities::new(model, &weights).unwrap();
         let x_world = forward_kinematics(model, &mut data, q).unwrap().to_vec();
+        let tendons = TendonKinematics::at(model, &mut data, q).unwrap();
         let mut rows = Rows::default();
         constraint_rows(
             model,
             &weights,
             (q, v),
-            &x_world,
+            (&x_world, &tendons),
             &[],
             &mut equalities,
             &mut rows,

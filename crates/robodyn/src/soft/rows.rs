@@ -29,6 +29,7 @@
 
 use super::equality::Equalities;
 use super::impedance::{impedance, spring_and_damper};
+use super::tendons::TendonKinematics;
 use super::weights::{point_columns, InverseWeights};
 use crate::collision::Contact;
 use crate::error::Result;
@@ -215,13 +216,14 @@ struct Softness<'a> {
     diagonal: &'a [f64],
 }
 
-/// The rows of `model` at (q, q̇) with its bodies at `x_world` and `contacts` found there, into
-/// `rows`. `weights` are the model's ([`super::weights::inverse_weights`]).
+/// The rows of `model` at (q, q̇) with its bodies at `x_world`, its tendons' lengths and
+/// Jacobians `tendons` and `contacts` found there, into `rows`. `weights` are the model's
+/// ([`super::weights::inverse_weights`]).
 pub fn constraint_rows(
     model: &Model,
     weights: &InverseWeights,
     (q, v): (&[f64], &[f64]),
-    x_world: &[Transform],
+    (x_world, tendons): (&[Transform], &TendonKinematics),
     contacts: &[Contact],
     equalities: &mut Equalities,
     rows: &mut Rows,
@@ -235,14 +237,20 @@ pub fn constraint_rows(
     }
     let safe_after = options.flag("refsafe").then_some(2.0 * options.timestep);
     // equality constraints, each a group of rows with its own softness
-    equalities.append(model, (q, v), rows, |rows, count, solver, diagonal| {
-        let softness = Softness {
-            solver,
-            friction_solref: [0.0; 2],
-            diagonal,
-        };
-        finish_group(rows, RowKind::Equality, count, &softness, safe_after, v);
-    })?;
+    equalities.append(
+        model,
+        (q, v),
+        tendons,
+        rows,
+        |rows, count, solver, diagonal| {
+            let softness = Softness {
+                solver,
+                friction_solref: [0.0; 2],
+                diagonal,
+            };
+            finish_group(rows, RowKind::Equality, count, &softness, safe_after, v);
+        },
+    )?;
     // friction loss, degree of freedom by degree of freedom: J = e_i in MuJoCo's velocities
     if options.flag("frictionloss") {
         for i in 1..model.nbodies() {
@@ -271,7 +279,7 @@ pub fn constraint_rows(
             let first = rows.len();
             let id = UnreadElements::mujoco_id(&model.unread.tendons, t);
             let row = rows.push(RowKind::FrictionTendon, id, 0.0, 0.0);
-            tendon.add_to_row(model, 1.0, row);
+            tendons.add_to_row(t, 1.0, row);
             rows.frictionloss[first] = tendon.frictionloss;
             let softness = Softness {
                 solver: &tendon.friction,
@@ -328,7 +336,7 @@ pub fn constraint_rows(
             let Some((lower, upper)) = tendon.range else {
                 continue;
             };
-            let length = tendon.length(model, q);
+            let length = tendons.lengths[t];
             let group = Softness {
                 solver: &tendon.limit,
                 friction_solref: [0.0; 2],
@@ -341,7 +349,7 @@ pub fn constraint_rows(
                 }
                 let id = UnreadElements::mujoco_id(&model.unread.tendons, t);
                 let row = rows.push(RowKind::LimitTendon, id, distance, tendon.margin);
-                tendon.add_to_row(model, side, row);
+                tendons.add_to_row(t, side, row);
                 finish_group(rows, RowKind::LimitTendon, 1, &group, safe_after, v);
             }
         }

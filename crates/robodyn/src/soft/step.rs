@@ -23,6 +23,7 @@
 //! (`crate::algo::rnea_derivatives`).
 
 use super::dynamics::{free_joint_velocity_product, ContactDynamics, ContactForward};
+use super::tendons::TendonKinematics;
 use super::TINY;
 use crate::algo::rnea_derivatives;
 use crate::algo::DerivativesInto;
@@ -145,7 +146,8 @@ impl SceneStep {
                 })
             }
             Integrator::ImplicitFast => {
-                let k = velocity_derivative(model, (q, v, act), ctrl)?;
+                let tendons = &self.forward.tendons;
+                let k = velocity_derivative(model, (q, v, act), ctrl, tendons)?;
                 let gyroscopic = self.free_body_gyroscopic(model, q, v)?;
                 let mass = &self.forward.mass;
                 Some(implicit_solve(
@@ -295,12 +297,13 @@ fn lone_free_bodies(model: &Model) -> Vec<usize> {
 /// K = ∂f/∂ν of the dampers (−D, and −b JᵀJ of each tendon's) and of the actuators whose force
 /// is not clamped ((b₂ + a₂ u) m mᵀ, m the moment arms: gear on a joint, gear J on a tendon;
 /// the activation w, or with `actearly` the next one, in place of u where the actuator has one),
-/// MuJoCo's `qDeriv` without the bias forces' terms; robodyn's actuators and tendons act on
-/// hinges and slides, where ν = v.
+/// MuJoCo's `qDeriv` without the bias forces' terms, in MuJoCo's velocities ν (robodyn's
+/// actuators act on hinges and slides, where ν = v; a spatial tendon's J is turned into ν's).
 fn velocity_derivative(
     model: &Model,
     (q, v, act): (&[f64], &[f64], &[f64]),
     ctrl: &[f64],
+    tendons: &TendonKinematics,
 ) -> Result<DMatrix<f64>> {
     let nv = model.nv;
     let mut k = DMatrix::zeros(nv, nv);
@@ -308,12 +311,14 @@ fn velocity_derivative(
         for c in 0..nv {
             k[(c, c)] -= model.damping[c];
         }
-        for tendon in &model.tendons {
-            for (a, _, ca) in tendon.entries(model) {
-                for (b, _, cb) in tendon.entries(model) {
-                    k[(a, b)] -= tendon.damping * ca * cb;
-                }
+        // −b JᵀJ with J in MuJoCo's velocities: J_ν = J T⁻¹, its transpose T Jᵀ
+        for (t, tendon) in model.tendons.iter().enumerate() {
+            if tendon.damping == 0.0 {
+                continue;
             }
+            let row: Vec<f64> = tendons.jacobian.row(t).iter().copied().collect();
+            let j = to_mujoco(model, q, &row);
+            k.ger(-tendon.damping, &j, &j, 1.0);
         }
     }
     check_vector("ctrl", ctrl, model.nu())?;
@@ -336,7 +341,36 @@ fn velocity_derivative(
             }
         }
     }
+    keep_tree_pattern(model, &mut k);
     Ok(k)
+}
+
+/// K keeps only the entries MuJoCo's `qDeriv` holds, those of M's sparsity: two degrees of
+/// freedom on one branch of the tree (one's body the other's or an ancestor of it). A tendon's
+/// or actuator's coupling of two branches (two trees, two fingers) is left out there, and so
+/// here.
+fn keep_tree_pattern(model: &Model, k: &mut DMatrix<f64>) {
+    let mut body_of = vec![0; model.nv];
+    for i in 1..model.nbodies() {
+        for dof in model.v_range(i) {
+            body_of[dof] = i;
+        }
+    }
+    // whether `ancestor` is `body` or above it
+    let above = |ancestor: usize, mut body: usize| {
+        while body > ancestor {
+            body = model.parent[body];
+        }
+        body == ancestor
+    };
+    for a in 0..model.nv {
+        for b in 0..model.nv {
+            let (i, j) = (body_of[a], body_of[b]);
+            if !above(i, j) && !above(j, i) {
+                k[(a, b)] = 0.0;
+            }
+        }
+    }
 }
 
 /// u with (M − h Tᵀ K T − h G) u = M a: the implicit step's acceleration in robodyn's basis

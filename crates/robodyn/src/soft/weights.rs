@@ -11,7 +11,7 @@
 //! ```
 //! (0 for a body welded to the world), and a joint's block of `M⁻¹` gives its own:
 //! `(M⁻¹)_ii` for a hinge or slide, the mean of the block's diagonal for a ball, of the
-//! translation and rotation blocks apart for a free joint; a fixed tendon's is `J M⁻¹ Jᵀ`. Both
+//! translation and rotation blocks apart for a free joint; a tendon's is `J M⁻¹ Jᵀ`. Both
 //! traces are the same in any
 //! coordinates of the velocities, so robodyn's free-joint velocities (linear in the body's axes)
 //! give MuJoCo's numbers (linear in the world's).
@@ -27,6 +27,7 @@ use crate::model::Model;
 use crate::spatial::{Transform, Vec3};
 use crate::Data;
 
+use super::tendons::TendonKinematics;
 use super::TINY;
 use nalgebra::DMatrix;
 
@@ -37,7 +38,7 @@ pub struct InverseWeights {
     pub bodies: Vec<[f64; 2]>,
     /// Per velocity coordinate.
     pub dofs: Vec<f64>,
-    /// Per fixed tendon: `J M⁻¹ Jᵀ` (MuJoCo's `tendon_invweight0`).
+    /// Per tendon: `J M⁻¹ Jᵀ` at qpos0 (MuJoCo's `tendon_invweight0`).
     pub tendons: Vec<f64>,
 }
 
@@ -107,22 +108,14 @@ pub fn inverse_weights(model: &Model, data: &mut Data) -> Result<InverseWeights>
             }
         }
     }
-    // the tendons: J M⁻¹ Jᵀ of their constant J
-    let inverse = &inverse;
-    let tendons = model
-        .tendons
-        .iter()
-        .map(|tendon| {
-            let entries: Vec<(usize, usize, f64)> = tendon.entries(model).collect();
-            entries
-                .iter()
-                .flat_map(|&(a, _, ca)| {
-                    entries
-                        .iter()
-                        .map(move |&(b, _, cb)| ca * cb * inverse[(a, b)])
-                })
-                .sum()
-        })
+    // the tendons: J M⁻¹ Jᵀ of their J at qpos0
+    let mut kinematics = TendonKinematics::default();
+    kinematics.update(model, q, &x_world);
+    let j = &kinematics.jacobian;
+    let tendons = (&inverse * j.transpose())
+        .column_iter()
+        .zip(j.row_iter())
+        .map(|(column, row)| row.dot(&column.transpose()))
         .collect();
     Ok(InverseWeights {
         bodies,

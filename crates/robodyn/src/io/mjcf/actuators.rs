@@ -94,7 +94,9 @@ impl<'a> Reader<'a> {
             match (actuator.coordinate, actuator.tendon) {
                 (Some(c), _) => moment[c] = actuator.gear,
                 (None, Some(t)) => {
-                    model.tendons[t].add_to_row(model, actuator.gear, moment.as_mut_slice())
+                    for (c, _, coefficient) in model.tendons[t].entries(model) {
+                        moment[c] += actuator.gear * coefficient;
+                    }
                 }
                 (None, None) => continue,
             }
@@ -217,6 +219,9 @@ impl<'a> Reader<'a> {
                 let message = format!("attribute 'tendon': no tendon named '{tendon_name}'");
                 return Err(self.error(element, message));
             };
+            if model.tendons[t].is_spatial() {
+                return unmodelled(actuator, format!("spatial tendon '{tendon_name}'"));
+            }
             actuator.tendon = Some(t);
             model.tendons[t].range.map(|(lower, upper)| [lower, upper])
         } else {

@@ -92,7 +92,10 @@ impl<'a> Reader<'a> {
                         Some((segment, _)) => segment,
                         None => self.placement(child, site_class)?,
                     };
-                    builder.add_frame(&name, body, placement * to_element);
+                    let placement = placement * to_element;
+                    builder.add_frame(&name, body, placement);
+                    let point = (body, placement.translation);
+                    self.site_points.borrow_mut().insert(name.clone(), point);
                     self.site_bodies.borrow_mut().insert(name, source_body);
                 }
                 "body" => self.read_body(builder, child, (body, source_body), to_element, class)?,
