@@ -479,3 +479,26 @@ fn scene_geoms_options_and_the_pairs_checked() {
     let pair = &model.contact_pairs[0];
     assert_eq!((pair.geoms, pair.contact.condim), ((0, 2), 3));
 }
+
+#[test]
+fn disabled_actuator_groups_are_named() {
+    let text = r#"<mujoco>
+      <option actuatorgroupdisable="2 5"/>
+      <default><default class="off"><motor group="5"/></default></default>
+      <worldbody><body><joint name="j" axis="0 1 0"/><geom size="0.1"/></body></worldbody>
+      <actuator>
+        <motor name="on" joint="j"/>
+        <motor name="grouped" joint="j" group="2"/>
+        <motor name="by_class" joint="j" class="off"/>
+        <position name="other" joint="j" group="3"/>
+      </actuator>
+    </mujoco>"#;
+    let model = load_mjcf_str(text, "groups.xml").unwrap();
+    let warning = model
+        .warnings
+        .iter()
+        .find(|w| w.contains("actuatorgroupdisable"))
+        .expect("a warning");
+    assert!(warning.contains("'grouped', 'by_class'"), "{warning}");
+    assert!(!warning.contains("'on'") && !warning.contains("'other'"));
+}

@@ -11,7 +11,7 @@
 
 use super::Reader;
 use crate::error::Result;
-use crate::io::xml::parse_numbers;
+use crate::io::xml::{parse_number_list, parse_numbers};
 use crate::model::{
     ConstraintSolver, FrictionCone, Integrator, Model, SimulationOptions, DISABLE_FLAGS,
     ENABLE_FLAGS,
@@ -77,6 +77,42 @@ impl<'a> Reader<'a> {
             ));
         }
         model.options = options;
+        self.warn_disabled_actuator_groups(sections, model)
+    }
+
+    /// `<option actuatorgroupdisable>`: MuJoCo switches off the actuators of those groups
+    /// (`group`, 0–30); robodyn does not, and names them in a warning.
+    fn warn_disabled_actuator_groups(
+        &self,
+        sections: &[Node<'a, 'a>],
+        model: &mut Model,
+    ) -> Result<()> {
+        let mut disabled: Vec<i64> = Vec::new();
+        for option in sections.iter().filter(|c| c.has_tag_name("option")) {
+            if let Some(text) = option.attribute("actuatorgroupdisable") {
+                disabled = parse_number_list(text, "actuatorgroupdisable")
+                    .map_err(|m| self.error(*option, m))?
+                    .iter()
+                    .map(|g| *g as i64)
+                    .collect();
+            }
+        }
+        let mut named = Vec::new();
+        for section in sections.iter().filter(|c| c.has_tag_name("actuator")) {
+            for (element, actuator) in self.children(*section)?.into_iter().zip(&model.actuators) {
+                let group = self.integer(element, "main", "group", 0)?;
+                if (0..=30).contains(&group) && disabled.contains(&group) {
+                    named.push(format!("'{}'", actuator.name));
+                }
+            }
+        }
+        if !named.is_empty() {
+            model.warnings.push(format!(
+                "actuatorgroupdisable: MuJoCo switches off actuators {} (their groups are \
+                 disabled); robodyn does not follow it and drives them",
+                named.join(", ")
+            ));
+        }
         Ok(())
     }
 
