@@ -177,6 +177,18 @@ fn check_structure(model: &Model) -> Result<()> {
             "a frame, visual, mimic, tendon or coordinate refers to a missing one".into(),
         );
     }
+    // a range the clamps use must be ordered (a loader never makes another)
+    let ordered = |range: &Option<(f64, f64)>| range.is_none_or(|(low, high)| low <= high);
+    if let Some(actuator) = model
+        .actuators
+        .iter()
+        .find(|a| !(ordered(&a.ctrl_range) && ordered(&a.force_range) && ordered(&a.act_range)))
+    {
+        return damaged(format!(
+            "actuator '{}' has a range whose lower end is above its upper",
+            actuator.name
+        ));
+    }
     let declared = model.constraints.iter().map(|c| c.constraint.clone());
     if let Err(error) = crate::constraint::ConstraintSet::new(model, declared.collect()) {
         return damaged(format!(
@@ -228,5 +240,13 @@ mod tests {
             act: nalgebra::DVector::zeros(0),
         });
         assert!(message(&model_to_bytes(&model)).contains("keyframe 'home' has 5 + 1"));
+        let mut model = crate::io::load_mjcf_str(
+            r#"<mujoco><worldbody><body><joint name="j"/><geom size="0.1"/></body></worldbody>
+               <actuator><motor name="m" joint="j" ctrlrange="-1 1"/></actuator></mujoco>"#,
+            "motor.xml",
+        )
+        .unwrap();
+        model.actuators[0].ctrl_range = Some((1.0, -1.0));
+        assert!(message(&model_to_bytes(&model)).contains("actuator 'm' has a range"));
     }
 }
