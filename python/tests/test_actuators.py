@@ -147,7 +147,8 @@ DEFAULTS_ARM = """<mujoco><compiler angle="radian"/>
   <actuator>{actuator}</actuator>
 </mujoco>"""
 
-#: (a class's actuator defaults, an actuator): what MuJoCo's rule passes on. A class has one
+#: (a class's actuator defaults, an actuator): what MuJoCo's rule passes on (pairs found by a
+#: randomised search against MuJoCo 4.0.0 among them). A class has one
 #: actuator default; a shortcut takes its parameters only from a default written with the same
 #: shortcut or a `general` of its gain type (nearest class first), mechanical ones (ranges, gear)
 #: from any; a `general` takes the raw parameters whatever wrote them; damping ratios.
@@ -189,6 +190,21 @@ ACTUATOR_DEFAULTS = [
     ('<position kp="3" dampratio="0.7"/>', '<general joint="j" armature="0.05" gear="1.5"/>'),
     ('<position kp="30" dampratio="1.2"/>', '<position tendon="t" gear="2"/>'),
     ('', '<position joint="j2" kp="8" dampratio="1" timeconst="0.05"/>'),
+    # a shortcut sets its activation layout without a general's actearly
+    ('<general actearly="true"/>', '<intvelocity joint="j"/>'),
+    ('<general actearly="true"/>', '<position joint="j" kp="3" timeconst="0.1"/>'),
+    ('<general actearly="true" dyntype="filter"/>', '<general joint="j"/>'),
+    # a damper default limits the control whatever ctrllimited said before it
+    ('<general ctrllimited="false"/><damper kv="2" ctrlrange="0.5 1"/>', '<motor joint="j"/>'),
+    ('<general ctrllimited="false"/><damper kv="2" ctrlrange="0.5 1"/>', '<general joint="j"/>'),
+    ('<motor ctrllimited="false"/>', '<damper joint="j" kv="2" ctrlrange="0.5 1"/>'),
+    # a shortcut's own range and inheritrange clear each other; a general's inheritrange wins
+    ('<motor ctrlrange="-2 -1"/><position inheritrange="0.5"/>', '<motor joint="j"/>'),
+    ('<general inheritrange="0.5"/><default class="k"><position ctrlrange="-1 1"/></default>',
+     '<position joint="j" class="k"/>'),
+    ('<position kp="1" inheritrange="0.5"/>', '<general joint="j" ctrlrange="-1 1"/>'),
+    ('<position timeconst="0.49"/><default class="k"><general/><intvelocity/></default>',
+     '<general joint="j" class="k" dyntype="filter"/>'),
 ]
 
 
@@ -226,6 +242,17 @@ def test_actuator_defaults_mujoco_refuses_are_refused():
         ('<position kv="-1"/>', '<position joint="j"/>', "attribute 'kv': expected a value ≥ 0"),
         ("", '<general joint="j" dyntype="filter" biastype="affine" biasprm="0 -1 0" inheritrange="1"/>',
          "attribute 'inheritrange': only for position and intvelocity"),
+        ('<position kp="1" inheritrange="0.5"/>', '<general joint="j" ctrlrange="-1 1" dyntype="filter"/>',
+         "attribute 'inheritrange': only for position and intvelocity"),
+        ('<position kp="2"/><position kv="1"/>', '<position joint="j"/>', "holds one <position>, this is a second"),
+        ('<general actrange="-1 1"/>', '<velocity joint="j"/>', "'actrange': an actuator without activation"),
+        ("", '<general joint="j" actrange="-1 1"/>', "'actrange': an actuator without activation"),
+        ("<damper/>", '<velocity joint="j"/>', "a limited range needs lower < upper"),
+        ('<damper ctrlrange="-1 1"/>', '<motor joint="j"/>', "a damper's range cannot be negative"),
+        ('<general gaintype="affine" gainprm="0 0 2"/>', '<damper joint="j" ctrlrange="0 1"/>',
+         "a damper's kv must be ≥ 0"),
+        ('<intvelocity actrange="-1 1" inheritrange="1"/>', '<intvelocity joint="j"/>',
+         "'actrange' and 'inheritrange'"),
     ]:
         text = DEFAULTS_ARM.format(defaults=defaults, actuator=actuator)
         with pytest.raises(ValueError, match=message):

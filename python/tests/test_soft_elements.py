@@ -247,6 +247,11 @@ def test_spatial_tendon_paths_mujoco_refuses_are_refused():
             load_quietly(None, text)
         with pytest.raises(ValueError):
             mujoco.MjModel.from_xml_string(text)
+    text = SPATIAL.replace("{cone}", "pyramidal").replace("</tendon>", f'<spatial width="0">{sites[0]}{sites[1]}</spatial></tendon>')
+    with pytest.raises(ValueError, match="'width': expected a positive width"):
+        load_quietly(None, text)
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_string(text)
     # an actuator on a spatial tendon is not modelled: a warning, no force
     text = SPATIAL.replace("{cone}", "pyramidal").replace("</mujoco>", '<actuator><motor tendon="cord"/></actuator></mujoco>')
     model = load_quietly(None, text)

@@ -503,8 +503,13 @@ impl<'a> Reader<'a> {
             .next()
             .cloned()
             .unwrap_or_default();
+        let mut seen = HashSet::new();
         for element in elements.iter().filter(|c| !c.has_tag_name("default")) {
             let tag = element.tag_name().name();
+            if !seen.insert(tag) {
+                let message = format!("a <default> holds one <{tag}>, this is a second");
+                return Err(self.error(*element, message));
+            }
             if ACTUATOR_KINDS.contains(&tag) {
                 actuator = self.raw_actuator(*element, &actuator, self.class_actuators(parent))?;
             }
@@ -522,6 +527,7 @@ impl<'a> Reader<'a> {
                 }
                 entry.insert(name.to_string(), value);
             }
+            self.shortcut_ranges(*element, entry)?;
         }
         self.defaults.insert(class.clone(), values);
         let parent = parent.map(str::to_string);

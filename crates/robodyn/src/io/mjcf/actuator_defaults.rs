@@ -23,6 +23,7 @@ use super::Reader;
 use crate::error::Result;
 use crate::io::xml::parse_number_list;
 use roxmltree::Node;
+use std::collections::HashMap;
 
 /// The MJCF actuator elements; in a `<default>` they share one actuator default.
 pub(super) const ACTUATOR_KINDS: [&str; 12] = [
@@ -59,6 +60,8 @@ pub(super) struct RawActuator {
     pub inherit_range: f64,
     /// `actdim`, where given (a `general`'s).
     pub act_dim: Option<f64>,
+    /// `actearly` (a `general`'s; a shortcut sets its activation layout without it).
+    pub act_early: bool,
 }
 
 impl Default for RawActuator {
@@ -76,6 +79,7 @@ impl Default for RawActuator {
             dynamics: unit,
             inherit_range: 0.0,
             act_dim: None,
+            act_early: false,
         }
     }
 }
@@ -133,11 +137,13 @@ impl Shortcut {
                 raw.bias[1] = -kp;
                 raw.bias[2] = source.bias[2];
                 raw.inherit_range = source.inherit_range;
-                if integrated {
-                    raw.dyn_type = "integrator".into();
-                } else if source.dyn_type == "filterexact" {
+                // a filterexact source's time constant stays (an intvelocity keeps it unused)
+                if source.dyn_type == "filterexact" {
                     raw.dyn_type = "filterexact".into();
                     raw.dynamics[0] = source.dynamics[0];
+                }
+                if integrated {
+                    raw.dyn_type = "integrator".into();
                 }
             }
             Shortcut::Velocity => {
@@ -261,6 +267,16 @@ impl<'a> Reader<'a> {
         if let Some(x) = self.own_first(element, "actdim")? {
             raw.act_dim = Some(x);
         }
+        match element.attribute("actearly") {
+            None => {}
+            Some("true") => raw.act_early = true,
+            Some("false") => raw.act_early = false,
+            Some(other) => {
+                let message =
+                    format!("attribute 'actearly': expected true or false, got '{other}'");
+                return Err(self.error(element, message));
+            }
+        }
         Ok(raw)
     }
 
@@ -307,8 +323,17 @@ impl<'a> Reader<'a> {
                         .into();
                     }
                 }
+                let range = if integrated { "actrange" } else { "ctrlrange" };
                 if let Some(x) = self.own_first(element, "inheritrange")? {
+                    if x > 0.0 && element.attribute(range).is_some() {
+                        let message =
+                            format!("attributes '{range}' and 'inheritrange': give one, not both");
+                        return Err(self.error(element, message));
+                    }
                     raw.inherit_range = x;
+                } else if element.attribute(range).is_some() {
+                    // a range given here overrides an inherited inheritrange
+                    raw.inherit_range = 0.0;
                 }
             }
             Shortcut::Velocity => {
@@ -320,6 +345,13 @@ impl<'a> Reader<'a> {
             Shortcut::Damper => {
                 if let Some(kv) = non_negative("kv")? {
                     raw.gain[2] = -kv;
+                }
+                if raw.gain[2] > 0.0 {
+                    let message = format!(
+                        "a damper's kv must be ≥ 0, got {} (from its class's default)",
+                        -raw.gain[2]
+                    );
+                    return Err(self.error(element, message));
                 }
             }
             Shortcut::Cylinder => {
@@ -344,6 +376,43 @@ impl<'a> Reader<'a> {
                     }
                 }
             }
+        }
+        Ok(())
+    }
+
+    /// What a shortcut in a `<default>` does to its class's ranges (`ranges`: the class's
+    /// actuator attributes so far, this element's in): a `damper` limits the control (its range
+    /// non-negative); a `position`'s or `intvelocity`'s own `inheritrange` clears the range it
+    /// sets (the control's, the activation's).
+    pub(super) fn shortcut_ranges(
+        &self,
+        element: Node<'a, 'a>,
+        ranges: &mut HashMap<String, String>,
+    ) -> Result<()> {
+        match element.tag_name().name() {
+            "damper" => {
+                ranges.insert("ctrllimited".into(), "true".into());
+                let range = ranges
+                    .get("ctrlrange")
+                    .map(|t| parse_number_list(t, "ctrlrange"));
+                let range = range.transpose().map_err(|m| self.error(element, m))?;
+                if range.is_some_and(|r| r.iter().any(|x| *x < 0.0)) {
+                    let message = "attribute 'ctrlrange': a damper's range cannot be negative";
+                    return Err(self.error(element, message));
+                }
+            }
+            tag @ ("position" | "intvelocity")
+                if self
+                    .own_first(element, "inheritrange")?
+                    .is_some_and(|x| x > 0.0) =>
+            {
+                ranges.remove(if tag == "position" {
+                    "ctrlrange"
+                } else {
+                    "actrange"
+                });
+            }
+            _ => {}
         }
         Ok(())
     }

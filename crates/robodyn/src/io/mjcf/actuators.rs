@@ -138,7 +138,7 @@ impl<'a> Reader<'a> {
             force_range: self.range(element, "force")?,
             dynamics: ActivationDynamics::None,
             act_range: self.range(element, "act")?,
-            act_early: self.flag(element, "main", "actearly")?,
+            act_early: false,
         };
         let unmodelled = |actuator: Actuator, why: String| Ok(Err((actuator, why)));
 
@@ -196,12 +196,23 @@ impl<'a> Reader<'a> {
             "affine" => b,
             other => return unmodelled(actuator, format!("biastype '{other}'")),
         };
+        actuator.act_early = raw.act_early;
         self.check_activation_size(element, &actuator, raw.act_dim)?;
+        if actuator.act_range.is_some() && !actuator.has_activation() {
+            let message = "attribute 'actrange': an actuator without activation dynamics has no \
+                           activation to limit";
+            return Err(self.error(element, message));
+        }
         if tag == "damper" {
-            // f = −k_v l̇ u, u in a non-negative range
-            if !matches!(actuator.ctrl_range, Some((low, high)) if 0.0 <= low && low < high) {
-                let message = "attribute 'ctrlrange': a damper needs a range 0 ≤ lower < upper";
-                return Err(self.error(element, message));
+            // f = −k_v l̇ u, u limited (whatever ctrllimited says) to a non-negative range
+            match self.numbers::<2>(element, "main", "ctrlrange")? {
+                Some([low, high]) if 0.0 <= low && low < high => {
+                    actuator.ctrl_range = Some((low, high));
+                }
+                _ => {
+                    let message = "attribute 'ctrlrange': a damper needs a range 0 ≤ lower < upper";
+                    return Err(self.error(element, message));
+                }
             }
         }
 
@@ -257,8 +268,8 @@ impl<'a> Reader<'a> {
     /// `inheritrange` (MuJoCo's compiler rule): on a position-like actuator (a fixed gain kp
     /// with an affine bias −kp l), the transmission's `range` scaled about its middle becomes
     /// the control's range (no dynamics or filterexact: a position servo) or the activation's
-    /// (an integrator: `intvelocity`). A range the element gives itself wins over an
-    /// `inheritrange` of its class; an element gives one or the other.
+    /// (an integrator: `intvelocity`), over any range given (a shortcut's own range has already
+    /// cleared an inherited `inheritrange`, [`super::actuator_defaults`]).
     fn inherit_range(
         &self,
         element: Node<'a, 'a>,
@@ -267,23 +278,12 @@ impl<'a> Reader<'a> {
         actuator: &mut Actuator,
     ) -> Result<()> {
         let integrated = actuator.dynamics == ActivationDynamics::Integrator;
-        let (target, limited) = if integrated {
-            ("actrange", "actlimited")
+        let limited = if integrated {
+            "actlimited"
         } else {
-            ("ctrlrange", "ctrllimited")
+            "ctrllimited"
         };
-        let own_inherit = element.attribute("inheritrange").is_some();
-        let own_range = element.attribute(target).is_some();
-        let shortcut = element.tag_name().name() != "general";
-        if own_inherit && own_range && shortcut {
-            let message = format!("attributes '{target}' and 'inheritrange': give one, not both");
-            return Err(self.error(element, message));
-        }
-        let inherit = if own_range && !own_inherit {
-            0.0
-        } else {
-            raw.inherit_range
-        };
+        let inherit = raw.inherit_range;
         let position_like =
             raw.gain_type == "fixed" && raw.bias_type == "affine" && raw.gain[0] == -raw.bias[1];
         if inherit <= 0.0 || !position_like {

@@ -190,6 +190,12 @@ impl<'a> Reader<'a> {
                 solimp: self.leading_numbers(element, "main", "tendon", solimp, DEFAULT_SOLIMP)?,
             })
         };
+        // a spatial tendon is drawn with a positive width (MuJoCo refuses others)
+        let width = first("width", 0.003)?;
+        if !path.is_empty() && width <= 0.0 {
+            let message = format!("attribute 'width': expected a positive width, got {width}");
+            return Err(self.error(element, message));
+        }
         // what is not modelled: warned
         let mut unmodelled = Vec::new();
         for name in ["stiffness", "damping"] {
