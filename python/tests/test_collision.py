@@ -62,8 +62,8 @@ CONVEX_PAIRS = [
     ("cylinder", "cylinder"),
     ("cylinder", "box"),
 ]
-#: MuJoCo's height field and mesh types, which robodyn does not collide yet.
-NOT_COLLIDED_TYPES = {1, 7}
+#: MuJoCo's height field type, which robodyn does not collide yet.
+NOT_COLLIDED_TYPES = {1}
 
 
 def scene(first, second, margin=MARGIN):
@@ -82,20 +82,21 @@ def random_quaternion(rng):
     return quaternion / np.linalg.norm(quaternion)
 
 
-def random_qpos(first, second, mj_model, mj_data, rng):
-    """A random placement of the two geoms near contact (see the module's header)."""
+def random_qpos(first, second, mj_model, mj_data, rng, bounding_radius=BOUNDING_RADIUS):
+    """A random placement of the two geoms near contact (see the module's header), their
+    bounding radii by kind in `bounding_radius`."""
     qpos = np.zeros(mj_model.nq)
     if first == "plane":
         mujoco.mj_kinematics(mj_model, mj_data)
         normal = mj_data.geom_xmat[0].reshape(3, 3)[:, 2]
         along = rng.uniform(-1, 1, size=3) * 0.3
-        height = rng.uniform(-1.0, 1.1) * BOUNDING_RADIUS[second]
+        height = rng.uniform(-1.0, 1.1) * bounding_radius[second]
         qpos[0:3] = along - normal * along.dot(normal) + normal * height
         qpos[3:7] = random_quaternion(rng)
         return qpos
     direction = rng.normal(size=3)
     direction /= np.linalg.norm(direction)
-    reach = BOUNDING_RADIUS[first] + BOUNDING_RADIUS[second]
+    reach = bounding_radius[first] + bounding_radius[second]
     qpos[0:3] = rng.normal(size=3) * 0.05
     qpos[3:7] = random_quaternion(rng)
     qpos[7:10] = qpos[0:3] + direction * reach * rng.uniform(0.2, 1.05)
@@ -242,15 +243,19 @@ def test_special_placements_collide_as_in_mujoco(first, second):
     assert not failures, failures
 
 
-def test_pairs_without_a_collider_are_named_at_load():
-    """A mesh: no contacts yet, and the warning says so; the other pairs are found."""
-    text = """<mujoco><asset><mesh name="tet" vertex="0 0 0 0.1 0 0 0 0.1 0 0 0 0.1" face="0 2 1 0 1 3 0 3 2 1 2 3"/></asset>
+def test_pairs_without_a_collider_are_named_at_load(tmp_path):
+    """A mesh whose file is missing: nothing touches it, and the warnings say so; the other
+    pairs are found."""
+    text = """<mujoco><asset><mesh name="lost" file="no_such_file.stl"/></asset>
     <worldbody><geom name="floor" type="plane" size="0 0 1"/>
       <body pos="0 0 0.05"><freejoint/><geom name="egg" type="ellipsoid" size="0.1 0.08 0.06"/></body>
       <body pos="0.5 0 0.05"><freejoint/><geom name="drum" type="cylinder" size="0.1 0.06"/></body>
-      <body pos="0.5 0 0.1"><freejoint/><geom name="tet" type="mesh" mesh="tet"/></body>
+      <body pos="0.5 0 0.1"><freejoint/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>
+        <geom name="lost" type="mesh" mesh="lost"/></body>
     </worldbody></mujoco>"""
-    model = load_quietly(text=text)
+    (tmp_path / "scene.xml").write_text(text)
+    model = load_quietly(tmp_path / "scene.xml")
+    assert any("the geom's mesh file is missing, so nothing touches it" in message for message in model.warnings)
     said = "the contacts of plane–mesh, ellipsoid–mesh, cylinder–mesh pairs are not found yet"
     assert any(said in message for message in model.warnings), model.warnings
     found = [(c["geom1"], c["geom2"]) for c in model.collide(model.neutral())]

@@ -133,6 +133,7 @@ impl PyModel {
             if let Shape::Mesh {
                 source,
                 file_to_visual,
+                ..
             } = &visual.shape
             {
                 item.set_item("file_to_visual", matrix(py, file_to_visual)?)?;

@@ -1,10 +1,12 @@
 //! What a robot looks like: the visual geometry of its links (URDF `<visual>`, MJCF geoms), each
 //! placed on the body it moves with. The dynamics never read it; the viewer draws it.
 
+use crate::collision::hull::ConvexHull;
 use crate::io::mesh::TriangleMesh;
 use crate::spatial::{Transform, Vec3};
 use nalgebra::Matrix4;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// MuJoCo's geom colour when neither the geom nor a material gives one.
 pub const DEFAULT_RGBA: [f64; 4] = [0.5, 0.5, 0.5, 1.0];
@@ -65,6 +67,10 @@ pub enum Shape {
         source: MeshSource,
         /// The homogeneous map from the file's coordinates to the visual's frame.
         file_to_visual: Matrix4<f64>,
+        /// Its convex hull in the visual's frame, what contacts see: set on a model's collision
+        /// geoms (MJCF mesh geoms that may touch something), `None` on what is only drawn.
+        #[serde(default)]
+        hull: Option<Arc<ConvexHull>>,
     },
 }
 

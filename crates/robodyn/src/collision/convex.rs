@@ -23,6 +23,7 @@
 //! - a contact is at `(x₁ + x₂)/2`, normal `(x₁ − x₂)/|x₁ − x₂|`, distance the signed gap.
 
 use super::gjk::{self, Convex, Query};
+use super::hull::ConvexHull;
 use super::{Placed, Touch};
 use crate::spatial::{Mat3, Vec3};
 use crate::visual::Shape;
@@ -54,7 +55,7 @@ fn unit_or_x(v: &Vec3) -> Vec3 {
 
 /// The support functions: the shapes, and the cores GJK measures first.
 #[derive(Debug, Clone, Copy)]
-enum Kind {
+enum Kind<'a> {
     Point,
     Segment { half_length: f64 },
     Sphere { radius: f64 },
@@ -62,20 +63,21 @@ enum Kind {
     Ellipsoid { radii: Vec3 },
     Cylinder { radius: f64, half_length: f64 },
     Cuboid { half_extents: Vec3 },
+    Mesh { hull: &'a ConvexHull },
 }
 
 /// A placed convex shape, grown by `inflation` along every support direction.
 #[derive(Debug, Clone, Copy)]
-struct Body {
-    kind: Kind,
+struct Body<'a> {
+    kind: Kind<'a>,
     rotation: Mat3,
     position: Vec3,
     inflation: f64,
 }
 
-impl Body {
-    /// The shape as a support function (`None`: a plane or a mesh).
-    fn new(placed: &Placed) -> Option<Self> {
+impl<'a> Body<'a> {
+    /// The shape as a support function (`None`: a plane, or a mesh without its hull).
+    fn new(placed: &Placed<'a>) -> Option<Self> {
         let kind = match *placed.shape {
             Shape::Sphere { radius } => Kind::Sphere { radius },
             Shape::Capsule {
@@ -94,7 +96,11 @@ impl Body {
                 half_length,
             },
             Shape::Box { half_extents } => Kind::Cuboid { half_extents },
-            Shape::Plane { .. } | Shape::Mesh { .. } => return None,
+            Shape::Mesh {
+                hull: Some(ref hull),
+                ..
+            } => Kind::Mesh { hull },
+            Shape::Plane { .. } | Shape::Mesh { hull: None, .. } => return None,
         };
         Some(Body {
             kind,
@@ -135,9 +141,9 @@ impl Body {
     }
 }
 
-impl Convex for Body {
-    /// The support point along `d`; the tag is a box's corner (bit k: +x_k) or a cylinder's cap
-    /// (0 top, 1 bottom).
+impl Convex for Body<'_> {
+    /// The support point along `d`; the tag is a box's corner (bit k: +x_k), a cylinder's cap
+    /// (0 top, 1 bottom) or a mesh's corner (its index in the hull).
     fn support(&self, d: &Vec3) -> (Vec3, i32) {
         let (point, tag) = match self.kind {
             Kind::Point => (self.position, -1),
@@ -211,6 +217,10 @@ impl Convex for Body {
                 }
                 (self.world_of(&s), corner)
             }
+            Kind::Mesh { hull } => {
+                let (s, corner) = hull.support(&self.local_of(d));
+                (self.world_of(&s), corner as i32)
+            }
         };
         if self.inflation > 0.0 {
             (point + d * self.inflation, tag)
@@ -262,10 +272,15 @@ fn inflate(witnesses: &mut [Witness], grow: [f64; 2], n: &Vec3) {
     }
 }
 
-/// How many contacts a pair may have: four between cylinders and boxes, two for a capsule
-/// against one of them, one otherwise.
+/// How many contacts a pair may have: four between cylinders, boxes and meshes, two for a
+/// capsule against one of them, one otherwise.
 fn contact_budget(a: &Body, b: &Body) -> usize {
-    let flat = |body: &Body| matches!(body.kind, Kind::Cylinder { .. } | Kind::Cuboid { .. });
+    let flat = |body: &Body| {
+        matches!(
+            body.kind,
+            Kind::Cylinder { .. } | Kind::Cuboid { .. } | Kind::Mesh { .. }
+        )
+    };
     let capsule = |body: &Body| matches!(body.kind, Kind::Capsule { .. });
     if flat(a) && flat(b) {
         4
@@ -278,7 +293,7 @@ fn contact_budget(a: &Body, b: &Body) -> usize {
 
 /// The contacts of `a` and `b` grown by `margin`/2 each (MuJoCo's `mjc_ccd`), distances of the
 /// grown shapes.
-fn penetration(a: &Body, b: &Body, margin: f64) -> Manifold {
+fn penetration<'a>(a: &Body<'a>, b: &Body<'a>, margin: f64) -> Manifold {
     let query = Query {
         tolerance: TOLERANCE,
         iterations: ITERATIONS,
@@ -290,7 +305,7 @@ fn penetration(a: &Body, b: &Body, margin: f64) -> Manifold {
     let rounded = |body: &Body| matches!(body.kind, Kind::Sphere { .. } | Kind::Capsule { .. });
     if rounded(a) || rounded(b) || margin > 0.0 {
         // the cores' distance: spheres as points, capsules as segments, margins left out
-        let core = |body: &Body| {
+        let core = |body: &Body<'a>| {
             let mut core = *body;
             let mut grow = 0.5 * margin;
             match body.kind {
@@ -382,8 +397,87 @@ pub fn plane_convex(first: &Placed, second: &Placed, margin: f64, touches: &mut 
     ));
 }
 
-/// Two convex shapes (see the module's header). Meshes are not handled here yet (they give no
-/// touches).
+/// Plane `first` against a mesh `second`: the hull's corner deepest below the plane, then the
+/// other corners within the margin of the face at that corner most opposed to the plane's
+/// normal n. Of more than four, the deepest and the three spread the most: the farthest from
+/// it, then the farthest from the line of those two, then the farthest from the lines joining
+/// the third to the other two. Each contact is at its corner v moved halfway to the plane:
+/// `d = n·(v − o)`, `p = v − (d/2) n`.
+pub fn plane_mesh(first: &Placed, second: &Placed, margin: f64, touches: &mut Vec<Touch>) {
+    let Some(body) = Body::new(second) else {
+        return;
+    };
+    let Kind::Mesh { hull } = body.kind else {
+        return;
+    };
+    let normal = first.axis(2);
+    let local_normal = body.local_of(&normal);
+    let (lowest, deepest) = hull.support(&(local_normal * -1.0));
+    let touch = |v: Vec3| {
+        let distance = dot(&normal, &(v - first.position));
+        Touch::new(distance, normal * (distance * -0.5) + v, normal)
+    };
+    let corner = body.world_of(&lowest);
+    let first_touch = touch(corner);
+    if first_touch.distance > margin {
+        return;
+    }
+    touches.push(first_touch);
+    // the face at the deepest corner turned most against the normal (the first of equals)
+    let Some(face) = hull
+        .faces_at(deepest)
+        .iter()
+        .copied()
+        .fold(None, |best, f| {
+            let facing = dot(&hull.normals[f], &local_normal);
+            match best {
+                Some((top, _)) if facing >= top => best,
+                _ => Some((facing, f)),
+            }
+        })
+    else {
+        return;
+    };
+    let candidates = || {
+        hull.face(face.1)
+            .iter()
+            .filter(move |&&c| c != deepest)
+            .map(|&c| body.world_of(&hull.vertices[c]))
+            .filter(|v| dot(&normal, &(v - first.position)) <= margin)
+    };
+    if candidates().count() <= 3 {
+        touches.extend(candidates().map(touch));
+        return;
+    }
+    // the first candidate of largest positive `measure`
+    let farthest = |measure: &dyn Fn(&Vec3) -> f64| {
+        candidates()
+            .fold(None, |best: Option<(f64, Vec3)>, v| {
+                let m = measure(&v);
+                match best {
+                    Some((top, _)) if m <= top => best,
+                    _ if m > 0.0 => Some((m, v)),
+                    _ => best,
+                }
+            })
+            .map(|(_, v)| v)
+    };
+    let from_line = |a: Vec3, b: Vec3| move |v: &Vec3| (v - a).cross(&(b - a)).norm();
+    let Some(second) = farthest(&|v| (v - corner).norm()) else {
+        return;
+    };
+    touches.push(touch(second));
+    let Some(third) = farthest(&from_line(corner, second)) else {
+        return;
+    };
+    touches.push(touch(third));
+    let (to_first, to_second) = (from_line(third, corner), from_line(third, second));
+    if let Some(fourth) = farthest(&|v| to_first(v).max(to_second(v))) {
+        touches.push(touch(fourth));
+    }
+}
+
+/// Two convex shapes (see the module's header): primitives, and meshes by their hulls.
 pub fn convex_convex(first: &Placed, second: &Placed, margin: f64, touches: &mut Vec<Touch>) {
     let (Some(a), Some(b)) = (Body::new(first), Body::new(second)) else {
         return;

@@ -18,12 +18,13 @@
 //! cylinders, in closed form), [`boxes`] and [`box_box`] (boxes against spheres, capsules
 //! and boxes), and [`convex`] with [`gjk`] for the pairs MuJoCo collides by the support
 //! functions of convex shapes (an ellipsoid against anything, a cylinder against a capsule, a
-//! cylinder or a box). Meshes have no collider yet.
+//! cylinder or a box), meshes by their convex hulls ([`hull`]).
 
 pub mod box_box;
 pub mod boxes;
 pub mod convex;
 pub mod gjk;
+pub mod hull;
 pub mod pairs;
 pub mod primitives;
 
@@ -134,11 +135,13 @@ pub fn contact_frame(normal: &Vec3, tangent: &Vec3) -> Mat3 {
     Mat3::from_rows(&[normal.transpose(), t1.transpose(), t2.transpose()])
 }
 
-/// The collision function of two shapes, the lower type first (`None`: a mesh, which has no
-/// collider yet, or two planes, which never touch).
+/// The collision function of two shapes, the lower type first (`None`: a mesh without its hull,
+/// which is only drawn, or two planes, which never touch).
 pub fn collider(first: &Shape, second: &Shape) -> Option<Collider> {
     use Shape::*;
     let function: Collider = match (first, second) {
+        (Mesh { hull: None, .. }, _) | (_, Mesh { hull: None, .. }) => return None,
+        (Plane { .. }, Mesh { .. }) => convex::plane_mesh,
         (Plane { .. }, Sphere { .. }) => primitives::plane_sphere,
         (Plane { .. }, Capsule { .. }) => primitives::plane_capsule,
         (Plane { .. }, Cylinder { .. }) => primitives::plane_cylinder,
@@ -151,7 +154,7 @@ pub fn collider(first: &Shape, second: &Shape) -> Option<Collider> {
         (Capsule { .. }, Box { .. }) => boxes::capsule_box,
         (Box { .. }, Box { .. }) => box_box::box_box,
         (Plane { .. }, Ellipsoid { .. }) => convex::plane_convex,
-        (Plane { .. } | Mesh { .. }, _) | (_, Plane { .. } | Mesh { .. }) => return None,
+        (Plane { .. }, _) | (_, Plane { .. }) => return None,
         _ => convex::convex_convex,
     };
     Some(function)
@@ -183,7 +186,7 @@ pub struct CheckedPair {
     /// and `gap` together).
     pub margin: f64,
     /// Geoms whose origins are farther apart than this cannot touch: their bounding spheres'
-    /// radii and the margin (infinite when one is unbounded, a plane or a mesh).
+    /// radii and the margin (infinite when one is a plane).
     pub reach: f64,
 }
 
@@ -240,7 +243,8 @@ fn lower_type_first(model: &Model, g1: usize, g2: usize, pair: Option<usize>) ->
 }
 
 /// The radius of the smallest sphere about the shape's origin that holds it (MuJoCo's
-/// `rbound`); infinite for a plane, and for a mesh (not collided yet).
+/// `rbound`; for a mesh, its hull's corners' farthest); infinite for a plane and a mesh
+/// without its hull.
 fn bounding_radius(shape: &Shape) -> f64 {
     match shape {
         Shape::Sphere { radius } => *radius,
@@ -254,7 +258,10 @@ fn bounding_radius(shape: &Shape) -> f64 {
         } => radius.hypot(*half_length),
         Shape::Box { half_extents } => half_extents.norm(),
         Shape::Ellipsoid { radii } => radii.max(),
-        Shape::Plane { .. } | Shape::Mesh { .. } => f64::INFINITY,
+        Shape::Mesh {
+            hull: Some(hull), ..
+        } => hull.radius,
+        Shape::Plane { .. } | Shape::Mesh { hull: None, .. } => f64::INFINITY,
     }
 }
 

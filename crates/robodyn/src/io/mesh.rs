@@ -259,7 +259,8 @@ fn face_line(bytes: &[u8], k: usize, corners: usize) -> Option<usize> {
 }
 
 /// MuJoCo's `.msh`: four int32 counts (vertices, normals, texture coordinates, faces), then the
-/// vertices (3 float32 each), normals, texture coordinates (2 float32 each) and faces (3 int32).
+/// vertices (3 float32 each), normals, texture coordinates (2 float32 each) and faces (3 int32;
+/// none: the mesh is its vertices' convex hull, [`TriangleMesh::closed`]).
 fn read_msh(bytes: &[u8]) -> Result<TriangleMesh, String> {
     let int = |k: usize| -> Option<i32> {
         bytes
@@ -294,11 +295,6 @@ fn read_msh(bytes: &[u8]) -> Result<TriangleMesh, String> {
             [index(0), index(1), index(2)]
         })
         .collect();
-    if nf == 0 {
-        return Err(
-            "a MSH file without faces needs its convex hull, which robodyn does not build".into(),
-        );
-    }
     Ok(TriangleMesh { vertices, faces })
 }
 
@@ -422,6 +418,16 @@ impl TriangleMesh {
             com,
             inertia,
         })
+    }
+
+    /// The mesh itself, or, when it has vertices only, their convex hull: MuJoCo's mesh of a
+    /// `<mesh vertex>` without `face` (or a `.msh` without faces).
+    pub fn closed(self) -> Result<TriangleMesh, String> {
+        if self.faces.is_empty() && self.vertices.len() >= 4 {
+            self.convex_hull()
+        } else {
+            Ok(self)
+        }
     }
 
     /// The convex hull of the vertices (parry3d's), its triangles pointing out.

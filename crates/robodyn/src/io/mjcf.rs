@@ -169,6 +169,9 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         mesh_directory: None,
         fit_aabb: false,
         mesh_cache: RefCell::new(HashMap::new()),
+        mesh_triangles: RefCell::new(HashMap::new()),
+        hull_cache: RefCell::new(HashMap::new()),
+        paired_geoms: HashSet::new(),
         textures: HashMap::new(),
         skybox: None,
         texture_directory: None,
@@ -202,6 +205,9 @@ fn load_sources(sources: &Sources) -> Result<Model> {
     }
     for default in sections.iter().filter(|c| c.has_tag_name("default")) {
         reader.read_defaults(*default, None)?;
+    }
+    for contact in sections.iter().filter(|c| c.has_tag_name("contact")) {
+        reader.note_paired_geoms(*contact)?;
     }
     for asset in sections.iter().filter(|c| c.has_tag_name("asset")) {
         reader.read_assets(*asset)?;
@@ -307,6 +313,12 @@ struct Reader<'a> {
     /// `<compiler fitaabb>`: primitives fitted to a mesh's bounding box rather than its inertia
     fit_aabb: bool,
     mesh_cache: RefCell<HashMap<String, meshes::CompiledMesh>>,
+    /// each mesh's triangles in its geoms' frame, read once
+    mesh_triangles: RefCell<HashMap<String, std::rc::Rc<crate::io::mesh::TriangleMesh>>>,
+    /// each mesh's convex hull for its collision geoms, built once
+    hull_cache: RefCell<HashMap<String, std::sync::Arc<crate::collision::hull::ConvexHull>>>,
+    /// the geoms a `<contact><pair>` names: they collide whatever their bits say
+    paired_geoms: HashSet<String>,
     /// `<asset><texture>` elements by name, the first skybox, and `<compiler texturedir>` (or
     /// `assetdir`)
     textures: HashMap<String, Node<'a, 'a>>,

@@ -3,7 +3,9 @@
 
 use super::{dot, gjk, inflate, unit_or_x, Body, Kind, Manifold, Witness};
 use crate::collision::gjk::Vertex;
+use crate::collision::hull::MAX_VERTEX_FACES;
 use crate::spatial::Vec3;
+use std::cell::RefCell;
 
 /// Faces whose normals are within ~5° of opposite count as parallel (MuJoCo's `mjFACE_TOL`).
 const FACE_TOLERANCE: f64 = 0.996;
@@ -26,8 +28,21 @@ const RIM_SIN: [f64; 16] = [
     0.0, -0.38268343236509, -0.707106781186547, -0.923879532511287,
     -1.0, -0.923879532511287, -0.707106781186548, -0.38268343236509,
 ];
-/// Room for a face or a clipped polygon (a 16-gon clipped by a 16-gon has at most 32 corners).
-const POLYGON: usize = 40;
+thread_local! {
+    /// The polygons of a multi-contact, kept from call to call: they allocate only when a larger
+    /// face than any before comes (a mesh's).
+    static POLYGONS: RefCell<Polygons> = RefCell::new(Polygons::default());
+}
+
+/// Room for the two faces and the clipped polygon (an n-gon clipped by an m-gon has at most
+/// n + m corners).
+#[derive(Debug, Default)]
+struct Polygons {
+    face_a: Vec<Vec3>,
+    face_b: Vec<Vec3>,
+    current: Vec<Vec3>,
+    next: Vec<Vec3>,
+}
 
 /// The part of a shape a contact lies on, from the support points (and tags) of the simplex
 /// that found it: `dim` 1 a vertex, 2 an edge, 3 a face.
@@ -62,17 +77,46 @@ impl Feature {
     }
 }
 
-/// Up to three directions (face normals or edge directions) with a face id or an edge's end.
-#[derive(Debug, Clone, Copy, Default)]
+/// Up to [`MAX_VERTEX_FACES`] directions (face normals or edge directions) with a face id or
+/// an edge's end; more are left out.
+#[derive(Debug, Clone, Copy)]
 struct Directions {
-    vectors: [Vec3; 3],
-    ids: [i32; 3],
-    ends: [Vec3; 3],
+    vectors: [Vec3; MAX_VERTEX_FACES],
+    ids: [i32; MAX_VERTEX_FACES],
+    ends: [Vec3; MAX_VERTEX_FACES],
     len: usize,
 }
 
+impl Default for Directions {
+    fn default() -> Self {
+        Directions {
+            vectors: [Vec3::zeros(); MAX_VERTEX_FACES],
+            ids: [0; MAX_VERTEX_FACES],
+            ends: [Vec3::zeros(); MAX_VERTEX_FACES],
+            len: 0,
+        }
+    }
+}
+
 impl Directions {
+    /// Orders the directions by how far they point along `toward`, the most first (a stable
+    /// insertion sort: equals keep their order).
+    fn sort_along(&mut self, toward: &Vec3) {
+        for i in 1..self.len {
+            let mut j = i;
+            while j > 0 && dot(&self.vectors[j], toward) > dot(&self.vectors[j - 1], toward) {
+                self.vectors.swap(j, j - 1);
+                self.ids.swap(j, j - 1);
+                self.ends.swap(j, j - 1);
+                j -= 1;
+            }
+        }
+    }
+
     fn push(&mut self, vector: Vec3, id: i32, end: Vec3) {
+        if self.len == MAX_VERTEX_FACES {
+            return;
+        }
         self.vectors[self.len] = vector;
         self.ids[self.len] = id;
         self.ends[self.len] = end;
@@ -90,7 +134,7 @@ const BOX_FACES: [[i32; 4]; 6] = [
     [0b011, 0b010, 0b000, 0b001],
 ];
 
-impl Body {
+impl Body<'_> {
     /// The box corner with sign bits `tag` (bit k set: +half-extent along axis k).
     fn corner(&self, tag: i32, half: &Vec3) -> Vec3 {
         let sign = |k: i32| if tag & (1 << k) != 0 { 1.0 } else { -1.0 };
@@ -103,7 +147,9 @@ impl Body {
 
     /// The outward normals of the faces the feature may lie on, with their ids: a box's faces
     /// shared by its corners (one of them picked by `toward`, the direction to the other
-    /// shape, when they share none), a cylinder's cap holding the whole feature.
+    /// shape, when they share none), a cylinder's cap holding the whole feature, a mesh's
+    /// faces holding all the feature's corners (the first one for three corners), those facing
+    /// along `toward` the most first.
     fn face_normals(&self, feature: &Feature, toward: &Vec3) -> Directions {
         let mut normals = Directions::default();
         let mut push = |local: Vec3, id: i32| normals.push(self.turn(&local), id, Vec3::zeros());
@@ -162,6 +208,21 @@ impl Body {
                     }
                 }
             }
+            Kind::Mesh { hull } => {
+                let corners = &feature.tags[..feature.dim];
+                for &face in hull.faces_at(corners[0] as usize) {
+                    if corners[1..]
+                        .iter()
+                        .all(|&c| hull.faces_at(c as usize).contains(&face))
+                    {
+                        push(hull.normals[face], face as i32);
+                        if feature.dim == 3 {
+                            break;
+                        }
+                    }
+                }
+                normals.sort_along(toward);
+            }
             _ => {}
         }
         normals
@@ -169,8 +230,8 @@ impl Body {
 
     /// The edges the feature may lie on, as unit directions from `start` (moved onto the
     /// shape's own surface) to the edges' ends: a capsule's generator through its witness
-    /// point `witness`, a cylinder's side line from the feature's cap, a box's edge or the
-    /// three edges at a corner.
+    /// point `witness`, a cylinder's side line from the feature's cap, a box's or a mesh's
+    /// edge, or the edges at a corner (a mesh's: to the corner before it on each of its faces).
     fn edges(
         &self,
         feature: &Feature,
@@ -226,20 +287,39 @@ impl Body {
                     edges.push(unit_or_x(&(end - *start)), k as i32, end);
                 }
             }
+            Kind::Mesh { hull } => {
+                let corner = feature.tags[0] as usize;
+                *start = self.world_of(&hull.vertices[corner]);
+                let mut push = |other: usize, k: usize| {
+                    let end = self.world_of(&hull.vertices[other]);
+                    edges.push(unit_or_x(&(end - *start)), k as i32, end);
+                };
+                match feature.dim {
+                    2 => push(feature.tags[1] as usize, 0),
+                    1 => {
+                        for (k, &face) in hull.faces_at(corner).iter().enumerate() {
+                            let corners = hull.face(face);
+                            let at = corners.iter().position(|&c| c == corner).unwrap_or(0);
+                            push(corners[(at + corners.len() - 1) % corners.len()], k);
+                        }
+                    }
+                    _ => {}
+                }
+            }
             _ => {}
         }
         edges
     }
 
-    /// The polygon of face `id`: a box's 4 corners, a cylinder's cap (id 0 top, 1 bottom) as a
-    /// 16-gon.
-    fn face(&self, id: i32, polygon: &mut [Vec3; POLYGON]) -> usize {
+    /// The polygon of face `id` into `polygon`, clockwise seen from outside: a box's 4 corners, a
+    /// cylinder's cap (id 0 top, 1 bottom) as a 16-gon, a mesh's face.
+    fn face(&self, id: i32, polygon: &mut Vec<Vec3>) {
+        polygon.clear();
         match self.kind {
             Kind::Cuboid { half_extents } => {
-                for (k, tag) in BOX_FACES[id as usize].iter().enumerate() {
-                    polygon[k] = self.corner(*tag, &half_extents);
+                for tag in &BOX_FACES[id as usize] {
+                    polygon.push(self.corner(*tag, &half_extents));
                 }
-                4
             }
             Kind::Cylinder {
                 radius,
@@ -252,11 +332,15 @@ impl Body {
                         side * (radius * -RIM_SIN[k]),
                         side * half_length,
                     );
-                    polygon[k] = self.world_of(&local);
+                    polygon.push(self.world_of(&local));
                 }
-                16
             }
-            _ => 0,
+            Kind::Mesh { hull } => {
+                for &corner in hull.face(id as usize).iter().rev() {
+                    polygon.push(self.world_of(&hull.vertices[corner]));
+                }
+            }
+            _ => {}
         }
     }
 }
@@ -346,47 +430,56 @@ pub(super) fn manifold(
     };
     let grow = [grow(a), grow(b)];
     let reach = grow[0] + grow[1];
-    let (mut face_a, mut face_b) = ([Vec3::zeros(); POLYGON], [Vec3::zeros(); POLYGON]);
     let mut clipped = Manifold::default();
-    let out = match meeting {
-        Meeting::Faces(i, j) => {
-            let na = a.face(normals_a.ids[i], &mut face_a);
-            let nb = b.face(normals_b.ids[j], &mut face_b);
-            let normals = (normals_a.vectors[i], normals_b.vectors[j]);
-            let clip_a = Clip {
-                normals,
-                reach,
-                budget,
-                b_face: false,
-            };
-            clip_a.run(&face_a[..na], &face_b[..nb], &mut clipped);
-            -normals.1
+    let out = POLYGONS.with_borrow_mut(|polygons| {
+        let Polygons {
+            face_a,
+            face_b,
+            current,
+            next,
+        } = polygons;
+        match meeting {
+            Meeting::Faces(i, j) => {
+                a.face(normals_a.ids[i], face_a);
+                b.face(normals_b.ids[j], face_b);
+                let normals = (normals_a.vectors[i], normals_b.vectors[j]);
+                let clip_a = Clip {
+                    normals,
+                    reach,
+                    budget,
+                    b_face: false,
+                };
+                clip_a.run(face_a, face_b, (current, next), &mut clipped);
+                -normals.1
+            }
+            Meeting::EdgeOfA(edges, i, j) => {
+                b.face(normals_b.ids[j], face_b);
+                let n = normals_b.vectors[j];
+                let clip_b = Clip {
+                    normals: (n, -n),
+                    reach,
+                    budget,
+                    b_face: true,
+                };
+                let edge = [start_a, edges.ends[i]];
+                clip_b.run(face_b, &edge, (current, next), &mut clipped);
+                -n
+            }
+            Meeting::EdgeOfB(edges, i, j) => {
+                a.face(normals_a.ids[i], face_a);
+                let n = normals_a.vectors[i];
+                let clip_a = Clip {
+                    normals: (n, -n),
+                    reach,
+                    budget,
+                    b_face: false,
+                };
+                let edge = [start_b, edges.ends[j]];
+                clip_a.run(face_a, &edge, (current, next), &mut clipped);
+                n
+            }
         }
-        Meeting::EdgeOfA(edges, i, j) => {
-            let nb = b.face(normals_b.ids[j], &mut face_b);
-            let n = normals_b.vectors[j];
-            let clip_b = Clip {
-                normals: (n, -n),
-                reach,
-                budget,
-                b_face: true,
-            };
-            clip_b.run(&face_b[..nb], &[start_a, edges.ends[i]], &mut clipped);
-            -n
-        }
-        Meeting::EdgeOfB(edges, i, j) => {
-            let na = a.face(normals_a.ids[i], &mut face_a);
-            let n = normals_a.vectors[i];
-            let clip_a = Clip {
-                normals: (n, -n),
-                reach,
-                budget,
-                b_face: false,
-            };
-            clip_a.run(&face_a[..na], &[start_b, edges.ends[j]], &mut clipped);
-            n
-        }
-    };
+    });
     if clipped.len > 0 {
         inflate(&mut clipped.witnesses[..clipped.len], grow, &out);
         *found = clipped;
@@ -408,25 +501,27 @@ impl Clip {
     /// Hodgman), keeps the vertices within `reach` of the face's plane, and makes a contact of
     /// each (at most `budget`: more reduced to the largest quadrilateral, a clipped edge to its
     /// two farthest points): `x_face = v − ((v − f₀)·n) n`, `x_poly = x_face − ((x_face − v)·w) w`,
-    /// distance `(x_face − v)·w`.
-    fn run(&self, face: &[Vec3], polygon: &[Vec3], out: &mut Manifold) {
+    /// distance `(x_face − v)·w`. `scratch`: room for the clipped polygon.
+    fn run(
+        &self,
+        face: &[Vec3],
+        polygon: &[Vec3],
+        scratch: (&mut Vec<Vec3>, &mut Vec<Vec3>),
+        out: &mut Manifold,
+    ) {
         let (n, w) = self.normals;
-        if !face.is_empty() && face.len() < 3 {
+        if face.len() < 3 {
             return;
         }
-        let mut current = [Vec3::zeros(); POLYGON];
-        let mut next = [Vec3::zeros(); POLYGON];
-        current[..polygon.len()].copy_from_slice(polygon);
-        let mut len = polygon.len();
+        let (mut current, mut next) = scratch;
+        current.clear();
+        current.extend_from_slice(polygon);
         for (e, corner) in face.iter().enumerate() {
             // inward normal of the plane through edge e: (q − p) × ((p + n) − p)
             let q = face[(e + 1) % face.len()];
             let inward = unit_or_x(&(q - corner).cross(&((corner + n) - corner)));
-            let mut kept = 0;
-            let mut keep = |v: Vec3| {
-                next[kept] = v;
-                kept += 1;
-            };
+            next.clear();
+            let len = current.len();
             for i in 0..len {
                 let (p, q) = (current[i], current[if i + 1 < len { i + 1 } else { 0 }]);
                 let (dp, dq) = (dot(&(p - corner), &inward), dot(&(q - corner), &inward));
@@ -435,25 +530,18 @@ impl Clip {
                     // where pq crosses the plane: p + t (q − p), t = dp/(dp − dq)
                     let t = dp / (dp - dq);
                     if (0.0..=1.0).contains(&t) {
-                        keep((q - p) * t + p);
+                        next.push((q - p) * t + p);
                     }
                 }
                 if in_q {
-                    keep(q);
+                    next.push(q);
                 }
             }
             std::mem::swap(&mut current, &mut next);
-            len = kept;
         }
         let origin = face.first().copied().unwrap_or_default();
-        let mut kept = 0;
-        for i in 0..len {
-            if self.reach >= dot(&(current[i] - origin), &n) {
-                current[kept] = current[i];
-                kept += 1;
-            }
-        }
-        let vertices = &current[..kept];
+        current.retain(|v| self.reach >= dot(&(v - origin), &n));
+        let vertices = &current[..];
         if vertices.is_empty() {
             return;
         }

@@ -56,13 +56,20 @@ impl<'a> Reader<'a> {
             let name = geom
                 .attribute("name")
                 .map_or_else(|| format!("geom{}", geom.range().start), str::to_string);
+            // a mesh that may touch something is collided as its convex hull
+            let collides = contype != 0 || conaffinity != 0 || self.paired_geoms.contains(&name);
+            let collision_shape = if collides {
+                self.collision_shape(geom, class, shape.clone())?
+            } else {
+                shape.clone()
+            };
             // X_{geom←body} = X_{geom←frame} X_{frame←element} X_{element←body}
             let placement = frame * to_frame * to_element;
             builder.add_visual(Visual {
                 name: name.clone(),
                 body,
                 placement,
-                shape: shape.clone(),
+                shape,
                 rgba: self.geom_rgba(geom, class)?,
                 group: self.geom_group(geom, class)?,
                 element: self.location(geom),
@@ -84,7 +91,7 @@ impl<'a> Reader<'a> {
                 body,
                 source_body,
                 placement,
-                shape,
+                shape: collision_shape,
                 contype: bits(contype, "contype")?,
                 conaffinity: bits(conaffinity, "conaffinity")?,
                 priority: bits(self.integer(geom, class, "priority", 0)?, "priority")?,

@@ -5,6 +5,7 @@
 //! mesh's centre of mass, placed by the geom's pose.
 
 use super::Reader;
+use crate::collision::hull::{ConvexHull, MAX_VERTEX_FACES};
 use crate::error::Result;
 use crate::io::mesh::{read_mesh, reference_map, MeshInertia, MeshMassProperties, TriangleMesh};
 use crate::io::xml::parse_number_list;
@@ -12,6 +13,8 @@ use crate::spatial::{Inertia, Mat3, Transform, Vec3};
 use crate::visual::{MeshSource, Shape};
 use roxmltree::Node;
 use std::path::PathBuf;
+use std::rc::Rc;
+use std::sync::Arc;
 
 /// An asset's name: its `name`, else its file's name without the extension, as MuJoCo names
 /// an unnamed mesh or texture.
@@ -45,11 +48,11 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
-    /// The mesh named `name` as the compiler uses it (mass properties at unit density, principal
-    /// frame, bounding box), read once.
-    fn compiled_mesh(&self, geom: Node<'a, 'a>, name: &str) -> Result<CompiledMesh> {
-        if let Some(compiled) = self.mesh_cache.borrow().get(name) {
-            return Ok(*compiled);
+    /// The mesh named `name` read from its file (or its `vertex` and `face`) and moved into its
+    /// geoms' frame by `refpos`, `refquat` and `scale`, once.
+    fn mesh_triangles(&self, geom: Node<'a, 'a>, name: &str) -> Result<Rc<TriangleMesh>> {
+        if let Some(triangles) = self.mesh_triangles.borrow().get(name) {
+            return Ok(Rc::clone(triangles));
         }
         let mesh = self.mesh_asset(geom, name)?;
         let class = self.declared_class(mesh, "class", "main")?;
@@ -76,9 +79,26 @@ impl<'a> Reader<'a> {
             }
             None => self.inline_mesh(mesh)?,
         };
+        let triangles = triangles.closed().map_err(&error)?;
         triangles.check().map_err(&error)?;
         let (refpos, refquat, scale) = self.mesh_reference(mesh, class)?;
-        let triangles = triangles.transformed(refpos, refquat, scale);
+        let triangles = Rc::new(triangles.transformed(refpos, refquat, scale));
+        self.mesh_triangles
+            .borrow_mut()
+            .insert(name.to_string(), Rc::clone(&triangles));
+        Ok(triangles)
+    }
+
+    /// The mesh named `name` as the compiler uses it (mass properties at unit density, principal
+    /// frame, bounding box), computed once.
+    fn compiled_mesh(&self, geom: Node<'a, 'a>, name: &str) -> Result<CompiledMesh> {
+        if let Some(compiled) = self.mesh_cache.borrow().get(name) {
+            return Ok(*compiled);
+        }
+        let triangles = self.mesh_triangles(geom, name)?;
+        let mesh = self.mesh_asset(geom, name)?;
+        let class = self.declared_class(mesh, "class", "main")?;
+        let error = |message: String| self.error(mesh, message);
         let mode = match self.attribute(mesh, class, "inertia") {
             None => MeshInertia::Legacy,
             Some(name) => MeshInertia::from_name(&name).map_err(&error)?,
@@ -120,6 +140,91 @@ impl<'a> Reader<'a> {
             .borrow_mut()
             .insert(name.to_string(), compiled);
         Ok(compiled)
+    }
+
+    /// The convex hull of the mesh named `name`, what its collision geoms' contacts see
+    /// (`collision/hull.rs`), built once.
+    fn collision_hull(&self, geom: Node<'a, 'a>, name: &str) -> Result<Arc<ConvexHull>> {
+        if let Some(hull) = self.hull_cache.borrow().get(name) {
+            return Ok(Arc::clone(hull));
+        }
+        let triangles = self.mesh_triangles(geom, name)?;
+        let mesh = self.mesh_asset(geom, name)?;
+        let hull = ConvexHull::new(&triangles.vertices).map_err(|m| self.error(mesh, m))?;
+        let class = self.declared_class(mesh, "class", "main")?;
+        let corners = hull.vertices.len();
+        if let Some([limit]) = self.numbers::<1>(mesh, class, "maxhullvert")? {
+            if limit > -1.0 && corners as f64 > limit {
+                self.warnings.borrow_mut().push(format!(
+                    "{}: maxhullvert='{limit}': MuJoCo collides qhull's hull stopped at {limit} vertices, robodyn the whole hull of {corners}: their contacts differ",
+                    self.location(mesh)
+                ));
+            }
+        }
+        let most = hull.most_faces_at_a_corner();
+        if most > MAX_VERTEX_FACES {
+            self.warnings.borrow_mut().push(format!(
+                "{}: a corner of the mesh's convex hull lies on {most} faces: robodyn's multi-contact considers {MAX_VERTEX_FACES} of them, so a pair touching there may get fewer contacts than in MuJoCo",
+                self.location(mesh)
+            ));
+        }
+        let hull = Arc::new(hull);
+        self.hull_cache
+            .borrow_mut()
+            .insert(name.to_string(), Arc::clone(&hull));
+        Ok(hull)
+    }
+
+    /// A collision geom's shape: a mesh with its convex hull (a mesh whose file is missing
+    /// touches nothing: a warning says so); any other shape as it is.
+    pub(super) fn collision_shape(
+        &self,
+        geom: Node<'a, 'a>,
+        class: &str,
+        shape: Shape,
+    ) -> Result<Shape> {
+        let Shape::Mesh {
+            source,
+            file_to_visual,
+            ..
+        } = shape
+        else {
+            return Ok(shape);
+        };
+        if let MeshSource::Missing(why) = &source {
+            self.warnings.borrow_mut().push(format!(
+                "{}: the geom's mesh file is missing, so nothing touches it ({why})",
+                self.location(geom)
+            ));
+            return Ok(Shape::Mesh {
+                source,
+                file_to_visual,
+                hull: None,
+            });
+        }
+        let name = self
+            .attribute(geom, class, "mesh")
+            .ok_or_else(|| self.error(geom, "a mesh geom needs a 'mesh' attribute"))?;
+        Ok(Shape::Mesh {
+            source,
+            file_to_visual,
+            hull: Some(self.collision_hull(geom, &name)?),
+        })
+    }
+
+    /// Notes the geoms the `<pair>`s of a `<contact>` section name (before the bodies are read:
+    /// such a geom collides whatever its `contype` and `conaffinity`).
+    pub(super) fn note_paired_geoms(&mut self, contact: Node<'a, 'a>) -> Result<()> {
+        for pair in self.children(contact)? {
+            if pair.has_tag_name("pair") {
+                for attribute in ["geom1", "geom2"] {
+                    if let Some(name) = pair.attribute(attribute) {
+                        self.paired_geoms.insert(name.to_string());
+                    }
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The `<mesh>` named `name`, for `geom`'s messages.
@@ -167,18 +272,20 @@ impl<'a> Reader<'a> {
         Ok(Shape::Mesh {
             source,
             file_to_visual: reference_map(refpos, refquat, scale),
+            hull: None,
         })
     }
 
-    /// A mesh given in the XML by `vertex` (and `face`) instead of a file.
+    /// A mesh given in the XML by `vertex` (and `face`: without it, the mesh is the vertices'
+    /// convex hull, as in MuJoCo) instead of a file.
     fn inline_mesh(&self, mesh: Node<'a, 'a>) -> Result<TriangleMesh> {
         let numbers = |name: &str| -> Result<Vec<f64>> {
-            let text = mesh.attribute(name).ok_or_else(|| {
-                self.error(
-                    mesh,
-                    format!("expected 'file', or 'vertex' and 'face', got no '{name}'"),
-                )
-            })?;
+            let Some(text) = mesh.attribute(name) else {
+                return match name {
+                    "face" => Ok(Vec::new()),
+                    _ => Err(self.error(mesh, "expected 'file' or 'vertex', got neither")),
+                };
+            };
             parse_number_list(text, name).map_err(|m| self.error(mesh, m))
         };
         // the vertices are float32 in MuJoCo, as in a file
@@ -190,7 +297,9 @@ impl<'a> Reader<'a> {
             .chunks_exact(3)
             .map(|f| [f[0] as usize, f[1] as usize, f[2] as usize])
             .collect();
-        Ok(TriangleMesh { vertices, faces })
+        TriangleMesh { vertices, faces }
+            .closed()
+            .map_err(|m| self.error(mesh, m))
     }
 
     /// Where a mesh file is: see [`Reader::find_asset_file`], under `<compiler meshdir>`.

@@ -176,6 +176,7 @@ impl<'a> Parser<'a> {
                 Shape::Mesh {
                     source: self.find_mesh(shape, uri),
                     file_to_visual: Matrix4::new_nonuniform_scaling(&scale),
+                    hull: None,
                 }
             }
             other => {
