@@ -191,3 +191,67 @@ def test_mesh_resting_on_a_plane(tilt, contacts):
     )
     assert len(expected) == contacts
     assert same_set(found, expected, pairs.CLOSED_FORM_AGREEMENT)
+
+
+# --- their forces and steps --------------------------------------------------------------------
+
+MESH_BLOCKS = """<mujoco><option cone="{cone}" integrator="{integrator}"/>
+  <asset><mesh name="cuboid" vertex="{vertices}"/></asset>
+  <worldbody><geom name="floor" type="plane" size="0 0 1"/>
+    <body name="block" pos="0 0 0.099"><freejoint name="block"/><geom name="block" type="mesh" mesh="cuboid"/></body>
+    <body name="top" pos="0.01 0.02 0.298" euler="0 0 20"><freejoint name="top"/><geom name="top" type="mesh" mesh="cuboid"/></body>
+    <body name="crate" pos="0.4 0 0.049"><freejoint name="crate"/><geom name="crate" type="box" size="0.05 0.05 0.05"/></body>
+    <body name="lid" pos="0.4 0 0.148" euler="0 0 30"><freejoint name="lid"/><geom name="lid" type="mesh" mesh="cuboid"/></body>
+  </worldbody></mujoco>"""
+
+
+def mesh_blocks(cone, integrator="Euler"):
+    """Mesh cuboids on a floor, on each other and on a box, each 1 mm into what carries it."""
+    return MESH_BLOCKS.format(cone=cone, integrator=integrator, vertices=VERTICES)
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+def test_mesh_contact_forces_as_in_mujoco(cone):
+    """At rest and moving: MuJoCo's accelerations and constraint forces (its contacts in another
+    order within a pair: compared through q̈ and the joint-space constraint force)."""
+    from test_contact_dynamics import (
+        FORCE_AGREEMENT,
+        assert_close,
+        load_both,
+        mujoco_solution,
+    )
+
+    model, mj_model, layout = load_both(mesh_blocks(cone))
+    rng = np.random.default_rng(3)
+    for case in range(3):
+        qvel = rng.normal(size=mj_model.nv) * 0.3 * (case > 0)
+        q, v, expected = mujoco_solution(mj_model, layout, mj_model.qpos0, qvel)
+        ours = model.contact_forward_dynamics(q, v)
+        assert sorted((c["geom1"], c["geom2"]) for c in ours["contacts"]) == sorted(
+            c[:2] for c in expected["contacts"]
+        )
+        assert len(expected["contacts"]) == 4 + 4 + 4 + 4
+        for key in ("qdd", "tau_constraint"):
+            assert_close(
+                ours[key], expected[key], FORCE_AGREEMENT, f"case {case} {key}"
+            )
+
+
+@pytest.mark.parametrize("integrator", ["Euler", "implicitfast", "RK4"])
+def test_mesh_blocks_step_as_in_mujoco(integrator):
+    """100 steps of the blocks settling, nudged: mj_step's states."""
+    from test_contact_dynamics import load_both
+    from test_scene_stepping import STEP_AGREEMENT, assert_steps_like_mujoco
+
+    model, mj_model, layout = load_both(mesh_blocks("pyramidal", integrator))
+    qvel = np.zeros(mj_model.nv)
+    qvel[0:3], qvel[9:12] = [0.2, 0.1, 0.0], [0.0, 0.0, 0.5]
+    assert_steps_like_mujoco(
+        model,
+        mj_model,
+        layout,
+        mj_model.qpos0,
+        qvel,
+        tolerance=STEP_AGREEMENT,
+        label=integrator,
+    )

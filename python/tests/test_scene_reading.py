@@ -202,6 +202,26 @@ def test_a_scene_with_classes_and_leading_values_is_mujocos():
     assert model.options.disabled == ["warmstart"] and model.options.enabled == ["energy"]
 
 
+#: Two top-level <default>s (an included file's and the includer's): the second adds to the
+#: first's "main", a class takes its parent as it stands where the class is declared.
+TWO_DEFAULTS = """<mujoco>
+  <default><geom contype="0" size="0.3"/><default class="a"><geom conaffinity="0"/></default></default>
+  <default><geom priority="2"/><default class="b"><geom size="0.5"/></default></default>
+  <worldbody><geom name="g"/><geom name="h" class="a"/><geom name="k" class="b"/></worldbody>
+</mujoco>"""
+
+
+def test_a_second_top_level_default_adds_to_the_first():
+    model, compiled = load(text=TWO_DEFAULTS), mujoco.MjModel.from_xml_string(TWO_DEFAULTS)
+    assert_geoms_are_mujocos(model, compiled, "two defaults")
+    geoms = {geom["name"]: geom for geom in model.geoms}
+    assert [(geoms[n]["contype"], geoms[n]["conaffinity"], geoms[n]["priority"]) for n in "ghk"] == [
+        (0, 1, 2),
+        (0, 0, 0),
+        (0, 1, 2),
+    ]
+
+
 SCENE_FILES = [
     ("testdata", "mjcf/cassie_nomesh.xml"),
     ("testdata", "mjcf/iiwa14_scene.xml"),

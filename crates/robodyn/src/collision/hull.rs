@@ -19,6 +19,8 @@ use std::collections::BTreeMap;
 const ANGLE_GRID: f64 = 0.01;
 /// A triangle whose doubled area is below this is left out of the polygons (MuJoCo's mjMINVAL).
 const MIN_AREA: f64 = 1e-15;
+/// A hull whose volume is below this fraction of its bounding sphere's radius cubed is flat.
+const FLAT: f64 = 1e-12;
 /// The most faces at a corner that multi-contact considers: the others are left out.
 pub const MAX_VERTEX_FACES: usize = 32;
 
@@ -78,14 +80,21 @@ impl ConvexHull {
             vertex_starts: Vec::new(),
             vertex_faces: Vec::new(),
         };
-        hull.merge_coplanar(&triangles);
-        // a solid has four faces or more; coplanar points give two, back to back
-        if hull.face_count() < 4 {
+        // coplanar points give a flat hull, two faces back to back: no volume
+        let volume: f64 = triangles
+            .iter()
+            .map(|&[a, b, c]| {
+                let [pa, pb, pc] = [a, b, c].map(|k| hull.vertices[k]);
+                pa.dot(&pb.cross(&pc)) / 6.0
+            })
+            .sum();
+        if volume <= FLAT * hull.radius.powi(3) {
             return Err(
                 "its vertices are coplanar, so it has no convex hull to collide (as MuJoCo says): use a plane or a thin box"
                     .into(),
             );
         }
+        hull.merge_coplanar(&triangles);
         Ok(hull)
     }
 

@@ -61,16 +61,15 @@ impl<'a> Reader<'a> {
             (None, None) => "main".to_string(),
             (None, Some(_)) => return Err(self.error(node, "a nested <default> needs a 'class'")),
         };
-        let mut values = parent
-            .and_then(|p| self.defaults.get(p))
-            .cloned()
-            .unwrap_or_default();
+        // a second top-level <default> adds to "main", as in MuJoCo; a class starts from its parent
+        let start = parent.unwrap_or(&class);
+        let mut values = self.defaults.get(start).cloned().unwrap_or_default();
         let elements = self.children(node)?;
-        let mut actuator = self
-            .class_actuators(parent)
-            .next()
-            .cloned()
-            .unwrap_or_default();
+        let mut actuator = match parent {
+            Some(_) => self.class_actuators(parent).next().cloned(),
+            None => self.actuator_defaults.get(&class).map(|c| c.raw.clone()),
+        }
+        .unwrap_or_default();
         let mut seen = HashSet::new();
         for element in elements.iter().filter(|c| !c.has_tag_name("default")) {
             let tag = element.tag_name().name();
