@@ -437,3 +437,113 @@ fn contacts_match_mujoco() {
         }
     }
 }
+
+/// A cuboid of half-sides `h` as a mesh: its eight corners' hull.
+fn cuboid_mesh(h: Vec3) -> Shape {
+    use crate::collision::hull::ConvexHull;
+    let corners: Vec<Vec3> = (0..8)
+        .map(|k| {
+            let sign = |bit: usize| if k >> bit & 1 == 1 { -1.0 } else { 1.0 };
+            Vec3::new(sign(0) * h.x, sign(1) * h.y, sign(2) * h.z)
+        })
+        .collect();
+    Shape::Mesh {
+        source: crate::visual::MeshSource::Missing(String::new()),
+        file_to_visual: nalgebra::Matrix4::identity(),
+        hull: Some(std::sync::Arc::new(ConvexHull::new(&corners).unwrap())),
+    }
+}
+
+/// A rotation by `angle` about the unit `axis`.
+fn turned(axis: Vec3, angle: f64) -> Mat3 {
+    nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), angle).into_inner()
+}
+
+#[test]
+fn a_mesh_is_collided_as_the_box_of_its_corners() {
+    // the same support points, faces and edges: every convex partner finds the same contacts
+    let h = Vec3::new(0.05, 0.07, 0.1);
+    let (mesh, cuboid) = (cuboid_mesh(h), Shape::Box { half_extents: h });
+    let partners = [
+        Shape::Cylinder {
+            radius: 0.06,
+            half_length: 0.05,
+        },
+        Shape::Ellipsoid {
+            radii: Vec3::new(0.08, 0.06, 0.04),
+        },
+    ];
+    let rotation = turned(Vec3::new(0.3, -0.5, 0.8), 0.9);
+    for partner in &partners {
+        let first = placed(partner, [0.0; 3], Mat3::identity());
+        for (k, offset) in [[0.02, -0.03, 0.12], [0.1, 0.05, 0.02], [0.0, 0.0, 0.16]]
+            .iter()
+            .enumerate()
+        {
+            for margin in [0.0, 0.01] {
+                let as_mesh = collide(&first, &placed(&mesh, *offset, rotation), margin);
+                let as_box = collide(&first, &placed(&cuboid, *offset, rotation), margin);
+                assert!(
+                    !as_box.is_empty() || k == 2,
+                    "{partner:?} at {offset:?}: no contact"
+                );
+                assert_eq!(as_mesh.len(), as_box.len(), "{partner:?} at {offset:?}");
+                for touch in &as_box {
+                    assert!(as_mesh
+                        .iter()
+                        .any(|t| (t.position - touch.position).norm() < ROUNDING
+                            && (t.distance - touch.distance).abs() < ROUNDING
+                            && (t.normal - touch.normal).norm() < ROUNDING));
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_mesh_on_a_plane_touches_at_its_lowest_faces_corners() {
+    let h = Vec3::new(0.05, 0.07, 0.1);
+    let mesh = cuboid_mesh(h);
+    let plane = Shape::Plane {
+        half_extents: [0.0, 0.0],
+    };
+    let floor = placed(&plane, [0.0; 3], Mat3::identity());
+    let mut touches = Vec::new();
+    // flat, 1 mm deep: the bottom face's four corners
+    plane_mesh(
+        &floor,
+        &placed(&mesh, [0.0, 0.0, 0.099], Mat3::identity()),
+        0.0,
+        &mut touches,
+    );
+    assert_eq!(touches.len(), 4);
+    for touch in &touches {
+        assert!((touch.distance + 0.001).abs() < ROUNDING);
+        assert!((touch.position.z + 0.0005).abs() < ROUNDING);
+        assert!((touch.position.x.abs() - h.x).abs() < ROUNDING);
+        assert!((touch.position.y.abs() - h.y).abs() < ROUNDING);
+        assert_eq!(touch.normal, Vec3::z());
+    }
+    // turned 40° about x: only the lower edge's two corners are below the plane
+    touches.clear();
+    let tilted = placed(
+        &mesh,
+        [0.0, 0.0, 0.05],
+        turned(Vec3::x(), 40f64.to_radians()),
+    );
+    plane_mesh(&floor, &tilted, 0.0, &mut touches);
+    assert_eq!(touches.len(), 2);
+    let depth = 0.05 - h.z * 40f64.to_radians().cos() - h.y * 40f64.to_radians().sin();
+    for touch in &touches {
+        assert!((touch.distance - depth).abs() < ROUNDING);
+    }
+    // lifted beyond the margin: none
+    touches.clear();
+    plane_mesh(
+        &floor,
+        &placed(&mesh, [0.0, 0.0, 0.2], Mat3::identity()),
+        0.01,
+        &mut touches,
+    );
+    assert!(touches.is_empty());
+}
