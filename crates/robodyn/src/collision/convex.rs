@@ -449,9 +449,10 @@ pub fn plane_mesh(first: &Placed, second: &Placed, margin: f64, touches: &mut Ve
         touches.extend(candidates().map(touch));
         return;
     }
-    // the first candidate of largest positive `measure`
-    let farthest = |measure: &dyn Fn(&Vec3) -> f64| {
+    // the first candidate of largest positive `measure`, not one already `taken`
+    let farthest = |measure: &dyn Fn(&Vec3) -> f64, taken: &[Vec3]| {
         candidates()
+            .filter(|v| !taken.contains(v))
             .fold(None, |best: Option<(f64, Vec3)>, v| {
                 let m = measure(&v);
                 match best {
@@ -463,16 +464,17 @@ pub fn plane_mesh(first: &Placed, second: &Placed, margin: f64, touches: &mut Ve
             .map(|(_, v)| v)
     };
     let from_line = |a: Vec3, b: Vec3| move |v: &Vec3| (v - a).cross(&(b - a)).norm();
-    let Some(second) = farthest(&|v| (v - corner).norm()) else {
+    let Some(second) = farthest(&|v| (v - corner).norm(), &[]) else {
         return;
     };
     touches.push(touch(second));
-    let Some(third) = farthest(&from_line(corner, second)) else {
+    let Some(third) = farthest(&from_line(corner, second), &[second]) else {
         return;
     };
     touches.push(touch(third));
     let (to_first, to_second) = (from_line(third, corner), from_line(third, second));
-    if let Some(fourth) = farthest(&|v| to_first(v).max(to_second(v))) {
+    let spread = |v: &Vec3| to_first(v).max(to_second(v));
+    if let Some(fourth) = farthest(&spread, &[second, third]) {
         touches.push(touch(fourth));
     }
 }
