@@ -11,6 +11,7 @@
 //! along its triangles' edges, is one polygon (two, if the group is two islands). A polygon's
 //! normal is its area vector made unit (Newell's formula), `Σ (vₖ × vₖ₊₁) / |Σ vₖ × vₖ₊₁|`.
 
+use crate::io::mesh::TriangleMesh;
 use crate::spatial::Vec3;
 use rustc_hash::{FxHashMap, FxHashSet};
 use std::collections::BTreeMap;
@@ -43,33 +44,27 @@ pub struct ConvexHull {
 }
 
 impl ConvexHull {
-    /// The hull of `points` (in the geom's frame).
-    pub fn new(points: &[Vec3]) -> Result<Self, String> {
-        use parry3d_f64::math::Vector3;
-        let input: Vec<Vector3> = points.iter().map(|v| Vector3::new(v.x, v.y, v.z)).collect();
-        let (corners, triangles) =
-            parry3d_f64::transformation::try_convex_hull(&input).map_err(|e| {
-                format!("the mesh has no convex hull ({e:?}): are its vertices coplanar?")
-            })?;
+    /// The hull of `mesh`'s vertices (in the geom's frame): [`TriangleMesh::convex_hull`], its
+    /// corners put back in the mesh's vertex order.
+    pub fn new(mesh: &TriangleMesh) -> Result<Self, String> {
+        let hull = mesh.convex_hull()?;
         // the hull's corners in the order of the mesh's vertices (the first of equal ones)
         let mut first_index: FxHashMap<[u64; 3], usize> = FxHashMap::default();
-        for (k, p) in points.iter().enumerate().rev() {
+        for (k, p) in mesh.vertices.iter().enumerate().rev() {
             first_index.insert([p.x, p.y, p.z].map(f64::to_bits), k);
         }
-        let original = |c: &Vector3| first_index.get(&[c.x, c.y, c.z].map(f64::to_bits)).copied();
-        let mut order: Vec<usize> = (0..corners.len()).collect();
-        order.sort_by_key(|&k| original(&corners[k]).unwrap_or(usize::MAX));
-        let mut renumbered = vec![0; corners.len()];
+        let original = |c: &Vec3| first_index.get(&[c.x, c.y, c.z].map(f64::to_bits)).copied();
+        let mut order: Vec<usize> = (0..hull.vertices.len()).collect();
+        order.sort_by_key(|&k| original(&hull.vertices[k]).unwrap_or(usize::MAX));
+        let mut renumbered = vec![0; order.len()];
         for (new, &old) in order.iter().enumerate() {
             renumbered[old] = new;
         }
-        let vertices: Vec<Vec3> = order
+        let vertices: Vec<Vec3> = order.iter().map(|&k| hull.vertices[k]).collect();
+        let triangles: Vec<[usize; 3]> = hull
+            .faces
             .iter()
-            .map(|&k| Vec3::new(corners[k].x, corners[k].y, corners[k].z))
-            .collect();
-        let triangles: Vec<[usize; 3]> = triangles
-            .iter()
-            .map(|t| t.map(|k| renumbered[k as usize]))
+            .map(|t| t.map(|k| renumbered[k]))
             .collect();
         let mut hull = ConvexHull {
             radius: vertices.iter().map(|v| v.norm()).fold(0.0, f64::max),
@@ -231,6 +226,14 @@ fn grid_key(n: &Vec3) -> (i64, i64) {
 mod tests {
     use super::*;
 
+    /// Vertices without faces.
+    fn mesh_of(points: &[Vec3]) -> TriangleMesh {
+        TriangleMesh {
+            vertices: points.to_vec(),
+            faces: Vec::new(),
+        }
+    }
+
     /// The corners of a box with half-sides `h`, and an inner point.
     fn box_points(h: Vec3) -> Vec<Vec3> {
         let mut points: Vec<Vec3> = (0..8)
@@ -246,7 +249,7 @@ mod tests {
     #[test]
     fn a_box_has_six_square_faces_in_the_mesh_vertex_order() {
         let points = box_points(Vec3::new(0.3, 0.2, 0.1));
-        let hull = ConvexHull::new(&points).unwrap();
+        let hull = ConvexHull::new(&mesh_of(&points)).unwrap();
         // the inner point is not a corner; the corners keep the mesh's order
         let expected: Vec<Vec3> = points.iter().copied().filter(|p| p.norm() > 0.0).collect();
         assert_eq!(hull.vertices, expected);
@@ -270,7 +273,7 @@ mod tests {
 
     #[test]
     fn support_takes_the_first_of_equal_corners() {
-        let hull = ConvexHull::new(&box_points(Vec3::new(0.3, 0.2, 0.1))).unwrap();
+        let hull = ConvexHull::new(&mesh_of(&box_points(Vec3::new(0.3, 0.2, 0.1)))).unwrap();
         // along +x four corners are equal: the first in the mesh's order
         let (point, index) = hull.support(&Vec3::x());
         assert_eq!(index, 1);
@@ -289,7 +292,7 @@ mod tests {
                 points.push(Vec3::new(0.1 * angle.cos(), 0.1 * angle.sin(), z));
             }
         }
-        let hull = ConvexHull::new(&points).unwrap();
+        let hull = ConvexHull::new(&mesh_of(&points)).unwrap();
         assert_eq!(hull.face_count(), sides + 2);
         let largest = (0..hull.face_count()).map(|f| hull.face(f).len()).max();
         assert_eq!(largest, Some(sides));
@@ -300,6 +303,8 @@ mod tests {
         let points: Vec<Vec3> = (0..5)
             .map(|k| Vec3::new(k as f64, (k * k) as f64, 0.0))
             .collect();
-        assert!(ConvexHull::new(&points).unwrap_err().contains("coplanar"));
+        assert!(ConvexHull::new(&mesh_of(&points))
+            .unwrap_err()
+            .contains("coplanar"));
     }
 }

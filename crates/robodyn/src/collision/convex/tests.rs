@@ -450,7 +450,13 @@ fn cuboid_mesh(h: Vec3) -> Shape {
     Shape::Mesh {
         source: crate::visual::MeshSource::Missing(String::new()),
         file_to_visual: nalgebra::Matrix4::identity(),
-        hull: Some(std::sync::Arc::new(ConvexHull::new(&corners).unwrap())),
+        hull: Some(std::sync::Arc::new(
+            ConvexHull::new(&crate::io::mesh::TriangleMesh {
+                vertices: corners,
+                faces: Vec::new(),
+            })
+            .unwrap(),
+        )),
     }
 }
 

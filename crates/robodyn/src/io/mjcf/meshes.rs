@@ -150,7 +150,7 @@ impl<'a> Reader<'a> {
         }
         let triangles = self.mesh_triangles(geom, name)?;
         let mesh = self.mesh_asset(geom, name)?;
-        let hull = ConvexHull::new(&triangles.vertices).map_err(|m| self.error(mesh, m))?;
+        let hull = ConvexHull::new(&triangles).map_err(|m| self.error(mesh, m))?;
         let class = self.declared_class(mesh, "class", "main")?;
         let corners = hull.vertices.len();
         if let Some([limit]) = self.numbers::<1>(mesh, class, "maxhullvert")? {
