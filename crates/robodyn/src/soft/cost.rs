@@ -17,6 +17,68 @@
 
 use super::rows::{Group, RowKind, Rows};
 
+/// Where [`forces_at`] puts each group's curvature ∂²s/∂x²: stored for the Hessian
+/// ([`Curvature`]), taken along one direction for the line search ([`Along`]), or dropped (`()`).
+pub(super) trait CurvatureSink {
+    /// Row `i`'s cost is its own, with ∂²s/∂x_i² = `d`.
+    fn row(&mut self, i: usize, d: f64);
+    /// An elliptic contact on its cone's surface.
+    fn surface(&mut self, surface: &Surface);
+}
+
+impl CurvatureSink for () {
+    fn row(&mut self, _: usize, _: f64) {}
+    fn surface(&mut self, _: &Surface) {}
+}
+
+/// An elliptic contact on its cone's surface, s = ½ D_m h², h = N − μ T:
+/// ```text
+///   ∇²s = D_m (∇h ∇hᵀ − c diag(f) (I − û ûᵀ) diag(f)),   c = μ h / T,  û = u / T
+/// ```
+/// on its rows `first..first + len` (û and f on the friction rows 1..len).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Surface {
+    first: usize,
+    len: usize,
+    dm: f64,
+    gradient: [f64; 6],
+    c: f64,
+    friction: [f64; 5],
+    direction: [f64; 6],
+}
+
+impl Surface {
+    /// ∇²s as a dense block (its first `len` rows and columns).
+    fn block(&self) -> [[f64; 6]; 6] {
+        let (g, f, d) = (&self.gradient, &self.friction, &self.direction);
+        let mut block = [[0.0; 6]; 6];
+        for a in 0..self.len {
+            for b in 0..self.len {
+                let mut value = g[a] * g[b];
+                if a > 0 && b > 0 {
+                    let projector = f64::from(u8::from(a == b)) - d[a] * d[b];
+                    value -= self.c * f[a - 1] * f[b - 1] * projector;
+                }
+                block[a][b] = self.dm * value;
+            }
+        }
+        block
+    }
+
+    /// yᵀ ∇²s y for y over all rows: D_m ((∇h·y)² − c (|diag(f) y|² − (û·diag(f) y)²)).
+    fn along(&self, y: &[f64]) -> f64 {
+        let y = &y[self.first..self.first + self.len];
+        let slope: f64 = self.gradient.iter().zip(y).map(|(g, y)| g * y).sum();
+        let (mut scaled, mut projected) = (0.0, 0.0);
+        for k in 1..self.len {
+            let fy = self.friction[k - 1] * y[k];
+            scaled += fy * fy;
+            projected += self.direction[k] * fy;
+        }
+        self.dm * (slope * slope - self.c * (scaled - projected * projected))
+    }
+}
+
 /// ∂²s/∂x²: one value per active row whose cost is its own, a dense block per elliptic contact
 /// on its cone's surface (0 elsewhere).
 #[derive(Debug, Clone, Default)]
@@ -32,35 +94,51 @@ impl Curvature {
         self.diagonal.clear();
         self.blocks.clear();
     }
+}
 
-    /// yᵀ H_s y.
-    pub(super) fn along(&self, y: &[f64]) -> f64 {
-        let diagonal: f64 = self.diagonal.iter().map(|&(i, d)| d * y[i] * y[i]).sum();
-        let blocks: f64 = self
-            .blocks
-            .iter()
-            .map(|(first, len, block)| {
-                let y = &y[*first..first + len];
-                (0..*len)
-                    .map(|a| (0..*len).map(|b| y[a] * block[a][b] * y[b]).sum::<f64>())
-                    .sum::<f64>()
-            })
-            .sum();
-        diagonal + blocks
+impl CurvatureSink for Curvature {
+    fn row(&mut self, i: usize, d: f64) {
+        self.diagonal.push((i, d));
+    }
+
+    fn surface(&mut self, surface: &Surface) {
+        self.blocks
+            .push((surface.first, surface.len, surface.block()));
+    }
+}
+
+/// yᵀ H_s y summed over the groups, H_s the curvature where [`forces_at`] was asked.
+#[derive(Debug)]
+pub(super) struct Along<'a> {
+    y: &'a [f64],
+    /// The sum so far.
+    pub(super) value: f64,
+}
+
+impl<'a> Along<'a> {
+    pub(super) fn new(y: &'a [f64]) -> Self {
+        Along { y, value: 0.0 }
+    }
+}
+
+impl CurvatureSink for Along<'_> {
+    fn row(&mut self, i: usize, d: f64) {
+        self.value += d * self.y[i] * self.y[i];
+    }
+
+    fn surface(&mut self, surface: &Surface) {
+        self.value += surface.along(self.y);
     }
 }
 
 /// The forces `f` of every row at `x = J q̈ − a_ref` (`x` per row), into `forces`; the cost `s`
-/// is returned. With `curvature`, each group's ∂²s/∂x² goes into it.
+/// is returned. Each group's ∂²s/∂x² goes to `curvature`.
 pub(super) fn forces_at(
     rows: &Rows,
     x: &[f64],
     forces: &mut [f64],
-    mut curvature: Option<&mut Curvature>,
+    curvature: &mut impl CurvatureSink,
 ) -> f64 {
-    if let Some(c) = curvature.as_deref_mut() {
-        c.clear();
-    }
     let mut cost = 0.0;
     for group in &rows.groups {
         let range = group.first..group.first + group.len;
@@ -70,9 +148,7 @@ pub(super) fn forces_at(
                     let d = 1.0 / rows.regulariser[i];
                     forces[i] = -d * x[i];
                     cost += 0.5 * d * x[i] * x[i];
-                    if let Some(c) = curvature.as_deref_mut() {
-                        c.diagonal.push((i, d));
-                    }
+                    curvature.row(i, d);
                 }
             }
             RowKind::FrictionDof | RowKind::FrictionTendon => {
@@ -87,13 +163,11 @@ pub(super) fn forces_at(
                 } else {
                     forces[i] = -x[i] / r;
                     cost += 0.5 * x[i] * x[i] / r;
-                    if let Some(c) = curvature.as_deref_mut() {
-                        c.diagonal.push((i, 1.0 / r));
-                    }
+                    curvature.row(i, 1.0 / r);
                 }
             }
             RowKind::ContactElliptic => {
-                cost += elliptic(rows, group, x, forces, curvature.as_deref_mut());
+                cost += elliptic(rows, group, x, forces, curvature);
             }
             _ => {
                 for i in range {
@@ -101,9 +175,7 @@ pub(super) fn forces_at(
                         let d = 1.0 / rows.regulariser[i];
                         forces[i] = -d * x[i];
                         cost += 0.5 * d * x[i] * x[i];
-                        if let Some(c) = curvature.as_deref_mut() {
-                            c.diagonal.push((i, d));
-                        }
+                        curvature.row(i, d);
                     } else {
                         forces[i] = 0.0;
                     }
@@ -120,7 +192,7 @@ fn elliptic(
     group: &Group,
     x: &[f64],
     forces: &mut [f64],
-    curvature: Option<&mut Curvature>,
+    curvature: &mut impl CurvatureSink,
 ) -> f64 {
     let (first, len, mu, f) = (group.first, group.len, group.mu, group.friction);
     let normal = mu * x[first];
@@ -137,44 +209,34 @@ fn elliptic(
     // opposite the cone: every row a spring
     if mu * normal + tangent <= 0.0 || (tangent == 0.0 && normal < 0.0) {
         let mut cost = 0.0;
-        let mut curvature = curvature;
         for i in first..first + len {
             let d = 1.0 / rows.regulariser[i];
             forces[i] = -d * x[i];
             cost += 0.5 * d * x[i] * x[i];
-            if let Some(c) = curvature.as_deref_mut() {
-                c.diagonal.push((i, d));
-            }
+            curvature.row(i, d);
         }
         return cost;
     }
-    // on the cone's surface: s = ½ D_m h², h = N − μ T
+    // on the cone's surface: s = ½ D_m h², h = N − μ T, ∇h = (μ, −μ f_k u_k / T)
     let dm = 1.0 / rows.regulariser[first] / (mu * mu * (1.0 + mu * mu));
     let h = normal - mu * tangent;
     forces[first] = -dm * h * mu;
+    let mut surface = Surface {
+        first,
+        len,
+        dm,
+        gradient: [0.0; 6],
+        c: mu * h / tangent,
+        friction: f,
+        direction: [0.0; 6],
+    };
+    surface.gradient[0] = mu;
     for k in 1..len {
         forces[first + k] = -forces[first] * u[k] * f[k - 1] / tangent;
+        surface.direction[k] = u[k] / tangent;
+        surface.gradient[k] = -mu * f[k - 1] * surface.direction[k];
     }
-    if let Some(curvature) = curvature {
-        // ∇h = (μ, −μ f_k u_k / T);  ∇²s = D_m (∇h ∇hᵀ − μ h diag(f) (I − û ûᵀ) diag(f) / T)
-        let mut gradient = [0.0; 6];
-        gradient[0] = mu;
-        for k in 1..len {
-            gradient[k] = -mu * f[k - 1] * u[k] / tangent;
-        }
-        let mut block = [[0.0; 6]; 6];
-        for a in 0..len {
-            for b in 0..len {
-                let mut value = gradient[a] * gradient[b];
-                if a > 0 && b > 0 {
-                    let projector = f64::from(u8::from(a == b)) - u[a] * u[b] / (tangent * tangent);
-                    value -= mu * h * f[a - 1] * f[b - 1] * projector / tangent;
-                }
-                block[a][b] = dm * value;
-            }
-        }
-        curvature.blocks.push((first, len, block));
-    }
+    curvature.surface(&surface);
     0.5 * dm * h * h
 }
 
@@ -238,7 +300,7 @@ pub(super) mod tests {
         let x = [0.3, 1e-3, -0.2, -0.3, 0.4, -0.1];
         let mut curvature = Curvature::default();
         let mut forces = [0.0; 6];
-        forces_at(&rows, &x, &mut forces, Some(&mut curvature));
+        forces_at(&rows, &x, &mut forces, &mut curvature);
         assert_eq!(curvature.blocks.len(), 1, "on the cone's surface");
         let mut dense = DMatrix::zeros(6, 6);
         for &(i, d) in &curvature.diagonal {
@@ -251,6 +313,13 @@ pub(super) mod tests {
                 }
             }
         }
+        // the line search's yᵀ H_s y, taken without the blocks
+        let y = [0.7, -1.1, 0.4, 0.9, -0.6, 1.3];
+        let mut along = Along::new(&y);
+        forces_at(&rows, &x, &mut forces, &mut along);
+        let y = nalgebra::DVector::from_column_slice(&y);
+        let quadratic = (y.transpose() * &dense * &y)[0];
+        assert!((along.value - quadratic).abs() < 1e-12 * quadratic.abs());
         // H_s = −∂f/∂x, by central differences
         let step = 1e-6;
         for k in 0..6 {
@@ -258,8 +327,8 @@ pub(super) mod tests {
             up[k] += step;
             down[k] -= step;
             let (mut f_up, mut f_down) = ([0.0; 6], [0.0; 6]);
-            forces_at(&rows, &up, &mut f_up, None);
-            forces_at(&rows, &down, &mut f_down, None);
+            forces_at(&rows, &up, &mut f_up, &mut ());
+            forces_at(&rows, &down, &mut f_down, &mut ());
             for i in 0..6 {
                 let derivative = -(f_up[i] - f_down[i]) / (2.0 * step);
                 let scale = 1.0 + dense[(i, k)].abs();

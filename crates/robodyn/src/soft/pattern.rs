@@ -1,35 +1,48 @@
-//! The constraint Jacobian J used through its nonzero columns: a friction row has one, a foot's
+//! The constraint Jacobian J kept by its nonzero columns: a friction row has one, a foot's
 //! contact the columns of its leg and its base. Products with J and Jᵀ, and the Hessian's terms
-//! Jᵀ H_s J row by row and block by block, touch those columns only.
+//! Jᵀ H_s J row by row and block by block, touch those columns only, read from compact copies of
+//! J's values made once per solve.
+//!
+//! The Hessian's terms go into its lower triangle only (row ≥ column): the Cholesky
+//! factorisation reads no more.
 
 use super::rows::{RowKind, Rows};
 use nalgebra::DMatrix;
 
-/// Where each row of J is not zero: row i's columns are `columns[starts[i]..starts[i + 1]]`;
-/// those of an elliptic contact's rows together, `group_columns[group_starts[i]..]` up to its
-/// length `group_len[i]`, i its first row.
+/// Where each row of J is not zero and its values there: row i's columns are
+/// `columns[starts[i]..starts[i + 1]]`, its values `values[..]` alike. An elliptic contact's rows
+/// together: the columns where any of them is not zero, `group_columns[group_starts[i]..]` up to
+/// its width `group_width[i]` (i its first row), and its rows' values on each of them (a column
+/// of J_g, zeros past its rows) alike in `group_values`.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Pattern {
     starts: Vec<usize>,
     columns: Vec<usize>,
+    values: Vec<f64>,
     group_starts: Vec<usize>,
-    group_len: Vec<usize>,
+    group_width: Vec<usize>,
     group_columns: Vec<usize>,
+    group_values: Vec<[f64; 6]>,
 }
 
 impl Pattern {
     pub(super) fn find(&mut self, rows: &Rows) {
         self.starts.clear();
         self.columns.clear();
+        self.values.clear();
         self.starts.push(0);
         for i in 0..rows.len() {
             let row = rows.row(i);
-            self.columns.extend((0..rows.nv).filter(|&c| row[c] != 0.0));
+            for (c, &value) in row.iter().enumerate().filter(|(_, v)| **v != 0.0) {
+                self.columns.push(c);
+                self.values.push(value);
+            }
             self.starts.push(self.columns.len());
         }
         self.group_starts.resize(rows.len(), 0);
-        self.group_len.resize(rows.len(), 0);
+        self.group_width.resize(rows.len(), 0);
         self.group_columns.clear();
+        self.group_values.clear();
         for group in rows
             .groups
             .iter()
@@ -40,87 +53,82 @@ impl Pattern {
             let used = |c: usize| (first..first + len).any(|i| rows.row(i)[c] != 0.0);
             self.group_columns.extend((0..rows.nv).filter(|&c| used(c)));
             self.group_starts[first] = start;
-            self.group_len[first] = self.group_columns.len() - start;
+            self.group_width[first] = self.group_columns.len() - start;
+            let column = |c: usize| {
+                std::array::from_fn(|a| match a < len {
+                    true => rows.row(first + a)[c],
+                    false => 0.0,
+                })
+            };
+            let values = self.group_columns[start..].iter().map(|&c| column(c));
+            self.group_values.extend(values);
         }
     }
 
-    /// The columns of the elliptic contact whose first row is `first`.
-    pub(super) fn group_columns(&self, first: usize) -> &[usize] {
-        let start = self.group_starts[first];
-        &self.group_columns[start..start + self.group_len[first]]
-    }
-
-    pub(super) fn columns(&self, i: usize) -> &[usize] {
-        &self.columns[self.starts[i]..self.starts[i + 1]]
+    /// Row i's columns and its values there.
+    fn row(&self, i: usize) -> (&[usize], &[f64]) {
+        let range = self.starts[i]..self.starts[i + 1];
+        (&self.columns[range.clone()], &self.values[range])
     }
 
     /// y = J a.
-    pub(super) fn multiply(&self, rows: &Rows, a: &[f64], y: &mut [f64]) {
+    pub(super) fn multiply(&self, a: &[f64], y: &mut [f64]) {
         for (i, y) in y.iter_mut().enumerate() {
-            let row = rows.row(i);
-            *y = self.columns(i).iter().map(|&c| row[c] * a[c]).sum();
+            let (columns, values) = self.row(i);
+            *y = columns.iter().zip(values).map(|(&c, v)| v * a[c]).sum();
         }
     }
 
     /// out −= Jᵀ f.
-    pub(super) fn subtract_transposed(&self, rows: &Rows, f: &[f64], out: &mut [f64]) {
+    pub(super) fn subtract_transposed(&self, f: &[f64], out: &mut [f64]) {
         for (i, f) in f.iter().enumerate().filter(|(_, f)| **f != 0.0) {
-            let row = rows.row(i);
-            for &c in self.columns(i) {
-                out[c] -= row[c] * f;
+            let (columns, values) = self.row(i);
+            for (&c, v) in columns.iter().zip(values) {
+                out[c] -= v * f;
             }
         }
     }
 
-    /// H += J_gᵀ B J_g for an elliptic contact's rows `first..first + len` of J (J_g) and a
-    /// block B over them (`len` ≤ 6), on the columns where any of those rows is not zero;
-    /// `product` (B J_g on them) is scratch space.
+    /// H += J_gᵀ B J_g (lower triangle) for an elliptic contact's rows `first..first + len` of J
+    /// (J_g) and a block B over them (`len` ≤ 6, zeros past it), on the columns where any of
+    /// those rows is not zero; `scratch` holds B J_g's columns.
     pub(super) fn add_block(
         &self,
-        rows: &Rows,
-        (first, len, block): (usize, usize, &[[f64; 6]; 6]),
-        product: &mut Vec<f64>,
+        (first, block): (usize, &[[f64; 6]; 6]),
+        scratch: &mut Vec<[f64; 6]>,
         h: &mut DMatrix<f64>,
     ) {
-        let columns = self.group_columns(first);
-        let width = columns.len();
-        // W = B J_g on those columns
-        product.clear();
-        product.resize(len * width, 0.0);
-        for (a, weights) in block.iter().enumerate().take(len) {
-            for (b, &weight) in weights.iter().enumerate().take(len) {
-                let row = rows.row(first + b);
-                if weight != 0.0 {
-                    for (w, &c) in product[a * width..(a + 1) * width].iter_mut().zip(columns) {
-                        *w += weight * row[c];
-                    }
-                }
-            }
-        }
-        // H += J_gᵀ W
-        let nv = rows.nv;
+        let start = self.group_starts[first];
+        let width = self.group_width[first];
+        let columns = &self.group_columns[start..start + width];
+        let j = &self.group_values[start..start + width];
+        // W = B J_g, column by column
+        scratch.clear();
+        scratch.extend(
+            j.iter()
+                .map(|j| std::array::from_fn(|a| (0..6).map(|b| block[a][b] * j[b]).sum())),
+        );
+        // H[k, l] += J_g[:, k] · W[:, l], k ≥ l
+        let nv = h.nrows();
         let h = h.as_mut_slice();
-        for a in 0..len {
-            let (row, w) = (rows.row(first + a), &product[a * width..(a + 1) * width]);
-            for &k in columns.iter() {
-                let left = row[k];
-                if left != 0.0 {
-                    for (&l, w) in columns.iter().zip(w) {
-                        h[k + l * nv] += left * w;
-                    }
-                }
+        for (l, (&column, w)) in columns.iter().zip(scratch.iter()).enumerate() {
+            let target = &mut h[column * nv..(column + 1) * nv];
+            for (&k, j) in columns[l..].iter().zip(&j[l..]) {
+                target[k] += (0..6).map(|a| j[a] * w[a]).sum::<f64>();
             }
         }
     }
 
-    /// H += d · J_iᵀ J_i (row i of J).
-    pub(super) fn add_row(&self, rows: &Rows, (i, d): (usize, f64), h: &mut DMatrix<f64>) {
-        let (row, nv) = (rows.row(i), rows.nv);
+    /// H += d · J_iᵀ J_i (row i of J; lower triangle).
+    pub(super) fn add_row(&self, (i, d): (usize, f64), h: &mut DMatrix<f64>) {
+        let (columns, values) = self.row(i);
+        let nv = h.nrows();
         let h = h.as_mut_slice();
-        for &k in self.columns(i) {
-            let left = d * row[k];
-            for &l in self.columns(i) {
-                h[k + l * nv] += left * row[l];
+        for (li, (&l, &right)) in columns.iter().zip(values).enumerate() {
+            let weight = d * right;
+            let column = &mut h[l * nv..(l + 1) * nv];
+            for (&k, value) in columns[li..].iter().zip(&values[li..]) {
+                column[k] += value * weight;
             }
         }
     }

@@ -17,7 +17,7 @@
 //! friction row has one column, a foot's contact the columns of its leg and base): its rows are
 //! used through their nonzero columns only.
 
-use super::cost::{forces_at, Curvature};
+use super::cost::{forces_at, Along, Curvature};
 use super::pattern::Pattern;
 use super::rows::Rows;
 use crate::error::{Error, Result};
@@ -67,7 +67,7 @@ pub struct Solver {
     /// The Hessian (its factor while solving).
     hessian: DMatrix<f64>,
     /// A block's B J_g on its columns ([`Pattern::add_block`]).
-    block_product: Vec<f64>,
+    block_product: Vec<[f64; 6]>,
     /// q̈ − q̈₀, then M (q̈ − q̈₀).
     difference: DVector<f64>,
     m_difference: DVector<f64>,
@@ -110,8 +110,9 @@ impl Solver {
         while out.iterations < MAX_ITERATIONS {
             // g = M (q̈ − q̈₀) − Jᵀ f and H = M + Jᵀ H_s J (f and H_s: the line search's last)
             if out.iterations == 0 {
-                self.residual(rows, reference, &out.acceleration);
-                forces_at(rows, &self.x, &mut self.forces, Some(&mut self.curvature));
+                self.residual(reference, &out.acceleration);
+                self.curvature.clear();
+                forces_at(rows, &self.x, &mut self.forces, &mut self.curvature);
             }
             out.iterations += 1;
             self.difference.copy_from(&out.acceleration);
@@ -119,8 +120,8 @@ impl Solver {
             self.m_difference.gemv(1.0, mass, &self.difference, 0.0);
             self.step.copy_from(&self.m_difference);
             self.pattern
-                .subtract_transposed(rows, &self.forces, self.step.as_mut_slice());
-            self.assemble_hessian(rows, mass);
+                .subtract_transposed(&self.forces, self.step.as_mut_slice());
+            self.assemble_hessian(mass);
             // δ = −H⁻¹ g
             let factor = Cholesky::new(std::mem::take(&mut self.hessian)).ok_or_else(|| {
                 Error::InvalidValue {
@@ -138,9 +139,9 @@ impl Solver {
                 break;
             }
         }
-        self.residual(rows, reference, &out.acceleration);
+        self.residual(reference, &out.acceleration);
         out.forces.resize(count, 0.0);
-        forces_at(rows, &self.x, &mut out.forces, None);
+        forces_at(rows, &self.x, &mut out.forces, &mut ());
         if self.warm_start.len() == nv {
             self.warm_start.copy_from(&out.acceleration);
         } else {
@@ -178,9 +179,9 @@ impl Solver {
     }
 
     /// x = J q̈ − a_ref (J q̈ kept).
-    fn residual(&mut self, rows: &Rows, reference: &[f64], acceleration: &DVector<f64>) {
+    fn residual(&mut self, reference: &[f64], acceleration: &DVector<f64>) {
         self.pattern
-            .multiply(rows, acceleration.as_slice(), &mut self.j_acceleration);
+            .multiply(acceleration.as_slice(), &mut self.j_acceleration);
         for ((x, ja), r) in self.x.iter_mut().zip(&self.j_acceleration).zip(reference) {
             *x = ja - r;
         }
@@ -195,36 +196,32 @@ impl Solver {
         reference: &[f64],
         acceleration: &DVector<f64>,
     ) -> f64 {
-        self.residual(rows, reference, acceleration);
+        self.residual(reference, acceleration);
         self.difference.copy_from(acceleration);
         self.difference -= free;
         self.m_difference.gemv(1.0, mass, &self.difference, 0.0);
         0.5 * self.difference.dot(&self.m_difference)
-            + forces_at(rows, &self.x, &mut self.forces, None)
+            + forces_at(rows, &self.x, &mut self.forces, &mut ())
     }
 
     /// H = M + Jᵀ H_s J from the curvature of the last [`forces_at`], row by row on J's
-    /// nonzero columns.
-    fn assemble_hessian(&mut self, rows: &Rows, mass: &DMatrix<f64>) {
+    /// nonzero columns: its lower triangle, all the Cholesky factorisation reads.
+    fn assemble_hessian(&mut self, mass: &DMatrix<f64>) {
         self.hessian.copy_from(mass);
         for &(i, d) in &self.curvature.diagonal {
-            self.pattern.add_row(rows, (i, d), &mut self.hessian);
+            self.pattern.add_row((i, d), &mut self.hessian);
         }
-        for &(first, len, ref block) in &self.curvature.blocks {
-            self.pattern.add_block(
-                rows,
-                (first, len, block),
-                &mut self.block_product,
-                &mut self.hessian,
-            );
+        for &(first, _, ref block) in &self.curvature.blocks {
+            self.pattern
+                .add_block((first, block), &mut self.block_product, &mut self.hessian);
         }
     }
 
     /// The step length α minimising the cost along δ from `start`: where its slope
     /// `φ'(α) = δᵀ M (q̈ + α δ − q̈₀) − (J δ)ᵀ f(α)` (monotone) is zero, by Newton's method on
     /// it (`φ''(α) = δᵀ M δ + (J δ)ᵀ H_s(α) (J δ)`) kept inside the bracket found so far.
-    /// Expects `m_difference` = M (q̈ − q̈₀), `forces` f and `curvature` H_s at `start`; leaves f
-    /// and H_s at the step's end.
+    /// Expects `m_difference` = M (q̈ − q̈₀) and `forces` f at `start`; leaves f and H_s at the
+    /// step's end.
     fn line_search(
         &mut self,
         rows: &Rows,
@@ -234,28 +231,44 @@ impl Solver {
     ) -> f64 {
         self.m_step.gemv(1.0, mass, &self.step, 0.0);
         self.pattern
-            .multiply(rows, self.step.as_slice(), &mut self.j_step);
+            .multiply(self.step.as_slice(), &mut self.j_step);
         self.pattern
-            .multiply(rows, start.as_slice(), &mut self.j_acceleration);
+            .multiply(start.as_slice(), &mut self.j_acceleration);
         let base = self.step.dot(&self.m_difference);
         let step_mass = self.step.dot(&self.m_step);
         // φ'(0) from the forces at the start, still in `forces`
         let start_slope = base - dot(&self.forces, &self.j_step);
+        let alpha = if start_slope >= 0.0 {
+            0.0
+        } else {
+            self.slope_root(rows, reference, (base, step_mass), start_slope)
+        };
+        // f and H_s at the step's end, for the next iteration
+        self.move_residual(reference, alpha);
+        self.curvature.clear();
+        forces_at(rows, &self.x, &mut self.forces, &mut self.curvature);
+        alpha
+    }
+
+    /// The root of φ'(α) = `base` + α `step_mass` − (J δ)ᵀ f(α), Newton's full step first,
+    /// from φ'(0) = `start_slope` < 0 (see [`Self::line_search`]).
+    fn slope_root(
+        &mut self,
+        rows: &Rows,
+        reference: &[f64],
+        (base, step_mass): (f64, f64),
+        start_slope: f64,
+    ) -> f64 {
+        // φ'(α) and φ''(α), with H_s taken along J δ only
         let mut derivatives = |alpha: f64| {
-            let moved = self.j_acceleration.iter().zip(&self.j_step);
-            for ((x, (ja, js)), r) in self.x.iter_mut().zip(moved).zip(reference) {
-                *x = ja + alpha * js - r;
-            }
-            forces_at(rows, &self.x, &mut self.forces, Some(&mut self.curvature));
+            self.move_residual(reference, alpha);
+            let mut along = Along::new(&self.j_step);
+            forces_at(rows, &self.x, &mut self.forces, &mut along);
             (
                 base + alpha * step_mass - dot(&self.forces, &self.j_step),
-                step_mass + self.curvature.along(&self.j_step),
+                step_mass + along.value,
             )
         };
-        if start_slope >= 0.0 {
-            return 0.0;
-        }
-        // Newton's full step first
         let (mut low, mut high, mut alpha) = (0.0, f64::INFINITY, 1.0);
         for _ in 0..LINE_ITERATIONS {
             let (slope, curvature) = derivatives(alpha);
@@ -277,8 +290,15 @@ impl Solver {
                 (false, false) => 2.0 * alpha,
             };
         }
-        derivatives(alpha);
         alpha
+    }
+
+    /// x = J q̈ + α J δ − a_ref from the kept J q̈ and J δ.
+    fn move_residual(&mut self, reference: &[f64], alpha: f64) {
+        let moved = self.j_acceleration.iter().zip(&self.j_step);
+        for ((x, (ja, js)), r) in self.x.iter_mut().zip(moved).zip(reference) {
+            *x = ja + alpha * js - r;
+        }
     }
 }
 
@@ -368,7 +388,7 @@ mod tests {
     }
 
     #[test]
-    fn the_sparse_hessian_is_m_plus_jt_hs_j() {
+    fn the_sparse_hessians_lower_triangle_is_m_plus_jt_hs_js() {
         let rows = mixed_rows();
         let mass = mixed_mass();
         let mut solver = Solver::default();
@@ -376,8 +396,8 @@ mod tests {
         solver.pattern.find(&rows);
         let x = [0.3, 1e-3, -0.2, -0.3, 0.4, -0.1];
         let mut forces = [0.0; 6];
-        forces_at(&rows, &x, &mut forces, Some(&mut solver.curvature));
-        solver.assemble_hessian(&rows, &mass);
+        forces_at(&rows, &x, &mut forces, &mut solver.curvature);
+        solver.assemble_hessian(&mass);
         let mut hs = DMatrix::zeros(6, 6);
         for &(i, d) in &solver.curvature.diagonal {
             hs[(i, i)] = d;
@@ -391,11 +411,8 @@ mod tests {
         }
         let j = DMatrix::from_row_slice(6, 4, &rows.jacobian);
         let expected = &mass + j.transpose() * hs * &j;
-        assert!(
-            (&solver.hessian - &expected).amax() < EXACT,
-            "{}",
-            solver.hessian
-        );
+        let difference = solver.hessian.lower_triangle() - expected.lower_triangle();
+        assert!(difference.amax() < EXACT, "{}", solver.hessian);
     }
 
     #[test]
