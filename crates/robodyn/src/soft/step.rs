@@ -384,11 +384,20 @@ fn implicit_solve(
     h: f64,
     acceleration: &DVector<f64>,
 ) -> Option<DVector<f64>> {
-    let t = basis_change(model, q);
-    let mut matrix = mass - (t.transpose() * k * &t) * h;
-    if let Some(g) = gyroscopic {
-        matrix -= g * h;
+    // Tᵀ K T, T the identity but for each free joint's linear block R: Rᵀ on those rows, R on
+    // those columns
+    let mut matrix = k.clone();
+    for (s, rotation) in free_rotations(model, q) {
+        let turned = rotation.transpose() * matrix.fixed_rows::<3>(s);
+        matrix.fixed_rows_mut::<3>(s).copy_from(&turned);
+        let turned = matrix.fixed_columns::<3>(s) * rotation;
+        matrix.fixed_columns_mut::<3>(s).copy_from(&turned);
     }
+    if let Some(g) = gyroscopic {
+        matrix += g;
+    }
+    matrix *= -h;
+    matrix += mass;
     matrix.lu().solve(&(mass * acceleration))
 }
 
@@ -404,15 +413,6 @@ fn advance(model: &Model, q: &mut [f64], v: &mut [f64], u: &DVector<f64>, h: f64
 /// free joints).
 fn mujoco_acceleration(model: &Model, v: &[f64], qdd: &DVector<f64>) -> DVector<f64> {
     qdd + free_joint_velocity_product(model, v)
-}
-
-/// T: the identity but for each free joint's linear block, its rotation R (ν = T v).
-fn basis_change(model: &Model, q: &[f64]) -> DMatrix<f64> {
-    let mut t = DMatrix::identity(model.nv, model.nv);
-    for (s, rotation) in free_rotations(model, q) {
-        t.fixed_view_mut::<3, 3>(s, s).copy_from(&rotation);
-    }
-    t
 }
 
 /// ν = T v.
