@@ -70,10 +70,11 @@ impl Surface {
         let y = &y[self.first..self.first + self.len];
         let slope: f64 = self.gradient.iter().zip(y).map(|(g, y)| g * y).sum();
         let (mut scaled, mut projected) = (0.0, 0.0);
-        for k in 1..self.len {
-            let fy = self.friction[k - 1] * y[k];
+        let friction = self.friction.iter().zip(&self.direction[1..]);
+        for ((f, direction), y) in friction.zip(&y[1..]) {
+            let fy = f * y;
             scaled += fy * fy;
-            projected += self.direction[k] * fy;
+            projected += direction * fy;
         }
         self.dm * (slope * slope - self.c * (scaled - projected * projected))
     }
