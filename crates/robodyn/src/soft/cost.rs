@@ -86,14 +86,31 @@ impl Surface {
 pub(super) struct Curvature {
     /// (row, ∂²s/∂x_row²).
     pub(super) diagonal: Vec<(usize, f64)>,
-    /// (first row, rows, the block).
-    pub(super) blocks: Vec<(usize, usize, [[f64; 6]; 6])>,
+    /// (first row, the block: zero past the contact's rows).
+    pub(super) blocks: Vec<(usize, [[f64; 6]; 6])>,
 }
 
 impl Curvature {
     pub(super) fn clear(&mut self) {
         self.diagonal.clear();
         self.blocks.clear();
+    }
+
+    /// H_s as a dense matrix over `count` rows.
+    #[cfg(test)]
+    pub(super) fn dense(&self, count: usize) -> nalgebra::DMatrix<f64> {
+        let mut dense = nalgebra::DMatrix::zeros(count, count);
+        for &(i, d) in &self.diagonal {
+            dense[(i, i)] = d;
+        }
+        for (first, block) in &self.blocks {
+            for a in (0..6).filter(|a| first + a < count) {
+                for b in (0..6).filter(|b| first + b < count) {
+                    dense[(first + a, first + b)] += block[a][b];
+                }
+            }
+        }
+        dense
     }
 }
 
@@ -103,8 +120,7 @@ impl CurvatureSink for Curvature {
     }
 
     fn surface(&mut self, surface: &Surface) {
-        self.blocks
-            .push((surface.first, surface.len, surface.block()));
+        self.blocks.push((surface.first, surface.block()));
     }
 }
 
@@ -245,7 +261,6 @@ fn elliptic(
 pub(super) mod tests {
     use super::*;
     use crate::soft::rows::Group;
-    use nalgebra::DMatrix;
 
     /// Four degrees of freedom under an equality row, a friction-loss row, a limit and an
     /// elliptic contact of three rows (μ = 0.5), J with zeros in it as a robot's has.
@@ -303,17 +318,7 @@ pub(super) mod tests {
         let mut forces = [0.0; 6];
         forces_at(&rows, &x, &mut forces, &mut curvature);
         assert_eq!(curvature.blocks.len(), 1, "on the cone's surface");
-        let mut dense = DMatrix::zeros(6, 6);
-        for &(i, d) in &curvature.diagonal {
-            dense[(i, i)] = d;
-        }
-        for (first, len, block) in &curvature.blocks {
-            for a in 0..*len {
-                for b in 0..*len {
-                    dense[(first + a, first + b)] += block[a][b];
-                }
-            }
-        }
+        let dense = curvature.dense(6);
         // the line search's yᵀ H_s y, taken without the blocks
         let y = [0.7, -1.1, 0.4, 0.9, -0.6, 1.3];
         let mut along = Along::new(&y);

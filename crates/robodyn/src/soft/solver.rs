@@ -211,7 +211,7 @@ impl Solver {
         for &(i, d) in &self.curvature.diagonal {
             self.pattern.add_row((i, d), &mut self.hessian);
         }
-        for &(first, _, ref block) in &self.curvature.blocks {
+        for &(first, ref block) in &self.curvature.blocks {
             self.pattern
                 .add_block((first, block), &mut self.block_product, &mut self.hessian);
         }
@@ -398,17 +398,7 @@ mod tests {
         let mut forces = [0.0; 6];
         forces_at(&rows, &x, &mut forces, &mut solver.curvature);
         solver.assemble_hessian(&mass);
-        let mut hs = DMatrix::zeros(6, 6);
-        for &(i, d) in &solver.curvature.diagonal {
-            hs[(i, i)] = d;
-        }
-        for (first, len, block) in &solver.curvature.blocks {
-            for a in 0..*len {
-                for b in 0..*len {
-                    hs[(first + a, first + b)] += block[a][b];
-                }
-            }
-        }
+        let hs = solver.curvature.dense(6);
         let j = DMatrix::from_row_slice(6, 4, &rows.jacobian);
         let expected = &mass + j.transpose() * hs * &j;
         let difference = solver.hessian.lower_triangle() - expected.lower_triangle();
