@@ -96,6 +96,13 @@ impl Curvature {
         self.blocks.clear();
     }
 
+    /// The rows that curve and the contacts on their cone's surface (`true`): where H_s is
+    /// nonzero, which changes only where a row or a contact changes zone.
+    pub(super) fn zones(&self) -> impl Iterator<Item = (usize, bool)> + '_ {
+        let rows = self.diagonal.iter().map(|&(i, _)| (i, false));
+        rows.chain(self.blocks.iter().map(|&(first, _)| (first, true)))
+    }
+
     /// H_s as a dense matrix over `count` rows.
     #[cfg(test)]
     pub(super) fn dense(&self, count: usize) -> nalgebra::DMatrix<f64> {

@@ -11,9 +11,9 @@ use nalgebra::DMatrix;
 
 /// Where each row of J is not zero and its values there: row i's columns are
 /// `columns[starts[i]..starts[i + 1]]`, its values `values[..]` alike. An elliptic contact's rows
-/// together: the columns where any of them is not zero, `group_columns[group_starts[i]..]` up to
-/// its width `group_width[i]` (i its first row), and its rows' values on each of them (a column
-/// of J_g, zeros past its rows) alike in `group_values`.
+/// together (`group_len[i]` of them, i the first): the columns where any of them is not zero,
+/// `group_columns[group_starts[i]..]` up to its width `group_width[i]`, and its rows' values on
+/// each of them (a column of J_g, zeros past its rows) alike in `group_values`.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Pattern {
     starts: Vec<usize>,
@@ -21,6 +21,7 @@ pub(super) struct Pattern {
     values: Vec<f64>,
     group_starts: Vec<usize>,
     group_width: Vec<usize>,
+    group_len: Vec<usize>,
     group_columns: Vec<usize>,
     group_values: Vec<[f64; 6]>,
 }
@@ -41,6 +42,7 @@ impl Pattern {
         }
         self.group_starts.resize(rows.len(), 0);
         self.group_width.resize(rows.len(), 0);
+        self.group_len.resize(rows.len(), 0);
         self.group_columns.clear();
         self.group_values.clear();
         for group in rows
@@ -54,6 +56,7 @@ impl Pattern {
             self.group_columns.extend((0..rows.nv).filter(|&c| used(c)));
             self.group_starts[first] = start;
             self.group_width[first] = self.group_columns.len() - start;
+            self.group_len[first] = len;
             let column = |c: usize| {
                 std::array::from_fn(|a| match a < len {
                     true => rows.row(first + a)[c],
@@ -90,11 +93,27 @@ impl Pattern {
     }
 
     /// H += J_gᵀ B J_g (lower triangle) for an elliptic contact's rows `first..first + len` of J
-    /// (J_g) and a block B over them (`len` ≤ 6, zeros past it), on the columns where any of
-    /// those rows is not zero; `scratch` holds B J_g's columns.
+    /// (J_g) and a block B over them (zeros past them), on the columns where any of those rows
+    /// is not zero; `scratch` holds B J_g's columns.
     pub(super) fn add_block(
         &self,
         (first, block): (usize, &[[f64; 6]; 6]),
+        scratch: &mut Vec<[f64; 6]>,
+        h: &mut DMatrix<f64>,
+    ) {
+        // the products over the contact's rows only, their count known to the compiler
+        match self.group_len[first] {
+            3 => self.add_block_of::<3>(first, block, scratch, h),
+            4 => self.add_block_of::<4>(first, block, scratch, h),
+            _ => self.add_block_of::<6>(first, block, scratch, h),
+        }
+    }
+
+    /// [`Self::add_block`] over the block's first `N` rows and columns.
+    fn add_block_of<const N: usize>(
+        &self,
+        first: usize,
+        block: &[[f64; 6]; 6],
         scratch: &mut Vec<[f64; 6]>,
         h: &mut DMatrix<f64>,
     ) {
@@ -104,17 +123,19 @@ impl Pattern {
         let j = &self.group_values[start..start + width];
         // W = B J_g, column by column
         scratch.clear();
-        scratch.extend(
-            j.iter()
-                .map(|j| std::array::from_fn(|a| (0..6).map(|b| block[a][b] * j[b]).sum())),
-        );
+        scratch.extend(j.iter().map(|j| {
+            std::array::from_fn(|a| match a < N {
+                true => (0..N).map(|b| block[a][b] * j[b]).sum(),
+                false => 0.0,
+            })
+        }));
         // H[k, l] += J_g[:, k] · W[:, l], k ≥ l
         let nv = h.nrows();
         let h = h.as_mut_slice();
         for (l, (&column, w)) in columns.iter().zip(scratch.iter()).enumerate() {
             let target = &mut h[column * nv..(column + 1) * nv];
             for (&k, j) in columns[l..].iter().zip(&j[l..]) {
-                target[k] += (0..6).map(|a| j[a] * w[a]).sum::<f64>();
+                target[k] += (0..N).map(|a| j[a] * w[a]).sum::<f64>();
             }
         }
     }

@@ -13,7 +13,10 @@
 //!   δ = −H⁻¹ g                             Newton's step
 //!   α: φ'(α) = 0,  φ(α) the cost at q̈ + α δ (convex: its slope is monotone)
 //! ```
-//! from the last solution when it costs less than q̈₀ (MuJoCo's warm start). J is sparse (a
+//! from the last solution when it costs less than q̈₀ (MuJoCo's warm start), until a step is
+//! below tolerance. Where no row has changed zone since the last factorisation, H differs from
+//! that factor's only by the cones' curvature: its step −H⁻¹ g, below tolerance, ends the solve
+//! (and is taken) without another Hessian, the last of Newton's iterations. J is sparse (a
 //! friction row has one column, a foot's contact the columns of its leg and base): its rows are
 //! used through their nonzero columns only.
 
@@ -36,6 +39,9 @@ const LINE_ITERATIONS: usize = 50;
 /// outer iterations converge from any such point, and where the active set no longer changes
 /// the slope is linear and Newton's full step already exact.
 const LINE_TOLERANCE: f64 = 1e-10;
+/// A slope is known to this much of the sum of its terms' magnitudes (round-off): the line
+/// search ends where it is no larger (near the optimum the slope at the start may be no more).
+const ROUND_OFF: f64 = 64.0 * f64::EPSILON;
 
 /// The solution: accelerations, the rows' forces.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -64,14 +70,17 @@ pub struct Solver {
     /// J q̈ and J δ.
     j_acceleration: Vec<f64>,
     j_step: Vec<f64>,
-    /// The Hessian (its factor while solving).
+    /// The Hessian, then its Cholesky factor L (lower triangle), kept for the next iteration.
     hessian: DMatrix<f64>,
+    /// The zones of the rows (`Curvature::zones`) where the factored Hessian was taken.
+    factored_zones: Vec<(usize, bool)>,
     /// A block's B J_g on its columns ([`Pattern::add_block`]).
     block_product: Vec<[f64; 6]>,
     /// q̈ − q̈₀, then M (q̈ − q̈₀).
     difference: DVector<f64>,
     m_difference: DVector<f64>,
-    /// g, then δ; M δ.
+    /// g; δ, M δ.
+    gradient: DVector<f64>,
     step: DVector<f64>,
     m_step: DVector<f64>,
 }
@@ -107,35 +116,42 @@ impl Solver {
         }
         self.warm_start = warm_start;
         out.iterations = 0;
+        self.residual(reference, &out.acceleration);
+        self.curvature.clear();
+        forces_at(rows, &self.x, &mut self.forces, &mut self.curvature);
         while out.iterations < MAX_ITERATIONS {
-            // g = M (q̈ − q̈₀) − Jᵀ f and H = M + Jᵀ H_s J (f and H_s: the line search's last)
-            if out.iterations == 0 {
-                self.residual(reference, &out.acceleration);
-                self.curvature.clear();
-                forces_at(rows, &self.x, &mut self.forces, &mut self.curvature);
-            }
-            out.iterations += 1;
+            // g = M (q̈ − q̈₀) − Jᵀ f (f and H_s: the line search's last)
             self.difference.copy_from(&out.acceleration);
             self.difference -= free;
             self.m_difference.gemv(1.0, mass, &self.difference, 0.0);
-            self.step.copy_from(&self.m_difference);
+            self.gradient.copy_from(&self.m_difference);
             self.pattern
-                .subtract_transposed(&self.forces, self.step.as_mut_slice());
-            self.assemble_hessian(mass);
-            // δ = −H⁻¹ g
-            let factor = Cholesky::new(std::mem::take(&mut self.hessian)).ok_or_else(|| {
-                Error::InvalidValue {
-                    argument: "model".into(),
-                    message: "the constraint problem's Hessian is not positive definite".into(),
+                .subtract_transposed(&self.forces, self.gradient.as_mut_slice());
+            // the last factor's step, where no row has changed zone since, and below tolerance
+            if out.iterations > 0
+                && self
+                    .curvature
+                    .zones()
+                    .eq(self.factored_zones.iter().copied())
+            {
+                self.step.copy_from(&self.gradient);
+                self.solve_factored();
+                if self.converged(1.0, &out.acceleration) {
+                    out.acceleration -= &self.step;
+                    break;
                 }
-            })?;
-            factor.solve_mut(&mut self.step);
+            }
+            out.iterations += 1;
+            // δ = −H⁻¹ g,  H = M + Jᵀ H_s J
+            self.assemble_hessian(mass);
+            self.factor()?;
+            self.step.copy_from(&self.gradient);
+            self.solve_factored();
             self.step.neg_mut();
-            self.hessian = factor.unpack_dirty();
             // q̈ += α δ
-            let length = self.line_search(rows, mass, reference, &out.acceleration);
+            let length = self.line_search(rows, mass, reference);
             out.acceleration.axpy(length, &self.step, 1.0);
-            if length * self.step.amax() <= STEP_TOLERANCE * (1.0 + out.acceleration.amax()) {
+            if self.converged(length, &out.acceleration) {
                 break;
             }
         }
@@ -170,6 +186,7 @@ impl Solver {
             for v in [
                 &mut self.difference,
                 &mut self.m_difference,
+                &mut self.gradient,
                 &mut self.step,
                 &mut self.m_step,
             ] {
@@ -215,25 +232,44 @@ impl Solver {
             self.pattern
                 .add_block((first, block), &mut self.block_product, &mut self.hessian);
         }
+        self.factored_zones.clear();
+        self.factored_zones.extend(self.curvature.zones());
     }
 
-    /// The step length α minimising the cost along δ from `start`: where its slope
+    /// H = L Lᵀ in place (Cholesky).
+    fn factor(&mut self) -> Result<()> {
+        let factor = Cholesky::new(std::mem::take(&mut self.hessian)).ok_or_else(|| {
+            Error::InvalidValue {
+                argument: "model".into(),
+                message: "the constraint problem's Hessian is not positive definite".into(),
+            }
+        })?;
+        self.hessian = factor.unpack_dirty();
+        Ok(())
+    }
+
+    /// `step` ← H⁻¹ `step` by the kept factor: L⁻ᵀ L⁻¹.
+    fn solve_factored(&mut self) {
+        self.hessian
+            .solve_lower_triangular_unchecked_mut(&mut self.step);
+        self.hessian
+            .tr_solve_lower_triangular_unchecked_mut(&mut self.step);
+    }
+
+    /// Whether a step of `length` × `step` is below tolerance against the accelerations.
+    fn converged(&self, length: f64, acceleration: &DVector<f64>) -> bool {
+        length * self.step.amax() <= STEP_TOLERANCE * (1.0 + acceleration.amax())
+    }
+
+    /// The step length α minimising the cost along δ from q̈: where its slope
     /// `φ'(α) = δᵀ M (q̈ + α δ − q̈₀) − (J δ)ᵀ f(α)` (monotone) is zero, by Newton's method on
     /// it (`φ''(α) = δᵀ M δ + (J δ)ᵀ H_s(α) (J δ)`) kept inside the bracket found so far.
-    /// Expects `m_difference` = M (q̈ − q̈₀) and `forces` f at `start`; leaves f and H_s at the
-    /// step's end.
-    fn line_search(
-        &mut self,
-        rows: &Rows,
-        mass: &DMatrix<f64>,
-        reference: &[f64],
-        start: &DVector<f64>,
-    ) -> f64 {
+    /// Expects `m_difference` = M (q̈ − q̈₀), `j_acceleration` J q̈ and `forces` f at the start;
+    /// leaves J q̈, f and H_s at the step's end.
+    fn line_search(&mut self, rows: &Rows, mass: &DMatrix<f64>, reference: &[f64]) -> f64 {
         self.m_step.gemv(1.0, mass, &self.step, 0.0);
         self.pattern
             .multiply(self.step.as_slice(), &mut self.j_step);
-        self.pattern
-            .multiply(start.as_slice(), &mut self.j_acceleration);
         let base = self.step.dot(&self.m_difference);
         let step_mass = self.step.dot(&self.m_step);
         // φ'(0) from the forces at the start, still in `forces`
@@ -243,10 +279,13 @@ impl Solver {
         } else {
             self.slope_root(rows, reference, (base, step_mass), start_slope)
         };
-        // f and H_s at the step's end, for the next iteration
+        // f and H_s at the step's end, for the next iteration; J q̈ += α J δ
         self.move_residual(reference, alpha);
         self.curvature.clear();
         forces_at(rows, &self.x, &mut self.forces, &mut self.curvature);
+        for (ja, js) in self.j_acceleration.iter_mut().zip(&self.j_step) {
+            *ja += alpha * js;
+        }
         alpha
     }
 
@@ -264,30 +303,51 @@ impl Solver {
             self.move_residual(reference, alpha);
             let mut along = Along::new(&self.j_step);
             forces_at(rows, &self.x, &mut self.forces, &mut along);
+            let work = dot(&self.forces, &self.j_step);
+            let terms =
+                base.abs() + (alpha * step_mass).abs() + abs_dot(&self.forces, &self.j_step);
             (
-                base + alpha * step_mass - dot(&self.forces, &self.j_step),
+                base + alpha * step_mass - work,
                 step_mass + along.value,
+                ROUND_OFF * terms,
             )
         };
-        let (mut low, mut high, mut alpha) = (0.0, f64::INFINITY, 1.0);
-        for _ in 0..LINE_ITERATIONS {
-            let (slope, curvature) = derivatives(alpha);
-            if slope.abs() <= LINE_TOLERANCE * start_slope.abs() {
-                return alpha;
+        // the bracket's ends (α, φ'(α)): φ' < 0 at the low one, ≥ 0 at the high one; its
+        // widths one and two evaluations before
+        let (mut low, mut high) = ((0.0, start_slope), (f64::INFINITY, 0.0));
+        let mut widths = [f64::INFINITY; 2];
+        let mut alpha = 1.0;
+        for evaluations in 1.. {
+            let (slope, curvature, noise) = derivatives(alpha);
+            let flat = slope.abs() <= (LINE_TOLERANCE * start_slope.abs()).max(noise);
+            if flat || evaluations == LINE_ITERATIONS {
+                break;
             }
             if slope < 0.0 {
-                low = alpha;
+                low = (alpha, slope);
             } else {
-                high = alpha;
+                high = (alpha, slope);
             }
-            if high - low <= f64::EPSILON * high {
-                return alpha;
+            let width = high.0 - low.0;
+            if width <= f64::EPSILON * high.0 {
+                break;
             }
+            // Newton's step, else the secant through the bracket's ends, inside the bracket;
+            // its middle where two evaluations have not halved it (across a kink Newton's steps
+            // bounce between its sides, a secant may keep one end)
+            let stalled = 2.0 * width > widths[1];
+            widths = [width, widths[0]];
             let newton = alpha - slope / curvature;
-            alpha = match (newton > low && newton < high, high.is_finite()) {
-                (true, _) => newton,
-                (false, true) => 0.5 * (low + high),
-                (false, false) => 2.0 * alpha,
+            let secant = low.0 + width * low.1 / (low.1 - high.1);
+            let inside = |a: f64| a > low.0 && a < high.0 && !stalled;
+            alpha = if inside(newton) {
+                newton
+            } else if !high.0.is_finite() {
+                2.0 * alpha
+            } else if inside(secant) {
+                secant
+            } else {
+                0.5 * (low.0 + high.0)
             };
         }
         alpha
@@ -300,6 +360,11 @@ impl Solver {
             *x = ja + alpha * js - r;
         }
     }
+}
+
+/// Σ |a_i b_i| of two slices.
+fn abs_dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(a, b)| (a * b).abs()).sum()
 }
 
 /// aᵀ b of two slices.
@@ -403,6 +468,23 @@ mod tests {
         let expected = &mass + j.transpose() * hs * &j;
         let difference = solver.hessian.lower_triangle() - expected.lower_triangle();
         assert!(difference.amax() < EXACT, "{}", solver.hessian);
+    }
+
+    #[test]
+    fn a_quadratic_cost_ends_after_one_newton_step_on_its_factor() {
+        // equality rows only: the cost is quadratic, Newton's first step lands on the optimum,
+        // and the kept factor (same zones) shows the next step below tolerance
+        let mut rows = one_row(RowKind::Equality, 0.25, 0.0);
+        rows.reference = vec![2.0];
+        let solution = solve(
+            &rows,
+            &DMatrix::from_element(1, 1, 1.0),
+            &DVector::from_element(1, -1.0),
+            &rows.reference,
+        );
+        // q̈ = (m q̈₀ + D a_ref)/(m + D) with D = 4
+        assert!((solution.acceleration[0] - 7.0 / 5.0).abs() < EXACT);
+        assert_eq!(solution.iterations, 1);
     }
 
     #[test]
