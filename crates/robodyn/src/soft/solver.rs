@@ -274,11 +274,11 @@ impl Solver {
         let step_mass = self.step.dot(&self.m_step);
         // φ'(0) from the forces at the start, still in `forces`
         let start_slope = base - dot(&self.forces, &self.j_step);
-        let alpha = if start_slope >= 0.0 {
-            0.0
-        } else {
-            self.slope_root(rows, reference, (base, step_mass), start_slope)
-        };
+        // δ no descent (round-off at the optimum): f, H_s and J q̈ stay the start's
+        if start_slope >= 0.0 {
+            return 0.0;
+        }
+        let alpha = self.slope_root(rows, reference, (base, step_mass), start_slope);
         // f and H_s at the step's end, for the next iteration; J q̈ += α J δ
         self.move_residual(reference, alpha);
         self.curvature.clear();
