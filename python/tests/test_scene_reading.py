@@ -396,20 +396,19 @@ def test_a_tendon_mujoco_refuses_is_refused_by_name_and_line(change, message):
 
 
 def test_what_tendons_robodyn_does_not_model_are_named():
-    """A spatial tendon wrapping a geom (and what uses it), an actuator on a spatial tendon, a
-    tendon's armature: a warning each; an invalid range under limited="auto" leaves the tendon
-    unlimited, as in MuJoCo; the actuator on the fixed tendon pulls with gear times its
-    coefficients."""
+    """A spatial tendon wrapping a geom (and an actuator on it), a tendon's armature: a warning
+    each; an invalid range under limited="auto" leaves the tendon unlimited, as in MuJoCo; the
+    actuator on the fixed tendon pulls with gear times its coefficients."""
     text = TENDON_ARM.replace('range="0 1"', 'range="1 0" armature="0.1"').replace(
         "</fixed></tendon>", '</fixed><spatial name="string"><site site="s1"/><site site="s2"/></spatial>'
         '<spatial name="wrapped"><site site="s1"/><geom geom="pin"/><site site="s2"/></spatial></tendon>'
     ).replace('<geom size="0.1"/></body></body></body>', '<geom size="0.1"/><site name="s2"/></body></body><site name="s1"/>'
               '<geom name="pin" type="cylinder" size="0.02 0.1" pos="0.2 0 -0.3"/></body>')
-    text = text.replace("</actuator>", '<motor name="reel" tendon="string"/></actuator>')
+    text = text.replace("</actuator>", '<motor name="reel" tendon="wrapped"/></actuator>')
     model = robodyn.load_mjcf_string(text)
     messages = " ".join(model.warnings)
     assert "<spatial name='wrapped'> (line" in messages and "'armature' not modelled" in messages
-    assert "<motor name='reel'> (line" in messages and "spatial tendon 'string'" in messages
+    assert "<motor name='reel'> (line" in messages and "tendon 'wrapped' (not read: it wraps" in messages
     assert model.tendon_names == ["pull", "string"]
     q = model.neutral()
     q[model.joint_idx_q[model.joint_names.index("hinge")]] = 0.3
@@ -418,4 +417,4 @@ def test_what_tendons_robodyn_does_not_model_are_named():
     expected = np.zeros(model.nv)
     expected[model.joint_idx_v[model.joint_names.index("hinge")]] = 3.0
     expected[model.joint_idx_v[model.joint_names.index("slide")]] = -6.0
-    assert_close(tau, expected, 0.0, "gear × coefficients; the spatial tendon's actuator none")
+    assert_close(tau, expected, 0.0, "gear × coefficients; the wrapped tendon's actuator none")

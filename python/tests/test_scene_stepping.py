@@ -23,7 +23,7 @@ from test_contact_dynamics import (
     without_unmodelled,
 )
 from test_menagerie import MENAGERIE, mujoco_model
-from test_soft_elements import EQUALITIES, SPATIAL, TENDONS
+from test_soft_elements import EQUALITIES, SPATIAL, SPATIAL_ACTUATORS, TENDONS
 
 STEPS = 100
 # 100 steps without elliptic friction: the same arithmetic in another order; measured up to 1.1e-12
@@ -164,6 +164,18 @@ def test_spatial_tendons_step_as_in_mujoco(integrator):
     qpos = mj_model.qpos0.copy()
     mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.3, 1.0)
     assert_steps_like_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv), label=integrator)
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+def test_actuators_on_spatial_tendons_step_as_in_mujoco(integrator):
+    """test_soft_elements's actuators on spatial tendons under steady controls: their moment arms
+    move with the state; implicitfast takes their velocity gains into K (gear² J_νᵀ J_ν)."""
+    model, mj_model, layout = load_both(text=with_integrator(SPATIAL_ACTUATORS.replace("{cone}", "pyramidal"), integrator))
+    rng = np.random.default_rng(5)
+    qpos = mj_model.qpos0.copy()
+    mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.3, 1.0)
+    assert_steps_like_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv),
+                             ctrl=[0.4, 0.7, 0.2, 1.1, 0.3], label=integrator)
 
 
 # --- 3. a Menagerie quadruped, dm_control's suite ----------------------------------------------

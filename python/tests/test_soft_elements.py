@@ -1,6 +1,7 @@
 """MuJoCo's soft model beyond contacts and joints (`m.contact_forward_dynamics` against `mj_forward`,
 as in test_contact_dynamics.py): equality constraints of every kind robodyn reads, fixed tendons
-(limits, friction, springs, equalities, actuators), spatial tendons through sites and pulleys, rows' ids past what robodyn does not read,
+(limits, friction, springs, equalities, actuators), spatial tendons through sites and pulleys (and actuators on them),
+rows' ids past what robodyn does not read,
 MuJoCo's simple bodies, and a URDF's mimic joints as joint equalities.
 
 MuJoCo solves to convergence here (`converged`: Newton, tolerance 1e-15)."""
@@ -252,10 +253,45 @@ def test_spatial_tendon_paths_mujoco_refuses_are_refused():
         load_quietly(None, text)
     with pytest.raises(ValueError):
         mujoco.MjModel.from_xml_string(text)
-    # an actuator on a spatial tendon is not modelled: a warning, no force
-    text = SPATIAL.replace("{cone}", "pyramidal").replace("</mujoco>", '<actuator><motor tendon="cord"/></actuator></mujoco>')
-    model = load_quietly(None, text)
-    assert [w for w in model.warnings if "spatial tendon 'cord'" in w]
+
+
+# Actuators on the spatial tendons above: a motor (gear 2), a position servo (kp, kv), a velocity
+# servo, a general one with a filtered activation and affine gain and bias, and a position servo
+# whose kv MuJoCo's compiler derives from a damping ratio and the inertia the tendon sees at qpos0.
+SPATIAL_ACTUATORS = SPATIAL.replace("</mujoco>", """<actuator>
+    <motor name="reel" tendon="cord" gear="2" ctrlrange="-1 1"/>
+    <position name="winch" tendon="tackle" kp="40" kv="3"/>
+    <velocity name="brake" tendon="inner" kv="5"/>
+    <general name="filtered" tendon="cord" gear="1.5" dyntype="filter" dynprm="0.05"
+             gainprm="3 -1 0.5" biasprm="1 -2 -0.3"/>
+    <position name="ratio" tendon="inner" kp="20" dampratio="0.7"/>
+  </actuator></mujoco>""")
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+def test_actuators_on_spatial_tendons_as_in_mujoco(cone):
+    """Their forces gear Jᵀ f, with l = gear L and l̇ = gear J v moving with the state (the arms on
+    the free box in its own axes), against qfrc_actuator; the solution with them, against
+    mj_forward."""
+    model, mj_model, layout = load_both(SPATIAL_ACTUATORS.replace("{cone}", cone))
+    assert not [w for w in model.warnings if "not modelled" in w], model.warnings
+    rng, d = np.random.default_rng(11), mujoco.MjData(mj_model)
+    states = []
+    for case in range(8):
+        qpos = mj_model.qpos0.copy()
+        mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.4, 1.0)
+        qvel, ctrl, act = rng.normal(size=mj_model.nv), rng.uniform(-2, 2, size=mj_model.nu), rng.normal(size=mj_model.na)
+        d.qpos[:], d.qvel[:], d.ctrl[:], d.act[:] = qpos, qvel, ctrl, act
+        mujoco.mj_forward(mj_model, d)
+        q = layout.q_from_mujoco(qpos)
+        v = layout.v_from_mujoco(q, qvel)
+        tau = model.actuator_forces(q, v, ctrl, act)
+        assert_close(tau, layout.force_from_mujoco(q, d.qfrc_actuator), ROW_AGREEMENT, f"{cone} case {case}")
+        assert_matches_mujoco(model, mj_model, layout, qpos, qvel, ctrl=ctrl, label=f"{cone} case {case}")
+        states.append((q, v, ctrl, act, tau))
+    # a batch is each state's
+    batch = model.actuator_forces(*(np.array([s[k] for s in states]) for k in range(4)))
+    assert_close(batch, np.array([s[4] for s in states]), 0.0, "batch")
 
 
 # --- 8. MuJoCo's simple bodies -------------------------------------------------------------------

@@ -5,6 +5,7 @@ use crate::args::*;
 use crate::model::*;
 use numpy::PyArray2;
 use pyo3::prelude::*;
+use robodyn::soft::tendons::TendonKinematics;
 
 #[pymethods]
 impl PyModel {
@@ -54,9 +55,9 @@ impl PyModel {
     /// The generalised forces (nv,) the actuators exert under the controls `ctrl` (nu,) and the
     /// activations `act` (na,; None: zero) at (q, v): MuJoCo's `qfrc_actuator` — each control
     /// clamped to its range, its actuator's force `(a₀ + a₁ l + a₂ l̇) u + (b₀ + b₁ l + b₂ l̇)`
-    /// (l = gear q_j, or gear L on a fixed tendon; its activation w, or with `actearly` the
-    /// next one, in place of u where it has one) clamped to its force range, times the gear on
-    /// its joint (gear coef on each of its tendon's joints). A batch gives (N, nv).
+    /// (l = gear q_j, or gear L on a tendon; its activation w, or with `actearly` the next one,
+    /// in place of u where it has one) clamped to its force range, times its moment arms: the
+    /// gear on its joint, gear J on a tendon (J = ∂L̇/∂v, fixed or spatial). A batch gives (N, nv).
     #[pyo3(signature = (q, v, ctrl, act=None))]
     fn actuator_forces<'py>(
         &self,
@@ -74,9 +75,13 @@ impl PyModel {
         }
         // without `act`: zero activations
         let zeros = vec![0.0; self.model.na()];
-        self.evaluate(py, &arguments, &[self.model.nv], &|m, _, i, out| {
+        self.evaluate(py, &arguments, &[self.model.nv], &|m, workspace, i, out| {
             let act = i.get(3).copied().unwrap_or(&zeros);
-            m.actuator_forces((i[0], i[1]), i[2], act, out)
+            let tendons = match m.tendons.is_empty() {
+                true => TendonKinematics::default(),
+                false => TendonKinematics::at(m, &mut workspace.data, i[0])?,
+            };
+            m.actuator_forces((i[0], i[1]), (i[2], act), &tendons, out)
         })
     }
 

@@ -2,6 +2,7 @@
 
 use robodyn::algo::frame_pose;
 use robodyn::io::load_mjcf_str;
+use robodyn::soft::tendons::TendonKinematics;
 use robodyn::spatial::Transform;
 use robodyn::{Data, Joint, Model};
 
@@ -357,7 +358,12 @@ fn activation_dynamics_as_mujoco_compiles_and_integrates_them() {
         without.actuators = vec![model.actuators[k].clone()];
         let own = usize::from(model.actuators[k].has_activation());
         without
-            .actuator_forces((&q, &v), &only[k..=k], &w[slot..slot + own], &mut tau)
+            .actuator_forces(
+                (&q, &v),
+                (&only[k..=k], &w[slot..slot + own]),
+                &TendonKinematics::default(),
+                &mut tau,
+            )
             .unwrap();
         tau[0]
     };
@@ -418,7 +424,12 @@ fn actuators_on_hinges_with_gears_and_ranges() {
         ctrl[k] = u;
         let mut tau = [0.0];
         model
-            .actuator_forces((&q, &v), &ctrl, &[], &mut tau)
+            .actuator_forces(
+                (&q, &v),
+                (&ctrl, &[]),
+                &TendonKinematics::default(),
+                &mut tau,
+            )
             .unwrap();
         tau[0]
     };
@@ -431,7 +442,12 @@ fn actuators_on_hinges_with_gears_and_ranges() {
     let general = (1.0 + 2.0 * 0.5 + 3.0 * 0.25) * 2.0;
     assert!((one(3, 2.0) - one(3, 0.0) - general).abs() < 1e-14);
     assert!(model
-        .actuator_forces((&q, &v), &[0.0; 2], &[], &mut tau)
+        .actuator_forces(
+            (&q, &v),
+            (&[0.0; 2], &[]),
+            &TendonKinematics::default(),
+            &mut tau
+        )
         .is_err());
 }
 

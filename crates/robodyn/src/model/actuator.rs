@@ -8,7 +8,9 @@
 //!                                                             gainprm and biasprm, affine)
 //! ```
 //! clamped to `forcerange` when limited, and it adds `g f` to the joint's generalised force, whose
-//! total is clamped to the joint's `actuatorfrcrange` where it has one. A
+//! total is clamped to the joint's `actuatorfrcrange` where it has one. On a tendon of length L
+//! and Jacobian J (fixed or spatial, [`TendonKinematics`]) `l = g L`, `l̇ = g J q̇`, and it adds
+//! `g Jᵀ f`: its moment arms are g J, which move with q on a spatial tendon. A
 //! `motor` has a = (1, 0, 0), b = 0; a `position` a = (k_p, 0, 0), b = (0, −k_p, −k_v); a `velocity`
 //! a = (k_v, 0, 0), b = (0, 0, −k_v). Inputs: q, q̇, the controls (nu), the activations (na).
 //! Cost: O(nu).
@@ -26,7 +28,8 @@
 //! force answers the control within the same step).
 
 use super::Model;
-use crate::error::{check_vector, Result};
+use crate::error::{check_length, check_vector, Result};
+use crate::soft::tendons::TendonKinematics;
 
 /// A below-this time constant is taken as this (MuJoCo's `mjMINVAL`).
 const MIN_TIME_CONSTANT: f64 = 1e-15;
@@ -67,8 +70,8 @@ pub struct Actuator {
     pub coordinate: Option<usize>,
     /// The coordinate of the same joint in q (its length is `gear q`).
     pub position: usize,
-    /// The fixed tendon ([`Model::tendons`]) it pulls on instead of a joint (its length is
-    /// `gear L`).
+    /// The tendon ([`Model::tendons`], fixed or spatial) it pulls on instead of a joint (its
+    /// length is `gear L`).
     #[serde(default)]
     pub tendon: Option<usize>,
     /// g: the moment arm, the length's scale (MJCF `gear[0]`).
@@ -175,35 +178,37 @@ impl Actuator {
 }
 
 impl Model {
-    /// The moment arms of `actuator`: (velocity coordinate, configuration coordinate, ∂l/∂q̇)
-    /// with its length `l = Σ arm q` and `τ = Σ arm f e_k`: `gear` on its joint, `gear c_k` on
-    /// each joint of its tendon; none for an actuator robodyn does not model.
+    /// The moment arms of `actuator`: (velocity coordinate, ∂l/∂q̇) with `τ = Σ arm f e_k`:
+    /// `gear` on its joint, `gear J_k` on its tendon (J from `tendons`, the tendons at the
+    /// state's q); none for an actuator robodyn does not model.
     pub fn actuator_arms<'a>(
         &'a self,
         actuator: &'a Actuator,
-    ) -> impl Iterator<Item = (usize, usize, f64)> + 'a {
-        let joint = actuator
-            .coordinate
-            .map(|c| (c, actuator.position, actuator.gear));
-        let tendon = actuator.tendon.map(|t| &self.tendons[t]);
-        let tendon_arms = tendon
-            .into_iter()
-            .flat_map(move |t| t.entries(self))
-            .map(move |(k, p, c)| (k, p, actuator.gear * c));
+        tendons: &'a TendonKinematics,
+    ) -> impl Iterator<Item = (usize, f64)> + 'a {
+        let joint = actuator.coordinate.map(|c| (c, actuator.gear));
+        let tendon_arms = actuator.tendon.into_iter().flat_map(move |t| {
+            (0..self.nv)
+                .map(move |k| (k, actuator.gear * tendons.jacobian[(t, k)]))
+                .filter(|&(_, arm)| arm != 0.0)
+        });
         joint.into_iter().chain(tendon_arms)
     }
 
-    /// `actuator`'s length l = Σ arm q and its rate l̇ = Σ arm q̇ at (q, q̇).
+    /// `actuator`'s length l and its rate l̇ at (q, q̇): `gear q_j` and `gear q̇_j` on a joint,
+    /// `gear L` and `gear J q̇` on a tendon (`tendons` at q).
     pub fn actuator_length_and_rate(
         &self,
         actuator: &Actuator,
-        q: &[f64],
-        v: &[f64],
+        (q, v): (&[f64], &[f64]),
+        tendons: &TendonKinematics,
     ) -> (f64, f64) {
-        self.actuator_arms(actuator)
-            .fold((0.0, 0.0), |(l, rate), (k, p, arm)| {
-                (l + arm * q[p], rate + arm * v[k])
-            })
+        let g = actuator.gear;
+        match (actuator.coordinate, actuator.tendon) {
+            (Some(c), _) => (g * q[actuator.position], g * v[c]),
+            (None, Some(t)) => (g * tendons.lengths[t], g * tendons.rate(t, v)),
+            (None, None) => (0.0, 0.0),
+        }
     }
 
     /// nu: the number of actuators (of the controls).
@@ -268,26 +273,27 @@ impl Model {
     }
 
     /// The generalised forces (nv) the actuators exert under controls `ctrl` (nu, in the
-    /// order of [`Model::actuators`]) and activations `act` (na) at (q, q̇), into `tau`:
-    /// MuJoCo's `qfrc_actuator`.
+    /// order of [`Model::actuators`]) and activations `act` (na) at (q, q̇), the tendons at q
+    /// `tendons` ([`TendonKinematics::update`]), into `tau`: MuJoCo's `qfrc_actuator`.
     pub fn actuator_forces(
         &self,
         (q, v): (&[f64], &[f64]),
-        ctrl: &[f64],
-        act: &[f64],
+        (ctrl, act): (&[f64], &[f64]),
+        tendons: &TendonKinematics,
         tau: &mut [f64],
     ) -> Result<()> {
         self.check_configuration(q)?;
         check_vector("v", v, self.nv)?;
         check_vector("ctrl", ctrl, self.nu())?;
         check_vector("act", act, self.na())?;
+        check_length("tendons", tendons.lengths.len(), self.tendons.len())?;
         tau.fill(0.0);
         let h = self.options.timestep;
         for (actuator, u, w) in self.actuator_states(ctrl, act) {
             // τ += arm f(l, l̇, input)
-            let (length, rate) = self.actuator_length_and_rate(actuator, q, v);
+            let (length, rate) = self.actuator_length_and_rate(actuator, (q, v), tendons);
             let force = actuator.force_at(length, rate, actuator.input(u, w, h));
-            for (k, _, arm) in self.actuator_arms(actuator) {
+            for (k, arm) in self.actuator_arms(actuator, tendons) {
                 tau[k] += arm * force;
             }
         }

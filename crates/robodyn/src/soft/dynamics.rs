@@ -108,7 +108,8 @@ impl ContactDynamics {
         out.tendons.update(model, q, &x_world);
         // 2. q̈₀ = M⁻¹ (τ + τ_actuator + τ_passive − C q̇ − g), by the articulated-body algorithm
         out.actuator = DVector::zeros(nv);
-        model.actuator_forces((q, v), ctrl, act, out.actuator.as_mut_slice())?;
+        let actuator = out.actuator.as_mut_slice();
+        model.actuator_forces((q, v), (ctrl, act), &out.tendons, actuator)?;
         out.activation_rate = DVector::zeros(act.len());
         model.activation_rates(ctrl, act, out.activation_rate.as_mut_slice())?;
         out.passive = passive_forces(model, q, v, &out.tendons);

@@ -7,15 +7,16 @@
 //! `bias`: a filter activation) and `general` with `dyntype` none, integrator, filter or
 //! filterexact (`dynprm`) and a fixed or affine gain and bias (`gainprm`, `biasprm`,
 //! `inheritrange`), with `actrange`/`actlimited` and `actearly`; on a hinge or slide (`joint`) or
-//! a fixed tendon (`tendon`), `gear`'s first entry its moment arm, with `ctrlrange` and
-//! `forcerange` (`ctrllimited`, `forcelimited`: "auto" limits where a range is given); an
+//! a tendon (`tendon`: fixed, or spatial through sites and pulleys), `gear`'s first entry its
+//! moment arm, with `ctrlrange` and `forcerange` (`ctrllimited`, `forcelimited`: "auto" limits
+//! where a range is given); an
 //! actuator's `damping` and `armature` join its joint's, times gear² (as MuJoCo adds them). A
 //! damping ratio becomes kv as MuJoCo's compiler makes it, from the inertia the transmission
 //! sees at qpos0.
 //!
-//! Any other actuator (muscles, user dynamics, spatial tendon, site or body transmissions, a ball
-//! or free joint) keeps its place in the controls (and its activation, if it has one) but exerts
-//! no force, with a warning naming it. Defaults: a class has one actuator default, whichever
+//! Any other actuator (muscles, user dynamics, a tendon that wraps around a geom, site or body
+//! transmissions, a ball or free joint) keeps its place in the controls (and its activation, if
+//! it has one) but exerts no force, with a warning naming it. Defaults: a class has one actuator default, whichever
 //! element wrote it; what a shortcut inherits from it is in [`super::actuator_defaults`].
 
 use super::actuator_defaults::RawActuator;
@@ -24,6 +25,7 @@ use crate::algo::inverse_mass_matrix;
 use crate::error::Result;
 use crate::io::xml::parse_number_list;
 use crate::model::{ActivationDynamics, Actuator, Model};
+use crate::soft::tendons::TendonKinematics;
 use crate::soft::TINY;
 use crate::Data;
 use nalgebra::DVector;
@@ -32,7 +34,7 @@ use roxmltree::Node;
 /// What robodyn models, for the warning about an actuator it does not.
 const MODELLED: &str = "robodyn models motor, position, intvelocity, velocity, damper, cylinder \
                         and general actuators (dyntype none, integrator, filter, filterexact) on a \
-                        hinge, a slide or a fixed tendon";
+                        hinge, a slide or a tendon";
 
 impl<'a> Reader<'a> {
     /// The elements of the `<actuator>` sections among `sections`, in order, into
@@ -83,6 +85,7 @@ impl<'a> Reader<'a> {
         let mut data = Data::new(model);
         let q = model.neutral_configuration.clone();
         let inverse = inverse_mass_matrix(model, &mut data, q.as_slice())?.clone();
+        let tendons = TendonKinematics::at(model, &mut data, q.as_slice())?;
         let mut moment = DVector::zeros(model.nv);
         for (k, element) in elements.iter().enumerate() {
             let actuator = &model.actuators[k];
@@ -91,14 +94,8 @@ impl<'a> Reader<'a> {
             }
             // the moment arms g
             moment.fill(0.0);
-            match (actuator.coordinate, actuator.tendon) {
-                (Some(c), _) => moment[c] = actuator.gear,
-                (None, Some(t)) => {
-                    for (c, _, coefficient) in model.tendons[t].entries(model) {
-                        moment[c] += actuator.gear * coefficient;
-                    }
-                }
-                (None, None) => continue,
+            for (c, arm) in model.actuator_arms(actuator, &tendons) {
+                moment[c] += arm;
             }
             // m = 1 / (g M⁻¹ gᵀ)
             let inertia = 1.0 / moment.dot(&(&inverse * &moment)).max(TINY);
@@ -216,7 +213,7 @@ impl<'a> Reader<'a> {
             }
         }
 
-        // the transmission: a fixed tendon, or a hinge or slide
+        // the transmission: a tendon, or a hinge or slide
         let range = if let Some(tendon_name) = element.attribute("tendon") {
             let Some(t) = model.tendons.iter().position(|t| t.name == tendon_name) else {
                 if self
@@ -225,14 +222,12 @@ impl<'a> Reader<'a> {
                     .iter()
                     .any(|n| n == tendon_name)
                 {
-                    return unmodelled(actuator, format!("spatial tendon '{tendon_name}'"));
+                    let what = format!("tendon '{tendon_name}' (not read: it wraps around a geom)");
+                    return unmodelled(actuator, what);
                 }
                 let message = format!("attribute 'tendon': no tendon named '{tendon_name}'");
                 return Err(self.error(element, message));
             };
-            if model.tendons[t].is_spatial() {
-                return unmodelled(actuator, format!("spatial tendon '{tendon_name}'"));
-            }
             actuator.tendon = Some(t);
             model.tendons[t].range.map(|(lower, upper)| [lower, upper])
         } else {
