@@ -16,6 +16,7 @@ from conftest import REPOSITORY, assert_close
 from conftest import load_quietly as load
 
 import robodyn
+from robodyn.convert import MujocoLayout
 
 #: MuJoCo's compiler and robodyn place the geoms from the same poses in double precision.
 COMPILER_TOLERANCE = 1e-12
@@ -396,25 +397,31 @@ def test_a_tendon_mujoco_refuses_is_refused_by_name_and_line(change, message):
 
 
 def test_what_tendons_robodyn_does_not_model_are_named():
-    """A spatial tendon wrapping a geom (and an actuator on it), a tendon's armature: a warning
-    each; an invalid range under limited="auto" leaves the tendon unlimited, as in MuJoCo; the
-    actuator on the fixed tendon pulls with gear times its coefficients."""
+    """A tendon's armature: a warning; an invalid range under limited="auto" leaves the tendon
+    unlimited, as in MuJoCo; the actuator on the fixed tendon pulls with gear times its
+    coefficients, the one on the spatial tendon wrapping a cylinder with gear times its J."""
     text = TENDON_ARM.replace('range="0 1"', 'range="1 0" armature="0.1"').replace(
         "</fixed></tendon>", '</fixed><spatial name="string"><site site="s1"/><site site="s2"/></spatial>'
         '<spatial name="wrapped"><site site="s1"/><geom geom="pin"/><site site="s2"/></spatial></tendon>'
     ).replace('<geom size="0.1"/></body></body></body>', '<geom size="0.1"/><site name="s2"/></body></body><site name="s1"/>'
               '<geom name="pin" type="cylinder" size="0.02 0.1" pos="0.2 0 -0.3"/></body>')
     text = text.replace("</actuator>", '<motor name="reel" tendon="wrapped"/></actuator>')
+    mj_model = mujoco.MjModel.from_xml_string(text)
     model = robodyn.load_mjcf_string(text)
     messages = " ".join(model.warnings)
-    assert "<spatial name='wrapped'> (line" in messages and "'armature' not modelled" in messages
-    assert "<motor name='reel'> (line" in messages and "tendon 'wrapped' (not read: it wraps" in messages
-    assert model.tendon_names == ["pull", "string"]
+    assert "'armature' not modelled" in messages and "wrapped" not in messages
+    assert model.tendon_names == ["pull", "string", "wrapped"]
     q = model.neutral()
     q[model.joint_idx_q[model.joint_names.index("hinge")]] = 0.3
     assert_close(model.tendon_lengths(q)[:1], [0.3], 0.0, "L = q_hinge")
-    tau = model.actuator_forces(q, np.zeros(model.nv), [1.0, 1.0])
+    tau = model.actuator_forces(q, np.zeros(model.nv), [1.0, 0.0])
     expected = np.zeros(model.nv)
     expected[model.joint_idx_v[model.joint_names.index("hinge")]] = 3.0
     expected[model.joint_idx_v[model.joint_names.index("slide")]] = -6.0
-    assert_close(tau, expected, 0.0, "gear × coefficients; the wrapped tendon's actuator none")
+    assert_close(tau, expected, 0.0, "gear × coefficients")
+    layout = MujocoLayout(model, mj_model)
+    d = mujoco.MjData(mj_model)
+    d.qpos[:], d.ctrl[:] = layout.q_to_mujoco(q), [1.0, 1.0]
+    mujoco.mj_forward(mj_model, d)
+    tau = model.actuator_forces(q, np.zeros(model.nv), [1.0, 1.0])
+    assert_close(tau, layout.force_from_mujoco(q, d.qfrc_actuator), 1e-12, "and gear × J on the wrapped tendon")

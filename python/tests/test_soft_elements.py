@@ -1,6 +1,6 @@
 """MuJoCo's soft model beyond contacts and joints (`m.contact_forward_dynamics` against `mj_forward`,
 as in test_contact_dynamics.py): equality constraints of every kind robodyn reads, fixed tendons
-(limits, friction, springs, equalities, actuators), spatial tendons through sites and pulleys (and actuators on them),
+(limits, friction, springs, equalities, actuators), spatial tendons through sites and pulleys and around spheres and cylinders (and actuators on them),
 rows' ids past what robodyn does not read,
 MuJoCo's simple bodies, and a URDF's mimic joints as joint equalities.
 
@@ -10,7 +10,7 @@ import mujoco
 import numpy as np
 import pytest
 from conftest import assert_close, load_quietly
-from test_contact_dynamics import ROW_AGREEMENT, assert_matches_mujoco, load_both
+from test_contact_dynamics import ROW_AGREEMENT, assert_entries_close, assert_matches_mujoco, load_both, mujoco_solution
 
 # --- 6. equality constraints ------------------------------------------------------------------
 
@@ -151,7 +151,7 @@ def test_tendon_lengths_as_in_mujoco():
     assert_close(model.tendon_lengths(layout.q_from_mujoco(states[0])), expected[0], ROW_AGREEMENT, "one")
 
 
-SKIPPED_ELEMENTS = """<mujoco><option timestep="0.002"/>
+MIXED_ELEMENTS = """<mujoco><option timestep="0.002"/>
   <worldbody>
     <site name="s0" pos="0 0 1.5"/>
     <geom name="pin" type="cylinder" size=".02 .05" pos=".15 0 1.3" contype="0" conaffinity="0"/>
@@ -172,11 +172,11 @@ SKIPPED_ELEMENTS = """<mujoco><option timestep="0.002"/>
 </mujoco>"""
 
 
-def test_rows_carry_mujocos_ids_past_what_robodyn_does_not_read():
-    """A spatial tendon wrapping a geom (not read) before the fixed ones, and its equality before a joint equality:
-    the rows' ids are still MuJoCo's (tendon 2, equality 1); a tendon whose Jacobian is zero has no
+def test_rows_carry_mujocos_ids_in_the_files_order():
+    """A spatial tendon wrapping a geom before the fixed ones, and its (inactive) equality before a joint
+    equality: the rows' ids are MuJoCo's (tendon 2, equality 1); a tendon whose Jacobian is zero has no
     rows, as in MuJoCo (its friction and its limit within the margin)."""
-    model, mj_model, layout = load_both(SKIPPED_ELEMENTS)
+    model, mj_model, layout = load_both(MIXED_ELEMENTS)
     _, expected = assert_matches_mujoco(model, mj_model, layout, np.array([0.3, -0.2]), np.array([0.4, -1.0]))
     assert expected["row_types"] == ["equality", "friction_tendon", "limit_joint", "limit_tendon"]
     assert list(expected["row_ids"]) == [1, 2, 0, 2]
@@ -292,6 +292,124 @@ def test_actuators_on_spatial_tendons_as_in_mujoco(cone):
     # a batch is each state's
     batch = model.actuator_forces(*(np.array([s[k] for s in states]) for k in range(4)))
     assert_close(batch, np.array([s[4] for s in states]), 0.0, "batch")
+
+
+# Spatial tendons wrapping around spheres and cylinders: a cylinder in the world (a side site
+# outside it) then a sphere on the arm (a side site above it); the same sphere without a side
+# site, on to a free box; a sphere on the free box, then a pulley's branch around the arm's
+# sphere; and (INSIDE, tested on its own) the sphere with a side site inside it, the path
+# pressed against it from within. Each has dry friction, so that its row carries its J.
+WRAPS = """<mujoco><option timestep="0.002" cone="{cone}"/>
+  <default><geom contype="0" conaffinity="0"/><tendon frictionloss="0.1"/></default>
+  <worldbody>
+    <site name="anchor" pos="0 0 1.8"/>
+    <geom name="pin" type="cylinder" size="0.06 0.1" pos="0.05 0 1.55" euler="90 0 0"/>
+    <site name="pin_side" pos="0.2 0 1.55"/>
+    <body name="upper" pos="0 0 1"><joint name="shoulder" axis="0 1 0" damping="0.05"/>
+      <geom type="capsule" fromto="0 0 0 .4 0 0" size=".04"/>
+      <geom name="knob" type="sphere" size="0.07" pos="0.4 0 0"/>
+      <site name="knob_side" pos="0.4 0 0.2"/><site name="knob_in" pos="0.4 0 0.01"/>
+      <site name="s1" pos="0.2 0 0.05"/>
+      <body name="lower" pos=".4 0 0"><joint name="elbow" axis="0 1 0"/>
+        <joint name="reach" type="slide" axis="1 0 0" range="-.1 .2"/>
+        <geom type="capsule" fromto="0 0 0 .3 0 0" size=".03"/>
+        <site name="tip" pos=".3 0 -0.02"/></body></body>
+    <body name="float" pos="0.6 0.1 1.2" euler="0.3 0.2 0.1"><freejoint/><geom type="box" size=".05 .04 .03"/>
+      <geom name="ball" type="sphere" size="0.04" pos="0 0.02 0"/><site name="eye" pos="0 0 -.06"/></body>
+  </worldbody>
+  <tendon>
+    <spatial name="over" range="0.3 1.2" stiffness="20" damping="0.2"><site site="anchor"/>
+      <geom geom="pin" sidesite="pin_side"/><site site="s1"/><geom geom="knob" sidesite="knob_side"/><site site="tip"/></spatial>
+    <spatial name="plain" limited="true" range="0 0.9"><site site="s1"/><geom geom="knob"/><site site="tip"/><site site="eye"/></spatial>
+    <spatial name="tackle"><site site="anchor"/><geom geom="ball"/><site site="eye"/><pulley divisor="2"/>
+      <site site="eye"/><geom geom="knob"/><site site="tip"/></spatial>
+  </tendon>
+  <actuator><position tendon="over" kp="30" kv="1"/><motor tendon="tackle" gear="2"/></actuator>
+</mujoco>"""
+INSIDE = '<spatial name="inside"><site site="s1"/><geom geom="knob" sidesite="knob_in"/><site site="tip"/></spatial>'
+# A path pressed against a sphere from within touches it at the root of an equation robodyn
+# solves to round-off and MuJoCo to |f| <= 1e-6 (its Newton iteration's stop): measured over 400
+# states of WRAPS with INSIDE, J of that tendon differs by up to 6.2e-8 (every other row's by
+# 8e-15); the length, stationary there, by 2e-14.
+INSIDE_WRAP_AGREEMENT = 1e-7
+
+
+def mujoco_wraps(mj_model, d):
+    """The geoms (names) each tendon's path wraps around in MuJoCo's d after mj_fwdPosition."""
+    wraps = []
+    for t in range(mj_model.ntendon):
+        start, count = d.ten_wrapadr[t], d.ten_wrapnum[t]
+        wraps.append({mj_model.geom(int(g)).name for g in d.wrap_obj.ravel()[start:start + count] if g >= 0})
+    return wraps
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+def test_tendons_wrapping_geoms_as_in_mujoco(cone):
+    """Lengths against ten_length, and the friction rows (J), limits, springs, dampers and
+    actuators against mj_forward, at random states where the paths wrap around each geom, the
+    other way round and not at all."""
+    model, mj_model, layout = load_both(WRAPS.replace("{cone}", cone))
+    assert not [w for w in model.warnings if "not read" in w or "not modelled" in w], model.warnings
+    rng, d = np.random.default_rng(12), mujoco.MjData(mj_model)
+    seen = [set() for _ in range(mj_model.ntendon)]
+    for case in range(16):
+        qpos = mj_model.qpos0.copy()
+        mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.5, 1.0)
+        qvel, ctrl = rng.normal(size=mj_model.nv), rng.uniform(-1, 1, size=mj_model.nu)
+        d.qpos[:] = qpos
+        mujoco.mj_fwdPosition(mj_model, d)
+        for t, wrapped in enumerate(mujoco_wraps(mj_model, d)):
+            seen[t].add(frozenset(wrapped))
+        assert_close(model.tendon_lengths(layout.q_from_mujoco(qpos)), d.ten_length, ROW_AGREEMENT, f"case {case}")
+        assert_matches_mujoco(model, mj_model, layout, qpos, qvel, ctrl=ctrl, label=f"{cone} case {case}")
+    # each path wrapped and went straight
+    assert seen[0] >= {frozenset({"pin", "knob"})}, seen[0]
+    for t in range(1, 3):
+        assert len(seen[t]) >= 2, (t, seen[t])
+
+
+def test_a_side_site_inside_the_geom_presses_the_path_against_it():
+    """The path from within: its length as ten_length (round-off), its friction row's J to
+    INSIDE_WRAP_AGREEMENT, at states where it touches and where it passes straight through."""
+    model, mj_model, layout = load_both(WRAPS.replace("{cone}", "pyramidal").replace("</tendon>", INSIDE + "</tendon>"))
+    rng, d, touched = np.random.default_rng(12), mujoco.MjData(mj_model), set()
+    for case in range(24):
+        qpos = mj_model.qpos0.copy()
+        mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.5, 1.0)
+        d.qpos[:] = qpos
+        mujoco.mj_fwdPosition(mj_model, d)
+        touched.add(bool(mujoco_wraps(mj_model, d)[3]))
+        assert_close(model.tendon_lengths(layout.q_from_mujoco(qpos)), d.ten_length, ROW_AGREEMENT, f"case {case}")
+        q, v, expected = mujoco_solution(mj_model, layout, qpos, np.zeros(mj_model.nv))
+        ours = model.contact_forward_dynamics(q, v)
+        assert list(ours["row_types"]) == expected["row_types"] and list(ours["row_ids"]) == list(expected["row_ids"])
+        rows = [i for i, (kind, t) in enumerate(zip(ours["row_types"], ours["row_ids"])) if kind == "friction_tendon" and t == 3]
+        others = [i for i in range(len(ours["row_types"])) if i not in rows]
+        jacobian = np.asarray(ours["jacobian"])
+        assert_entries_close(jacobian[rows], expected["jacobian"][rows], INSIDE_WRAP_AGREEMENT, f"case {case}")
+        assert_entries_close(jacobian[others], expected["jacobian"][others], ROW_AGREEMENT, f"case {case}")
+    assert touched == {True, False}
+
+
+def test_wrapping_paths_mujoco_refuses_are_refused():
+    for path, message in [
+        ('<geom geom="pin"/><site site="anchor"/><site site="tip"/>', "a site on either side"),
+        ('<site site="anchor"/><geom geom="pin"/><geom geom="knob"/><site site="tip"/>', "a site on either side"),
+        ('<site site="anchor"/><geom geom="nowhere"/><site site="tip"/>', "no geom named 'nowhere'"),
+        ('<site site="anchor"/><geom geom="pin" sidesite="nowhere"/><site site="tip"/>', "no site named 'nowhere'"),
+        ('<site site="anchor"/><geom geom="box"/><site site="tip"/>', "neither"),
+    ]:
+        text = WRAPS.replace("{cone}", "pyramidal").replace('<geom type="box"', '<geom name="box" type="box"')
+        text = text.replace("</tendon>", f'<spatial name="bad">{path}</spatial></tendon>')
+        with pytest.raises(ValueError, match=message):
+            load_quietly(None, text)
+        with pytest.raises(ValueError):
+            mujoco.MjModel.from_xml_string(text)
+    text = WRAPS.replace("{cone}", "pyramidal").replace('<spatial name="plain"', '<spatial name="plain" armature="0.1"')
+    with pytest.raises(ValueError, match="'armature'"):
+        load_quietly(None, text)
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_string(text)
 
 
 # --- 8. MuJoCo's simple bodies -------------------------------------------------------------------

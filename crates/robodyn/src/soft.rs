@@ -35,6 +35,7 @@ pub mod solver;
 pub mod step;
 pub mod tendons;
 pub mod weights;
+pub mod wrap;
 
 use crate::model::{ContactPair, Geom, Model, SolverParameters};
 

@@ -186,7 +186,6 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         }]),
         site_bodies: RefCell::new(HashMap::new()),
         site_points: RefCell::new(HashMap::new()),
-        unread_tendons: RefCell::new(Vec::new()),
     };
     if !root.has_tag_name("mujoco") {
         return Err(reader.error(root, "expected the root element <mujoco>"));
@@ -332,8 +331,6 @@ struct Reader<'a> {
     site_bodies: RefCell<HashMap<String, usize>>,
     /// each site's body in the model and its position in that body's frame
     site_points: RefCell<HashMap<String, (usize, Vec3)>>,
-    /// the names of the tendons not read (spatial ones)
-    unread_tendons: RefCell<Vec<String>>,
 }
 
 impl<'a> Reader<'a> {

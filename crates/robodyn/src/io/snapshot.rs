@@ -163,6 +163,7 @@ fn check_structure(model: &Model) -> Result<()> {
         .chain(model.tendons.iter().flat_map(|t| {
             let sites = t.path.iter().filter_map(|p| match p {
                 crate::model::PathPoint::Site { body, .. } => Some(*body),
+                crate::model::PathPoint::Geom { side, .. } => side.map(|(body, _)| body),
                 crate::model::PathPoint::Pulley { .. } => None,
             });
             t.joints.iter().map(|(body, _)| *body).chain(sites)
@@ -176,6 +177,25 @@ fn check_structure(model: &Model) -> Result<()> {
         return damaged(
             "a frame, visual, mimic, tendon or coordinate refers to a missing one".into(),
         );
+    }
+    // a tendon wraps around a sphere or a cylinder of the model
+    let wraps_around = |geom: &usize| {
+        model.geoms.get(*geom).is_some_and(|g| {
+            matches!(
+                g.shape,
+                crate::visual::Shape::Sphere { .. } | crate::visual::Shape::Cylinder { .. }
+            )
+        })
+    };
+    let wrapped = model.tendons.iter().flat_map(|t| &t.path);
+    if wrapped
+        .filter_map(|p| match p {
+            crate::model::PathPoint::Geom { geom, .. } => Some(geom),
+            _ => None,
+        })
+        .any(|geom| !wraps_around(geom))
+    {
+        return damaged("a tendon wraps around a geom that is not a sphere or cylinder".into());
     }
     // a range the clamps use must be ordered (a loader never makes another)
     let ordered = |range: &Option<(f64, f64)>| range.is_none_or(|(low, high)| low <= high);

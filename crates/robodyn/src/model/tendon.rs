@@ -3,8 +3,8 @@
 //! ```text
 //!   L = Σ_k c_k q_k,   L̇ = J q̇,   J = Σ_k c_k e_k
 //! ```
-//! a spatial one (`<tendon><spatial>` through sites, and pulleys) the length of its path through
-//! the sites, which moves with the bodies ([`crate::soft::tendons`] computes both at a state:
+//! a spatial one (`<tendon><spatial>` through sites, pulleys, and around spheres and cylinders)
+//! the length of its path through the sites, which moves with the bodies ([`crate::soft::tendons`] computes both at a state:
 //! MuJoCo's `ten_length`, `ten_J`). What MuJoCo hangs on it: a spring and a damper on L (its
 //! `stiffness` outside the dead band `springlength` and `damping`), dry friction and limits as
 //! constraint rows, equalities coupling two lengths, and actuators pulling on it.
@@ -21,6 +21,16 @@ pub enum PathPoint {
         body: usize,
         /// Its position in that body's frame.
         point: Vec3,
+    },
+    /// A sphere or cylinder the path wraps around between the sites on either side of it
+    /// (the shortest path over its surface where the straight one would pass through it).
+    Geom {
+        /// The geom ([`Model::geoms`]): a sphere or a cylinder.
+        geom: usize,
+        /// A side site (`sidesite`: its body, its position in that body's frame): of the two
+        /// ways around, the one on its side; inside the geom, the path is pressed against the
+        /// surface from within.
+        side: Option<(usize, Vec3)>,
     },
     /// A pulley: the branch after it counts its length divided by `divisor`.
     Pulley {
@@ -122,7 +132,8 @@ pub struct TendonEquality {
 /// its kind that robodyn reads come before it in the file.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct UnreadElements {
-    /// Tendons (spatial ones) among [`Model::tendons`].
+    /// Tendons among [`Model::tendons`] (none since robodyn reads every spatial path; kept for
+    /// snapshots written before).
     pub tendons: Vec<usize>,
     /// Equalities (flex ones, those of unread tendons) among the file's read equalities
     /// ([`Model::constraints`] and [`Model::tendon_equalities`] together, in the file's order).

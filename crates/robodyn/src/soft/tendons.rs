@@ -14,13 +14,19 @@
 //! with u_i = (p_{i+1} − p_i) / |p_{i+1} − p_i| and J_p the Jacobian of the point p (its velocity
 //! over q̇, in robodyn's coordinates); a segment between two sites of one body adds no J, a
 //! vanishing one (shorter than 1e-15, MuJoCo's `mjMINVAL`) takes the x axis for u_i, as MuJoCo.
+//! Between two sites, a sphere or cylinder that the path wraps around ([`super::wrap`]) adds
+//! two points t₀, t₁ on its surface: the pieces p_i → t₀ and t₁ → p_{i+1} count as segments
+//! (t₀, t₁ moving with the geom's body), and the path over the surface adds its length to L
+//! but nothing to J (the geodesic's length is stationary as its ends slide on the surface).
 
 use super::weights::{point_columns, world_point};
+use super::wrap::{wrap, Surface, Wrap};
 use super::TINY;
 use crate::algo::forward_kinematics;
 use crate::error::Result;
 use crate::model::{Model, PathPoint, Tendon};
 use crate::spatial::{Transform, Vec3};
+use crate::visual::Shape;
 use crate::Data;
 use nalgebra::DMatrix;
 
@@ -69,6 +75,7 @@ impl TendonKinematics {
     fn spatial(&mut self, model: &Model, t: usize, tendon: &Tendon, x_world: &[Transform]) -> f64 {
         let (mut length, mut divisor) = (0.0, 1.0);
         let mut previous: Option<(usize, Vec3)> = None;
+        let mut around: Option<(usize, Option<(usize, Vec3)>)> = None;
         for point in &tendon.path {
             let (body, p) = match point {
                 PathPoint::Pulley { divisor: d } => {
@@ -77,32 +84,64 @@ impl TendonKinematics {
                     previous = None;
                     continue;
                 }
+                PathPoint::Geom { geom, side } => {
+                    around = Some((*geom, *side));
+                    continue;
+                }
                 PathPoint::Site { body, point } => (*body, world_point(&x_world[*body], point)),
             };
-            if let Some((from_body, from)) = previous {
-                // |p_{i+1} − p_i| / d, and u_iᵀ (J_{p_{i+1}} − J_{p_i}) / d
-                let segment = p - from;
-                let norm = segment.norm();
-                length += norm / divisor;
-                if from_body != body {
-                    // MuJoCo's direction of a vanishing segment: the x axis
-                    let u = if norm < TINY {
-                        Vec3::x()
-                    } else {
-                        segment / norm
-                    } / divisor;
-                    let mut row = self.jacobian.row_mut(t);
-                    point_columns(model, x_world, body, &p, |k, linear, _| {
-                        row[k] += u.dot(linear)
-                    });
-                    point_columns(model, x_world, from_body, &from, |k, linear, _| {
-                        row[k] -= u.dot(linear)
-                    });
+            if let Some(from) = previous {
+                let wrapped = around
+                    .take()
+                    .and_then(|(geom, side)| wrap_around(model, x_world, geom, side, from.1, p));
+                match wrapped {
+                    // p_i → t₀, over the surface, t₁ → p_{i+1}; t₀ and t₁ move with the geom
+                    Some((geom_body, wrap)) => {
+                        let [t0, t1] = wrap.points;
+                        length += ((t0 - from.1).norm() + wrap.arc + (p - t1).norm()) / divisor;
+                        self.add_segment(model, x_world, t, (from, (geom_body, t0)), divisor);
+                        self.add_segment(model, x_world, t, ((geom_body, t1), (body, p)), divisor);
+                    }
+                    // the straight segment
+                    None => {
+                        length += (p - from.1).norm() / divisor;
+                        self.add_segment(model, x_world, t, (from, (body, p)), divisor);
+                    }
                 }
             }
             previous = Some((body, p));
         }
         length
+    }
+
+    /// Adds a straight piece's `u_iᵀ (J_{p_{i+1}} − J_{p_i}) / d` to row `t` (nothing between two
+    /// points of one body).
+    fn add_segment(
+        &mut self,
+        model: &Model,
+        x_world: &[Transform],
+        t: usize,
+        ((from_body, from), (body, p)): ((usize, Vec3), (usize, Vec3)),
+        divisor: f64,
+    ) {
+        if from_body == body {
+            return;
+        }
+        let segment = p - from;
+        let norm = segment.norm();
+        // MuJoCo's direction of a vanishing segment: the x axis
+        let u = if norm < TINY {
+            Vec3::x()
+        } else {
+            segment / norm
+        } / divisor;
+        let mut row = self.jacobian.row_mut(t);
+        point_columns(model, x_world, body, &p, |k, linear, _| {
+            row[k] += u.dot(linear)
+        });
+        point_columns(model, x_world, from_body, &from, |k, linear, _| {
+            row[k] -= u.dot(linear)
+        });
     }
 
     /// L̇ of tendon `t` at the velocity v: `J_t v`.
@@ -116,6 +155,30 @@ impl TendonKinematics {
             *entry += scale * j;
         }
     }
+}
+
+/// The wrap of the path from `from` to `to` around geom `geom` (a sphere or a cylinder), its
+/// side site `side` (body, position in its frame): the geom's body and the [`Wrap`]; `None`
+/// where the path stays straight.
+fn wrap_around(
+    model: &Model,
+    x_world: &[Transform],
+    geom: usize,
+    side: Option<(usize, Vec3)>,
+    from: Vec3,
+    to: Vec3,
+) -> Option<(usize, Wrap)> {
+    let geom = &model.geoms[geom];
+    let surface = match geom.shape {
+        Shape::Sphere { radius } => Surface::Sphere(radius),
+        Shape::Cylinder { radius, .. } => Surface::Cylinder(radius),
+        _ => return None,
+    };
+    // X_{geom←0} = X_{geom←body} X_{body←0}: its axes and origin in the world
+    let x = geom.placement * x_world[geom.body];
+    let side = side.map(|(body, point)| world_point(&x_world[body], &point));
+    let frame = (&x.rotation.transpose(), &x.translation);
+    wrap((&from, &to), frame, surface, side.as_ref()).map(|w| (geom.body, w))
 }
 
 #[cfg(test)]

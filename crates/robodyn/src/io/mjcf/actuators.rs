@@ -14,8 +14,7 @@
 //! damping ratio becomes kv as MuJoCo's compiler makes it, from the inertia the transmission
 //! sees at qpos0.
 //!
-//! Any other actuator (muscles, user dynamics, a tendon that wraps around a geom, site or body
-//! transmissions, a ball or free joint) keeps its place in the controls (and its activation, if
+//! Any other actuator (muscles, user dynamics, site or body transmissions, a ball or free joint) keeps its place in the controls (and its activation, if
 //! it has one) but exerts no force, with a warning naming it. Defaults: a class has one actuator default, whichever
 //! element wrote it; what a shortcut inherits from it is in [`super::actuator_defaults`].
 
@@ -216,15 +215,6 @@ impl<'a> Reader<'a> {
         // the transmission: a tendon, or a hinge or slide
         let range = if let Some(tendon_name) = element.attribute("tendon") {
             let Some(t) = model.tendons.iter().position(|t| t.name == tendon_name) else {
-                if self
-                    .unread_tendons
-                    .borrow()
-                    .iter()
-                    .any(|n| n == tendon_name)
-                {
-                    let what = format!("tendon '{tendon_name}' (not read: it wraps around a geom)");
-                    return unmodelled(actuator, what);
-                }
                 let message = format!("attribute 'tendon': no tendon named '{tendon_name}'");
                 return Err(self.error(element, message));
             };

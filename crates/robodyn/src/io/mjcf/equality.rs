@@ -56,10 +56,8 @@ impl<'a> Reader<'a> {
                     "weld" => self.weld(element, model, &mut data)?,
                     "joint" => self.joint_equality(element, model)?,
                     "tendon" => {
-                        match self.tendon_equality(element, model)? {
-                            Some(equality) => model.tendon_equalities.push(equality),
-                            None => read_none(model),
-                        }
+                        let equality = self.tendon_equality(element, model)?;
+                        model.tendon_equalities.push(equality);
                         continue;
                     }
                     _ => {
@@ -297,52 +295,35 @@ impl<'a> Reader<'a> {
     }
 
     /// A tendon equality: tendon1's length a polynomial of tendon2's about their lengths at
-    /// qpos0; `None` (warned) when it names a tendon that is not read.
-    fn tendon_equality(
-        &self,
-        element: Node<'a, 'a>,
-        model: &mut Model,
-    ) -> Result<Option<TendonEquality>> {
-        let tendon = |attribute: &str| -> Result<Option<std::result::Result<usize, String>>> {
+    /// qpos0.
+    fn tendon_equality(&self, element: Node<'a, 'a>, model: &mut Model) -> Result<TendonEquality> {
+        let tendon = |attribute: &str| -> Result<Option<usize>> {
             let Some(name) = element.attribute(attribute) else {
                 return Ok(None);
             };
-            if let Some(t) = model.tendons.iter().position(|t| t.name == name) {
-                return Ok(Some(Ok(t)));
-            }
-            if self.unread_tendons.borrow().iter().any(|n| n == name) {
-                return Ok(Some(Err(name.to_string())));
-            }
-            let message = format!("attribute '{attribute}': no tendon is called '{name}'");
-            Err(self.error(element, message))
+            let found = model.tendons.iter().position(|t| t.name == name);
+            let message = || format!("attribute '{attribute}': no tendon is called '{name}'");
+            found
+                .map(Some)
+                .ok_or_else(|| self.error(element, message()))
         };
         let first = tendon("tendon1")?
             .ok_or_else(|| self.error(element, "expected attribute 'tendon1'"))?;
-        let second = tendon("tendon2")?.transpose();
-        let (first, second) = match (first, second) {
-            (Ok(first), Ok(second)) => (first, second),
-            (Err(name), _) | (_, Err(name)) => {
-                model.warnings.push(format!(
-                    "{}: not read (spatial tendon '{name}' is not read)",
-                    self.location(element)
-                ));
-                return Ok(None);
-            }
-        };
+        let second = tendon("tendon2")?;
         let (active, solver) = self.activity_and_softness(element)?;
         model.warnings.push(format!(
             "{}: held by MuJoCo's soft model only (contact_forward_dynamics, step, simulate with \
              integrator=\"mujoco\"), not by robodyn's exact constraints",
             self.location(element)
         ));
-        Ok(Some(TendonEquality {
+        Ok(TendonEquality {
             name: element.attribute("name").unwrap_or_default().to_string(),
             tendons: (first, second),
             polynomial: self.polynomial(element)?,
             active,
             solver,
             before: model.constraints.len(),
-        }))
+        })
     }
 
     /// A joint or tendon equality's `polycoef` (MuJoCo's default: the identity, 0 1 0 0 0).

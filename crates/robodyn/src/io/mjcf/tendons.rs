@@ -3,9 +3,9 @@
 //! (<https://mujoco.readthedocs.io/en/stable/XMLreference.html#tendon>).
 //!
 //! A fixed tendon's `<joint joint coef>` children (hinges and slides, each once) give its length
-//! `L = Σ coef q`; a spatial tendon's `<site site>` and `<pulley divisor>` children its path
-//! (from a site to a site; a pulley starts a branch at a site). A spatial tendon that wraps
-//! around a `<geom>` is not read (a warning). Either kind's `limited` ("auto": where `range` is a
+//! `L = Σ coef q`; a spatial tendon's `<site site>`, `<geom geom sidesite>` and `<pulley divisor>`
+//! children its path (from a site to a site; a geom, a sphere or a cylinder, between two sites;
+//! a pulley starts a branch at a site). Either kind's `limited` ("auto": where `range` is a
 //! valid range), `range`, `margin`, `solreflimit`/`solimplimit`, `frictionloss`,
 //! `solreffriction`/`solimpfriction`, `stiffness` and `damping` (their first value),
 //! `springlength` (one value, a dead band of two, or the length at the joints' `springref` when
@@ -19,6 +19,8 @@ use crate::error::Result;
 use crate::io::xml::parse_number_list;
 use crate::model::{Model, PathPoint, SolverParameters, Tendon, DEFAULT_SOLIMP, DEFAULT_SOLREF};
 use crate::soft::tendons::TendonKinematics;
+use crate::spatial::Vec3;
+use crate::visual::Shape;
 use crate::Data;
 use roxmltree::Node;
 
@@ -29,8 +31,8 @@ type TendonShape = (Vec<(usize, f64)>, Vec<PathPoint>);
 const UNGIVEN_SPRING_LENGTH: [f64; 2] = [-1.0, -1.0];
 
 /// What robodyn models, for the warnings about the rest.
-const MODELLED: &str = "robodyn models fixed tendons and spatial ones through sites and pulleys, \
-                        with a linear spring and damper";
+const MODELLED: &str = "robodyn models fixed tendons and spatial ones (sites, pulleys, spheres \
+                        and cylinders), with a linear spring and damper";
 
 impl<'a> Reader<'a> {
     /// The `<fixed>` and `<spatial>` elements of the `<tendon>` sections among `sections`, in
@@ -39,20 +41,9 @@ impl<'a> Reader<'a> {
         let first = model.tendons.len();
         for section in sections.iter().filter(|c| c.has_tag_name("tendon")) {
             for element in self.children(*section)? {
-                let read = match element.tag_name().name() {
-                    "fixed" => Some(self.fixed_path(element, model)?),
-                    _ => self.spatial_path(element)?,
-                };
-                let Some((joints, path)) = read else {
-                    let name = element.attribute("name").unwrap_or_default().to_string();
-                    self.unread_tendons.borrow_mut().push(name);
-                    model.unread.tendons.push(model.tendons.len());
-                    model.warnings.push(format!(
-                        "{}: not read (its path wraps around a geom; {MODELLED}): its limits, \
-                         friction, equalities and actuators are left out",
-                        self.location(element)
-                    ));
-                    continue;
+                let (joints, path) = match element.tag_name().name() {
+                    "fixed" => self.fixed_path(element, model)?,
+                    _ => self.spatial_path(element, model)?,
                 };
                 let tendon = self.tendon(element, model, joints, path)?;
                 model.tendons.push(tendon);
@@ -104,20 +95,36 @@ impl<'a> Reader<'a> {
         Ok((joints, Vec::new()))
     }
 
-    /// A `<spatial>` element's path: its sites and pulleys; `None` where it wraps around a geom.
-    /// Refused as MuJoCo refuses them: fewer than two stops, consecutive pulleys, a pulley last,
-    /// a site between pulleys (or the path's ends), a site repeated next to itself.
-    fn spatial_path(&self, element: Node<'a, 'a>) -> Result<Option<TendonShape>> {
+    /// A `<spatial>` element's path: its sites, the spheres and cylinders it wraps around (with
+    /// their side sites) and its pulleys. Refused as MuJoCo refuses them: fewer than two stops,
+    /// consecutive pulleys, a pulley last, a site between pulleys (or the path's ends), a site
+    /// repeated next to itself, a geom not between two sites or neither a sphere nor a cylinder.
+    fn spatial_path(&self, element: Node<'a, 'a>, model: &Model) -> Result<TendonShape> {
         let children = self.children(element)?;
         let mut path = Vec::new();
+        let site = |child: Node<'a, 'a>, attribute: &str| -> Result<(usize, Vec3)> {
+            let name = child.attribute(attribute).unwrap_or_default();
+            let found = self.site_points.borrow().get(name).copied();
+            found.ok_or_else(|| {
+                self.error(
+                    child,
+                    format!("attribute '{attribute}': no site named '{name}'"),
+                )
+            })
+        };
         for child in &children {
             match child.tag_name().name() {
                 "site" => {
-                    let name = child.attribute("site").unwrap_or_default();
-                    let (body, point) = *self.site_points.borrow().get(name).ok_or_else(|| {
-                        self.error(*child, format!("attribute 'site': no site named '{name}'"))
-                    })?;
+                    let (body, point) = site(*child, "site")?;
                     path.push(PathPoint::Site { body, point });
+                }
+                "geom" => {
+                    let geom = self.wrapped_geom(*child, model)?;
+                    let side = match child.attribute("sidesite") {
+                        Some(_) => Some(site(*child, "sidesite")?),
+                        None => None,
+                    };
+                    path.push(PathPoint::Geom { geom, side });
                 }
                 "pulley" => {
                     let divisor = child
@@ -132,7 +139,10 @@ impl<'a> Reader<'a> {
                     }
                     path.push(PathPoint::Pulley { divisor });
                 }
-                _ => return Ok(None),
+                other => {
+                    let message = format!("expected <site>, <geom> or <pulley>, got <{other}>");
+                    return Err(self.error(*child, message));
+                }
             }
         }
         if path.len() < 2 {
@@ -142,6 +152,10 @@ impl<'a> Reader<'a> {
         let pulley = |k: Option<usize>| {
             k.and_then(|k| path.get(k))
                 .is_none_or(|p| matches!(p, PathPoint::Pulley { .. }))
+        };
+        let site_at = |k: Option<usize>| {
+            k.and_then(|k| path.get(k))
+                .is_some_and(|p| matches!(p, PathPoint::Site { .. }))
         };
         for (k, (point, child)) in path.iter().zip(&children).enumerate() {
             let message = match point {
@@ -158,11 +172,33 @@ impl<'a> Reader<'a> {
                 {
                     "a site is repeated next to itself"
                 }
+                PathPoint::Geom { .. } if !(site_at(k.checked_sub(1)) && site_at(Some(k + 1))) => {
+                    "a geom must have a site on either side of it"
+                }
                 _ => continue,
             };
             return Err(self.error(*child, message));
         }
-        Ok(Some((Vec::new(), path)))
+        Ok((Vec::new(), path))
+    }
+
+    /// The geom a `<geom geom>` stop of a path names: a sphere or a cylinder of the model.
+    fn wrapped_geom(&self, child: Node<'a, 'a>, model: &Model) -> Result<usize> {
+        let name = child.attribute("geom").unwrap_or_default();
+        let geom = model.geoms.iter().position(|g| g.name == name);
+        let geom = geom.ok_or_else(|| {
+            self.error(child, format!("attribute 'geom': no geom named '{name}'"))
+        })?;
+        match model.geoms[geom].shape {
+            Shape::Sphere { .. } | Shape::Cylinder { .. } => Ok(geom),
+            _ => {
+                let message = format!(
+                    "attribute 'geom': a tendon wraps around a sphere or a cylinder, '{name}' is \
+                     neither"
+                );
+                Err(self.error(child, message))
+            }
+        }
     }
 
     /// A tendon element (fixed or spatial) on its joints or path.
@@ -194,6 +230,12 @@ impl<'a> Reader<'a> {
         let width = first("width", 0.003)?;
         if !path.is_empty() && width <= 0.0 {
             let message = format!("attribute 'width': expected a positive width, got {width}");
+            return Err(self.error(element, message));
+        }
+        // MuJoCo has no armature for a path that wraps around a geom
+        let wraps = path.iter().any(|p| matches!(p, PathPoint::Geom { .. }));
+        if wraps && first("armature", 0.0)? > 0.0 {
+            let message = "attribute 'armature': a tendon that wraps around a geom has none";
             return Err(self.error(element, message));
         }
         // what is not modelled: warned
