@@ -10,8 +10,8 @@
 //! clamped to `forcerange` when limited, and it adds `g f` to the joint's generalised force, whose
 //! total is clamped to the joint's `actuatorfrcrange` where it has one. On a tendon of length L
 //! and Jacobian J (fixed or spatial, [`TendonKinematics`]) `l = g L`, `l̇ = g J q̇`, and it adds
-//! `g Jᵀ f`: its moment arms are g J, which move with q on a spatial tendon. A
-//! `motor` has a = (1, 0, 0), b = 0; a `position` a = (k_p, 0, 0), b = (0, −k_p, −k_v); a `velocity`
+//! `g Jᵀ f`: its moment arms are g J, which move with q on a spatial tendon. A `motor` has
+//! a = (1, 0, 0), b = 0; a `position` a = (k_p, 0, 0), b = (0, −k_p, −k_v); a `velocity`
 //! a = (k_v, 0, 0), b = (0, 0, −k_v). Inputs: q, q̇, the controls (nu), the activations (na).
 //! Cost: O(nu).
 //!

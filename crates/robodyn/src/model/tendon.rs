@@ -4,8 +4,8 @@
 //!   L = Σ_k c_k q_k,   L̇ = J q̇,   J = Σ_k c_k e_k
 //! ```
 //! a spatial one (`<tendon><spatial>` through sites, pulleys, and around spheres and cylinders)
-//! the length of its path through the sites, which moves with the bodies ([`crate::soft::tendons`] computes both at a state:
-//! MuJoCo's `ten_length`, `ten_J`). What MuJoCo hangs on it: a spring and a damper on L (its
+//! the length of its path through the sites, which moves with the bodies
+//! ([`crate::soft::tendons`] computes both at a state: MuJoCo's `ten_length`, `ten_J`). What MuJoCo hangs on it: a spring and a damper on L (its
 //! `stiffness` outside the dead band `springlength` and `damping`), dry friction and limits as
 //! constraint rows, equalities coupling two lengths, and actuators pulling on it.
 
