@@ -49,17 +49,22 @@ anchor = np.array([-0.3, -0.1])
 tips = np.stack([0.3 + 0.4 * np.cos(angles), -0.4 * np.sin(angles)], axis=1)  # (x, z) about the pulley
 
 
-def tangent_angles(p, q):
+def reach(e: np.ndarray) -> float:
+    """The angle between an end's direction and its tangent point: acos(r/|e|)."""
+    return float(np.arccos(RADIUS / np.linalg.norm(e)))
+
+
+def tangent_angles(p: np.ndarray, q: np.ndarray) -> tuple[float, float]:
     """The angles of the tangent points of a cord from p over the top of the circle to q."""
     # the ends' directions: p's in [0, 2π) (left of the pulley), q's in (−π, π] (right of it)
-    reach = lambda e: np.arccos(RADIUS / np.linalg.norm(e))
-    return np.mod(np.arctan2(p[1], p[0]), 2 * np.pi) - reach(p), np.arctan2(q[1], q[0]) + reach(q)
+    from_p = float(np.mod(np.arctan2(p[1], p[0]), 2 * np.pi)) - reach(p)
+    return from_p, float(np.arctan2(q[1], q[0])) + reach(q)
 
 
-def over_the_top(p, q):
+def over_the_top(p: np.ndarray, q: np.ndarray) -> float:
     """Straight pieces and arc of a cord from p over the top of the circle to q (both outside)."""
     from_p, to_q = tangent_angles(p, q)
-    pieces = np.sqrt(p @ p - RADIUS**2) + np.sqrt(q @ q - RADIUS**2)
+    pieces = float(np.sqrt(p @ p - RADIUS**2) + np.sqrt(q @ q - RADIUS**2))
     return pieces + RADIUS * (from_p - to_q)
 
 
