@@ -23,7 +23,7 @@ from test_contact_dynamics import (
     without_unmodelled,
 )
 from test_menagerie import MENAGERIE, mujoco_model
-from test_soft_elements import EQUALITIES, SPATIAL, SPATIAL_ACTUATORS, TENDONS, WRAPS
+from test_soft_elements import EQUALITIES, SPATIAL, SPATIAL_ACTUATORS, TENDON_FORCE_RANGES, TENDONS, WRAPS
 
 STEPS = 100
 # 100 steps without elliptic friction: the same arithmetic in another order; measured up to 1.1e-12
@@ -176,6 +176,18 @@ def test_actuators_on_spatial_tendons_step_as_in_mujoco(integrator):
     mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.3, 1.0)
     assert_steps_like_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv),
                              ctrl=[0.4, 0.7, 0.2, 1.1, 0.3], label=integrator)
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+def test_tendon_actuator_force_ranges_step_as_in_mujoco(integrator):
+    """test_soft_elements's tendon actuators bounded by their tendons' actuatorfrcrange through 100
+    steps; implicitfast leaves out of K the actuators whose final force sits on its forcerange."""
+    model, mj_model, layout = load_both(text=with_integrator(TENDON_FORCE_RANGES.replace("{cone}", "pyramidal"), integrator))
+    rng = np.random.default_rng(6)
+    qpos = mj_model.qpos0.copy()
+    mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.3, 1.0)
+    assert_steps_like_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv),
+                             ctrl=[0.9, 1.7, -1.2, 1.6, 0.9], label=integrator)
 
 
 @pytest.mark.parametrize("integrator", INTEGRATORS)

@@ -1,6 +1,7 @@
 """MuJoCo's soft model beyond contacts and joints (`m.contact_forward_dynamics` against `mj_forward`,
 as in test_contact_dynamics.py): equality constraints of every kind robodyn reads, fixed tendons
-(limits, friction, springs, equalities, actuators), spatial tendons through sites and pulleys and around spheres and cylinders (and actuators on them),
+(limits, friction, springs, equalities, actuators), spatial tendons through sites and pulleys and around spheres and cylinders (and actuators on them,
+their forces bounded together by a tendon's actuatorfrcrange),
 rows' ids past what robodyn does not read,
 MuJoCo's simple bodies, and a URDF's mimic joints as joint equalities.
 
@@ -268,16 +269,12 @@ SPATIAL_ACTUATORS = SPATIAL.replace("</mujoco>", """<actuator>
   </actuator></mujoco>""")
 
 
-@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
-def test_actuators_on_spatial_tendons_as_in_mujoco(cone):
-    """Their forces gear Jᵀ f, with l = gear L and l̇ = gear J v moving with the state (the arms on
-    the free box in its own axes), against qfrc_actuator; the solution with them, against
-    mj_forward."""
-    model, mj_model, layout = load_both(SPATIAL_ACTUATORS.replace("{cone}", cone))
-    assert not [w for w in model.warnings if "not modelled" in w], model.warnings
-    rng, d = np.random.default_rng(11), mujoco.MjData(mj_model)
-    states = []
-    for case in range(8):
+def actuated_states_as_in_mujoco(loaded, rng, cases, cone):
+    """(q, v, ctrl, act, τ) at `cases` random states and controls of a model with actuators, τ its
+    m.actuator_forces, each checked against qfrc_actuator and its solution against mj_forward."""
+    model, mj_model, layout = loaded
+    d = mujoco.MjData(mj_model)
+    for case in range(cases):
         qpos = mj_model.qpos0.copy()
         mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.4, 1.0)
         qvel, ctrl, act = rng.normal(size=mj_model.nv), rng.uniform(-2, 2, size=mj_model.nu), rng.normal(size=mj_model.na)
@@ -288,10 +285,60 @@ def test_actuators_on_spatial_tendons_as_in_mujoco(cone):
         tau = model.actuator_forces(q, v, ctrl, act)
         assert_close(tau, layout.force_from_mujoco(q, d.qfrc_actuator), ROW_AGREEMENT, f"{cone} case {case}")
         assert_matches_mujoco(model, mj_model, layout, qpos, qvel, ctrl=ctrl, label=f"{cone} case {case}")
-        states.append((q, v, ctrl, act, tau))
+        yield q, v, ctrl, act, tau
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+def test_actuators_on_spatial_tendons_as_in_mujoco(cone):
+    """Their forces gear Jᵀ f, with l = gear L and l̇ = gear J v moving with the state (the arms on
+    the free box in its own axes), against qfrc_actuator; the solution with them, against
+    mj_forward."""
+    model, _, _ = loaded = load_both(SPATIAL_ACTUATORS.replace("{cone}", cone))
+    assert not [w for w in model.warnings if "not modelled" in w], model.warnings
+    states = list(actuated_states_as_in_mujoco(loaded, np.random.default_rng(11), 8, cone))
     # a batch is each state's
     batch = model.actuator_forces(*(np.array([s[k] for s in states]) for k in range(4)))
     assert_close(batch, np.array([s[4] for s in states]), 0.0, "batch")
+
+
+# The actuators above with their tendons' forces bounded together: the cord's two (the motor, whose
+# own forcerange then clamps it, and the filtered one) and the inner tendon's two (the velocity
+# servo and the damping-ratio servo) scaled into each tendon's actuatorfrcrange.
+TENDON_FORCE_RANGES = (SPATIAL_ACTUATORS.replace('<spatial name="cord"', '<spatial name="cord" actuatorfrcrange="-1.5 2"')
+                       .replace('<spatial name="inner"', '<spatial name="inner" actuatorfrcrange="-3 0.8"')
+                       .replace('ctrlrange="-1 1"/>', 'ctrlrange="-1 1" forcerange="-0.6 0.6"/>'))
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+def test_tendon_actuator_force_ranges_as_in_mujoco(cone):
+    """Where the sum F of a tendon's actuator forces leaves its actuatorfrcrange [f₋, f₊], each
+    force f becomes f f₊/F (f f₋/F), before its own forcerange (MuJoCo's order): qfrc_actuator
+    and mj_forward at random states, the bounds reached in most of them."""
+    model, _, _ = loaded = load_both(TENDON_FORCE_RANGES.replace("{cone}", cone))
+    unbounded, _, _ = load_both(SPATIAL_ACTUATORS.replace("{cone}", cone))
+    assert not [w for w in model.warnings if "not modelled" in w], model.warnings
+    bounded = sum(not np.allclose(tau, unbounded.actuator_forces(q, v, ctrl, act))
+                  for q, v, ctrl, act, tau in actuated_states_as_in_mujoco(loaded, np.random.default_rng(12), 10, cone))
+    assert bounded >= 5, bounded
+
+
+def test_tendon_actuator_force_ranges_mujoco_refuses_are_refused():
+    for attributes, message in [
+        ('actuatorfrcrange="0.5 1"', r"'actuatorfrcrange': expected low ≤ 0 ≤ high, got '0.5 1'"),
+        ('actuatorfrcrange="-1 -0.5"', r"expected low ≤ 0 ≤ high"),
+        ('actuatorfrclimited="true"', r"'actuatorfrcrange': a limited tendon needs low < high"),
+        ('actuatorfrclimited="true" actuatorfrcrange="1 -1"', r"a limited tendon needs low < high"),
+        ('actuatorfrclimited="yes" actuatorfrcrange="-1 1"', r"'actuatorfrclimited': expected true, false or auto, got 'yes'"),
+    ]:
+        text = TENDON_FORCE_RANGES.replace("{cone}", "pyramidal").replace('<spatial name="tackle"', f'<spatial name="tackle" {attributes}')
+        with pytest.raises(ValueError, match=r"line \d+.*" + message):
+            load_quietly(None, text)
+        with pytest.raises(ValueError):
+            mujoco.MjModel.from_xml_string(text)
+    # MuJoCo's auto: a range without low < high is no limit
+    text = TENDON_FORCE_RANGES.replace("{cone}", "pyramidal").replace('<spatial name="tackle"', '<spatial name="tackle" actuatorfrcrange="1 -1"')
+    assert not mujoco.MjModel.from_xml_string(text).tendon_actfrclimited[1]
+    load_quietly(None, text)
 
 
 # Spatial tendons wrapping around spheres and cylinders: a cylinder in the world (a side site

@@ -10,7 +10,7 @@ mod options;
 mod physical;
 mod tendon;
 
-pub use actuator::{ActivationDynamics, Actuator};
+pub use actuator::{ActivationDynamics, Actuator, ActuatorForce};
 pub use builder::{ModelBuilder, NewBody};
 use derived::run_start;
 pub(crate) use derived::tree_transform;

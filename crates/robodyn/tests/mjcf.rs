@@ -451,6 +451,49 @@ fn actuators_on_hinges_with_gears_and_ranges() {
         .is_err());
 }
 
+#[test]
+fn a_tendons_actuators_are_scaled_together_into_its_force_range() {
+    // two motors on L = 2 q: forces 3 u₀ (gear 1) and u₁, their sum held in [−1, 2]; the second
+    // motor's own forcerange clamps it after the scaling
+    let text = r#"<mujoco>
+      <worldbody><body><joint name="j" axis="0 1 0"/><geom size="0.1"/></body></worldbody>
+      <tendon><fixed name="t" actuatorfrcrange="-1 2"><joint joint="j" coef="2"/></fixed></tendon>
+      <actuator>
+        <general tendon="t" gainprm="3"/>
+        <motor tendon="t" gear="4" forcerange="-0.25 0.25"/>
+      </actuator>
+    </mujoco>"#;
+    let model = load_mjcf_str(text, "bounded.xml").unwrap();
+    assert_eq!(model.tendons[0].actuator_force_range, Some((-1.0, 2.0)));
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let (q, v) = ([0.3], [0.0]);
+    let tendons = TendonKinematics::at(&model, &mut Data::new(&model), &q).unwrap();
+    let forces = |ctrl: [f64; 2]| -> Vec<f64> {
+        let states = model.actuator_scalar_forces((&q, &v), (&ctrl, &[]), &tendons);
+        states.map(|(_, out)| out.force).collect()
+    };
+    // inside the range: as they are (but the motor's clamp)
+    assert_eq!(forces([0.25, 0.3]), vec![0.75, 0.25]);
+    // saturated: the motor on its forcerange; both where the tendon's forces are scaled
+    let saturated = |ctrl: [f64; 2]| -> Vec<bool> {
+        let states = model.actuator_scalar_forces((&q, &v), (&ctrl, &[]), &tendons);
+        states.map(|(_, out)| out.saturated).collect()
+    };
+    assert_eq!(saturated([0.25, 0.1]), vec![false, false]);
+    assert_eq!(saturated([0.25, 0.3]), vec![false, true]);
+    assert_eq!(saturated([1.0, 0.1]), vec![true, true]);
+    // F = 3 + 1 = 4 > 2: each halved, then the motor's 0.5 clamped to 0.25
+    assert_eq!(forces([1.0, 1.0]), vec![1.5, 0.25]);
+    // F = −6 + 2 = −4 < −1: each times 1/4
+    assert_eq!(forces([-2.0, 2.0]), vec![-1.5, 0.25]);
+    // τ = Σ gear J f = 2 (1.5 + 4 · 0.25)
+    let mut tau = [0.0];
+    model
+        .actuator_forces((&q, &v), (&[1.0, 1.0], &[]), &tendons, &mut tau)
+        .unwrap();
+    assert!((tau[0] - 2.0 * (1.5 + 4.0 * 0.25)).abs() < 1e-14);
+}
+
 const SCENE: &str = r#"<mujoco model="scene">
   <option timestep="0.005" integrator="RK4" cone="elliptic">
     <flag gravity="disable" filterparent="disable" energy="enable"/>

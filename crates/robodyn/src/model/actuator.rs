@@ -8,7 +8,10 @@
 //!                                                             gainprm and biasprm, affine)
 //! ```
 //! clamped to `forcerange` when limited, and it adds `g f` to the joint's generalised force, whose
-//! total is clamped to the joint's `actuatorfrcrange` where it has one. On a tendon of length L
+//! total is clamped to the joint's `actuatorfrcrange` where it has one. The actuators on a
+//! tendon with an `actuatorfrcrange` [f₋, f₊] are scaled together first, before each one's
+//! `forcerange`: where the sum F = Σ f of their forces leaves the range, each f becomes
+//! f f₊ / F (or f f₋ / F) (MuJoCo's `mj_fwdActuation`, in that order). On a tendon of length L
 //! and Jacobian J (fixed or spatial, [`TendonKinematics`]) `l = g L`, `l̇ = g J q̇`, and it adds
 //! `g Jᵀ f`: its moment arms are g J, which move with q on a spatial tendon. A `motor` has
 //! a = (1, 0, 0), b = 0; a `position` a = (k_p, 0, 0), b = (0, −k_p, −k_v); a `velocity`
@@ -30,6 +33,19 @@
 use super::Model;
 use crate::error::{check_length, check_vector, Result};
 use crate::soft::tendons::TendonKinematics;
+
+/// One actuator's output ([`Model::actuator_scalar_forces`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ActuatorForce {
+    /// What its gain multiplies ([`Actuator::input`]).
+    pub input: f64,
+    /// Its force f (MuJoCo's `actuator_force`).
+    pub force: f64,
+    /// Whether f sits on its `forcerange` or its tendon's forces were scaled into the tendon's
+    /// `actuatorfrcrange`: f then does not answer a change of velocity, and MuJoCo's implicit
+    /// integrators leave it out of ∂f/∂q̇ (MuJoCo 4.0, measured: `qDeriv`).
+    pub saturated: bool,
+}
 
 /// A below-this time constant is taken as this (MuJoCo's `mjMINVAL`).
 const MIN_TIME_CONSTANT: f64 = 1e-15;
@@ -168,11 +184,15 @@ impl Actuator {
         }
     }
 
-    /// f at its length l and rate l̇ for the gain's input `input` ([`Self::input`]).
-    pub fn force_at(&self, l: f64, l_dot: f64, input: f64) -> f64 {
+    /// f at its length l and rate l̇ for the gain's input `input` ([`Self::input`]), before
+    /// any range: `(a₀ + a₁ l + a₂ l̇) input + (b₀ + b₁ l + b₂ l̇)`.
+    pub fn unlimited_force_at(&self, l: f64, l_dot: f64, input: f64) -> f64 {
         let (a, b) = (&self.gain, &self.bias);
-        // f = (a₀ + a₁ l + a₂ l̇) input + (b₀ + b₁ l + b₂ l̇)
-        let f = (a[0] + a[1] * l + a[2] * l_dot) * input + (b[0] + b[1] * l + b[2] * l_dot);
+        (a[0] + a[1] * l + a[2] * l_dot) * input + (b[0] + b[1] * l + b[2] * l_dot)
+    }
+
+    /// A force clamped to `forcerange` where limited.
+    pub fn clamp_force(&self, f: f64) -> f64 {
         self.force_range.map_or(f, |(low, high)| f.clamp(low, high))
     }
 }
@@ -288,13 +308,10 @@ impl Model {
         check_vector("act", act, self.na())?;
         check_length("tendons", tendons.lengths.len(), self.tendons.len())?;
         tau.fill(0.0);
-        let h = self.options.timestep;
-        for (actuator, u, w) in self.actuator_states(ctrl, act) {
-            // τ += arm f(l, l̇, input)
-            let (length, rate) = self.actuator_length_and_rate(actuator, (q, v), tendons);
-            let force = actuator.force_at(length, rate, actuator.input(u, w, h));
+        for (actuator, out) in self.actuator_scalar_forces((q, v), (ctrl, act), tendons) {
+            // τ += arm f
             for (k, arm) in self.actuator_arms(actuator, tendons) {
-                tau[k] += arm * force;
+                tau[k] += arm * out.force;
             }
         }
         // a hinge's or slide's total actuator force is clamped to its range
@@ -305,5 +322,62 @@ impl Model {
             }
         }
         Ok(())
+    }
+
+    /// Each actuator with its force at (q, q̇) under `ctrl` (nu) and `act` (na), the tendons at
+    /// q `tendons`: f of the module's header, scaled with the other forces on its tendon into
+    /// the tendon's `actuatorfrcrange`, then clamped to its own `forcerange`. Expects checked
+    /// arguments ([`Model::actuator_forces`] checks them).
+    pub fn actuator_scalar_forces<'a>(
+        &'a self,
+        (q, v): (&'a [f64], &'a [f64]),
+        (ctrl, act): (&'a [f64], &'a [f64]),
+        tendons: &'a TendonKinematics,
+    ) -> impl Iterator<Item = (&'a Actuator, ActuatorForce)> + 'a {
+        let h = self.options.timestep;
+        // each actuator's force before any range
+        let unlimited = move |(actuator, u, w): (&'a Actuator, f64, f64)| {
+            let (length, rate) = self.actuator_length_and_rate(actuator, (q, v), tendons);
+            let input = actuator.input(u, w, h);
+            (
+                actuator,
+                input,
+                actuator.unlimited_force_at(length, rate, input),
+            )
+        };
+        // tendon t's factor: f₊ / F or f₋ / F where the sum F of its actuators' forces leaves
+        // its range [f₋, f₊], else 1
+        let tendon_scale = move |t: usize| {
+            let Some((low, high)) = self.tendons[t].actuator_force_range else {
+                return 1.0;
+            };
+            let total: f64 = self
+                .actuator_states(ctrl, act)
+                .filter(|(actuator, ..)| actuator.tendon == Some(t))
+                .map(|state| unlimited(state).2)
+                .sum();
+            match total {
+                _ if total < low => low / total,
+                _ if total > high => high / total,
+                _ => 1.0,
+            }
+        };
+        self.actuator_states(ctrl, act).map(move |state| {
+            let (actuator, input, force) = unlimited(state);
+            let scale = actuator.tendon.map_or(1.0, tendon_scale);
+            let force = actuator.clamp_force(force * scale);
+            let clamped = actuator
+                .force_range
+                .is_some_and(|(low, high)| force <= low || force >= high);
+            let saturated = clamped || scale != 1.0;
+            (
+                actuator,
+                ActuatorForce {
+                    input,
+                    force,
+                    saturated,
+                },
+            )
+        })
     }
 }

@@ -68,6 +68,10 @@ pub struct Tendon {
     pub spring_length: [f64; 2],
     /// The damper on L̇ (`damping`).
     pub damping: f64,
+    /// The range [f₋, f₊] the forces of the tendon's actuators are scaled into together, where
+    /// limited (`actuatorfrclimited`, `actuatorfrcrange`; f₋ ≤ 0 ≤ f₊).
+    #[serde(default)]
+    pub actuator_force_range: Option<(f64, f64)>,
 }
 
 impl Tendon {
@@ -167,6 +171,7 @@ mod tests {
             stiffness: 10.0,
             spring_length: [0.2, 0.4],
             damping: 2.0,
+            actuator_force_range: None,
         };
         assert_eq!(tendon.passive_force(0.1, 0.0, true, true), 10.0 * 0.1);
         assert_eq!(tendon.passive_force(0.3, 0.0, true, true), 0.0);

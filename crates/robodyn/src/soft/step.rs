@@ -295,7 +295,7 @@ fn lone_free_bodies(model: &Model) -> Vec<usize> {
 }
 
 /// K = ∂f/∂ν of the dampers (−D, and −b JᵀJ of each tendon's) and of the actuators whose force
-/// is not clamped ((b₂ + a₂ u) m mᵀ, m the moment arms: gear on a joint, gear J on a tendon;
+/// is not saturated ([`crate::model::ActuatorForce::saturated`]; (b₂ + a₂ u) m mᵀ, m the moment arms: gear on a joint, gear J on a tendon;
 /// the activation w, or with `actearly` the next one, in place of u where the actuator has one),
 /// MuJoCo's `qDeriv` without the bias forces' terms, in MuJoCo's velocities ν (a joint
 /// actuator's hinge or slide has ν = v; a tendon's J, on a free body's sites, is turned into ν's).
@@ -323,17 +323,11 @@ fn velocity_derivative(
     }
     check_vector("ctrl", ctrl, model.nu())?;
     if model.options.flag("actuation") {
-        let h = model.options.timestep;
-        for (actuator, u, w) in model.actuator_states(ctrl, act) {
-            let (length, rate) = model.actuator_length_and_rate(actuator, (q, v), tendons);
-            let input = actuator.input(u, w, h);
-            let force = actuator.force_at(length, rate, input);
-            let clamped = actuator
-                .force_range
-                .is_some_and(|(low, high)| force <= low || force >= high);
-            if !clamped {
+        check_vector("act", act, model.na())?;
+        for (actuator, out) in model.actuator_scalar_forces((q, v), (ctrl, act), tendons) {
+            if !out.saturated {
                 // (b₂ + a₂ u) m mᵀ with m in MuJoCo's velocities: T m
-                let slope = actuator.bias[2] + actuator.gain[2] * input;
+                let slope = actuator.bias[2] + actuator.gain[2] * out.input;
                 let mut arms = vec![0.0; nv];
                 for (c, arm) in model.actuator_arms(actuator, tendons) {
                     arms[c] += arm;

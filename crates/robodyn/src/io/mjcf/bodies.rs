@@ -420,28 +420,38 @@ impl<'a> Reader<'a> {
     /// `actuatorfrcrange` where `actuatorfrclimited` is true (a range with low < high needed), or
     /// "auto" (the default) and a range with low < high is given.
     fn actuator_force_range(&self, joint: Node<'a, 'a>, class: &str) -> Result<Option<(f64, f64)>> {
-        let range = self
-            .numbers::<2>(joint, class, "actuatorfrcrange")?
+        let range = self.numbers::<2>(joint, class, "actuatorfrcrange")?;
+        let limited = self.attribute(joint, class, "actuatorfrclimited");
+        let message = "attribute 'actuatorfrclimited' is true: expected an 'actuatorfrcrange' \
+                       with low < high";
+        self.limited_range(
+            joint,
+            (range, limited.as_deref()),
+            "actuatorfrclimited",
+            message,
+        )
+    }
+
+    /// A range where limited, MuJoCo's way: its `limited` attribute (named `limited_name`)
+    /// true, false, or auto (absent: limited where the range is given with low < high); a
+    /// limited one without low < high refused with `message`.
+    pub(super) fn limited_range(
+        &self,
+        element: Node<'a, 'a>,
+        (range, limited): (Option<[f64; 2]>, Option<&str>),
+        limited_name: &str,
+        message: &str,
+    ) -> Result<Option<(f64, f64)>> {
+        let valid = range
             .filter(|[low, high]| low < high)
             .map(|[low, high]| (low, high));
-        match self
-            .attribute(joint, class, "actuatorfrclimited")
-            .as_deref()
-        {
-            None | Some("auto") => Ok(range),
+        match limited {
+            None | Some("auto") => Ok(valid),
             Some("false") => Ok(None),
-            Some("true") => range.map(Some).ok_or_else(|| {
-                self.error(
-                    joint,
-                    "attribute 'actuatorfrclimited' is true: expected an 'actuatorfrcrange' \
-                     with low < high",
-                )
-            }),
+            Some("true") => valid.map(Some).ok_or_else(|| self.error(element, message)),
             Some(other) => Err(self.error(
-                joint,
-                format!(
-                    "attribute 'actuatorfrclimited': expected true, false or auto, got '{other}'"
-                ),
+                element,
+                format!("attribute '{limited_name}': expected true, false or auto, got '{other}'"),
             )),
         }
     }

@@ -10,9 +10,9 @@
 //! `solreffriction`/`solimpfriction`, `stiffness` and `damping` (their first value),
 //! `springlength` (one value, a dead band of two, or the length at the joints' `springref` when
 //! not given) come from the element or its class's `<tendon>` default; L at qpos0 and the
-//! default dead band are measured once the model's tendons are all read. A tendon's `armature`,
-//! polynomial `stiffness` or `damping`, `springyield` and `actuatorfrcrange` are not modelled (a
-//! warning each).
+//! default dead band are measured once the model's tendons are all read; `actuatorfrclimited`
+//! and `actuatorfrcrange` bound its actuators' forces together. A tendon's `armature`,
+//! polynomial `stiffness` or `damping` and `springyield` are not modelled (a warning each).
 
 use super::Reader;
 use crate::error::Result;
@@ -250,9 +250,6 @@ impl<'a> Reader<'a> {
                 unmodelled.push(format!("'{name}'"));
             }
         }
-        if self.tendon_attribute(element, "actuatorfrcrange").is_some() {
-            unmodelled.push("'actuatorfrcrange'".into());
-        }
         if !unmodelled.is_empty() {
             model.warnings.push(format!(
                 "{}: {} not modelled ({MODELLED})",
@@ -275,6 +272,7 @@ impl<'a> Reader<'a> {
             stiffness: first("stiffness", 0.0)?,
             spring_length: [0.0; 2],
             damping: first("damping", 0.0)?,
+            actuator_force_range: self.tendon_actuator_force_range(element)?,
         };
         // the dead band: given, or (MuJoCo's (−1, −1)) the length at the joints' springref
         tendon.spring_length = match values("springlength")?.as_deref() {
@@ -301,29 +299,42 @@ impl<'a> Reader<'a> {
     /// `range` where `limited` limits it: "auto" (the default) where a valid range (lower <
     /// upper) is given, as MuJoCo; "true" with an invalid one is refused.
     fn tendon_range(&self, element: Node<'a, 'a>) -> Result<Option<(f64, f64)>> {
-        let range = match self.tendon_attribute(element, "range") {
-            Some(text) => Some(
-                crate::io::xml::parse_numbers::<2>(&text, "range")
-                    .map_err(|m| self.error(element, m))?,
-            ),
-            None => None,
-        };
-        let valid = range.filter(|[lower, upper]| lower < upper);
-        match self.tendon_attribute(element, "limited").as_deref() {
-            None | Some("auto") => Ok(valid.map(|[lower, upper]| (lower, upper))),
-            Some("false") => Ok(None),
-            Some("true") => valid
-                .map(|[lower, upper]| Some((lower, upper)))
-                .ok_or_else(|| {
-                    self.error(
-                        element,
-                        "attribute 'range': a limited tendon needs lower < upper",
-                    )
-                }),
-            Some(other) => Err(self.error(
-                element,
-                format!("attribute 'limited': expected true, false or auto, got '{other}'"),
-            )),
+        let range = self.tendon_pair(element, "range")?;
+        let limited = self.tendon_attribute(element, "limited");
+        let message = "attribute 'range': a limited tendon needs lower < upper";
+        self.limited_range(element, (range, limited.as_deref()), "limited", message)
+    }
+
+    /// The range [f₋, f₊] the forces of a tendon's actuators are scaled into where limited
+    /// (`actuatorfrclimited`, `actuatorfrcrange`); MuJoCo refuses a limited one without
+    /// f₋ < f₊ or with 0 outside it.
+    fn tendon_actuator_force_range(&self, element: Node<'a, 'a>) -> Result<Option<(f64, f64)>> {
+        let range = self.tendon_pair(element, "actuatorfrcrange")?;
+        let limited = self.tendon_attribute(element, "actuatorfrclimited");
+        let message = "attribute 'actuatorfrcrange': a limited tendon needs low < high";
+        let range = self.limited_range(
+            element,
+            (range, limited.as_deref()),
+            "actuatorfrclimited",
+            message,
+        )?;
+        match range {
+            Some((low, high)) if low > 0.0 || high < 0.0 => {
+                let message = format!(
+                    "attribute 'actuatorfrcrange': expected low ≤ 0 ≤ high, got '{low} {high}'"
+                );
+                Err(self.error(element, message))
+            }
+            _ => Ok(range),
         }
+    }
+
+    /// Two numbers of a tendon element or its class's default, where given.
+    fn tendon_pair(&self, element: Node<'a, 'a>, name: &str) -> Result<Option<[f64; 2]>> {
+        self.tendon_attribute(element, name)
+            .map(|text| {
+                crate::io::xml::parse_numbers::<2>(&text, name).map_err(|m| self.error(element, m))
+            })
+            .transpose()
     }
 }
