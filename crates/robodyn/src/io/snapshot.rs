@@ -9,6 +9,7 @@
 
 use crate::error::{Error, Result};
 use crate::model::Model;
+use crate::soft::wrap::Surface;
 
 /// What every snapshot starts with.
 const TAG: &[u8; 8] = b"robodyn\0";
@@ -179,14 +180,8 @@ fn check_structure(model: &Model) -> Result<()> {
         );
     }
     // a tendon wraps around a sphere or a cylinder of the model
-    let wraps_around = |geom: &usize| {
-        model.geoms.get(*geom).is_some_and(|g| {
-            matches!(
-                g.shape,
-                crate::visual::Shape::Sphere { .. } | crate::visual::Shape::Cylinder { .. }
-            )
-        })
-    };
+    let wraps_around =
+        |geom: &usize| (model.geoms.get(*geom)).is_some_and(|g| Surface::of(&g.shape).is_some());
     let wrapped = model.tendons.iter().flat_map(|t| &t.path);
     if wrapped
         .filter_map(|p| match p {

@@ -324,11 +324,12 @@ fn velocity_derivative(
     check_vector("ctrl", ctrl, model.nu())?;
     if model.options.flag("actuation") {
         check_vector("act", act, model.na())?;
+        let mut arms = vec![0.0; nv];
         for (actuator, out) in model.actuator_scalar_forces((q, v), (ctrl, act), tendons) {
             if !out.saturated {
                 // (b₂ + a₂ u) m mᵀ with m in MuJoCo's velocities: T m
                 let slope = actuator.bias[2] + actuator.gain[2] * out.input;
-                let mut arms = vec![0.0; nv];
+                arms.fill(0.0);
                 for (c, arm) in model.actuator_arms(actuator, tendons) {
                     arms[c] += arm;
                 }

@@ -26,7 +26,6 @@ use crate::algo::forward_kinematics;
 use crate::error::Result;
 use crate::model::{Model, PathPoint, Tendon};
 use crate::spatial::{Transform, Vec3};
-use crate::visual::Shape;
 use crate::Data;
 use nalgebra::DMatrix;
 
@@ -169,11 +168,7 @@ fn wrap_around(
     to: Vec3,
 ) -> Option<(usize, Wrap)> {
     let geom = &model.geoms[geom];
-    let surface = match geom.shape {
-        Shape::Sphere { radius } => Surface::Sphere(radius),
-        Shape::Cylinder { radius, .. } => Surface::Cylinder(radius),
-        _ => return None,
-    };
+    let surface = Surface::of(&geom.shape)?;
     // X_{geom←0} = X_{geom←body} X_{body←0}: its axes and origin in the world
     let x = geom.placement * x_world[geom.body];
     let side = side.map(|(body, point)| world_point(&x_world[body], &point));

@@ -37,6 +37,7 @@
 
 use super::TINY;
 use crate::spatial::{Mat3, Vec3};
+use crate::visual::Shape;
 use nalgebra::{SVector, Vector2};
 use std::f64::consts::PI;
 
@@ -49,6 +50,18 @@ pub enum Surface {
     Sphere(f64),
     /// An infinite cylinder of this radius about the geom's z axis.
     Cylinder(f64),
+}
+
+impl Surface {
+    /// The surface of a geom's shape a tendon wraps around: a sphere's or a cylinder's; `None`
+    /// for the other shapes (MuJoCo wraps around no other).
+    pub fn of(shape: &Shape) -> Option<Surface> {
+        match *shape {
+            Shape::Sphere { radius } => Some(Surface::Sphere(radius)),
+            Shape::Cylinder { radius, .. } => Some(Surface::Cylinder(radius)),
+            _ => None,
+        }
+    }
 }
 
 /// What a wrap puts between a path's two ends: its two points on the surface (world
@@ -283,6 +296,23 @@ mod tests {
     use super::*;
 
     const EXACT: f64 = 1e-12;
+
+    #[test]
+    fn tendons_wrap_around_spheres_and_cylinders_only() {
+        let sphere = Shape::Sphere { radius: 0.5 };
+        assert_eq!(Surface::of(&sphere), Some(Surface::Sphere(0.5)));
+        let (radius, half_length) = (0.25, 1.0);
+        let cylinder = Shape::Cylinder {
+            radius,
+            half_length,
+        };
+        assert_eq!(Surface::of(&cylinder), Some(Surface::Cylinder(0.25)));
+        let capsule = Shape::Capsule {
+            radius,
+            half_length,
+        };
+        assert_eq!(Surface::of(&capsule), None);
+    }
 
     /// A path from (−2, 0.5, 0) to (2, 0.5, 0) around the unit sphere passes over its top (the
     /// shorter way), as the closed form has it: seen from an end at distance d and angle β, the

@@ -19,8 +19,8 @@ use crate::error::Result;
 use crate::io::xml::parse_number_list;
 use crate::model::{Model, PathPoint, SolverParameters, Tendon, DEFAULT_SOLIMP, DEFAULT_SOLREF};
 use crate::soft::tendons::TendonKinematics;
+use crate::soft::wrap::Surface;
 use crate::spatial::Vec3;
-use crate::visual::Shape;
 use crate::Data;
 use roxmltree::Node;
 
@@ -189,9 +189,9 @@ impl<'a> Reader<'a> {
         let geom = geom.ok_or_else(|| {
             self.error(child, format!("attribute 'geom': no geom named '{name}'"))
         })?;
-        match model.geoms[geom].shape {
-            Shape::Sphere { .. } | Shape::Cylinder { .. } => Ok(geom),
-            _ => {
+        match Surface::of(&model.geoms[geom].shape) {
+            Some(_) => Ok(geom),
+            None => {
                 let message = format!(
                     "attribute 'geom': a tendon wraps around a sphere or a cylinder, '{name}' is \
                      neither"
