@@ -420,3 +420,47 @@ def test_the_viewer_draws_a_poses_contacts_and_their_forces() -> None:
         assert not viewer.scene.contact_nodes[1].visible
     finally:
         viewer.close()
+
+
+#: A see-through box resting on the floor (its contact arrows point up into it), and a camera
+#: that shows its four bottom corners clear of the page's notices and panel.
+SEE_THROUGH_BOX = BOX_SCENE.replace('rgba="0.9 0.1 0.1 1"', 'rgba="0.2 0.3 0.9 0.25"')
+CONTACT_CAMERA = (np.array([0.5, -0.5, 0.4]), np.array([0.15, 0.1, 0.0]))
+#: The points and arrows are a few pixels wide: a window of this half-side around a projected
+#: point, of which more than this fraction has the contacts' colour where they are drawn
+#: (measured: 0.16-0.4, the far corner's point, half under the floor, the least) and none where
+#: they are not (0 exactly).
+CONTACT_WINDOW = 2
+CONTACT_DRAWN_FRACTION = 0.1
+
+
+def test_a_screenshot_shows_the_contact_points_and_arrows_where_they_are(tmp_path: Path) -> None:
+    """The live viewer's page, screenshot in headless Chromium: the contacts' colour at each corner
+    of the box on the floor and halfway up each force arrow, none past an arrow's tip (the four
+    carry the box's weight at WEIGHT_ARROW_FRACTION of its size); none once hidden."""
+    from robodyn.viewer.scene import CONTACT_RGB, WEIGHT_ARROW_FRACTION
+
+    scene = robodyn.load_mjcf_string(SEE_THROUGH_BOX)
+    q = scene.neutral()
+    q[2] = 0.099
+    viewer = Viewer(scene, q, open_browser=False, port=0, camera=CONTACT_CAMERA)
+    try:
+        contacts = viewer.show_contacts(q)
+        points = np.array([c["position"] for c in contacts])
+        arrow = WEIGHT_ARROW_FRACTION * viewer.scene.size / len(contacts) * np.array([0.0, 0.0, 1.0])
+        drawn = [points, points + arrow / 2]
+        beyond = points + 1.6 * arrow
+
+        def fractions(pixels: np.ndarray, where: np.ndarray) -> list[float]:
+            pixel = project(where, CONTACT_CAMERA, CAMERA_FOV)
+            return [colour_fraction(pixels, p, CONTACT_WINDOW, CONTACT_RGB, CHROMA) for p in pixel]
+
+        pixels, _ = screenshot(viewer.url, tmp_path, "contacts")
+        for where in drawn:
+            assert min(fractions(pixels, where)) > CONTACT_DRAWN_FRACTION, fractions(pixels, where)
+        assert max(fractions(pixels, beyond)) == 0.0, fractions(pixels, beyond)
+        viewer.hide_contacts()
+        pixels, _ = screenshot(viewer.url, tmp_path, "hidden")
+        assert max(max(fractions(pixels, where)) for where in drawn) == 0.0
+    finally:
+        viewer.close()
