@@ -323,7 +323,8 @@ impl<'a> Reader<'a> {
 
     /// The actuator's own `damping` and `armature` (MuJoCo ≥ 3.5), which MuJoCo adds to its
     /// joint's (or its tendon's), scaled by gear²: a passive damper −g² b q̇ and a rotor
-    /// inertia g² I_a. A tendon's armature is not modelled (a warning).
+    /// inertia g² I_a. A tendon's armature and a polynomial damping's terms past the linear one
+    /// (MuJoCo's `actuator_dampingpoly`) are not modelled (a warning each).
     fn add_transmission_terms(
         &self,
         element: Node<'a, 'a>,
@@ -331,6 +332,16 @@ impl<'a> Reader<'a> {
         model: &mut Model,
     ) -> Result<()> {
         let scale = actuator.gear * actuator.gear;
+        let damping = self.attribute(element, "main", "damping");
+        let values = damping.map(|text| parse_number_list(&text, "damping"));
+        if let Some(Ok(values)) = values {
+            if values.iter().skip(1).any(|x| *x != 0.0) {
+                model.warnings.push(format!(
+                    "{}: a polynomial 'damping' not modelled (its linear term is: −g² b q̇)",
+                    self.location(element)
+                ));
+            }
+        }
         if let Some(t) = actuator.tendon {
             let damping = self.non_negative_term(element, "damping")?;
             model.tendons[t].damping += scale * damping;
