@@ -25,7 +25,7 @@ use crate::error::{check_vector, Result};
 use crate::integrate::forces::spring_displacement;
 use crate::joint::{quaternion_of, Joint};
 use crate::model::Model;
-use crate::spatial::Vec3;
+use crate::spatial::{Transform, Vec3};
 use crate::Data;
 use nalgebra::{DMatrix, DVector};
 
@@ -52,7 +52,8 @@ pub struct ContactForward {
     pub tendons: TendonKinematics,
 }
 
-/// A model's soft-constraint dynamics: its constant weights, pairs and scratch space.
+/// A model's soft-constraint dynamics: its constant weights, pairs and scratch space (sized by
+/// the first call: the calls after allocate nothing of their own).
 #[derive(Debug, Clone)]
 pub struct ContactDynamics {
     weights: InverseWeights,
@@ -61,6 +62,13 @@ pub struct ContactDynamics {
     scratch: CollisionScratch,
     solver: Solver,
     equalities: Equalities,
+    /// The bodies' world placements at q.
+    x_world: Vec<Transform>,
+    /// τ + τ_actuator + τ_passive, q̈₀, w (nv) and the rows' a_ref − J w.
+    total: DVector<f64>,
+    free: DVector<f64>,
+    w: DVector<f64>,
+    reference: Vec<f64>,
 }
 
 impl ContactDynamics {
@@ -75,6 +83,11 @@ impl ContactDynamics {
             data,
             scratch: CollisionScratch::default(),
             solver: Solver::default(),
+            x_world: Vec::new(),
+            total: DVector::zeros(model.nv),
+            free: DVector::zeros(model.nv),
+            w: DVector::zeros(model.nv),
+            reference: Vec::new(),
         })
     }
 
@@ -97,43 +110,61 @@ impl ContactDynamics {
         check_vector("tau", tau, model.nv)?;
         let nv = model.nv;
         // 1. the contacts
-        let x_world = forward_kinematics(model, &mut self.data, q)?.to_vec();
+        let placements = forward_kinematics(model, &mut self.data, q)?;
+        self.x_world.clear();
+        self.x_world.extend_from_slice(placements);
         collide(
             model,
-            &x_world,
+            &self.x_world,
             &self.pairs,
             &mut self.scratch,
             &mut out.contacts,
         );
-        out.tendons.update(model, q, &x_world);
+        out.tendons.update(model, q, &self.x_world);
         // 2. q̈₀ = M⁻¹ (τ + τ_actuator + τ_passive − C q̇ − g), by the articulated-body algorithm
-        out.actuator = DVector::zeros(nv);
+        sized(&mut out.actuator, nv);
         let actuator = out.actuator.as_mut_slice();
         model.actuator_forces((q, v), (ctrl, act), &out.tendons, actuator)?;
-        out.activation_rate = DVector::zeros(act.len());
+        sized(&mut out.activation_rate, act.len());
         model.activation_rates(ctrl, act, out.activation_rate.as_mut_slice())?;
-        out.passive = passive_forces(model, q, v, &out.tendons);
-        let total = DVector::from_column_slice(tau) + &out.actuator + &out.passive;
-        let free = aba(model, &mut self.data, q, v, total.as_slice(), None)?.clone();
-        out.mass.clone_from(crba(model, &mut self.data, q)?);
+        sized(&mut out.passive, nv);
+        passive_forces(model, q, v, &out.tendons, out.passive.as_mut_slice());
+        self.total.copy_from_slice(tau);
+        self.total += &out.actuator;
+        self.total += &out.passive;
+        let free = aba(model, &mut self.data, q, v, self.total.as_slice(), None)?;
+        self.free.copy_from(free);
+        let mass = crba(model, &mut self.data, q)?;
+        if out.mass.shape() == mass.shape() {
+            out.mass.copy_from(mass);
+        } else {
+            out.mass = mass.clone();
+        }
         // 3. the rows, their a_ref as robodyn's accelerations see it: a_ref − J w
         constraint_rows(
             model,
             &self.weights,
             (q, v),
-            (&x_world, &out.tendons),
+            (&self.x_world, &out.tendons),
             &out.contacts,
             &mut self.equalities,
             &mut out.rows,
         )?;
-        let w = free_joint_velocity_product(model, v);
-        let reference: Vec<f64> = (0..out.rows.len())
-            .map(|i| out.rows.reference[i] - dot(out.rows.row(i), w.as_slice()))
-            .collect();
+        write_free_joint_product(model, v, &mut self.w);
+        let rows = &out.rows;
+        self.reference.clear();
+        self.reference.extend(
+            (0..rows.len()).map(|i| rows.reference[i] - dot(rows.row(i), self.w.as_slice())),
+        );
         // 4. the solution
-        self.solver
-            .solve(&out.rows, &out.mass, &free, &reference, &mut out.solution)?;
-        out.constraint = DVector::zeros(nv);
+        self.solver.solve(
+            rows,
+            &out.mass,
+            &self.free,
+            &self.reference,
+            &mut out.solution,
+        )?;
+        sized(&mut out.constraint, nv);
         for (i, force) in out.solution.forces.iter().enumerate() {
             for (c, j) in out.rows.row(i).iter().enumerate() {
                 out.constraint[c] += j * force;
@@ -145,25 +176,43 @@ impl ContactDynamics {
 
 /// τ_passive = −K (q ⊖ q_ref) − D q̇ + Σ Jᵀ f_tendon: the joints' and the tendons' springs and
 /// dampers (MuJoCo's `qfrc_passive` without gravity compensation and fluid forces; dry friction
-/// is a constraint row).
-fn passive_forces(model: &Model, q: &[f64], v: &[f64], tendons: &TendonKinematics) -> DVector<f64> {
+/// is a constraint row), into `tau` (nv).
+fn passive_forces(
+    model: &Model,
+    q: &[f64],
+    v: &[f64],
+    tendons: &TendonKinematics,
+    tau: &mut [f64],
+) {
     let options = &model.options;
-    let mut tau = DVector::zeros(model.nv);
-    if options.flag("spring") && model.stiffness.iter().any(|k| *k != 0.0) {
-        mujoco_spring_displacement(model, q, tau.as_mut_slice());
-        tau.component_mul_assign(&(-&model.stiffness));
+    let (spring, damper) = (options.flag("spring"), options.flag("damper"));
+    tau.fill(0.0);
+    if spring && model.stiffness.iter().any(|k| *k != 0.0) {
+        mujoco_spring_displacement(model, q, tau);
+        for (t, k) in tau.iter_mut().zip(model.stiffness.iter()) {
+            *t *= -k;
+        }
     }
-    if options.flag("damper") {
-        tau -= model.damping.component_mul(&DVector::from_column_slice(v));
+    if damper {
+        for ((t, d), v) in tau.iter_mut().zip(model.damping.iter()).zip(v) {
+            *t -= d * v;
+        }
     }
     // each tendon's spring and damper along its length: τ += Jᵀ f
-    let (spring, damper) = (options.flag("spring"), options.flag("damper"));
     for (t, tendon) in model.tendons.iter().enumerate() {
         let (length, rate) = (tendons.lengths[t], tendons.rate(t, v));
         let force = tendon.passive_force(length, rate, spring, damper);
-        tendons.add_to_row(t, force, tau.as_mut_slice());
+        tendons.add_to_row(t, force, tau);
     }
-    tau
+}
+
+/// `vector` resized to `n` entries (kept where it has them), all zero.
+fn sized(vector: &mut DVector<f64>, n: usize) {
+    if vector.len() == n {
+        vector.fill(0.0);
+    } else {
+        *vector = DVector::zeros(n);
+    }
 }
 
 /// q ⊖ q_ref as MuJoCo's springs measure it, as robodyn's generalised coordinates see it
