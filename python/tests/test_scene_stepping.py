@@ -181,7 +181,8 @@ def test_actuators_on_spatial_tendons_step_as_in_mujoco(integrator):
 @pytest.mark.parametrize("integrator", INTEGRATORS)
 def test_tendon_actuator_force_ranges_step_as_in_mujoco(integrator):
     """test_soft_elements's tendon actuators bounded by their tendons' actuatorfrcrange through 100
-    steps; implicitfast leaves out of K the actuators whose final force sits on its forcerange."""
+    steps; implicitfast leaves out of K an actuator whose force sits on its forcerange and those of
+    a tendon whose forces are scaled into its range (as MuJoCo 4.0's qDeriv does)."""
     model, mj_model, layout = load_both(text=with_integrator(TENDON_FORCE_RANGES.replace("{cone}", "pyramidal"), integrator))
     rng = np.random.default_rng(6)
     qpos = mj_model.qpos0.copy()
