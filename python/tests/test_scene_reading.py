@@ -397,10 +397,10 @@ def test_a_tendon_mujoco_refuses_is_refused_by_name_and_line(change, message):
 
 
 def test_what_tendons_robodyn_does_not_model_are_named():
-    """A tendon's armature: a warning; an invalid range under limited="auto" leaves the tendon
+    """A tendon's springyield: a warning; an invalid range under limited="auto" leaves the tendon
     unlimited, as in MuJoCo; the actuator on the fixed tendon pulls with gear times its
     coefficients, the one on the spatial tendon wrapping a cylinder with gear times its J."""
-    text = TENDON_ARM.replace('range="0 1"', 'range="1 0" armature="0.1"').replace(
+    text = TENDON_ARM.replace('range="0 1"', 'range="1 0" springyield="0.1"').replace(
         "</fixed></tendon>", '</fixed><spatial name="string"><site site="s1"/><site site="s2"/></spatial>'
         '<spatial name="wrapped"><site site="s1"/><geom geom="pin"/><site site="s2"/></spatial></tendon>'
     ).replace('<geom size="0.1"/></body></body></body>', '<geom size="0.1"/><site name="s2"/></body></body><site name="s1"/>'
@@ -409,7 +409,7 @@ def test_what_tendons_robodyn_does_not_model_are_named():
     mj_model = mujoco.MjModel.from_xml_string(text)
     model = robodyn.load_mjcf_string(text)
     messages = " ".join(model.warnings)
-    assert "'armature' not modelled" in messages and "wrapped" not in messages
+    assert "'springyield' not modelled" in messages and "wrapped" not in messages
     assert model.tendon_names == ["pull", "string", "wrapped"]
     q = model.neutral()
     q[model.joint_idx_q[model.joint_names.index("hinge")]] = 0.3

@@ -23,7 +23,7 @@ from test_contact_dynamics import (
     without_unmodelled,
 )
 from test_menagerie import MENAGERIE, mujoco_model
-from test_soft_elements import EQUALITIES, SPATIAL, SPATIAL_ACTUATORS, TENDON_FORCE_RANGES, TENDONS, WRAPS
+from test_soft_elements import EQUALITIES, SPATIAL, SPATIAL_ACTUATORS, TENDON_FORCE_RANGES, TENDON_INERTIAS, TENDONS, WRAPS
 
 STEPS = 100
 # 100 steps without elliptic friction: the same arithmetic in another order; measured up to 1.1e-12
@@ -154,28 +154,28 @@ def test_fixed_tendons_step_as_in_mujoco(integrator):
     assert_steps_like_mujoco(model, mj_model, layout, mj_model.qpos0, qvel, ctrl=[0.7, 0.1, -0.4, 0.3], label=integrator)
 
 
+def assert_steps_from_a_turned_state(text, integrator, seed, ctrl=None):
+    """100 steps of the MJCF string `text` (pyramidal cone, the given integrator) like MuJoCo's,
+    from qpos0 turned and a velocity drawn with `seed`."""
+    model, mj_model, layout = load_both(text=with_integrator(text.replace("{cone}", "pyramidal"), integrator))
+    rng = np.random.default_rng(seed)
+    qpos = mj_model.qpos0.copy()
+    mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.3, 1.0)
+    assert_steps_like_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv), ctrl=ctrl, label=integrator)
+
+
 @pytest.mark.parametrize("integrator", INTEGRATORS)
 def test_spatial_tendons_step_as_in_mujoco(integrator):
     """test_soft_elements's spatial tendons from a turned state: their rows, springs and dampers
     (implicitfast: in K, through the free body's turned velocities) through 100 steps."""
-    text = with_integrator(SPATIAL.replace("{cone}", "pyramidal"), integrator)
-    model, mj_model, layout = load_both(text=text)
-    rng = np.random.default_rng(2)
-    qpos = mj_model.qpos0.copy()
-    mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.3, 1.0)
-    assert_steps_like_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv), label=integrator)
+    assert_steps_from_a_turned_state(SPATIAL, integrator, 2)
 
 
 @pytest.mark.parametrize("integrator", INTEGRATORS)
 def test_actuators_on_spatial_tendons_step_as_in_mujoco(integrator):
     """test_soft_elements's actuators on spatial tendons under steady controls: their moment arms
     move with the state; implicitfast takes their velocity gains into K (gear² J_νᵀ J_ν)."""
-    model, mj_model, layout = load_both(text=with_integrator(SPATIAL_ACTUATORS.replace("{cone}", "pyramidal"), integrator))
-    rng = np.random.default_rng(5)
-    qpos = mj_model.qpos0.copy()
-    mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.3, 1.0)
-    assert_steps_like_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv),
-                             ctrl=[0.4, 0.7, 0.2, 1.1, 0.3], label=integrator)
+    assert_steps_from_a_turned_state(SPATIAL_ACTUATORS, integrator, 5, ctrl=[0.4, 0.7, 0.2, 1.1, 0.3])
 
 
 @pytest.mark.parametrize("integrator", INTEGRATORS)
@@ -183,24 +183,22 @@ def test_tendon_actuator_force_ranges_step_as_in_mujoco(integrator):
     """test_soft_elements's tendon actuators bounded by their tendons' actuatorfrcrange through 100
     steps; implicitfast leaves out of K an actuator whose force sits on its forcerange and those of
     a tendon whose forces are scaled into its range (as MuJoCo 4.0's qDeriv does)."""
-    model, mj_model, layout = load_both(text=with_integrator(TENDON_FORCE_RANGES.replace("{cone}", "pyramidal"), integrator))
-    rng = np.random.default_rng(6)
-    qpos = mj_model.qpos0.copy()
-    mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.3, 1.0)
-    assert_steps_like_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv),
-                             ctrl=[0.9, 1.7, -1.2, 1.6, 0.9], label=integrator)
+    assert_steps_from_a_turned_state(TENDON_FORCE_RANGES, integrator, 6, ctrl=[0.9, 1.7, -1.2, 1.6, 0.9])
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+def test_tendon_inertias_step_as_in_mujoco(integrator):
+    """test_soft_elements's tendons with inertias (a cord across two trees, an actuator's armature,
+    fixed tendons, a demoted simple body) through 100 steps: Euler's implicit damping and
+    implicitfast's solve take M with them."""
+    assert_steps_from_a_turned_state(TENDON_INERTIAS, integrator, 8, ctrl=[0.9, 1.7, -1.2, 1.6, 0.9])
 
 
 @pytest.mark.parametrize("integrator", INTEGRATORS)
 def test_tendons_wrapping_geoms_step_as_in_mujoco(integrator):
     """test_soft_elements's wrapping tendons (a cylinder and spheres, side sites, a pulley, two
     tendon actuators) through 100 steps from a turned state."""
-    model, mj_model, layout = load_both(text=with_integrator(WRAPS.replace("{cone}", "pyramidal"), integrator))
-    rng = np.random.default_rng(3)
-    qpos = mj_model.qpos0.copy()
-    mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.3, 1.0)
-    assert_steps_like_mujoco(model, mj_model, layout, qpos, rng.normal(size=mj_model.nv), ctrl=[0.8, -0.5],
-                             label=integrator)
+    assert_steps_from_a_turned_state(WRAPS, integrator, 3, ctrl=[0.8, -0.5])
 
 
 # --- 3. a Menagerie quadruped, dm_control's suite ----------------------------------------------

@@ -1,7 +1,7 @@
 """MuJoCo's soft model beyond contacts and joints (`m.contact_forward_dynamics` against `mj_forward`,
 as in test_contact_dynamics.py): equality constraints of every kind robodyn reads, fixed tendons
 (limits, friction, springs, equalities, actuators), spatial tendons through sites and pulleys and around spheres and cylinders (and actuators on them,
-their forces bounded together by a tendon's actuatorfrcrange),
+their forces bounded together by a tendon's actuatorfrcrange), tendons' inertias (armature),
 rows' ids past what robodyn does not read,
 MuJoCo's simple bodies, and a URDF's mimic joints as joint equalities.
 
@@ -339,6 +339,51 @@ def test_tendon_actuator_force_ranges_mujoco_refuses_are_refused():
     text = TENDON_FORCE_RANGES.replace("{cone}", "pyramidal").replace('<spatial name="tackle"', '<spatial name="tackle" actuatorfrcrange="1 -1"')
     assert not mujoco.MjModel.from_xml_string(text).tendon_actfrclimited[1]
     load_quietly(None, text)
+
+
+# The actuators above with inertias on their tendons (MuJoCo's tendon armature): the cord's own
+# (from the world through the arm to the free box: two trees, so MuJoCo's M keeps only each
+# branch's terms), the tackle's from its position actuator (g² armature), a fixed tendon across the
+# arm, and one across both slides of a body MuJoCo would call simple (which then no longer is).
+TENDON_INERTIAS = (SPATIAL_ACTUATORS.replace('<spatial name="cord"', '<spatial name="cord" armature="0.2"')
+                   .replace('<position name="winch" tendon="tackle"', '<position name="winch" tendon="tackle" armature="0.3" gear="1.5"')
+                   .replace("</tendon>", """<fixed name="bend" armature="0.5"><joint joint="shoulder" coef="1"/><joint joint="elbow" coef="-0.5"/></fixed>
+    <fixed name="glide" armature="0.8"><joint joint="sx" coef="1"/><joint joint="sy" coef="-2"/></fixed></tendon>""")
+                   .replace("</worldbody>", """<body name="slider" pos="1 1 1"><joint name="sx" type="slide" axis="1 0 0" damping="0.5" frictionloss="0.3"/>
+      <joint name="sy" type="slide" axis="0 1 0"/><geom size=".05" mass="2"/></body></worldbody>"""))
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+def test_tendon_inertias_as_in_mujoco(cone):
+    """M + a JᵀJ (on M's tree pattern, as MuJoCo's) and the bias a J (J̇ ν) in q̈₀, the weights and a
+    damping ratio at qpos0 with them, the simple body demoted: mj_forward at random states."""
+    model, _, _ = loaded = load_both(TENDON_INERTIAS.replace("{cone}", cone))
+    assert not [w for w in model.warnings if "not modelled" in w], model.warnings
+    apart = [w for w in model.warnings if "armature couples" in w]
+    assert len(apart) == 2 and "tendon 'cord'" in apart[0] and "tendon 'tackle'" in apart[1], apart
+    plain, _, _ = load_both(SPATIAL_ACTUATORS.replace("{cone}", cone))
+    for q, v, ctrl, act, tau in actuated_states_as_in_mujoco(loaded, np.random.default_rng(13), 8, cone):
+        # the inertias move the accelerations
+        with_inertia = model.contact_forward_dynamics(q, v, ctrl=ctrl, act=act)["qdd"][:plain.nv]
+        without = plain.contact_forward_dynamics(q[:plain.nq], v[:plain.nv], ctrl=ctrl, act=act)["qdd"]
+        assert np.max(np.abs(with_inertia - without)) > 1e-3
+
+
+def test_tendon_inertias_mujoco_refuses_are_refused():
+    """A negative armature, and a tendon's or its actuator's on a path around a geom (MuJoCo's J̇
+    does not follow a wrap: its compiler fails there)."""
+    wraps = WRAPS.replace("{cone}", "pyramidal")
+    for text, message in [
+        (TENDON_INERTIAS.replace('armature="0.2"', 'armature="-0.2"'), r"attribute 'armature': expected a value ≥ 0, got -0.2"),
+        (wraps.replace('<spatial name="over"', '<spatial name="over" armature="0.1"'),
+         r"attribute 'armature': a tendon that wraps around a geom has none"),
+        (wraps.replace('<position tendon="over"', '<position tendon="over" armature="0.1"'),
+         r"attribute 'armature': tendon 'over' wraps around a geom, and has none"),
+    ]:
+        with pytest.raises(ValueError, match=message):
+            load_quietly(None, text)
+        with pytest.raises(ValueError):
+            mujoco.MjModel.from_xml_string(text)
 
 
 # Spatial tendons wrapping around spheres and cylinders: a cylinder in the world (a side site

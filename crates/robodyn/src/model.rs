@@ -27,7 +27,7 @@ pub use options::{
 pub use physical::{
     check_mass_and_inertia, check_physical_parameters, check_positive_semidefinite, Unphysical,
 };
-pub use tendon::{PathPoint, Tendon, TendonEquality, UnreadElements};
+pub use tendon::{PathPoint, PathSite, Tendon, TendonEquality, UnreadElements};
 
 use crate::error::{check_length, check_vector, Error, Result};
 use crate::joint::{Joint, MotionSubspace};
@@ -294,6 +294,16 @@ impl Model {
             model: self,
             top: Some(top),
         }
+    }
+
+    /// Whether velocity coordinates `a` and `b` lie on one branch of the tree (one is the other
+    /// or among its ancestors): where M_ab may be nonzero (MuJoCo's sparsity of M).
+    pub fn dofs_on_one_branch(&self, a: usize, b: usize) -> bool {
+        let (top, mut below) = (a.min(b), Some(a.max(b)));
+        while let Some(k) = below.filter(|k| *k > top) {
+            below = self.dof_parent[k];
+        }
+        below == Some(top)
     }
 
     /// Parent body of each body (`parent()[0] = 0`).

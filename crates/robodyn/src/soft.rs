@@ -28,6 +28,7 @@ pub(crate) const TINY: f64 = 1e-15;
 
 pub mod equality;
 pub mod impedance;
+pub mod inertia;
 mod pattern;
 pub mod rows;
 pub mod simulate;

@@ -46,7 +46,7 @@ pub use solve::{
 };
 
 use crate::algo::crba::crba;
-use crate::algo::kinematics::update_body_placements;
+use crate::algo::kinematics::{update_body_placements, update_velocity_products};
 use crate::algo::ltdl::{factor_mass_matrix, solve_lower_rows, solve_transposed_rows};
 use crate::constraint::{evaluate, BodyMotion, ConstraintRows, ConstraintSet};
 use crate::error::{check_vector, Error, Result};
@@ -242,16 +242,7 @@ pub(crate) fn evaluate_rows(
     model.check_configuration(q)?;
     check_vector("v", v, model.nv)?;
     update_body_placements(model, data, q);
-    // v_i = X_i v_λ(i) + S q̇_i;  a_i = X_i a_λ(i) + v_i × S q̇_i
-    data.v[0] = Motion::ZERO;
-    data.a[0] = Motion::ZERO;
-    for i in 1..model.nbodies() {
-        let parent = model.parent[i];
-        let v_j = model.joints[i].motion(&v[model.v_range(i)]);
-        let v_i = data.x_up[i].apply_motion(&data.v[parent]) + v_j;
-        data.a[i] = data.x_up[i].apply_motion(&data.a[parent]) + v_i.cross_motion(&v_j);
-        data.v[i] = v_i;
-    }
+    update_velocity_products(model, data, v);
     let bodies = BodyMotion {
         x_world: &data.x_world,
         v: &data.v,

@@ -7,7 +7,7 @@
 
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::spatial::{Real, Transform};
+use crate::spatial::{Motion, Real, Transform};
 use crate::Data;
 
 /// Writes `data.x_up` for configuration `q` (assumed already checked).
@@ -48,6 +48,22 @@ fn transforms_of_chunk<S: Real>(
         let joint = &model.joints[i];
         let (x_tree, pattern) = (&model.x_tree[i], model.turn(i));
         x_up[i] = joint.transform_after_turn_of(&q[model.q_range(i)], turn, x_tree, pattern);
+    }
+}
+
+/// Writes every body's velocity `data.v` and its acceleration with q̈ = 0 and no gravity
+/// `data.a` (its velocity product), in its own coordinates, at the velocity `v` (checked), the
+/// bodies placed (`data.x_up`): the outward pass of Featherstone's Table 5.1 without q̈.
+pub(crate) fn update_velocity_products(model: &Model, data: &mut Data, v: &[f64]) {
+    // v_i = X_i v_λ(i) + S q̇_i;  a_i = X_i a_λ(i) + v_i × S q̇_i
+    data.v[0] = Motion::ZERO;
+    data.a[0] = Motion::ZERO;
+    for i in 1..model.nbodies() {
+        let parent = model.parent[i];
+        let v_j = model.joints[i].motion(&v[model.v_range(i)]);
+        let v_i = data.x_up[i].apply_motion(&data.v[parent]) + v_j;
+        data.a[i] = data.x_up[i].apply_motion(&data.a[parent]) + v_i.cross_motion(&v_j);
+        data.v[i] = v_i;
     }
 }
 

@@ -248,6 +248,7 @@ fn load_sources(sources: &Sources) -> Result<Model> {
     reader.read_keyframes(&sections, &mut model)?;
     reader.read_options(&sections, &mut model)?;
     model.source_bodies = reader.source_bodies.take();
+    reader.tendon_inertias(root, &mut model);
     reader.read_contacts(&sections, &mut model)?;
     for message in reader.warnings.take() {
         model.warnings.push(message);

@@ -192,6 +192,18 @@ fn check_structure(model: &Model) -> Result<()> {
     {
         return damaged("a tendon wraps around a geom that is not a sphere or cylinder".into());
     }
+    // a tendon's inertia is not negative, and none on a path around a geom (no J̇ there)
+    let around_geom = |t: &crate::model::Tendon| {
+        (t.path.iter()).any(|p| matches!(p, crate::model::PathPoint::Geom { .. }))
+    };
+    if let Some(tendon) = (model.tendons.iter())
+        .find(|t| t.armature.is_nan() || t.armature < 0.0 || (t.armature > 0.0 && around_geom(t)))
+    {
+        return damaged(format!(
+            "tendon '{}' has an armature below 0 or on a path around a geom",
+            tendon.name
+        ));
+    }
     // a range the clamps use must be ordered (a loader never makes another)
     let ordered = |range: &Option<(f64, f64)>| range.is_none_or(|(low, high)| low <= high);
     if let Some(actuator) = model
@@ -263,5 +275,10 @@ mod tests {
         .unwrap();
         model.actuators[0].ctrl_range = Some((1.0, -1.0));
         assert!(message(&model_to_bytes(&model)).contains("actuator 'm' has a range"));
+        let mut model =
+            crate::io::load_mjcf_str(crate::soft::tendons::tests::CORDS, "cords.xml").unwrap();
+        model.tendons[1].armature = -0.5;
+        let refused = message(&model_to_bytes(&model));
+        assert!(refused.contains("tendon 'tendon1' has an armature below 0"));
     }
 }

@@ -7,7 +7,8 @@
 //! the length of its path through the sites, which moves with the bodies
 //! ([`crate::soft::tendons`] computes both at a state: MuJoCo's `ten_length`, `ten_J`). What MuJoCo hangs on it: a spring and a damper on L (its
 //! `stiffness` outside the dead band `springlength` and `damping`), dry friction and limits as
-//! constraint rows, equalities coupling two lengths, and actuators pulling on it.
+//! constraint rows, equalities coupling two lengths, actuators pulling on it, and an inertia
+//! moving with it (`armature`).
 
 use super::{Model, SolverParameters};
 use crate::spatial::Vec3;
@@ -37,6 +38,23 @@ pub enum PathPoint {
         /// The branch's divisor (MJCF `divisor`).
         divisor: f64,
     },
+}
+
+/// A site of a spatial tendon's path as its walkers read it: where it is, its branch's divisor,
+/// whether it starts a branch (the path's first site, or the first after a pulley), and the geom
+/// wrapped between it and the site before (`PathPoint::Geom`'s geom and side site).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathSite {
+    /// The body it moves with.
+    pub body: usize,
+    /// Its position in that body's frame.
+    pub point: Vec3,
+    /// The divisor of its branch (1 before any pulley).
+    pub divisor: f64,
+    /// Whether no segment ends at it.
+    pub starts_branch: bool,
+    /// The geom the segment ending at it wraps around, and that geom's side site.
+    pub wrapped: Option<(usize, Option<(usize, Vec3)>)>,
 }
 
 /// One tendon.
@@ -72,12 +90,43 @@ pub struct Tendon {
     /// limited (`actuatorfrclimited`, `actuatorfrcrange`; f₋ ≤ 0 ≤ f₊).
     #[serde(default)]
     pub actuator_force_range: Option<(f64, f64)>,
+    /// The inertia a of a mass moving with L (`armature`, and its actuators' g² `armature`):
+    /// MuJoCo's soft dynamics add a JᵀJ to M and a J (J̇ q̇) to the bias forces
+    /// ([`crate::soft::inertia`]).
+    #[serde(default)]
+    pub armature: f64,
 }
 
 impl Tendon {
     /// Whether it is a spatial tendon (a path through sites) rather than a fixed one.
     pub fn is_spatial(&self) -> bool {
         !self.path.is_empty()
+    }
+
+    /// A spatial tendon's sites in order, each with its branch and the geom wrapped before it.
+    pub fn path_sites(&self) -> impl Iterator<Item = PathSite> + '_ {
+        let (mut divisor, mut starts_branch, mut wrapped) = (1.0, true, None);
+        self.path.iter().filter_map(move |stop| match stop {
+            PathPoint::Pulley { divisor: d } => {
+                (divisor, starts_branch) = (*d, true);
+                None
+            }
+            PathPoint::Geom { geom, side } => {
+                wrapped = Some((*geom, *side));
+                None
+            }
+            PathPoint::Site { body, point } => {
+                let site = PathSite {
+                    body: *body,
+                    point: *point,
+                    divisor,
+                    starts_branch,
+                    wrapped: wrapped.take(),
+                };
+                starts_branch = false;
+                Some(site)
+            }
+        })
     }
 
     /// A fixed tendon's nonzero Jacobian entries, with each joint's coordinate in q: (velocity coordinate,
@@ -172,6 +221,7 @@ mod tests {
             spring_length: [0.2, 0.4],
             damping: 2.0,
             actuator_force_range: None,
+            armature: 0.0,
         };
         assert_eq!(tendon.passive_force(0.1, 0.0, true, true), 10.0 * 0.1);
         assert_eq!(tendon.passive_force(0.3, 0.0, true, true), 0.0);

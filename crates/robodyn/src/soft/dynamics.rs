@@ -6,6 +6,7 @@
 //! ```text
 //!   1. contacts   where the geoms touch (crate::collision)
 //!   2. q̈₀ = M⁻¹ (τ + τ_actuator(u, w) + τ_passive − C q̇ − g)   unconstrained; ẇ(u, w)
+//!               (M and the bias with the tendons' inertia: super::inertia)
 //!   3. rows       J, R, a_ref of every active constraint (super::rows)
 //!   4. q̈, f      the soft model's solution (super::solver)
 //! ```
@@ -15,13 +16,15 @@
 //! solution, and the forces of its rows.
 
 use super::equality::Equalities;
+use super::inertia::{add_tendon_inertia, add_tendon_inertia_bias, has_tendon_inertia};
 use super::rows::{constraint_rows, Rows};
 use super::solver::{dot, Solution, Solver};
 use super::tendons::TendonKinematics;
 use super::weights::{inverse_weights, InverseWeights};
+use crate::algo::kinematics::update_velocity_products;
 use crate::algo::{aba, crba, forward_kinematics};
 use crate::collision::{checked_pairs, collide, CheckedPair, CollisionScratch, Contact};
-use crate::error::{check_vector, Result};
+use crate::error::{check_vector, Error, Result};
 use crate::integrate::forces::spring_displacement;
 use crate::joint::{quaternion_of, Joint};
 use crate::model::Model;
@@ -46,7 +49,7 @@ pub struct ContactForward {
     pub constraint: DVector<f64>,
     /// The joints' and tendons' springs and dampers (MuJoCo's `qfrc_passive`).
     pub passive: DVector<f64>,
-    /// The mass matrix M at q.
+    /// The mass matrix M at q, with the tendons' inertia ([`super::inertia`]).
     pub mass: DMatrix<f64>,
     /// The tendons' lengths and Jacobians at q (MuJoCo's `ten_length`, `ten_J`).
     pub tendons: TendonKinematics,
@@ -69,6 +72,8 @@ pub struct ContactDynamics {
     free: DVector<f64>,
     w: DVector<f64>,
     reference: Vec<f64>,
+    /// The Cholesky factor of M with the tendons' inertia, where some tendon has one.
+    factor: DMatrix<f64>,
 }
 
 impl ContactDynamics {
@@ -88,6 +93,7 @@ impl ContactDynamics {
             free: DVector::zeros(model.nv),
             w: DVector::zeros(model.nv),
             reference: Vec::new(),
+            factor: DMatrix::zeros(0, 0),
         })
     }
 
@@ -140,6 +146,10 @@ impl ContactDynamics {
         } else {
             out.mass = mass.clone();
         }
+        write_free_joint_product(model, v, &mut self.w);
+        if has_tendon_inertia(model) {
+            self.add_tendon_inertia(model, v, out)?;
+        }
         // 3. the rows, their a_ref as robodyn's accelerations see it: a_ref − J w
         constraint_rows(
             model,
@@ -150,7 +160,6 @@ impl ContactDynamics {
             &mut self.equalities,
             &mut out.rows,
         )?;
-        write_free_joint_product(model, v, &mut self.w);
         let rows = &out.rows;
         self.reference.clear();
         self.reference.extend(
@@ -170,6 +179,43 @@ impl ContactDynamics {
                 out.constraint[c] += j * force;
             }
         }
+        Ok(())
+    }
+
+    /// The tendons' inertia (super::inertia) in M and q̈₀, in MuJoCo's accelerations q̈ + w:
+    /// `M' (q̈₀' + w) = M (q̈₀ + w) − Σ a Jᵀ (J̇ ν)`, M' = M + a JᵀJ on M's pattern.
+    fn add_tendon_inertia(
+        &mut self,
+        model: &Model,
+        v: &[f64],
+        out: &mut ContactForward,
+    ) -> Result<()> {
+        // Σ a Jᵀ (J̇ ν), from the bodies' velocity products
+        update_velocity_products(model, &mut self.data, v);
+        self.total.fill(0.0);
+        let bodies = (&self.x_world[..], &self.data.v[..], &self.data.a[..]);
+        let w = self.w.as_slice();
+        add_tendon_inertia_bias(model, &out.tendons, bodies, w, self.total.as_mut_slice());
+        // M (q̈₀ + w) − Σ a Jᵀ (J̇ ν)
+        self.free += &self.w;
+        self.total.gemv(1.0, &out.mass, &self.free, -1.0);
+        // q̈₀' = M'⁻¹ (…) − w
+        add_tendon_inertia(model, &out.tendons, &mut out.mass);
+        let mut factor = std::mem::replace(&mut self.factor, DMatrix::zeros(0, 0));
+        if factor.shape() == out.mass.shape() {
+            factor.copy_from(&out.mass);
+        } else {
+            factor = out.mass.clone();
+        }
+        let cholesky = factor.cholesky().ok_or_else(|| Error::InvalidValue {
+            argument: "q".into(),
+            message: "the mass matrix with the tendons' armature is not positive definite here"
+                .into(),
+        })?;
+        self.free.copy_from(&self.total);
+        cholesky.solve_mut(&mut self.free);
+        self.free -= &self.w;
+        self.factor = cholesky.unpack();
         Ok(())
     }
 }

@@ -348,23 +348,9 @@ fn velocity_derivative(
 /// or actuator's coupling of two branches (two trees, two fingers) is left out there, and so
 /// here.
 fn keep_tree_pattern(model: &Model, k: &mut DMatrix<f64>) {
-    let mut body_of = vec![0; model.nv];
-    for i in 1..model.nbodies() {
-        for dof in model.v_range(i) {
-            body_of[dof] = i;
-        }
-    }
-    // whether `ancestor` is `body` or above it
-    let above = |ancestor: usize, mut body: usize| {
-        while body > ancestor {
-            body = model.parent[body];
-        }
-        body == ancestor
-    };
     for a in 0..model.nv {
         for b in 0..model.nv {
-            let (i, j) = (body_of[a], body_of[b]);
-            if !above(i, j) && !above(j, i) {
+            if !model.dofs_on_one_branch(a, b) {
                 k[(a, b)] = 0.0;
             }
         }

@@ -24,7 +24,7 @@ use super::wrap::{wrap, Surface, Wrap};
 use super::TINY;
 use crate::algo::forward_kinematics;
 use crate::error::Result;
-use crate::model::{Model, PathPoint, Tendon};
+use crate::model::{Model, Tendon};
 use crate::spatial::{Transform, Vec3};
 use crate::Data;
 use nalgebra::DMatrix;
@@ -72,26 +72,13 @@ impl TendonKinematics {
 
     /// A spatial tendon's L, its J into row `t`.
     fn spatial(&mut self, model: &Model, t: usize, tendon: &Tendon, x_world: &[Transform]) -> f64 {
-        let (mut length, mut divisor) = (0.0, 1.0);
+        let mut length = 0.0;
         let mut previous: Option<(usize, Vec3)> = None;
-        let mut around: Option<(usize, Option<(usize, Vec3)>)> = None;
-        for point in &tendon.path {
-            let (body, p) = match point {
-                PathPoint::Pulley { divisor: d } => {
-                    // a new branch
-                    divisor = *d;
-                    previous = None;
-                    continue;
-                }
-                PathPoint::Geom { geom, side } => {
-                    around = Some((*geom, *side));
-                    continue;
-                }
-                PathPoint::Site { body, point } => (*body, world_point(&x_world[*body], point)),
-            };
-            if let Some(from) = previous {
-                let wrapped = around
-                    .take()
+        for site in tendon.path_sites() {
+            let (body, divisor) = (site.body, site.divisor);
+            let p = world_point(&x_world[body], &site.point);
+            if let (false, Some(from)) = (site.starts_branch, previous) {
+                let wrapped = (site.wrapped)
                     .and_then(|(geom, side)| wrap_around(model, x_world, geom, side, from.1, p));
                 match wrapped {
                     // p_i → t₀, over the surface, t₁ → p_{i+1}; t₀ and t₁ move with the geom
@@ -177,25 +164,29 @@ fn wrap_around(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::io::load_mjcf_str;
 
     /// A cord from the world through an arm to a free box, a pulley's branch, two sites on one
-    /// body.
-    const CORDS: &str = r#"<mujoco>
+    /// body; a fixed tendon across the arm and a hinge on a second tree; both with an inertia.
+    pub(crate) const CORDS: &str = r#"<mujoco>
       <worldbody>
         <site name="anchor" pos="0 0.2 1.6"/>
-        <body name="upper" pos="0 0 1"><joint axis="0 1 0"/><geom size=".05"/>
+        <body name="upper" pos="0 0 1"><joint name="shoulder" axis="0 1 0"/><geom size=".05"/>
           <site name="a" pos=".2 0 .05"/><site name="b" pos=".3 0 0"/>
-          <body pos=".4 0 0"><joint type="slide" axis="1 0 0"/><geom size=".05"/>
+          <body pos=".4 0 0"><joint name="reach" type="slide" axis="1 0 0"/><geom size=".05"/>
             <site name="tip" pos=".3 0 0"/></body></body>
         <body name="float" pos="0.6 0.1 1.2" euler="0.3 0.2 0.1"><freejoint/><geom size=".05"/>
           <site name="eye"/></body>
+        <body name="other" pos="0 1 1"><joint name="swing" axis="1 0 0"/><geom size=".05"/></body>
       </worldbody>
       <tendon>
-        <spatial><site site="anchor"/><site site="a"/><site site="b"/><site site="tip"/>
-          <site site="eye"/><pulley divisor="3"/><site site="eye"/><site site="anchor"/></spatial>
+        <spatial armature="0.4"><site site="anchor"/><site site="a"/><site site="b"/>
+          <site site="tip"/><site site="eye"/><pulley divisor="3"/><site site="eye"/>
+          <site site="anchor"/></spatial>
+        <fixed armature="0.7"><joint joint="shoulder" coef="1"/><joint joint="reach" coef="-2"/>
+          <joint joint="swing" coef="0.5"/></fixed>
       </tendon>
     </mujoco>"#;
 

@@ -11,7 +11,8 @@
 //! ```
 //! (0 for a body welded to the world), and a joint's block of `M⁻¹` gives its own:
 //! `(M⁻¹)_ii` for a hinge or slide, the mean of the block's diagonal for a ball, of the
-//! translation and rotation blocks apart for a free joint; a tendon's is `J M⁻¹ Jᵀ`. Both
+//! translation and rotation blocks apart for a free joint; a tendon's is `J M⁻¹ Jᵀ` (M with the
+//! tendons' inertia, [`super::inertia`]). Both
 //! traces are the same in any
 //! coordinates of the velocities, so robodyn's free-joint velocities (linear in the body's axes)
 //! give MuJoCo's numbers (linear in the world's).
@@ -20,13 +21,14 @@
 //! axis-aligned slides at its origin, its inertia frame its own, no child, under the world or a
 //! jointless child of it: [`crate::model::SourceBody::simple`]).
 
-use crate::algo::{forward_kinematics, inverse_mass_matrix};
+use crate::algo::forward_kinematics;
 use crate::error::Result;
 use crate::joint::Joint;
 use crate::model::Model;
 use crate::spatial::{Transform, Vec3};
 use crate::Data;
 
+use super::inertia::inverse_inertia;
 use super::tendons::TendonKinematics;
 use super::TINY;
 use nalgebra::DMatrix;
@@ -46,7 +48,7 @@ pub struct InverseWeights {
 pub fn inverse_weights(model: &Model, data: &mut Data) -> Result<InverseWeights> {
     let nv = model.nv;
     let q = model.neutral_configuration.as_slice();
-    let inverse = inverse_mass_matrix(model, data, q)?.clone();
+    let inverse = inverse_inertia(model, data, q)?;
     let x_world = forward_kinematics(model, data, q)?.to_vec();
     // the bodies: A = J_c M⁻¹ J_cᵀ at each centre of mass
     let mut bodies = Vec::with_capacity(model.source_bodies.len());

@@ -10,7 +10,8 @@
 //! a tendon (`tendon`: fixed, or spatial through sites and pulleys), `gear`'s first entry its
 //! moment arm, with `ctrlrange` and `forcerange` (`ctrllimited`, `forcelimited`: "auto" limits
 //! where a range is given); an
-//! actuator's `damping` and `armature` join its joint's, times gear² (as MuJoCo adds them). A
+//! actuator's `damping` and `armature` join its joint's or its tendon's, times gear² (as MuJoCo
+//! adds them). A
 //! damping ratio becomes kv as MuJoCo's compiler makes it, from the inertia the transmission
 //! sees at qpos0.
 //!
@@ -20,10 +21,10 @@
 
 use super::actuator_defaults::RawActuator;
 use super::Reader;
-use crate::algo::inverse_mass_matrix;
 use crate::error::Result;
 use crate::io::xml::parse_number_list;
-use crate::model::{ActivationDynamics, Actuator, Model};
+use crate::model::{ActivationDynamics, Actuator, Model, PathPoint};
+use crate::soft::inertia::inverse_inertia;
 use crate::soft::tendons::TendonKinematics;
 use crate::soft::TINY;
 use crate::Data;
@@ -71,7 +72,8 @@ impl<'a> Reader<'a> {
     /// A position-like actuator (gain kp, bias −kp l + r l̇) with r > 0 holds a damping ratio
     /// (`dampratio`), which MuJoCo's compiler turns into kv = 2 r √(kp m): m = 1 / (g M⁻¹ gᵀ) is
     /// the inertia the transmission reflects at qpos0 (g its moment arms, the row of ∂l/∂q̇; M the
-    /// mass matrix with every armature, those of actuators too). Measured against MuJoCo 4.0.0.
+    /// mass matrix with every armature, those of actuators and tendons too). Measured against
+    /// MuJoCo 4.0.0.
     fn resolve_damping_ratios(&self, elements: &[Node<'a, 'a>], model: &mut Model) -> Result<()> {
         let has_ratio = |a: &Actuator| {
             (a.coordinate.is_some() || a.tendon.is_some())
@@ -83,7 +85,7 @@ impl<'a> Reader<'a> {
         }
         let mut data = Data::new(model);
         let q = model.neutral_configuration.clone();
-        let inverse = inverse_mass_matrix(model, &mut data, q.as_slice())?.clone();
+        let inverse = inverse_inertia(model, &mut data, q.as_slice())?;
         let tendons = TendonKinematics::at(model, &mut data, q.as_slice())?;
         let mut moment = DVector::zeros(model.nv);
         for (k, element) in elements.iter().enumerate() {
@@ -323,8 +325,9 @@ impl<'a> Reader<'a> {
 
     /// The actuator's own `damping` and `armature` (MuJoCo ≥ 3.5), which MuJoCo adds to its
     /// joint's (or its tendon's), scaled by gear²: a passive damper −g² b q̇ and a rotor
-    /// inertia g² I_a. A tendon's armature and a polynomial damping's terms past the linear one
-    /// (MuJoCo's `actuator_dampingpoly`) are not modelled (a warning each).
+    /// inertia g² I_a (on a tendon: its inertia, [`crate::soft::inertia`]). A polynomial
+    /// damping's terms past the linear one (MuJoCo's `actuator_dampingpoly`) are not modelled (a
+    /// warning).
     fn add_transmission_terms(
         &self,
         element: Node<'a, 'a>,
@@ -343,14 +346,22 @@ impl<'a> Reader<'a> {
             }
         }
         if let Some(t) = actuator.tendon {
-            let damping = self.non_negative_term(element, "damping")?;
-            model.tendons[t].damping += scale * damping;
-            if self.non_negative_term(element, "armature")? != 0.0 {
-                model.warnings.push(format!(
-                    "{}: 'armature' on a tendon not modelled (the tendon's inertia JᵀJ)",
-                    self.location(element)
-                ));
+            let tendon = &mut model.tendons[t];
+            tendon.damping += scale * self.non_negative_term(element, "damping")?;
+            let armature = self.non_negative_term(element, "armature")?;
+            // MuJoCo's J̇ does not follow a path around a geom (its first step fails)
+            let wraps = tendon
+                .path
+                .iter()
+                .any(|p| matches!(p, PathPoint::Geom { .. }));
+            if wraps && armature > 0.0 {
+                let message = format!(
+                    "attribute 'armature': tendon '{}' wraps around a geom, and has none",
+                    tendon.name
+                );
+                return Err(self.error(element, message));
             }
+            tendon.armature += scale * armature;
             return Ok(());
         }
         let Some(c) = actuator.coordinate else {

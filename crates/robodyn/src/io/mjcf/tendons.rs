@@ -11,7 +11,8 @@
 //! `springlength` (one value, a dead band of two, or the length at the joints' `springref` when
 //! not given) come from the element or its class's `<tendon>` default; L at qpos0 and the
 //! default dead band are measured once the model's tendons are all read; `actuatorfrclimited`
-//! and `actuatorfrcrange` bound its actuators' forces together. A tendon's `armature`,
+//! and `actuatorfrcrange` bound its actuators' forces together; its `armature` (with its
+//! actuators' g² `armature`, [`tendon_inertias`]) is an inertia moving with L. A tendon's
 //! polynomial `stiffness` or `damping` and `springyield` are not modelled (a warning each).
 
 use super::Reader;
@@ -32,7 +33,7 @@ const UNGIVEN_SPRING_LENGTH: [f64; 2] = [-1.0, -1.0];
 
 /// What robodyn models, for the warnings about the rest.
 const MODELLED: &str = "robodyn models fixed tendons and spatial ones (sites, pulleys, spheres \
-                        and cylinders), with a linear spring and damper";
+                        and cylinders), with a linear spring and damper and an armature";
 
 impl<'a> Reader<'a> {
     /// The `<fixed>` and `<spatial>` elements of the `<tendon>` sections among `sections`, in
@@ -61,6 +62,54 @@ impl<'a> Reader<'a> {
             }
         }
         Ok(())
+    }
+
+    /// After the actuators (which add their armature to their tendons'): a body a tendon with an
+    /// inertia moves (a fixed tendon's joints' bodies, a spatial one's sites') is no simple body
+    /// (MuJoCo 4.0 demotes it, measured), and a warning for each tendon whose inertia couples two
+    /// branches of the tree, which MuJoCo's M leaves out ([`crate::soft::inertia`]).
+    pub(super) fn tendon_inertias(&self, root: Node<'a, 'a>, model: &mut Model) {
+        let mut body_of = vec![0; model.nv];
+        for i in 1..model.nbodies() {
+            body_of[model.v_range(i)].fill(i);
+        }
+        for tendon in model.tendons.iter().filter(|t| t.armature != 0.0) {
+            // the bodies it moves, and the coordinates of its J
+            let mut bodies: Vec<usize> = tendon.joints.iter().map(|(b, _)| *b).collect();
+            let mut columns: Vec<usize> = bodies.iter().map(|b| model.idx_v[*b]).collect();
+            for point in &tendon.path {
+                if let PathPoint::Site { body, .. } = point {
+                    bodies.push(*body);
+                    let mut j = *body;
+                    while j != 0 {
+                        columns.extend(model.v_range(j));
+                        j = model.parent[j];
+                    }
+                }
+            }
+            for source in model.source_bodies.iter_mut().filter(|s| s.simple) {
+                let mut chain = source.body;
+                while chain != 0 && !bodies.contains(&chain) {
+                    chain = model.parent[chain];
+                }
+                source.simple = chain == 0;
+            }
+            let apart = columns.iter().find_map(|&k| {
+                let other = columns.iter().find(|&&l| !model.dofs_on_one_branch(k, l));
+                other.map(|&l| (body_of[k], body_of[l]))
+            });
+            if let Some((one, other)) = apart {
+                model.warnings.push(format!(
+                    "{}: tendon '{}': its armature couples joints '{}' and '{}', on two branches \
+                     of the tree; MuJoCo's mass matrix keeps only the terms a J_k J_l along one \
+                     branch, and robodyn does as MuJoCo",
+                    self.location(root),
+                    tendon.name,
+                    model.joint_names[one],
+                    model.joint_names[other]
+                ));
+            }
+        }
     }
 
     /// A `<fixed>` element's joints (each a hinge or slide, once) and their coefficients.
@@ -232,9 +281,15 @@ impl<'a> Reader<'a> {
             let message = format!("attribute 'width': expected a positive width, got {width}");
             return Err(self.error(element, message));
         }
-        // MuJoCo has no armature for a path that wraps around a geom
+        // an inertia: not negative, and none on a path that wraps around a geom (MuJoCo's J̇
+        // does not follow such a path)
+        let armature = first("armature", 0.0)?;
+        if armature < 0.0 {
+            let message = format!("attribute 'armature': expected a value ≥ 0, got {armature}");
+            return Err(self.error(element, message));
+        }
         let wraps = path.iter().any(|p| matches!(p, PathPoint::Geom { .. }));
-        if wraps && first("armature", 0.0)? > 0.0 {
+        if wraps && armature > 0.0 {
             let message = "attribute 'armature': a tendon that wraps around a geom has none";
             return Err(self.error(element, message));
         }
@@ -245,10 +300,8 @@ impl<'a> Reader<'a> {
                 unmodelled.push(format!("a polynomial '{name}'"));
             }
         }
-        for name in ["armature", "springyield"] {
-            if first(name, 0.0)? != 0.0 {
-                unmodelled.push(format!("'{name}'"));
-            }
+        if first("springyield", 0.0)? != 0.0 {
+            unmodelled.push("'springyield'".to_string());
         }
         if !unmodelled.is_empty() {
             model.warnings.push(format!(
@@ -273,6 +326,7 @@ impl<'a> Reader<'a> {
             spring_length: [0.0; 2],
             damping: first("damping", 0.0)?,
             actuator_force_range: self.tendon_actuator_force_range(element)?,
+            armature,
         };
         // the dead band: given, or (MuJoCo's (−1, −1)) the length at the joints' springref
         tendon.spring_length = match values("springlength")?.as_deref() {
