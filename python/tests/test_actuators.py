@@ -116,7 +116,7 @@ def test_what_is_not_modelled_warns_and_bad_input_is_refused():
                                   '<motor name="push" joint="slide" gear="2" damping="0.5 0.2"/>')
     assert mujoco.MjModel.from_xml_string(polynomial).actuator_dampingpoly[0, 0] == 0.2
     warned = robodyn.load_mjcf_string(polynomial).warnings
-    assert [w for w in warned if "<motor name='push'>" in w and "a polynomial 'damping' not modelled" in w], warned
+    assert [w for w in warned if "<motor name='push'>" in w and "a polynomial 'damping' on a joint not modelled" in w], warned
     linear = polynomial.replace('damping="0.5 0.2"', 'damping="0.5 0 0"')
     assert not [w for w in robodyn.load_mjcf_string(linear).warnings if "polynomial" in w]
     text = ACTUATED.replace('joint="slide" gear="2"', 'joint="slid" gear="2"')

@@ -23,7 +23,7 @@ from test_contact_dynamics import (
     without_unmodelled,
 )
 from test_menagerie import MENAGERIE, mujoco_model
-from test_soft_elements import EQUALITIES, SPATIAL, SPATIAL_ACTUATORS, TENDON_FORCE_RANGES, TENDON_INERTIAS, TENDONS, WRAPS
+from test_soft_elements import EQUALITIES, SPATIAL, SPATIAL_ACTUATORS, TENDON_FORCE_RANGES, TENDON_INERTIAS, TENDON_POLYNOMIALS, TENDONS, WRAPS
 
 STEPS = 100
 # 100 steps without elliptic friction: the same arithmetic in another order; measured up to 1.1e-12
@@ -152,6 +152,13 @@ def test_fixed_tendons_step_as_in_mujoco(integrator):
     model, mj_model, layout = load_both(text=with_integrator(TENDONS.replace("{cone}", "pyramidal"), integrator))
     qvel = np.random.default_rng(7).normal(size=mj_model.nv)
     assert_steps_like_mujoco(model, mj_model, layout, mj_model.qpos0, qvel, ctrl=[0.7, 0.1, -0.4, 0.3], label=integrator)
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+def test_tendon_polynomials_step_as_in_mujoco(integrator):
+    """test_soft_elements's polynomial tendon springs and dampers: implicitfast's K takes each
+    damper's slope −(b + 2 b₁ |L̇| + 3 b₂ L̇²) JᵀJ at the step's L̇, as MuJoCo's qDeriv."""
+    assert_steps_from_a_turned_state(TENDON_POLYNOMIALS, integrator, 5, ctrl=[0.7, 0.1, -0.4, 0.3])
 
 
 def assert_steps_from_a_turned_state(text, integrator, seed, ctrl=None):

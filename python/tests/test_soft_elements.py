@@ -1,6 +1,6 @@
 """MuJoCo's soft model beyond contacts and joints (`m.contact_forward_dynamics` against `mj_forward`,
 as in test_contact_dynamics.py): equality constraints of every kind robodyn reads, fixed tendons
-(limits, friction, springs, equalities, actuators), spatial tendons through sites and pulleys and around spheres and cylinders (and actuators on them,
+(limits, friction, springs and dampers with polynomial terms, equalities, actuators), spatial tendons through sites and pulleys and around spheres and cylinders (and actuators on them,
 their forces bounded together by a tendon's actuatorfrcrange), tendons' inertias (armature),
 rows' ids past what robodyn does not read,
 MuJoCo's simple bodies, and a URDF's mimic joints as joint equalities.
@@ -135,6 +135,41 @@ def test_fixed_tendons_as_in_mujoco(cone):
                                         label=f"{cone} case {case}")
         kinds |= {(kind, int(i)) for kind, i in zip(ours["row_types"], ours["row_ids"])}
     assert {("equality", 1), ("equality", 2), ("friction_tendon", 0), ("limit_tendon", 0), ("limit_tendon", 1)} <= kinds
+
+
+# The tendons above with polynomial springs and dampers (MuJoCo's tendon_stiffnesspoly and
+# tendon_dampingpoly): −x (k + k₁ x + k₂ x²) and −L̇ (b + b₁ |L̇| + b₂ L̇²), and an actuator's
+# polynomial damping joining its tendon's times gear².
+TENDON_POLYNOMIALS = (TENDONS.replace('stiffness="40"', 'stiffness="40 -30 25"')
+                      .replace('frictionloss="0.3" damping="0.7"', 'frictionloss="0.3" damping="0.7 0.4 0.3"')
+                      .replace('<fixed name="rest" stiffness="5">', '<fixed name="rest" stiffness="5 2 1">')
+                      .replace('forcerange="-2 2" damping="0.3"/>', 'forcerange="-2 2" damping="0.3 0.05 0.02" gear="1.2"/>'))
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+def test_tendon_polynomial_springs_and_dampers_as_in_mujoco(cone):
+    """The polynomial terms in q̈₀ (through the rows' a_ref and the solution), against mj_forward at
+    random states; they move the accelerations."""
+    model, mj_model, layout = load_both(TENDON_POLYNOMIALS.replace("{cone}", cone))
+    assert not [w for w in model.warnings if "not modelled" in w], model.warnings
+    assert mj_model.tendon_stiffnesspoly[1].tolist() == [-30, 25] and mj_model.actuator_dampingpoly[2].tolist() == [0.05, 0.02]
+    linear, _, _ = load_both(TENDONS.replace("{cone}", cone))
+    rng = np.random.default_rng(3)
+    for case in range(10):
+        qpos = mj_model.qpos0 + rng.normal(size=mj_model.nq) * 0.4
+        qvel, ctrl = rng.normal(size=mj_model.nv), rng.uniform(-1.5, 1.5, size=mj_model.nu)
+        ours, _ = assert_matches_mujoco(model, mj_model, layout, qpos, qvel, ctrl=ctrl, label=f"{cone} case {case}")
+        q = layout.q_from_mujoco(qpos)
+        without = linear.contact_forward_dynamics(q, layout.v_from_mujoco(q, qvel), ctrl=ctrl)["qdd"]
+        assert np.max(np.abs(ours["qdd"] - without)) > 1e-3
+
+
+def test_tendon_polynomials_mujoco_refuses_are_refused():
+    text = TENDONS.replace("{cone}", "pyramidal").replace('<fixed name="rest" stiffness="5">', '<fixed name="rest" stiffness="5 1 1 1">')
+    with pytest.raises(ValueError, match=r"attribute 'stiffness': expected at most 3 numbers \(c c₁ c₂\), got 4"):
+        load_quietly(None, text)
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_string(text)
 
 
 def test_tendon_lengths_as_in_mujoco():

@@ -86,6 +86,14 @@ pub struct Tendon {
     pub spring_length: [f64; 2],
     /// The damper on L̇ (`damping`).
     pub damping: f64,
+    /// The spring's higher terms [k₁, k₂] (`stiffness="k k₁ k₂"`, MuJoCo's
+    /// `tendon_stiffnesspoly`): its force −x (k + k₁ x + k₂ x²), x the stretch out of the band.
+    #[serde(default)]
+    pub stiffness_poly: [f64; 2],
+    /// The damper's higher terms [b₁, b₂] (`damping="b b₁ b₂"`, with its actuators' g² terms;
+    /// MuJoCo's `tendon_dampingpoly`): its force −L̇ (b + b₁ |L̇| + b₂ L̇²).
+    #[serde(default)]
+    pub damping_poly: [f64; 2],
     /// The range [f₋, f₊] the forces of the tendon's actuators are scaled into together, where
     /// limited (`actuatorfrclimited`, `actuatorfrcrange`; f₋ ≤ 0 ≤ f₊).
     #[serde(default)]
@@ -140,25 +148,42 @@ impl Tendon {
             .map(|&(body, c)| (model.idx_v[body], model.idx_q[body], c))
     }
 
-    /// The spring's and the damper's force along the tendon at (L, L̇):
-    /// `k (low − L)` below the dead band, `k (high − L)` above it, then `− b L̇`.
+    /// The spring's and the damper's force along the tendon at (L, L̇): with x = L − high above
+    /// the dead band, L − low below it, 0 within, `−x (k + k₁ x + k₂ x²)` and
+    /// `− L̇ (b + b₁ |L̇| + b₂ L̇²)` (MuJoCo's `mju_polyForce`).
     pub fn passive_force(&self, length: f64, rate: f64, spring: bool, damper: bool) -> f64 {
         let [low, high] = self.spring_length;
-        let stretch = if length < low {
-            low - length
+        let x = if length < low {
+            length - low
         } else if length > high {
-            high - length
+            length - high
         } else {
             0.0
         };
         let spring_force = if spring {
-            self.stiffness * stretch
+            -x * polynomial_coefficient(self.stiffness, &self.stiffness_poly, x)
         } else {
             0.0
         };
-        let damper_force = if damper { -self.damping * rate } else { 0.0 };
+        let damper_force = if damper {
+            -rate * polynomial_coefficient(self.damping, &self.damping_poly, rate.abs())
+        } else {
+            0.0
+        };
         spring_force + damper_force
     }
+
+    /// ∂f/∂L̇ of the damper at L̇: `−(b + 2 b₁ |L̇| + 3 b₂ L̇²)` (MuJoCo's `mjd_xPolyForce`).
+    pub fn damping_slope(&self, rate: f64) -> f64 {
+        let [b1, b2] = self.damping_poly;
+        let speed = rate.abs();
+        -(self.damping + 2.0 * b1 * speed + 3.0 * b2 * speed * speed)
+    }
+}
+
+/// c + c₁ x + c₂ x²: a spring's or damper's coefficient at x (MuJoCo's `mju_polyForce`).
+fn polynomial_coefficient(linear: f64, [c1, c2]: &[f64; 2], x: f64) -> f64 {
+    linear + x * (c1 + c2 * x)
 }
 
 /// A tendon equality (MJCF `<equality><tendon>`): one tendon's length a polynomial of another's
@@ -222,6 +247,8 @@ mod tests {
             damping: 2.0,
             actuator_force_range: None,
             armature: 0.0,
+            stiffness_poly: [0.0; 2],
+            damping_poly: [0.0; 2],
         };
         assert_eq!(tendon.passive_force(0.1, 0.0, true, true), 10.0 * 0.1);
         assert_eq!(tendon.passive_force(0.3, 0.0, true, true), 0.0);
@@ -231,5 +258,21 @@ mod tests {
         );
         assert_eq!(tendon.passive_force(0.3, 1.5, true, true), -3.0);
         assert_eq!(tendon.passive_force(0.5, 1.5, false, false), 0.0);
+        // the polynomial terms: −x (k + k₁ x + k₂ x²), −L̇ (b + b₁ |L̇| + b₂ L̇²)
+        let tendon = Tendon {
+            stiffness_poly: [2.0, 0.5],
+            damping_poly: [-0.5, 0.3],
+            ..tendon
+        };
+        let spring = -0.1 * (10.0 + 2.0 * 0.1 + 0.5 * 0.01);
+        assert!((tendon.passive_force(0.5, 0.0, true, true) - spring).abs() < 1e-15);
+        let damper = 1.5 * (2.0 - 0.5 * 1.5 + 0.3 * 2.25);
+        assert!((tendon.passive_force(0.3, -1.5, true, true) - damper).abs() < 1e-15);
+        // the damper's slope: its force's derivative in L̇
+        for rate in [-1.5, 0.7] {
+            let force = |r: f64| tendon.passive_force(0.3, r, false, true);
+            let slope = (force(rate + 1e-6) - force(rate - 1e-6)) / 2e-6;
+            assert!((tendon.damping_slope(rate) - slope).abs() < 1e-8, "{rate}");
+        }
     }
 }

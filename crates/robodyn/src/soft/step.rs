@@ -294,7 +294,7 @@ fn lone_free_bodies(model: &Model) -> Vec<usize> {
         .collect()
 }
 
-/// K = ∂f/∂ν of the dampers (−D, and −b JᵀJ of each tendon's) and of the actuators whose force
+/// K = ∂f/∂ν of the dampers (−D, and (∂f/∂L̇) JᵀJ of each tendon's) and of the actuators whose force
 /// is not saturated ([`crate::model::ActuatorForce::saturated`]): (b₂ + a₂ u) m mᵀ, m the moment
 /// arms (gear on a joint, gear J on a tendon;
 /// the activation w, or with `actearly` the next one, in place of u where the actuator has one),
@@ -312,14 +312,16 @@ fn velocity_derivative(
         for c in 0..nv {
             k[(c, c)] -= model.damping[c];
         }
-        // −b JᵀJ with J in MuJoCo's velocities: J_ν = J T⁻¹, its transpose T Jᵀ
+        // (∂f/∂L̇) JᵀJ, ∂f/∂L̇ = −(b + 2 b₁ |L̇| + 3 b₂ L̇²), with J in MuJoCo's velocities:
+        // J_ν = J T⁻¹, its transpose T Jᵀ
         for (t, tendon) in model.tendons.iter().enumerate() {
-            if tendon.damping == 0.0 {
+            let slope = tendon.damping_slope(tendons.rate(t, v));
+            if slope == 0.0 {
                 continue;
             }
             let row: Vec<f64> = tendons.jacobian.row(t).iter().copied().collect();
             let j = to_mujoco(model, q, &row);
-            k.ger(-tendon.damping, &j, &j, 1.0);
+            k.ger(slope, &j, &j, 1.0);
         }
     }
     check_vector("ctrl", ctrl, model.nu())?;

@@ -326,8 +326,8 @@ impl<'a> Reader<'a> {
     /// The actuator's own `damping` and `armature` (MuJoCo ≥ 3.5), which MuJoCo adds to its
     /// joint's (or its tendon's), scaled by gear²: a passive damper −g² b q̇ and a rotor
     /// inertia g² I_a (on a tendon: its inertia, [`crate::soft::inertia`]). A polynomial
-    /// damping's terms past the linear one (MuJoCo's `actuator_dampingpoly`) are not modelled (a
-    /// warning).
+    /// damping's terms past the linear one (MuJoCo's `actuator_dampingpoly`) join a tendon's,
+    /// times g²; on a joint they are not modelled (a warning).
     fn add_transmission_terms(
         &self,
         element: Node<'a, 'a>,
@@ -335,19 +335,21 @@ impl<'a> Reader<'a> {
         model: &mut Model,
     ) -> Result<()> {
         let scale = actuator.gear * actuator.gear;
+        // a polynomial damping's higher terms [b₁, b₂]
         let damping = self.attribute(element, "main", "damping");
         let values = damping.map(|text| parse_number_list(&text, "damping"));
+        let mut higher = [0.0; 2];
         if let Some(Ok(values)) = values {
-            if values.iter().skip(1).any(|x| *x != 0.0) {
-                model.warnings.push(format!(
-                    "{}: a polynomial 'damping' not modelled (its linear term is: −g² b q̇)",
-                    self.location(element)
-                ));
+            for (term, value) in higher.iter_mut().zip(values.iter().skip(1)) {
+                *term = *value;
             }
         }
         if let Some(t) = actuator.tendon {
             let tendon = &mut model.tendons[t];
             tendon.damping += scale * self.non_negative_term(element, "damping")?;
+            for (term, value) in tendon.damping_poly.iter_mut().zip(higher) {
+                *term += scale * value;
+            }
             let armature = self.non_negative_term(element, "armature")?;
             // MuJoCo's J̇ does not follow a path around a geom (its first step fails)
             let wraps = tendon
@@ -367,6 +369,12 @@ impl<'a> Reader<'a> {
         let Some(c) = actuator.coordinate else {
             return Ok(());
         };
+        if higher != [0.0; 2] {
+            model.warnings.push(format!(
+                "{}: a polynomial 'damping' on a joint not modelled (its linear term is: −g² b q̇)",
+                self.location(element)
+            ));
+        }
         for (name, values) in [
             ("damping", &mut model.damping),
             ("armature", &mut model.armature),

@@ -7,13 +7,14 @@
 //! children its path (from a site to a site; a geom, a sphere or a cylinder, between two sites;
 //! a pulley starts a branch at a site). Either kind's `limited` ("auto": where `range` is a
 //! valid range), `range`, `margin`, `solreflimit`/`solimplimit`, `frictionloss`,
-//! `solreffriction`/`solimpfriction`, `stiffness` and `damping` (their first value),
+//! `solreffriction`/`solimpfriction`, `stiffness` and `damping` (a linear coefficient and up to
+//! two higher ones),
 //! `springlength` (one value, a dead band of two, or the length at the joints' `springref` when
 //! not given) come from the element or its class's `<tendon>` default; L at qpos0 and the
 //! default dead band are measured once the model's tendons are all read; `actuatorfrclimited`
 //! and `actuatorfrcrange` bound its actuators' forces together; its `armature` (with its
 //! actuators' g² `armature`, [`tendon_inertias`]) is an inertia moving with L. A tendon's
-//! polynomial `stiffness` or `damping` and `springyield` are not modelled (a warning each).
+//! `springyield` is not modelled (a warning).
 
 use super::Reader;
 use crate::error::Result;
@@ -33,7 +34,7 @@ const UNGIVEN_SPRING_LENGTH: [f64; 2] = [-1.0, -1.0];
 
 /// What robodyn models, for the warnings about the rest.
 const MODELLED: &str = "robodyn models fixed tendons and spatial ones (sites, pulleys, spheres \
-                        and cylinders), with a linear spring and damper and an armature";
+                        and cylinders), with a polynomial spring and damper and an armature";
 
 impl<'a> Reader<'a> {
     /// The `<fixed>` and `<spatial>` elements of the `<tendon>` sections among `sections`, in
@@ -293,21 +294,31 @@ impl<'a> Reader<'a> {
             let message = "attribute 'armature': a tendon that wraps around a geom has none";
             return Err(self.error(element, message));
         }
-        // what is not modelled: warned
-        let mut unmodelled = Vec::new();
-        for name in ["stiffness", "damping"] {
-            if values(name)?.is_some_and(|v| v.iter().skip(1).any(|x| *x != 0.0)) {
-                unmodelled.push(format!("a polynomial '{name}'"));
+        // a spring's or damper's coefficients: its linear one, then up to two higher
+        let polynomial = |name: &str| -> Result<(f64, [f64; 2])> {
+            match values(name)?.as_deref() {
+                None | Some([]) => Ok((0.0, [0.0; 2])),
+                Some(&[linear, ref higher @ ..]) if higher.len() <= 2 => {
+                    let mut terms = [0.0; 2];
+                    terms[..higher.len()].copy_from_slice(higher);
+                    Ok((linear, terms))
+                }
+                Some(more) => {
+                    let message = format!(
+                        "attribute '{name}': expected at most 3 numbers (c c₁ c₂), got {}",
+                        more.len()
+                    );
+                    Err(self.error(element, message))
+                }
             }
-        }
+        };
+        let ((stiffness, stiffness_poly), (damping, damping_poly)) =
+            (polynomial("stiffness")?, polynomial("damping")?);
+        // what is not modelled: warned
         if first("springyield", 0.0)? != 0.0 {
-            unmodelled.push("'springyield'".to_string());
-        }
-        if !unmodelled.is_empty() {
             model.warnings.push(format!(
-                "{}: {} not modelled ({MODELLED})",
+                "{}: 'springyield' not modelled ({MODELLED})",
                 self.location(element),
-                unmodelled.join(", ")
             ));
         }
         let mut tendon = Tendon {
@@ -322,11 +333,13 @@ impl<'a> Reader<'a> {
             limit: solver("solreflimit", "solimplimit")?,
             frictionloss: first("frictionloss", 0.0)?,
             friction: solver("solreffriction", "solimpfriction")?,
-            stiffness: first("stiffness", 0.0)?,
+            stiffness,
             spring_length: [0.0; 2],
-            damping: first("damping", 0.0)?,
+            damping,
             actuator_force_range: self.tendon_actuator_force_range(element)?,
             armature,
+            stiffness_poly,
+            damping_poly,
         };
         // the dead band: given, or (MuJoCo's (−1, −1)) the length at the joints' springref
         tendon.spring_length = match values("springlength")?.as_deref() {
