@@ -162,7 +162,6 @@ mod tests {
     use super::*;
     use crate::algo::kinematics::{update_body_placements, update_velocity_products};
     use crate::io::load_mjcf_str;
-
     use crate::soft::tendons::tests::CORDS;
 
     #[test]
