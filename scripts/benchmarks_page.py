@@ -88,7 +88,8 @@ robodyn against [Pinocchio](https://github.com/stack-of-tasks/pinocchio) and
 [MuJoCo](https://mujoco.org) from Python, in one run of `benchmarks/compare.py` on
 {result["date"]}: each algorithm's time per call on one state, a batch of {result["batch"]:,} states
 in one call against a Python loop over the other library, a 10 s UR5 rollout against `mj_step`
-and 64 rollouts against `mujoco.rollout`. The robots are example-robot-data's UR5, Panda and
+and 64 rollouts against `mujoco.rollout`, and Menagerie's Go2 on its floor stepped as `mj_step`
+steps it (contacts, actuators). The robots are example-robot-data's UR5, Panda and
 Talos (floating base); MuJoCo loads the same URDFs with a fixed base.
 
 **Read the ratios**, robodyn's time over the other library's (below 1, robodyn is faster). The run
