@@ -2,7 +2,9 @@
 //! `benchmarks/compare.py`'s scene section: Menagerie's Unitree Go2 on its floor from its `home`
 //! keyframe (four feet in contact, elliptic cones, dry friction on every joint), its motors
 //! told the keyframe's controls, with each of the three integrators; one step, its forward
-//! dynamics alone, and a run of `RUN_STEPS` steps.
+//! dynamics alone, and a run of `RUN_STEPS` steps. A step and a run start their solver from q̈₀,
+//! as `robodyn.step` and `robodyn.simulate` do (and `mj_step` after `mj_resetDataKeyframe`); the
+//! forward dynamics alone starts from its last solution (the same state's: the warm case).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use robodyn::io::load_mjcf_file;
@@ -51,6 +53,7 @@ fn scenes(c: &mut Criterion) {
         group.bench_function(format!("go2/step/{name}"), |b| {
             b.iter(|| {
                 let (mut q, mut v) = (home.q.as_slice().to_vec(), home.v.as_slice().to_vec());
+                stepper.forget_warm_start();
                 stepper
                     .step(&model, 0.0, (&mut q, &mut v, &mut []), &tau, ctrl)
                     .expect("step");
@@ -60,6 +63,7 @@ fn scenes(c: &mut Criterion) {
         group.bench_function(format!("go2/run{RUN_STEPS}/{name}"), |b| {
             b.iter(|| {
                 let (mut q, mut v) = (home.q.as_slice().to_vec(), home.v.as_slice().to_vec());
+                stepper.forget_warm_start();
                 for k in 0..RUN_STEPS {
                     let time = k as f64 * model.options.timestep;
                     stepper
