@@ -6,7 +6,8 @@
 //! of motion
 //! ```text
 //!   M' = M + a JᵀJ            MuJoCo keeps only M's own sparsity: the terms J_k J_l of two
-//!                             coordinates on one branch of the tree ([`Model::dofs_on_one_branch`])
+//!                             coordinates on one branch of the tree
+//!                             ([`Model::dofs_on_one_branch`])
 //!   bias += a Jᵀ (J̇ ν)        J̇ ν = L̈ at ν̇ = 0, in MuJoCo's velocities ν
 //! ```
 //! (the term ∂T/∂q cancels J̇ᵀ's part, J being the gradient of L). A fixed tendon's J is

@@ -294,12 +294,12 @@ fn lone_free_bodies(model: &Model) -> Vec<usize> {
         .collect()
 }
 
-/// K = ∂f/∂ν of the dampers (−D, and (∂f/∂L̇) JᵀJ of each tendon's) and of the actuators whose force
-/// is not saturated ([`crate::model::ActuatorForce::saturated`]): (b₂ + a₂ u) m mᵀ, m the moment
-/// arms (gear on a joint, gear J on a tendon;
-/// the activation w, or with `actearly` the next one, in place of u where the actuator has one),
-/// MuJoCo's `qDeriv` without the bias forces' terms, in MuJoCo's velocities ν (a joint
-/// actuator's hinge or slide has ν = v; a tendon's J, on a free body's sites, is turned into ν's).
+/// K = ∂f/∂ν of the dampers (−D, and (∂f/∂L̇) JᵀJ of each tendon's) and of the actuators
+/// whose force is not saturated ([`crate::model::ActuatorForce::saturated`]): (b₂ + a₂ u) m mᵀ,
+/// m the moment arms (gear on a joint, gear J on a tendon; the activation w, or with `actearly`
+/// the next one, in place of u where the actuator has one), MuJoCo's `qDeriv` without the bias
+/// forces' terms, in MuJoCo's velocities ν (a joint actuator's hinge or slide has ν = v; a
+/// tendon's J, on a free body's sites, is turned into ν's).
 fn velocity_derivative(
     model: &Model,
     (q, v, act): (&[f64], &[f64], &[f64]),
