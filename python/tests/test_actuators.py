@@ -119,6 +119,12 @@ def test_what_is_not_modelled_warns_and_bad_input_is_refused():
     assert [w for w in warned if "<motor name='push'>" in w and "a polynomial 'damping' on a joint not modelled" in w], warned
     linear = polynomial.replace('damping="0.5 0.2"', 'damping="0.5 0 0"')
     assert not [w for w in robodyn.load_mjcf_string(linear).warnings if "polynomial" in w]
+    # more than b b₁ b₂: refused, as MuJoCo refuses it
+    four = polynomial.replace('damping="0.5 0.2"', 'damping="0.5 0.2 0.1 0.3"')
+    with pytest.raises(ValueError, match=r"attribute 'damping': expected at most 3 numbers \(c c₁ c₂\), got 4"):
+        robodyn.load_mjcf_string(four)
+    with pytest.raises(ValueError, match="too much data"):
+        mujoco.MjModel.from_xml_string(four)
     text = ACTUATED.replace('joint="slide" gear="2"', 'joint="slid" gear="2"')
     with pytest.raises(ValueError, match=r"<motor name='push'> \(line \d+\): attribute 'joint': no joint named 'slid'"):
         robodyn.load_mjcf_string(text)

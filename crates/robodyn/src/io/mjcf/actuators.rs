@@ -335,18 +335,16 @@ impl<'a> Reader<'a> {
         model: &mut Model,
     ) -> Result<()> {
         let scale = actuator.gear * actuator.gear;
-        // a polynomial damping's higher terms [b₁, b₂]
-        let damping = self.attribute(element, "main", "damping");
-        let values = damping.map(|text| parse_number_list(&text, "damping"));
-        let mut higher = [0.0; 2];
-        if let Some(Ok(values)) = values {
-            for (term, value) in higher.iter_mut().zip(values.iter().skip(1)) {
-                *term = *value;
-            }
+        // damping b (not negative) and its higher terms [b₁, b₂]
+        let text = self.attribute(element, "main", "damping");
+        let (damping, higher) = self.spring_polynomial(element, "damping", text.as_deref())?;
+        if damping < 0.0 {
+            let message = format!("attribute 'damping': expected a value ≥ 0, got {damping}");
+            return Err(self.error(element, message));
         }
         if let Some(t) = actuator.tendon {
             let tendon = &mut model.tendons[t];
-            tendon.damping += scale * self.non_negative_term(element, "damping")?;
+            tendon.damping += scale * damping;
             for (term, value) in tendon.damping_poly.iter_mut().zip(higher) {
                 *term += scale * value;
             }
@@ -375,12 +373,8 @@ impl<'a> Reader<'a> {
                 self.location(element)
             ));
         }
-        for (name, values) in [
-            ("damping", &mut model.damping),
-            ("armature", &mut model.armature),
-        ] {
-            values[c] += scale * self.non_negative_term(element, name)?;
-        }
+        model.damping[c] += scale * damping;
+        model.armature[c] += scale * self.non_negative_term(element, "armature")?;
         Ok(())
     }
 

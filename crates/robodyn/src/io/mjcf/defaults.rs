@@ -6,7 +6,7 @@
 use super::actuator_defaults::{ClassActuator, ACTUATOR_KINDS};
 use super::Reader;
 use crate::error::Result;
-use crate::io::xml::parse_numbers;
+use crate::io::xml::{parse_number_list, parse_numbers};
 use roxmltree::Node;
 use std::collections::HashSet;
 
@@ -193,6 +193,36 @@ impl<'a> Reader<'a> {
             }
             Some(own) => Ok(own),
             None => Ok(class),
+        }
+    }
+
+    /// A polynomial spring's or damper's coefficients in attribute `name`'s text (MuJoCo's
+    /// "c c₁ c₂": the linear one, then up to two higher ones, `mjNPOLY`); (0, [0, 0]) when not
+    /// given, more than three numbers refused as MuJoCo refuses them.
+    pub(super) fn spring_polynomial(
+        &self,
+        node: Node<'a, 'a>,
+        name: &str,
+        text: Option<&str>,
+    ) -> Result<(f64, [f64; 2])> {
+        let Some(text) = text else {
+            return Ok((0.0, [0.0; 2]));
+        };
+        let values = parse_number_list(text, name).map_err(|m| self.error(node, m))?;
+        match values.as_slice() {
+            [] => Ok((0.0, [0.0; 2])),
+            [linear, higher @ ..] if higher.len() <= 2 => {
+                let mut terms = [0.0; 2];
+                terms[..higher.len()].copy_from_slice(higher);
+                Ok((*linear, terms))
+            }
+            more => {
+                let message = format!(
+                    "attribute '{name}': expected at most 3 numbers (c c₁ c₂), got {}",
+                    more.len()
+                );
+                Err(self.error(node, message))
+            }
         }
     }
 

@@ -295,22 +295,12 @@ impl<'a> Reader<'a> {
             return Err(self.error(element, message));
         }
         // a spring's or damper's coefficients: its linear one, then up to two higher
-        let polynomial = |name: &str| -> Result<(f64, [f64; 2])> {
-            match values(name)?.as_deref() {
-                None | Some([]) => Ok((0.0, [0.0; 2])),
-                Some(&[linear, ref higher @ ..]) if higher.len() <= 2 => {
-                    let mut terms = [0.0; 2];
-                    terms[..higher.len()].copy_from_slice(higher);
-                    Ok((linear, terms))
-                }
-                Some(more) => {
-                    let message = format!(
-                        "attribute '{name}': expected at most 3 numbers (c c₁ c₂), got {}",
-                        more.len()
-                    );
-                    Err(self.error(element, message))
-                }
-            }
+        let polynomial = |name: &str| {
+            self.spring_polynomial(
+                element,
+                name,
+                self.tendon_attribute(element, name).as_deref(),
+            )
         };
         let ((stiffness, stiffness_poly), (damping, damping_poly)) =
             (polynomial("stiffness")?, polynomial("damping")?);
