@@ -2,8 +2,8 @@
 a 10 000-state batch against a Python loop, forward dynamics under contacts (Solo12 on its feet,
 Talos on its soles) and impacts against Pinocchio's constraintDynamics and impulseDynamics, a 10 s
 UR5 rollout (RK4, PD) against mj_step and 64 rollouts of 1 s against mujoco.rollout, and Menagerie's
-Go2 scene stepped as mj_step steps it (one step, a run, 64 rollouts), printed as ratios (< 1 means
-robodyn is faster).
+Go2 scene stepped as mj_step steps it (one step, a run, 64 rollouts; against MuJoCo as the scene sets
+it and run to convergence as robodyn's solver is), printed as ratios (< 1 means robodyn is faster).
 
 Run: .venv/bin/python benchmarks/compare.py [--batch 10000] [--robots ur5 panda talos]
 [--sections pinocchio constrained mujoco simulation scene] [--criterion target/criterion] [--json out.json]
@@ -525,15 +525,41 @@ def compare_scene() -> list[tuple[str, float, float]]:
     """The Go2 scene stepped as mj_step steps it (its own integrator, Euler; contacts, dry friction
     and motors): robodyn.step against mj_step from the keyframe (MuJoCo's warm start cleared, as
     robodyn.step has none), robodyn.simulate against mujoco.rollout with one MjData, and a batch of
-    rollouts against mujoco.rollout with one MjData per core."""
+    rollouts against mujoco.rollout with one MjData per core; each against MuJoCo as the scene
+    sets it (its solver stops at `tolerance` 1e-8) and against MuJoCo run to convergence
+    (CONVERGED_TOLERANCE), as robodyn's solver runs: the same work on both sides."""
     import warnings
-
-    from mujoco import rollout
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", robodyn.ModelWarning)
         m = robodyn.load(GO2_SCENE)
     mj = go2_mujoco()
+    converged = go2_mujoco()
+    converged.opt.tolerance = CONVERGED_TOLERANCE
+    rows = scene_rows(m, mj, "")
+    rows += scene_rows(m, converged, ", MuJoCo converged")
+    home = m.keyframe("home")
+    h = m.options.timestep
+    final = robodyn.simulate(m, "home", t_end=SCENE_STEPS * h, dt=SCENE_STEPS * h, integrator="mujoco").q[-1]
+    for label, model in (("its tolerance", mj), ("converged", converged)):
+        d = mujoco.MjData(model)
+        mujoco.mj_resetDataKeyframe(model, d, 0)
+        for _ in range(SCENE_STEPS):
+            d.ctrl[:] = home.ctrl
+            mujoco.mj_step(model, d)
+        print(f"go2 scene: after {SCENE_STEPS} steps the base heights differ by {abs(final[2] - d.qpos[2]):.1e} m "
+              f"(MuJoCo {label})")
+    return rows
+
+
+#: MuJoCo's `tolerance` where its solver is run to convergence, as robodyn's is (its tests' too).
+CONVERGED_TOLERANCE = 1e-15
+
+
+def scene_rows(m, mj: mujoco.MjModel, label: str) -> list[tuple[str, float, float]]:
+    """The scene's three cases, robodyn's `m` against MuJoCo's `mj`, `label` after each case."""
+    from mujoco import rollout
+
     home = m.keyframe("home")
     h = m.options.timestep
     q, v, tau = np.asarray(home.q), np.asarray(home.v), np.zeros(m.nv)
@@ -555,10 +581,10 @@ def compare_scene() -> list[tuple[str, float, float]]:
 
     ours, theirs = best_times(our_step, their_step, 200)
     reset, _ = best_times(their_reset, their_reset, 200)
-    rows = [("go2 scene, one step (Euler)", ours, theirs - reset)]
+    rows = [(f"go2 scene, one step (Euler){label}", ours, theirs - reset)]
     duration = SCENE_STEPS * h
     control = np.tile(np.asarray(home.ctrl), (1, SCENE_STEPS, 1))
-    rows.append((f"go2 scene, {SCENE_STEPS} steps", *best_times(
+    rows.append((f"go2 scene, {SCENE_STEPS} steps{label}", *best_times(
         lambda: robodyn.simulate(m, "home", t_end=duration, dt=duration, integrator="mujoco"),
         lambda: rollout.rollout(mj, d, start[None], control), 1, 5)))
     duration = SCENE_ROLLOUT_STEPS * h
@@ -567,13 +593,9 @@ def compare_scene() -> list[tuple[str, float, float]]:
     workers = [mujoco.MjData(mj) for _ in range(os.cpu_count() or 1)]
     initial = np.tile(start, (SCENE_ROLLOUTS, 1))
     every_step = np.tile(np.asarray(home.ctrl), (SCENE_ROLLOUTS, SCENE_ROLLOUT_STEPS, 1))
-    rows.append((f"go2 scene, {SCENE_ROLLOUTS} rollouts of {SCENE_ROLLOUT_STEPS} steps", *best_times(
+    rows.append((f"go2 scene, {SCENE_ROLLOUTS} rollouts of {SCENE_ROLLOUT_STEPS} steps{label}", *best_times(
         lambda: robodyn.simulate(m, starts, speeds, t_end=duration, dt=duration, integrator="mujoco", ctrl=controls),
-        lambda: rollout.rollout(mj, workers, initial, every_step), 1, 3)))
-    final = robodyn.simulate(m, "home", t_end=SCENE_STEPS * h, dt=SCENE_STEPS * h, integrator="mujoco").q[-1]
-    states, _ = rollout.rollout(mj, d, start[None], control)
-    print(f"go2 scene: after {SCENE_STEPS} steps the base heights differ by {abs(final[2] - states[0, -1, 3]):.1e} m "
-          "(MuJoCo's solver stops at its tolerance, 1e-8; robodyn's converges)")
+        lambda: rollout.rollout(mj, workers, initial, every_step), 1, 5)))
     return rows
 
 
