@@ -62,8 +62,6 @@ CONVEX_PAIRS = [
     ("cylinder", "cylinder"),
     ("cylinder", "box"),
 ]
-#: MuJoCo's height field type, which robodyn does not collide yet.
-NOT_COLLIDED_TYPES = {1}
 
 
 def scene(first, second, margin=MARGIN):
@@ -308,8 +306,8 @@ SUITE_CASES = 40
 @pytest.mark.parametrize("name", SUITE)
 def test_dm_control_contacts_as_in_mujoco(name):
     """At random configurations about each model's `qpos0` (its joints turned by 0.3 rad or
-    moved 0.3 m at random), the same contacts as MuJoCo's, but those robodyn does not find yet
-    (warned at load): the quadruped's height field."""
+    moved 0.3 m at random), the same contacts as MuJoCo's (the quadruped's on its height field
+    too)."""
     path = REPOSITORY / "testdata" / "dm_control" / f"{name}.xml"
     model, mj_model = load_quietly(path), mujoco.MjModel.from_xml_path(str(path))
     mj_data, layout = mujoco.MjData(mj_model), MujocoLayout(model, mj_model)
@@ -318,8 +316,6 @@ def test_dm_control_contacts_as_in_mujoco(name):
         qpos = mj_model.qpos0.copy()
         mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.3, 1.0)
         expected = mujoco_contacts(mj_model, mj_data, qpos)
-        types = lambda g: int(mj_model.geom_type[mj_model.geom(g).id])
-        expected = [c for c in expected if not {types(c[0]), types(c[1])} & NOT_COLLIDED_TYPES]
         found = model.collide(layout.q_from_mujoco(qpos))
         assert [(c["geom1"], c["geom2"]) for c in found] == [(g1, g2) for g1, g2, *_ in expected], case
         for ours, (g1, g2, dist, pos, frame) in zip(found, expected):

@@ -82,9 +82,8 @@ def mujoco_name(compiled, kind, index):
 
 def assert_geoms_are_mujocos(model, compiled, label):
     """Every geom's filter and contact parameters, and a primitive's size and world pose at
-    qpos0, equal MuJoCo's (height fields and SDFs are not read)."""
-    unread = (mujoco.mjtGeom.mjGEOM_HFIELD, mujoco.mjtGeom.mjGEOM_SDF)
-    kept = [g for g in range(compiled.ngeom) if compiled.geom_type[g] not in unread]
+    qpos0, equal MuJoCo's (SDFs are not read)."""
+    kept = [g for g in range(compiled.ngeom) if compiled.geom_type[g] != mujoco.mjtGeom.mjGEOM_SDF]
     geoms = model.geoms
     assert len(geoms) == len(kept), label
     data = mujoco.MjData(compiled)
@@ -112,7 +111,11 @@ def assert_geoms_are_mujocos(model, compiled, label):
             assert_close(geom[key], value, 0.0, f"{where} {key}")
         if geom["kind"] == "mesh":
             continue  # MuJoCo moves a mesh geom's frame to the mesh's inertia frame
-        assert_close(geom["size"], compiled.geom_size[g][: len(geom["size"])], COMPILER_TOLERANCE, f"{where} size")
+        if geom["kind"] == "hfield":
+            # MuJoCo's geom size of a field is its inertia box's; the field's own is the asset's
+            assert_close(geom["size"], compiled.hfield_size[compiled.geom_dataid[g]], 0.0, f"{where} size")
+        else:
+            assert_close(geom["size"], compiled.geom_size[g][: len(geom["size"])], COMPILER_TOLERANCE, f"{where} size")
         world = poses[geom["body"]] @ geom["placement"]
         assert_close(world[:3, 3], data.geom_xpos[g], COMPILER_TOLERANCE, f"{where} position")
         assert_close(world[:3, :3], data.geom_xmat[g].reshape(3, 3), COMPILER_TOLERANCE, f"{where} rotation")
@@ -308,9 +311,8 @@ def test_the_pairs_checked_for_contact_are_mujocos(package, file):
     else:
         folder = REPOSITORY / "testdata" if package == "testdata" else package_folder(package)
         model, compiled = load(folder / file), mujoco.MjModel.from_xml_path(str(folder / file))
-    # robodyn's geoms are MuJoCo's in order, height fields and SDFs left out
-    unread = (mujoco.mjtGeom.mjGEOM_HFIELD, mujoco.mjtGeom.mjGEOM_SDF)
-    kept = [g for g in range(compiled.ngeom) if compiled.geom_type[g] not in unread]
+    # robodyn's geoms are MuJoCo's in order, SDFs left out
+    kept = [g for g in range(compiled.ngeom) if compiled.geom_type[g] != mujoco.mjtGeom.mjGEOM_SDF]
     index = {geom["name"]: kept[k] for k, geom in enumerate(model.geoms)}
     ids = lambda one, other: tuple(sorted((index[one], index[other])))  # noqa: E731
     explicit = {ids(p["geom1"], p["geom2"]) for p in model.contact_pairs}

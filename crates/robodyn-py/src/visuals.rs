@@ -20,8 +20,8 @@ pub(crate) fn matrix<'py>(py: Python<'py>, m: &Matrix4<f64>) -> PyResult<Bound<'
     Ok(PyArray1::from_vec(py, rows).reshape([4, 4])?.into_any())
 }
 
-/// A shape's size in MJCF's convention: half-extents, radius, [radius, half-length]; none for a
-/// mesh.
+/// A shape's size in MJCF's convention: half-extents, radius, [radius, half-length]; a height
+/// field's half-sides, top and base; none for a mesh.
 pub(crate) fn shape_size(shape: &Shape) -> Vec<f64> {
     match shape {
         Shape::Box { half_extents } => half_extents.as_slice().to_vec(),
@@ -37,6 +37,10 @@ pub(crate) fn shape_size(shape: &Shape) -> Vec<f64> {
         } => vec![*radius, *half_length],
         Shape::Plane { half_extents } => half_extents.to_vec(),
         Shape::Mesh { .. } => Vec::new(),
+        Shape::HeightField { field } => {
+            let [x, y] = field.half_extents;
+            vec![x, y, field.top, field.base]
+        }
     }
 }
 
@@ -99,9 +103,11 @@ impl PyModel {
 
     /// The robot's visual geometry (URDF `<visual>`s, MJCF geoms), one dict each: `name`,
     /// `body` (index into `["world"] + body_names`), `placement` (4x4 pose in the body),
-    /// `kind` ("box", "sphere", "cylinder", "capsule", "ellipsoid", "plane", "mesh"), `size`
-    /// (MJCF's convention: half-extents, radius, [radius, half-length]), `rgba`, `group` (MJCF;
-    /// MuJoCo shows 0–2), `element` (where it is written), and for meshes `mesh_file` (or
+    /// `kind` ("box", "sphere", "cylinder", "capsule", "ellipsoid", "plane", "mesh", "hfield"),
+    /// `size` (MJCF's convention: half-extents, radius, [radius, half-length]; a height field's
+    /// [x, y, top, base]), `rgba`, `group` (MJCF; MuJoCo shows 0–2), `element` (where it is
+    /// written), for a height field its triangles as `mesh_vertices` and `mesh_faces` (in its
+    /// frame: surface, walls and bottom), and for meshes `mesh_file` (or
     /// `mesh_vertices` and `mesh_faces` when written inline), `mesh_missing` (why the file was
     /// not found, else None) and `file_to_visual` (4x4, may scale); `texture`: None, or the
     /// texture its MJCF material lays on it, a dict with `name`, `kind` ("2d", "cube",
@@ -129,6 +135,11 @@ impl PyModel {
                     texture.set_item("uniform", mapping.uniform)?;
                     item.set_item("texture", texture)?;
                 }
+            }
+            if let Shape::HeightField { field } = &visual.shape {
+                let (vertices, faces) = mesh_arrays(py, &field.triangles())?;
+                item.set_item("mesh_vertices", vertices)?;
+                item.set_item("mesh_faces", faces)?;
             }
             if let Shape::Mesh {
                 source,

@@ -1,6 +1,7 @@
 //! What a robot looks like: the visual geometry of its links (URDF `<visual>`, MJCF geoms), each
 //! placed on the body it moves with. The dynamics never read it; the viewer draws it.
 
+use crate::collision::height_field::HeightField;
 use crate::collision::hull::ConvexHull;
 use crate::io::mesh::TriangleMesh;
 use crate::spatial::{Transform, Vec3};
@@ -72,6 +73,11 @@ pub enum Shape {
         #[serde(default)]
         hull: Option<Arc<ConvexHull>>,
     },
+    /// A height field: a terrain sampled on a grid over a rectangle about the origin.
+    HeightField {
+        /// Its grid and elevations.
+        field: Arc<HeightField>,
+    },
 }
 
 impl Shape {
@@ -85,6 +91,7 @@ impl Shape {
             Shape::Ellipsoid { .. } => "ellipsoid",
             Shape::Plane { .. } => "plane",
             Shape::Mesh { .. } => "mesh",
+            Shape::HeightField { .. } => "hfield",
         }
     }
 }

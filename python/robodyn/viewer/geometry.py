@@ -188,6 +188,12 @@ def visual_pieces(model, groups: tuple[int, ...] | None = MUJOCO_VISIBLE_GROUPS)
             textures.undrawn(texture, f"a {texture['kind']} texture on a {visual['kind']} geom is not drawn")
         elif texture is not None:
             image = textures.image(texture)
+        if visual["kind"] == "hfield":
+            if image is not None:
+                textures.undrawn(texture, "robodyn lays 2-D textures on planes and meshes, not on a height field")
+            pieces.append(Piece(visual["name"], visual["body"], _affine(placement, np.asarray(visual["mesh_vertices"], dtype=float)),
+                                np.asarray(visual["mesh_faces"], dtype=np.int64), rgba, backdrop=True))
+            continue
         if visual["kind"] == "mesh":
             to_body = placement @ np.asarray(visual["file_to_visual"])
             # a mirroring scale turns the faces inside out: turn them back

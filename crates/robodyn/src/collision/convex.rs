@@ -21,6 +21,10 @@
 //!   vertices become the contacts (a cylinder's cap is a 16-gon; at most 4 contacts, the
 //!   polygon's largest quadrilateral; 2 with a capsule);
 //! - a contact is at `(x₁ + x₂)/2`, normal `(x₁ − x₂)/|x₁ − x₂|`, distance the signed gap.
+//!
+//! Two polytopes without margins (boxes, meshes, a height field's prisms:
+//! [`height_field_convex`]) are searched as MuJoCo's "discrete" geoms: GJK and EPA to exact
+//! convergence, EPA stopping at a support point whose corners it has met before.
 
 use super::gjk::{self, Convex, Query};
 use super::hull::ConvexHull;
@@ -28,8 +32,10 @@ use super::{Placed, Touch};
 use crate::spatial::{Mat3, Vec3};
 use crate::visual::Shape;
 use manifold::manifold;
+pub use prisms::height_field_convex;
 
 mod manifold;
+mod prisms;
 #[cfg(test)]
 mod tests;
 
@@ -53,7 +59,8 @@ fn unit_or_x(v: &Vec3) -> Vec3 {
     }
 }
 
-/// The support functions: the shapes, and the cores GJK measures first.
+/// The support functions: the shapes, and the cores GJK measures first; a height field's prism
+/// by its corners (0–2 on its base, 3–5 on the surface above them).
 #[derive(Debug, Clone, Copy)]
 enum Kind<'a> {
     Point,
@@ -64,6 +71,7 @@ enum Kind<'a> {
     Cylinder { radius: f64, half_length: f64 },
     Cuboid { half_extents: Vec3 },
     Mesh { hull: &'a ConvexHull },
+    Prism { corners: &'a [Vec3; 6] },
 }
 
 /// A placed convex shape, grown by `inflation` along every support direction.
@@ -100,7 +108,9 @@ impl<'a> Body<'a> {
                 hull: Some(ref hull),
                 ..
             } => Kind::Mesh { hull },
-            Shape::Plane { .. } | Shape::Mesh { hull: None, .. } => return None,
+            Shape::Plane { .. } | Shape::Mesh { hull: None, .. } | Shape::HeightField { .. } => {
+                return None
+            }
         };
         Some(Body {
             kind,
@@ -221,6 +231,23 @@ impl Convex for Body<'_> {
                 let (s, corner) = hull.support(&self.local_of(d));
                 (self.world_of(&s), corner as i32)
             }
+            Kind::Prism { corners } => {
+                // of the base corners when d points down, else of the surface's: the first
+                // farthest along d
+                let l = self.local_of(d);
+                let face = if l.z < 0.0 {
+                    &corners[..3]
+                } else {
+                    &corners[3..]
+                };
+                let mut best = 0;
+                for k in 1..3 {
+                    if dot(&face[k], &l) > dot(&face[best], &l) {
+                        best = k;
+                    }
+                }
+                (self.world_of(&face[best]), -1)
+            }
         };
         if self.inflation > 0.0 {
             (point + d * self.inflation, tag)
@@ -229,8 +256,15 @@ impl Convex for Body<'_> {
         }
     }
 
+    /// The origin; a prism's corners' mean.
     fn centre(&self) -> Vec3 {
-        self.position
+        match self.kind {
+            Kind::Prism { corners } => {
+                let sum = corners.iter().fold(Vec3::zeros(), |sum, c| sum + c);
+                self.world_of(&(sum * (1.0 / 6.0)))
+            }
+            _ => self.position,
+        }
     }
 }
 
@@ -294,14 +328,21 @@ fn contact_budget(a: &Body, b: &Body) -> usize {
 /// The contacts of `a` and `b` grown by `margin`/2 each (MuJoCo's `mjc_ccd`), distances of the
 /// grown shapes.
 fn penetration<'a>(a: &Body<'a>, b: &Body<'a>, margin: f64) -> Manifold {
+    let polytope = |body: &Body| {
+        matches!(
+            body.kind,
+            Kind::Cuboid { .. } | Kind::Mesh { .. } | Kind::Prism { .. }
+        )
+    };
     let query = Query {
         tolerance: TOLERANCE,
         iterations: ITERATIONS,
         cutoff: 0.0,
+        discrete: margin == 0.0 && polytope(a) && polytope(b),
     };
     let budget = contact_budget(a, b);
     let mut found = Manifold::default();
-    let start = [a.position, b.position];
+    let start = [a.centre(), b.centre()];
     let rounded = |body: &Body| matches!(body.kind, Kind::Sphere { .. } | Kind::Capsule { .. });
     if rounded(a) || rounded(b) || margin > 0.0 {
         // the cores' distance: spheres as points, capsules as segments, margins left out
@@ -484,7 +525,12 @@ pub fn convex_convex(first: &Placed, second: &Placed, margin: f64, touches: &mut
     let (Some(a), Some(b)) = (Body::new(first), Body::new(second)) else {
         return;
     };
-    let found = penetration(&a, &b, margin);
+    push_touches(&a, &b, margin, touches);
+}
+
+/// The contacts of `a` and `b` within `margin`, into `touches`.
+fn push_touches(a: &Body, b: &Body, margin: f64, touches: &mut Vec<Touch>) {
+    let found = penetration(a, b, margin);
     let witnesses = found.as_slice();
     // the contacts exist when the deepest of them overlaps (distances of the grown shapes)
     if !witnesses.iter().any(|w| w.distance < 0.0) {

@@ -298,6 +298,10 @@ pub struct Query {
     pub iterations: usize,
     /// See the type's doc.
     pub cutoff: f64,
+    /// Both shapes are polytopes without margins (boxes, meshes, a height field's prisms):
+    /// GJK and EPA run to exact convergence (MuJoCo's "discrete geoms"), and EPA stops at a
+    /// support point whose two feature tags it has met before.
+    pub discrete: bool,
 }
 
 /// GJK from the points `start` of A and B: iterate `x ← nearest point of conv{simplex}` towards
@@ -307,8 +311,12 @@ pub struct Query {
 /// stops once `x·s/|x|` exceeds the cut-off.
 pub fn gjk(a: &impl Convex, b: &impl Convex, start: [Vec3; 2], query: &Query) -> Proximity {
     let wants_distance = query.cutoff > 0.0;
-    let epsilon = 0.5 * query.tolerance * query.tolerance;
-    let least_norm = if wants_distance {
+    let epsilon = if query.discrete {
+        0.0
+    } else {
+        0.5 * query.tolerance * query.tolerance
+    };
+    let least_norm = if wants_distance || query.discrete {
         TINY
     } else {
         query.tolerance

@@ -5,8 +5,8 @@
 //! ones MuJoCo's collision functions generate (read to understand, written anew here): the same
 //! number of contacts per pair, at the same points, with the same frames and distances.
 //!
-//! A contact between geoms A and B (A the one of lower MuJoCo type: plane, sphere, capsule,
-//! ellipsoid, cylinder, box, mesh) is
+//! A contact between geoms A and B (A the one of lower MuJoCo type: plane, height field,
+//! sphere, capsule, ellipsoid, cylinder, box, mesh) is
 //! ```text
 //!   distance d   signed: negative when they overlap (m)
 //!   position p   midway between the two surfaces along the normal
@@ -18,12 +18,14 @@
 //! cylinders, in closed form), [`boxes`] and [`box_box`] (boxes against spheres, capsules
 //! and boxes), and [`convex`] with [`gjk`] for the pairs MuJoCo collides by the support
 //! functions of convex shapes (an ellipsoid against anything, a cylinder against a capsule, a
-//! cylinder or a box), meshes by their convex hulls ([`hull`]).
+//! cylinder or a box), meshes by their convex hulls ([`hull`]), and height fields
+//! ([`height_field`]) prism by prism.
 
 pub mod box_box;
 pub mod boxes;
 pub mod convex;
 pub mod gjk;
+pub mod height_field;
 pub mod hull;
 pub mod pairs;
 pub mod primitives;
@@ -96,6 +98,7 @@ pub type Collider = fn(first: &Placed, second: &Placed, margin: f64, touches: &m
 pub fn type_rank(shape: &Shape) -> usize {
     match shape {
         Shape::Plane { .. } => 0,
+        Shape::HeightField { .. } => 1,
         Shape::Sphere { .. } => 2,
         Shape::Capsule { .. } => 3,
         Shape::Ellipsoid { .. } => 4,
@@ -136,7 +139,7 @@ pub fn contact_frame(normal: &Vec3, tangent: &Vec3) -> Mat3 {
 }
 
 /// The collision function of two shapes, the lower type first (`None`: a mesh without its hull,
-/// which is only drawn, or two planes, which never touch).
+/// which is only drawn, or two of planes and height fields, which never touch).
 pub fn collider(first: &Shape, second: &Shape) -> Option<Collider> {
     use Shape::*;
     let function: Collider = match (first, second) {
@@ -155,6 +158,8 @@ pub fn collider(first: &Shape, second: &Shape) -> Option<Collider> {
         (Box { .. }, Box { .. }) => box_box::box_box,
         (Plane { .. }, Ellipsoid { .. }) => convex::plane_convex,
         (Plane { .. }, _) | (_, Plane { .. }) => return None,
+        (HeightField { .. }, HeightField { .. }) => return None,
+        (HeightField { .. }, _) => convex::height_field_convex,
         _ => convex::convex_convex,
     };
     Some(function)
@@ -261,6 +266,7 @@ fn bounding_radius(shape: &Shape) -> f64 {
         Shape::Mesh {
             hull: Some(hull), ..
         } => hull.radius,
+        Shape::HeightField { field } => field.radius(),
         Shape::Plane { .. } | Shape::Mesh { hull: None, .. } => f64::INFINITY,
     }
 }

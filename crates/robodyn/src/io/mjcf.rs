@@ -43,6 +43,7 @@ mod contacts;
 mod defaults;
 mod equality;
 mod geoms;
+mod height_fields;
 mod inertia;
 mod keyframes;
 mod mass;
@@ -171,6 +172,8 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         mesh_cache: RefCell::new(HashMap::new()),
         mesh_triangles: RefCell::new(HashMap::new()),
         hull_cache: RefCell::new(HashMap::new()),
+        height_fields: HashMap::new(),
+        height_field_cache: RefCell::new(HashMap::new()),
         paired_geoms: HashSet::new(),
         textures: HashMap::new(),
         skybox: None,
@@ -210,6 +213,7 @@ fn load_sources(sources: &Sources) -> Result<Model> {
     }
     for asset in sections.iter().filter(|c| c.has_tag_name("asset")) {
         reader.read_assets(*asset)?;
+        reader.read_height_fields(*asset)?;
         reader.read_textures(*asset)?;
     }
     let mut builder = ModelBuilder::new(root.attribute("model").unwrap_or("mjcf"), "world");
@@ -317,6 +321,10 @@ struct Reader<'a> {
     mesh_triangles: RefCell<HashMap<String, std::rc::Rc<crate::io::mesh::TriangleMesh>>>,
     /// each mesh's convex hull for its collision geoms, built once
     hull_cache: RefCell<HashMap<String, std::sync::Arc<crate::collision::hull::ConvexHull>>>,
+    /// `<asset><hfield>` elements by name, and each field once read
+    height_fields: HashMap<String, Node<'a, 'a>>,
+    height_field_cache:
+        RefCell<HashMap<String, std::sync::Arc<crate::collision::height_field::HeightField>>>,
     /// the geoms a `<contact><pair>` names: they collide whatever their bits say
     paired_geoms: HashSet<String>,
     /// `<asset><texture>` elements by name, the first skybox, and `<compiler texturedir>` (or

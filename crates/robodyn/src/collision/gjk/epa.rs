@@ -239,6 +239,12 @@ fn expand(
     let mut upper = f64::MAX;
     let mut upper2 = f64::MAX;
     let mut best: Option<usize> = None;
+    // polytopes converge in finitely many steps: a tolerance of TINY only avoids absurd bounds
+    let tolerance = if query.discrete {
+        TINY
+    } else {
+        query.tolerance
+    };
     for k in 0..query.iterations.min(MAX_ITERATIONS) {
         let previous = best;
         // the candidate nearest the origin bounds the depth from below
@@ -264,10 +270,15 @@ fn expand(
         // n·w / |n| bounds the depth from above
         let upper_k = dot(&normal, &w) / lower;
         let bound = upper_k.min(upper);
-        if upper_k - lower < query.tolerance {
-            if k == 0 && lower - query.tolerance > bound {
+        if upper_k - lower < tolerance {
+            if k == 0 && lower - tolerance > bound {
                 best = None;
             }
+            break;
+        }
+        // a polytope's support point met before (by its features' tags): nothing more to find
+        let tags = polytope.vertices[w_index].tags;
+        if query.discrete && polytope.vertices[..w_index].iter().any(|v| v.tags == tags) {
             break;
         }
         if upper_k < upper {

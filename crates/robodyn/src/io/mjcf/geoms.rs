@@ -2,8 +2,8 @@
 //! a primitive fitted to a mesh) and kept twice: as a visual (what it looks like) and as a
 //! collision shape with its contact parameters (`contype`, `conaffinity`, `condim`, `priority`,
 //! `friction`, `solmix`, `solref`, `solimp`, `margin`, `gap`; MuJoCo's defaults, a class's values,
-//! leading values as MuJoCo reads them). Height fields and SDF geoms are neither drawn nor
-//! collided: a warning names each that could touch.
+//! leading values as MuJoCo reads them). SDF geoms are neither drawn nor collided: a warning
+//! names each that could touch.
 
 use super::Reader;
 use crate::error::Result;
@@ -34,7 +34,7 @@ impl<'a> Reader<'a> {
             let kind = self.geom_type(geom, class);
             let contype = self.integer(geom, class, "contype", 1)?;
             let conaffinity = self.integer(geom, class, "conaffinity", 1)?;
-            if matches!(kind.as_str(), "hfield" | "sdf") {
+            if kind == "sdf" {
                 if contype != 0 || conaffinity != 0 {
                     self.warnings.borrow_mut().push(format!(
                         "{}: a {kind} geom is not a collision shape robodyn models: nothing \

@@ -281,11 +281,20 @@ impl<'a> Reader<'a> {
             }
             // a plane has no mass (it may only be on a body welded to the world)
             "plane" => return Ok(Inertia::ZERO),
-            "hfield" => return Err(no_volume()),
             _ => {}
         }
-        // the shape checks the size, as the viewer reads it
-        let shape = self.geom_shape(geom, class, &kind, &size)?;
+        // the shape checks the size, as the viewer reads it; a height field weighs as MuJoCo's
+        // box of half-sides (s₀, s₁, s₂/4 + s₃/2)
+        let shape = match self.geom_shape(geom, class, &kind, &size)? {
+            Shape::HeightField { field } => Shape::Box {
+                half_extents: Vec3::new(
+                    field.half_extents[0],
+                    field.half_extents[1],
+                    0.25 * field.top + 0.5 * field.base,
+                ),
+            },
+            shape => shape,
+        };
         if text("shellinertia").as_deref() == Some("true") {
             return Err(self.error(
                 geom,
@@ -327,7 +336,9 @@ impl<'a> Reader<'a> {
                 let along = m_c * r * r / 2.0 + m_s * 0.4 * r * r;
                 (volume, Vec3::new(across, across, along))
             }
-            Shape::Plane { .. } | Shape::Mesh { .. } => return Err(no_volume()),
+            Shape::Plane { .. } | Shape::Mesh { .. } | Shape::HeightField { .. } => {
+                return Err(no_volume())
+            }
         };
         let mass = match given_mass {
             Some(mass) => mass,

@@ -31,6 +31,12 @@ impl<'a> Reader<'a> {
                     .ok_or_else(|| self.error(geom, "a mesh geom needs a 'mesh' attribute"))?;
                 return self.visual_mesh(geom, &name);
             }
+            "hfield" => {
+                let name = self.attribute(geom, class, "hfield").ok_or_else(|| {
+                    self.error(geom, "an hfield geom needs an 'hfield' attribute")
+                })?;
+                return self.height_field(geom, &name);
+            }
             other => {
                 return Err(self.error(
                     geom,
