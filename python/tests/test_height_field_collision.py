@@ -23,7 +23,9 @@ import robodyn
 import test_collision as pairs
 import test_mesh_collision as meshes
 from conftest import load_quietly
-from test_contact_dynamics import assert_matches_mujoco, load_both
+from robodyn.convert import MujocoLayout
+from test_contact_dynamics import assert_matches_mujoco, converged, load_both
+from test_menagerie import MENAGERIE, mujoco_model
 from test_scene_stepping import (
     ELLIPTIC_STEP_AGREEMENT,
     INTEGRATORS,
@@ -328,3 +330,39 @@ def test_the_viewer_draws_a_field_where_it_lies():
     # every edge shared by two faces, in opposite directions
     edges = {(int(f[k]), int(f[(k + 1) % 3])) for f in piece.faces for k in range(3)}
     assert len(edges) == 3 * len(piece.faces) and all((b, a) in edges for a, b in edges)
+
+
+# --- Menagerie's Barkour vB on its terrain -----------------------------------------------------
+
+#: A scene of Menagerie on a PNG height field (testdata/menagerie/README.md).
+BARKOUR = "google_barkour_vb/scene_hfield_mjx.xml"
+PLACES = 30
+#: Its contacts through robodyn's kinematics: a foot sunk wholly into a prism (lowered up to
+#: 20 cm) is EPA's, whose normal carries the placements' rounding further (measured: 1.6e-11 over
+#: 180 places, 8e-13 to 1.6e-11 per 30).
+BARKOUR_AGREEMENT = 1e-10
+
+
+def test_barkour_on_its_terrain_as_in_mujoco():
+    """Menagerie's Barkour vB at `home`, moved over its PNG terrain (the field 20 m wide, 5 cm
+    high) and lowered onto it: MuJoCo's contacts through robodyn's own kinematics (its feet are
+    spheres), and at a few of the places MuJoCo's forces."""
+    model = load_quietly(MENAGERIE / BARKOUR)
+    mj_model = converged(mujoco_model(MENAGERIE / BARKOUR, BARKOUR))
+    mj_data, layout = mujoco.MjData(mj_model), MujocoLayout(model, mj_model)
+    rng = np.random.default_rng(5)
+    touching = 0
+    for place in range(PLACES):
+        qpos = mj_model.key_qpos[0].copy()
+        qpos[0:2] += rng.uniform(-8, 8, size=2)
+        qpos[2] -= rng.uniform(0.0, 0.2)
+        expected = pairs.mujoco_contacts(mj_model, mj_data, qpos)
+        found = model.collide(layout.q_from_mujoco(qpos))
+        assert [(c["geom1"], c["geom2"]) for c in found] == [theirs[:2] for theirs in expected], place
+        for ours, theirs in zip(found, expected):
+            assert meshes.offset(ours, theirs) <= BARKOUR_AGREEMENT, place
+        touching += bool(expected)
+        if place < 3 and expected:
+            qvel = rng.normal(size=mj_model.nv) * 0.1
+            assert_matches_mujoco(model, mj_model, layout, qpos, qvel, label=f"place {place}", row_agreement=FIELD_ROW_AGREEMENT)
+    assert touching > PLACES // 2

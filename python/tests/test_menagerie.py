@@ -31,6 +31,7 @@ WITHOUT_MESHES = {
     "unitree_go2/scene.xml",
     "franka_emika_panda/mjx_panda.xml",
     "franka_emika_panda/mjx_single_cube.xml",
+    "google_barkour_vb/scene_hfield_mjx.xml",
 }
 
 
