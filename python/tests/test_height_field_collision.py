@@ -366,3 +366,18 @@ def test_barkour_on_its_terrain_as_in_mujoco():
             qvel = rng.normal(size=mj_model.nv) * 0.1
             assert_matches_mujoco(model, mj_model, layout, qpos, qvel, label=f"place {place}", row_agreement=FIELD_ROW_AGREEMENT)
     assert touching > PLACES // 2
+
+
+def test_planes_and_fields_never_touch_as_in_mujoco():
+    """A field on a body over a plane, and two fields: MuJoCo has no collision function for them,
+    and neither has robodyn; no warning calls their contacts missing."""
+    text = """<mujoco><asset><hfield name="t" nrow="2" ncol="2" size="1 1 1 1"/></asset><worldbody>
+      <geom name="floor" type="plane" size="1 1 1"/>
+      <body name="raft" pos="0 0 0.5"><freejoint/><geom name="raft" type="hfield" hfield="t" mass="1"/></body>
+      <body name="other" pos="0 0 1"><freejoint/><geom name="other" type="hfield" hfield="t" mass="1"/></body>
+    </worldbody></mujoco>"""
+    model, mj_model = load_quietly(text=text), mujoco.MjModel.from_xml_string(text)
+    assert len(model.contact_candidates) == 3
+    assert pairs.mujoco_contacts(mj_model, mujoco.MjData(mj_model), mj_model.qpos0) == []
+    assert model.collide(model.neutral()) == []
+    assert not any("not found yet" in message for message in model.warnings), model.warnings

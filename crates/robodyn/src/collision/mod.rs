@@ -165,6 +165,13 @@ pub fn collider(first: &Shape, second: &Shape) -> Option<Collider> {
     Some(function)
 }
 
+/// Whether two shapes never touch in MuJoCo: planes and height fields have no collision
+/// function between them (its table's empty entries).
+pub fn never_touch(first: &Shape, second: &Shape) -> bool {
+    let ground = |shape: &Shape| matches!(shape, Shape::Plane { .. } | Shape::HeightField { .. });
+    ground(first) && ground(second)
+}
+
 /// One contact between two of a model's geoms.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Contact {

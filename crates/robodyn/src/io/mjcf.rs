@@ -23,7 +23,7 @@
 //! computed: a warning says so when geoms could touch.
 //! Of the assets, the meshes are read, for the inertia of mesh geoms (`mjcf/meshes.rs`).
 
-use crate::collision::{checked_pairs, collider};
+use crate::collision::{checked_pairs, collider, never_touch};
 use crate::error::{Error, Result};
 use crate::io::read_model_file;
 use crate::io::schema;
@@ -260,7 +260,7 @@ fn load_sources(sources: &Sources) -> Result<Model> {
     // a warning only where MuJoCo would check some pair of geoms for contact
     let checked = checked_pairs(&model);
     if !checked.is_empty() && model.options.flag("contact") && model.options.flag("constraint") {
-        // the kinds of pairs whose contacts are not found yet
+        // the kinds of pairs whose contacts are not found yet (planes and fields never touch)
         let mut unfound: Vec<String> = Vec::new();
         for pair in &checked {
             let (one, other) = (
@@ -268,7 +268,8 @@ fn load_sources(sources: &Sources) -> Result<Model> {
                 &model.geoms[pair.geoms.1].shape,
             );
             let kinds = format!("{}–{}", one.kind(), other.kind());
-            if collider(one, other).is_none() && !unfound.contains(&kinds) {
+            let unmodelled = collider(one, other).is_none() && !never_touch(one, other);
+            if unmodelled && !unfound.contains(&kinds) {
                 unfound.push(kinds);
             }
         }
