@@ -22,13 +22,13 @@ use crate::visual::Shape;
 /// The most contacts of one pair (MuJoCo's `mjMAXCONPAIR`).
 pub const MAX_CONTACTS: usize = 50;
 
-/// Slides the prism's corners along the strip: the oldest corner leaves, `(x, y)` on the base
-/// and on the surface at `z` comes last.
-fn slide_in(corners: &mut [Vec3; 6], x: f64, y: f64, z: f64, base: f64) {
+/// Slides the prism's corners along the strip: the oldest corner leaves, the surface's point
+/// `surface` and the base's below it (at z = −`base`) come last.
+fn slide_in(corners: &mut [Vec3; 6], surface: Vec3, base: f64) {
     corners.copy_within(1..3, 0);
     corners.copy_within(4..6, 3);
-    corners[2] = Vec3::new(x, y, -base);
-    corners[5] = Vec3::new(x, y, z);
+    corners[2] = Vec3::new(surface.x, surface.y, -base);
+    corners[5] = surface;
 }
 
 /// Height field `first` against a convex `second` (see the module's header): contacts with
@@ -48,17 +48,13 @@ pub fn height_field_convex(first: &Placed, second: &Placed, margin: f64, touches
         return;
     };
     let [sx, sy] = field.half_extents;
-    let (top, base) = (field.top, field.base);
+    let base = field.base;
     // 1: its bounding sphere, then its bounding box, must reach the field's box
-    let p = local.position;
-    let reach = bounding_radius(second.shape) + margin;
-    if p.x - reach > sx
-        || p.x + reach < -sx
-        || p.y - reach > sy
-        || p.y + reach < -sy
-        || p.z - reach > top
-        || p.z + reach < -base
-    {
+    let (low_corner, high_corner) = (Vec3::new(-sx, -sy, -base), Vec3::new(sx, sy, field.top));
+    let apart =
+        |low: Vec3, high: Vec3| (0..3).any(|k| low[k] > high_corner[k] || high[k] < low_corner[k]);
+    let reach = Vec3::repeat(bounding_radius(second.shape) + margin);
+    if apart(local.position - reach, local.position + reach) {
         return;
     }
     let extent = |k: usize| {
@@ -69,13 +65,12 @@ pub fn height_field_convex(first: &Placed, second: &Placed, margin: f64, touches
         (geom.support(&d).0[k], high)
     };
     let ((x_min, x_max), (y_min, y_max), (z_min, z_max)) = (extent(0), extent(1), extent(2));
-    if x_min - margin > sx
-        || x_max + margin < -sx
-        || y_min - margin > sy
-        || y_max + margin < -sy
-        || z_min - margin > top
-        || z_max + margin < -base
-    {
+    let grown = Vec3::repeat(margin);
+    let (low, high) = (
+        Vec3::new(x_min, y_min, z_min),
+        Vec3::new(x_max, y_max, z_max),
+    );
+    if apart(low - grown, high + grown) {
         return;
     }
     // 2: the cells under the box grown by the margin
@@ -86,26 +81,16 @@ pub fn height_field_convex(first: &Placed, second: &Placed, margin: f64, touches
     let r_min = (grid(y_min - margin, sy, rows).floor() as i64).max(0);
     let r_max = (grid(y_max + margin, sy, rows).ceil() as i64).min(rows - 1);
     // 3: the prisms of each row's strip, two a cell
-    let (dx, dy) = field.spacing();
-    let surface = |r: i64, c: i64| {
-        let (r, c) = (r as usize, c as usize);
-        (
-            dx * c as f64 - sx,
-            dy * r as f64 - sy,
-            field.elevations[r * field.columns + c] * top,
-        )
-    };
+    let surface = |r: i64, c: i64| field.sample(r as usize, c as usize);
     let start = touches.len();
     let mut corners = [Vec3::zeros(); 6];
     'strips: for r in r_min..r_max {
         for row in [r + 1, r] {
-            let (x, y, z) = surface(row, c_min);
-            slide_in(&mut corners, x, y, z, base);
+            slide_in(&mut corners, surface(row, c_min), base);
         }
         for c in c_min + 1..=c_max {
             for row in [r + 1, r] {
-                let (x, y, z) = surface(row, c);
-                slide_in(&mut corners, x, y, z, base);
+                slide_in(&mut corners, surface(row, c), base);
                 // a top wholly below the geom, by more than the margin, touches nothing
                 if corners[3..].iter().all(|v| v.z + margin < z_min) {
                     continue;
