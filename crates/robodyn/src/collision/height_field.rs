@@ -38,7 +38,8 @@ pub struct HeightField {
 impl HeightField {
     /// A field of `rows × columns` `samples` (row 0 along −y) scaled to [0, 1] as MuJoCo's
     /// compiler scales them, in single precision: `e = (h − min h)/(max h − min h)`, or
-    /// `h − min h` when the range is below [`FLAT_RANGE`]. `size` is MJCF's: half-sides, top, base.
+    /// `h − min h` when the range is below [`FLAT_RANGE`]. `size` is MJCF's: half-sides, top,
+    /// base.
     pub fn new(
         size: [f64; 4],
         rows: usize,
@@ -68,16 +69,10 @@ impl HeightField {
         let low = samples.iter().copied().fold(f32::INFINITY, f32::min);
         let high = samples.iter().copied().fold(f32::NEG_INFINITY, f32::max);
         let range = high - low;
+        let scaled = f64::from(range) > FLAT_RANGE;
         let elevations = samples
             .iter()
-            .map(|&h| {
-                let shifted = h - low;
-                f64::from(if f64::from(range) > FLAT_RANGE {
-                    shifted / range
-                } else {
-                    shifted
-                })
-            })
+            .map(|&h| f64::from(if scaled { (h - low) / range } else { h - low }))
             .collect();
         Ok(HeightField {
             half_extents: [size[0], size[1]],

@@ -204,14 +204,16 @@ fn png_samples(bytes: &[u8]) -> std::result::Result<(usize, usize, Vec<f32>), St
 
 /// MuJoCo's binary height field: `nrow`, `ncol` (int32), then `nrow × ncol` float32.
 fn binary_samples(bytes: &[u8]) -> std::result::Result<(usize, usize, Vec<f32>), String> {
-    let word = |k: usize| -> [u8; 4] { bytes[4 * k..4 * k + 4].try_into().expect("four bytes") };
+    // little-endian 32-bit words, four bytes each
+    let words = || bytes.chunks_exact(4).map(|w| [w[0], w[1], w[2], w[3]]);
     if bytes.len() < 8 {
         return Err(format!(
             "expected a header of two 32-bit integers, got {} bytes",
             bytes.len()
         ));
     }
-    let (rows, columns) = (i32::from_le_bytes(word(0)), i32::from_le_bytes(word(1)));
+    let mut header = words().map(i32::from_le_bytes);
+    let (rows, columns) = (header.next().unwrap_or(0), header.next().unwrap_or(0));
     if rows < 1 || columns < 1 {
         return Err(format!(
             "expected positive nrow and ncol in the header, got {rows} and {columns}"
@@ -225,8 +227,6 @@ fn binary_samples(bytes: &[u8]) -> std::result::Result<(usize, usize, Vec<f32>),
             bytes.len()
         ));
     }
-    let samples = (0..rows * columns)
-        .map(|k| f32::from_le_bytes(word(2 + k)))
-        .collect();
+    let samples = words().skip(2).map(f32::from_le_bytes).collect();
     Ok((rows, columns, samples))
 }
