@@ -114,6 +114,7 @@ class MimicModel(ConstrainedMethods):
             self.coupling[idx_v[f], reduced_v[idx_v[r]]] = ratio
         # the velocity coordinate of each one-coordinate joint's configuration coordinate
         self._velocity_of = {idx_q[k]: idx_v[k] for k, kind in enumerate(kinds) if kind in ONE_COORDINATE_JOINTS}
+        self._joint_at = {idx_q[k]: name for k, name in enumerate(names)}
         # E: a reduced generalized force as a full one on the kept coordinates (Gᵀ E = 1)
         self._selection = np.zeros((full.nv, len(reduced_v)))
         self._selection[self.independent_v, np.arange(len(reduced_v))] = 1.0
@@ -258,17 +259,60 @@ class MimicModel(ConstrainedMethods):
         """Where the reduced coordinate's springs balance: the springs of a group,
         −k_k (r_k q + b_k − q_ref,k) summed through Gᵀ, pull towards
         Σ r_k k_k (q_ref,k − b_k) / Σ r_k² k_k (the kept coordinates' own reference where the
-        group has no spring)."""
+        group has no spring; a group's one spring's (q_ref,k − b_k) / r_k, whatever its terms)."""
         full = self.full
         reference = np.asarray(full.spring_reference)[self.independent_q].copy()
         stiffness = np.asarray(full.stiffness)
         for j in range(self.nq):
             group = self._q_group(j)
+            springs = self._springs_of(group)
             total = sum(r * r * stiffness[self._velocity_of[k]] for k, r in group)
-            if len(group) > 1 and total > 0:
+            if len(group) > 1 and len(springs) == 1:
+                k, r = springs[0]
+                reference[j] = (full.spring_reference[k] - self._q_offset[k]) / r
+            elif len(group) > 1 and total > 0:
                 reference[j] = sum(r * stiffness[self._velocity_of[k]] * (full.spring_reference[k] - self._q_offset[k])
                                    for k, r in group) / total
         return reference
+
+    def _springs_of(self, group: list[tuple[int, float]]) -> list[tuple[int, float]]:
+        """The members of a group (full configuration coordinate, r) that have a spring."""
+        stiffness, terms = np.asarray(self.full.stiffness), np.asarray(self.full.stiffness_poly)
+        return [(k, r) for k, r in group
+                if stiffness[self._velocity_of[k]] != 0 or np.any(terms[self._velocity_of[k]] != 0)]
+
+    @property
+    def stiffness_poly(self) -> np.ndarray:
+        """The springs' higher terms per reduced coordinate, (nv, 2): a group's one spring
+        −(k + k₁ x + k₂ x²) x with x = r s (s = q − q_ref on the reduced coordinate) pulls it
+        with r x, that is (r³ k₁, r⁴ k₂). A group with polynomial terms and more than one spring
+        has no such pair (ValueError naming it: read m.full.stiffness_poly)."""
+        terms = np.asarray(self.full.stiffness_poly)
+        for j in range(self.nq):
+            springs = self._springs_of(self._q_group(j))
+            if len(springs) > 1 and any(np.any(terms[self._velocity_of[k]] != 0) for k, _ in springs):
+                names = [self._joint_at[k] for k, _ in springs]
+                raise ValueError(f"argument 'stiffness_poly': reduced coordinate {j} moves {len(springs)} springs "
+                                 f"with polynomial terms ({', '.join(names)}), whose sum is no polynomial of it: "
+                                 "read m.full.stiffness_poly")
+        g = self.coupling.T
+        return np.column_stack([g**3 @ terms[:, 0], g**4 @ terms[:, 1]])
+
+    @stiffness_poly.setter
+    def stiffness_poly(self, value: Any) -> None:
+        _set_on_full("stiffness_poly")
+
+    @property
+    def damping_poly(self) -> np.ndarray:
+        """The dampers' higher terms per reduced coordinate, (nv, 2): each follower's
+        −(b + b₁ |r q̇| + b₂ r² q̇²) r q̇ pulls with r times it, so (Σ |r|³ b₁, Σ r⁴ b₂) over the
+        group (exact)."""
+        terms = np.asarray(self.full.damping_poly)
+        return np.column_stack([self._diagonal(terms[:, 0], 3), self._diagonal(terms[:, 1], 4)])
+
+    @damping_poly.setter
+    def damping_poly(self, value: Any) -> None:
+        _set_on_full("damping_poly")
 
     spring_reference = property(_spring_reference, lambda self, value: _set_on_full("spring_reference"),
                                 doc=_spring_reference.__doc__)

@@ -84,3 +84,14 @@ def load_quietly(path=None, text=None):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", robodyn.ModelWarning)
         return robodyn.load(path) if text is None else robodyn.load_mjcf_string(text)
+
+
+def assert_refused_as_in_mujoco(text, match):
+    """robodyn refuses the MJCF string `text` with a ValueError matching `match`, and MuJoCo refuses
+    it too."""
+    import mujoco
+
+    with pytest.raises(ValueError, match=match):
+        load_quietly(None, text)
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_string(text)

@@ -111,14 +111,14 @@ def test_what_is_not_modelled_warns_and_bad_input_is_refused():
     model = robodyn.load_mjcf_string(unmodelled)
     assert [w for w in model.warnings if "<muscle" in w and "not read" in w and "no force" in w]
     assert model.nu == 7 and model.na == 1  # it keeps its place in the controls and the activations
-    # a polynomial damping (MuJoCo's actuator_dampingpoly) keeps its linear term, and says so
+    # a polynomial damping (MuJoCo's actuator_dampingpoly) joins its joint's, times gear²
     polynomial = ACTUATED.replace('<motor name="push" joint="slide" gear="2"/>',
                                   '<motor name="push" joint="slide" gear="2" damping="0.5 0.2"/>')
     assert mujoco.MjModel.from_xml_string(polynomial).actuator_dampingpoly[0, 0] == 0.2
-    warned = robodyn.load_mjcf_string(polynomial).warnings
-    assert [w for w in warned if "<motor name='push'>" in w and "a polynomial 'damping' on a joint not modelled" in w], warned
-    linear = polynomial.replace('damping="0.5 0.2"', 'damping="0.5 0 0"')
-    assert not [w for w in robodyn.load_mjcf_string(linear).warnings if "polynomial" in w]
+    damped = robodyn.load_mjcf_string(polynomial)
+    assert not [w for w in damped.warnings if "polynomial" in w], damped.warnings
+    slide = damped.joint_idx_v[damped.joint_names.index("slide")]
+    assert damped.damping_poly[slide].tolist() == [4 * 0.2, 0.0]
     # more than b b₁ b₂: refused, as MuJoCo refuses it
     four = polynomial.replace('damping="0.5 0.2"', 'damping="0.5 0.2 0.1 0.3"')
     with pytest.raises(ValueError, match=r"attribute 'damping': expected at most 3 numbers \(c c₁ c₂\), got 4"):

@@ -7,12 +7,13 @@ Menagerie and mjlab."""
 from __future__ import annotations
 
 import importlib.util
+import re
 from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
-from conftest import REPOSITORY, assert_close
+from conftest import REPOSITORY, assert_close, assert_refused_as_in_mujoco
 from conftest import load_quietly as load
 
 import robodyn
@@ -427,3 +428,97 @@ def test_what_tendons_robodyn_does_not_model_are_named():
     mujoco.mj_forward(mj_model, d)
     tau = model.actuator_forces(q, np.zeros(model.nv), [1.0, 1.0])
     assert_close(tau, layout.force_from_mujoco(q, d.qfrc_actuator), 1e-12, "and gear × J on the wrapped tendon")
+
+
+@pytest.mark.parametrize(
+    ("original", "change", "neutral", "warning"),
+    [
+        ('margin="0.05"/>', 'margin="0.05" springyield="5"/>', 'springyield="0"',
+         r"<joint name='knee'> \(line \d+\): attribute 'springyield' not modelled \(the spring stays elastic"),
+        ('margin="0.05"/>', 'margin="0.05" actuatorgravcomp="true"/>', 'actuatorgravcomp="false"',
+         r"<joint name='knee'> \(line \d+\): attribute 'actuatorgravcomp' not modelled"),
+        ('<geom name="ankle" size="0.03"/>', '<geom name="ankle" size="0.03" adhesion="2"/>', 'adhesion="0"',
+         r"<geom name='ankle'> \(line \d+\): attribute 'adhesion' not modelled \(robodyn models no adhesion\)"),
+        ('<geom name="ankle" size="0.03"/>', '<geom name="ankle" size="0.03" surfacevel="0 0 1"/>', 'surfacevel="0 0 0"',
+         r"<geom name='ankle'> \(line \d+\): attribute 'surfacevel' not modelled"),
+    ],
+)
+def test_what_mujoco_reads_and_robodyn_does_not_model_is_named(original, change, neutral, warning):
+    """Each attribute that changes MuJoCo's result and that robodyn does not model warns, naming
+    the element and its line; at its neutral value it does not."""
+    assert SCENE.count(original) == 1
+    text = SCENE.replace(original, change)
+    mujoco.MjModel.from_xml_string(text)
+    messages = "\n".join(load(text=text).warnings)
+    assert re.search(warning, messages), messages
+    attribute = neutral.split("=")[0]
+    calm = re.sub(rf'{attribute}="[^"]*"', neutral, text)
+    assert not [w for w in load(text=calm).warnings if f"'{attribute}'" in w]
+
+
+def test_a_mocap_body_and_an_aligned_free_body_are_named():
+    """A mocap body is held where the file places it; MuJoCo's alignment of a childless free body
+    with its inertial frame (freejoint align, compiler alignfree) changes what its qpos means."""
+    extra = ('<body name="target" pos="1 0 1" mocap="true"><geom size="0.05" contype="0" conaffinity="0"/></body>'
+             '<body name="puck" pos="0 1 1"><freejoint name="puck"{align}/><geom size="0.1" pos="0.02 0 0"/></body>'
+             "</worldbody>")
+    for align, compiler, aligned in [("", "", False), (' align="true"', "", True), ("", ' alignfree="true"', True),
+                                     (' align="false"', ' alignfree="true"', False)]:
+        text = SCENE.replace("</worldbody>", extra.replace("{align}", align)).replace(
+            'angle="degree"', f'angle="degree"{compiler}')
+        mujoco.MjModel.from_xml_string(text)
+        messages = "\n".join(load(text=text).warnings)
+        assert re.search(r"<body name='target'> \(line \d+\): attribute 'mocap' not modelled", messages)
+        assert ("<freejoint name='puck'>" in messages and "free-joint alignment not followed" in messages) == aligned
+        # the base has children: MuJoCo aligns only childless free bodies
+        assert "<freejoint name='root'>" not in messages
+
+
+def test_flags_and_plugins_robodyn_does_not_follow_are_named():
+    flags = SCENE.replace('<flag warmstart="disable" energy="enable"/>',
+                          '<flag multiccd="disable" diagexact="enable" sleep="enable"/>')
+    messages = "\n".join(load(text=flags).warnings)
+    assert all(f"'{flag}'" in messages for flag in ["multiccd", "diagexact", "sleep"]), messages
+    assert "'warmstart'" not in "\n".join(load(text=SCENE).warnings)
+    plugin = SCENE.replace('<body name="toe" pos="0.05 0 -0.25">',
+                           '<body name="toe" pos="0.05 0 -0.25"><plugin plugin="mujoco.elasticity.cable"/>')
+    assert re.search(r"<plugin> \(line \d+\): not read \(robodyn runs no MuJoCo plugins", "\n".join(load(text=plugin).warnings))
+
+
+def test_an_actuator_delay_is_named():
+    text = SCENE.replace("</contact>", '</contact><actuator><motor name="m" joint="hip" delay="0.01" nsample="5"/></actuator>')
+    assert mujoco.MjModel.from_xml_string(text).nu == 1
+    messages = "\n".join(load(text=text).warnings)
+    assert re.search(r"<motor name='m'> \(line \d+\): attribute 'delay' not modelled \(the control acts at once\)", messages)
+
+
+def test_a_deformable_section_is_named():
+    text = SCENE.replace("</contact>", "</contact><deformable/>")
+    assert [w for w in load(text=text).warnings if "<deformable>" in w and "not read" in w]
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (('angle="degree"', 'angle="degree" autolimits="false"'),
+         r"<joint name='hip'> \(line \d+\): attribute 'range' without 'limited': with <compiler autolimits=\"false\">"),
+        (('angle="degree"', 'angle="degree" coordinate="global"'),
+         r"<compiler> \(line \d+\): attribute 'coordinate': global coordinates are refused"),
+    ],
+)
+def test_compiler_settings_mujoco_refuses_are_refused(change, message):
+    assert_refused_as_in_mujoco(SCENE.replace(*change), message)
+
+
+def test_autolimits_false_takes_an_explicit_limited():
+    """With autolimits="false" every range says whether it limits (joints, tendons, actuators)."""
+    text = SCENE.replace('angle="degree"', 'angle="degree" autolimits="false"').replace(
+        'range="-60 60"', 'range="-60 60" limited="true"').replace('range="-120 0"', 'range="-120 0" limited="false"')
+    model = load(text=text)
+    compiled = mujoco.MjModel.from_xml_string(text)
+    assert compiled.jnt_limited.tolist() == [0, 1, 0]
+    knee = model.joint_idx_q[model.joint_names.index("knee")]
+    hip = model.joint_idx_q[model.joint_names.index("hip")]
+    assert np.isinf(model.lower_position_limit[knee]) and model.lower_position_limit[hip] == pytest.approx(-np.pi / 3)
+    actuated = text.replace("</contact>", '</contact><actuator><motor joint="hip" ctrlrange="-1 1"/></actuator>')
+    assert_refused_as_in_mujoco(actuated, r"attribute 'ctrlrange' without 'ctrllimited'")

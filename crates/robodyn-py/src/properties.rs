@@ -188,6 +188,36 @@ impl PyModel {
         Ok(())
     }
 
+    /// The springs' higher coefficients (k₁, k₂) per velocity coordinate, shape (nv, 2) (MJCF
+    /// `stiffness="k k₁ k₂"`): the spring's force is −(k + k₁ s + k₂ s²) d, s the signed
+    /// displacement of a hinge or slide, the length of a ball's or either half of a free
+    /// joint's. Settable (finite; one pair per ball and per half of a free joint).
+    #[getter]
+    fn get_stiffness_poly<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        pairs_array(py, &self.model.stiffness_poly)
+    }
+
+    #[setter]
+    fn set_stiffness_poly(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        self.forget_scene_step();
+        let pairs = read_pairs("stiffness_poly", value, self.model.nv)?;
+        self.model.set_stiffness_poly(&pairs).map_err(to_py_err)
+    }
+
+    /// The dampers' higher coefficients (b₁, b₂) per velocity coordinate, shape (nv, 2) (MJCF
+    /// `damping="b b₁ b₂"`): the damper's force is −(b + b₁ |q̇| + b₂ q̇²) q̇. Settable (finite).
+    #[getter]
+    fn get_damping_poly<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        pairs_array(py, &self.model.damping_poly)
+    }
+
+    #[setter]
+    fn set_damping_poly(&mut self, value: &Bound<PyAny>) -> PyResult<()> {
+        self.forget_scene_step();
+        let pairs = read_pairs("damping_poly", value, self.model.nv)?;
+        self.model.set_damping_poly(&pairs).map_err(to_py_err)
+    }
+
     /// The configuration at which the joint springs are relaxed, shape (nq,) (MJCF `springref`;
     /// neutral for spherical and free joints), settable to any valid configuration.
     #[getter]
@@ -453,4 +483,18 @@ fn warn_model(py: Python<'_>, messages: &[String]) -> PyResult<()> {
 pub(crate) fn check_physical_parameters(parameters: [f64; 10]) -> PyResult<()> {
     robodyn::model::check_physical_parameters(&parameters)
         .map_err(|defect| PyValueError::new_err(defect.to_string()))
+}
+
+/// Pairs per velocity coordinate as an (n, 2) array.
+fn pairs_array<'py>(py: Python<'py>, pairs: &[[f64; 2]]) -> PyResult<Bound<'py, PyAny>> {
+    let flat: Vec<f64> = pairs.iter().flatten().copied().collect();
+    Ok(PyArray1::from_vec(py, flat)
+        .reshape([pairs.len(), 2])?
+        .into_any())
+}
+
+/// An (n, 2) array argument as pairs.
+fn read_pairs(name: &'static str, value: &Bound<PyAny>, n: usize) -> PyResult<Vec<[f64; 2]>> {
+    let flat = read_sample(name, value, SampleShape::matrix(n, 2))?;
+    Ok(flat.chunks_exact(2).map(|p| [p[0], p[1]]).collect())
 }

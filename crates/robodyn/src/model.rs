@@ -8,6 +8,7 @@ mod geom;
 mod keyframe;
 mod options;
 mod physical;
+mod springs;
 mod tendon;
 
 pub use actuator::{ActivationDynamics, Actuator, ActuatorForce};
@@ -95,6 +96,12 @@ pub struct JointProperties {
     pub friction: f64,
     /// Joint spring stiffness (MJCF `stiffness`), pulling q towards `spring_reference`.
     pub stiffness: f64,
+    /// The spring's higher coefficients k₁, k₂ (MJCF `stiffness="k k₁ k₂"`): its force is
+    /// −x (k + k₁ x + k₂ x²) ([`Model::spring_forces`]).
+    pub stiffness_poly: [f64; 2],
+    /// The damper's higher coefficients b₁, b₂ (MJCF `damping="b b₁ b₂"`): its force is
+    /// −q̇ (b + b₁ |q̇| + b₂ q̇²) ([`Model::damper_force`]).
+    pub damping_poly: [f64; 2],
     /// The position at which the spring is relaxed (MJCF `springref`); one-coordinate joints only.
     pub spring_reference: f64,
     /// How its limit and dry friction act in MuJoCo's soft constraint model.
@@ -115,6 +122,8 @@ impl Default for JointProperties {
             damping: 0.0,
             friction: 0.0,
             stiffness: 0.0,
+            stiffness_poly: [0.0; 2],
+            damping_poly: [0.0; 2],
             spring_reference: 0.0,
             softness: JointSoftness::default(),
             actuator_force_range: None,
@@ -197,6 +206,12 @@ pub struct Model {
     /// Joint spring stiffness per velocity coordinate, length nv. Kept for simulation, like
     /// damping and friction.
     pub stiffness: DVector<f64>,
+    /// The springs' higher coefficients (k₁, k₂) per velocity coordinate, length nv (the
+    /// joint's on each of its coordinates; [`Model::spring_forces`]).
+    pub stiffness_poly: Vec<[f64; 2]>,
+    /// The dampers' higher coefficients (b₁, b₂) per velocity coordinate, length nv
+    /// ([`Model::damper_force`]).
+    pub damping_poly: Vec<[f64; 2]>,
     /// The configuration where the joint springs are relaxed, length nq (the neutral
     /// configuration for spherical and free joints).
     pub spring_reference: DVector<f64>,

@@ -6,8 +6,10 @@
 //!
 //! - Springs: stiffness K per velocity coordinate, relaxed at `spring_reference` (MJCF `stiffness`
 //!   and `springref`; the UR5 dynamics notes' spring potential ½ k (q − q_ref)²). On spherical and free joints
-//!   q ⊖ q_ref is the rotation (and displacement) on the group.
-//! - Viscous damping D (URDF `<dynamics damping>`, MJCF `damping`).
+//!   q ⊖ q_ref is the rotation (and displacement) on the group. MJCF's polynomial terms make K
+//!   depend on the stretch ([`Model::spring_forces`]).
+//! - Viscous damping D (URDF `<dynamics damping>`, MJCF `damping`; with MJCF's polynomial terms
+//!   D depends on the speed, [`Model::damper_force`]).
 //! - Coulomb friction F_c (URDF `friction`, MJCF `frictionloss`), smoothed: the ideal
 //!   −F_c sign(q̇) is discontinuous at rest, which no explicit integrator can follow; tanh(q̇/v_s)
 //!   reaches 76 % of F_c at q̇ = v_s and 99.9 % at 4 v_s. A joint held by friction creeps
@@ -81,22 +83,23 @@ impl PassiveForces {
 
     /// τ_passive(q, q̇) into `tau` (nv). `q` must be a valid configuration.
     pub fn torque(&self, model: &Model, q: &[f64], v: &[f64], tau: &mut [f64]) {
-        // springs: −K (q ⊖ q_ref), with q ⊖ q_ref written into tau first (none without springs:
-        // the Lie-group differences are the costly part)
-        if model.stiffness.iter().any(|k| *k != 0.0) {
+        // springs: −(k + k₁ s + k₂ s²)(q ⊖ q_ref), with q ⊖ q_ref written into tau first (none
+        // without springs: the Lie-group differences are the costly part)
+        if model.has_springs() {
             spring_displacement(model, q, tau);
+            model.spring_forces(tau);
         } else {
             tau.fill(0.0);
         }
         for (k, value) in tau.iter_mut().enumerate() {
-            // −k (q − q_ref) − d q̇ − f_c tanh(q̇ / v_s), the tanh only where there is friction
+            // −(b + b₁ |q̇| + b₂ q̇²) q̇ − f_c tanh(q̇ / v_s), the tanh only where there is friction
             let f_c = model.friction[k];
             let friction = if f_c == 0.0 {
                 0.0
             } else {
                 f_c * (v[k] / self.friction_velocity).tanh()
             };
-            *value = -model.stiffness[k] * *value - model.damping[k] * v[k] - friction;
+            *value += model.damper_force(k, v[k]) - friction;
         }
         if let LimitModel::Penalty { stiffness, damping } = self.limits {
             for (dof, push) in limit_penalties(model, (stiffness, damping), q, v) {
@@ -106,8 +109,9 @@ impl PassiveForces {
     }
 
     /// ∂τ_passive/∂q (tangent space, right perturbations) and ∂τ_passive/∂q̇ into `d_q` and `d_v`
-    /// (nv × nv; block-diagonal by joint). Springs: −K ∂(q ⊖ q_ref)/∂q; damping −D; friction
-    /// −F_c sech²(q̇/v_s)/v_s; the limit penalty −k_l and −b_l where it pushes (zero where clipped).
+    /// (nv × nv; block-diagonal by joint). Springs: ∂f/∂d ∂(q ⊖ q_ref)/∂q
+    /// ([`Model::joint_spring_slope`], −K without polynomial terms); dampers their slopes
+    /// ([`Model::damper_slope`], −D); friction −F_c sech²(q̇/v_s)/v_s; the limit penalty −k_l and −b_l where it pushes (zero where clipped).
     pub fn jacobians(
         &self,
         model: &Model,
@@ -120,21 +124,28 @@ impl PassiveForces {
         d_v.as_mut_slice().fill(0.0);
         for i in 1..model.nbodies() {
             let (configuration, dofs) = (model.q_range(i), model.v_range(i));
-            // ∂(q ⊖ q_ref)/∂q, the joint's block
+            // ∂f/∂q = ∂f/∂d ∂(q ⊖ q_ref)/∂q, the joint's block, d = q ⊖ q_ref
             let (mut d_reference, mut d_displacement) = (Mat6::zeros(), Mat6::zeros());
+            let reference = &model.spring_reference.as_slice()[configuration.clone()];
             model.joints[i].difference_jacobians(
-                &model.spring_reference.as_slice()[configuration.clone()],
-                &q[configuration],
+                reference,
+                &q[configuration.clone()],
                 &mut d_reference,
                 &mut d_displacement,
             );
+            let mut displacement = [0.0; 6];
+            let nv = dofs.len();
+            model.joints[i].difference(reference, &q[configuration], &mut displacement[..nv]);
+            let mut slope = Mat6::zeros();
+            model.joint_spring_slope(i, &displacement[..nv], &mut slope);
+            let spring = slope * d_displacement;
             for (r, row) in dofs.clone().enumerate() {
                 for (c, column) in dofs.clone().enumerate() {
-                    d_q[(row, column)] = -model.stiffness[row] * d_displacement[(r, c)];
+                    d_q[(row, column)] = spring[(r, c)];
                 }
-                // d/dq̇ [−d q̇ − f_c tanh(q̇ / v_s)]
+                // d/dq̇ [−(b + b₁ |q̇| + b₂ q̇²) q̇ − f_c tanh(q̇ / v_s)]
                 let slope = (v[row] / self.friction_velocity).tanh();
-                d_v[(row, row)] = -model.damping[row]
+                d_v[(row, row)] = model.damper_slope(row, v[row])
                     - model.friction[row] * (1.0 - slope * slope) / self.friction_velocity;
             }
         }
@@ -176,14 +187,11 @@ fn limit_penalties<'a>(
         })
 }
 
-/// The energy stored in the joint springs, ½ Σ k (q ⊖ q_ref)²; `scratch` (nv) holds q ⊖ q_ref.
+/// The energy stored in the joint springs, Σ (k s²/2 + k₁ s³/3 + k₂ s⁴/4) over their stretches
+/// s ([`Model::spring_energy_at`]); `scratch` (nv) holds q ⊖ q_ref.
 pub fn spring_energy(model: &Model, q: &[f64], scratch: &mut [f64]) -> f64 {
     spring_displacement(model, q, scratch);
-    0.5 * scratch
-        .iter()
-        .zip(model.stiffness.iter())
-        .map(|(d, k)| k * d * d)
-        .sum::<f64>()
+    model.spring_energy_at(scratch)
 }
 
 /// q ⊖ q_ref, joint by joint on its group, into `out` (nv).

@@ -8,8 +8,11 @@
 //! `pos`, orientation, `diaginertia` or `fullinertia`), `<geom>`s (for the inertia of a body
 //! without `<inertial>`, as visuals and as collision shapes: `mjcf/geoms.rs`), `<joint>` (`hinge`,
 //! `slide`, `ball`, `free`; `pos`, `axis`, `ref`, `range`, `armature`, `damping`, `frictionloss`,
-//! `stiffness`, `springref`, and the soft limit's and friction's `solreflimit`, `solimplimit`,
-//! `margin`, `solreffriction`, `solimpfriction`), `<freejoint>` and `<site>`s.
+//! `stiffness` (both with polynomial terms), `springref`, `springdamper`, and the soft limit's and
+//! friction's `solreflimit`, `solimplimit`, `margin`, `solreffriction`, `solimpfriction`),
+//! `<freejoint>` and `<site>`s.
+//! A body's `gravcomp` is kept for the scene's dynamics; the attributes MuJoCo reads and robodyn
+//! does not model warn where given (`mjcf/unmodelled.rs`).
 //! Bodies and sites become frames; a body without joints is merged into its parent; several joints
 //! in one body become a chain of massless bodies, applied in order as MuJoCo does. A free joint's
 //! q is the body's pose in the world (the XML pose is only MuJoCo's initial qpos).
@@ -45,6 +48,7 @@ mod equality;
 mod geoms;
 mod height_fields;
 mod inertia;
+mod joints;
 mod keyframes;
 mod mass;
 mod meshes;
@@ -52,6 +56,7 @@ mod options;
 mod schema_table;
 mod tendons;
 mod textures;
+mod unmodelled;
 mod visuals;
 
 use actuator_defaults::ClassActuator;
@@ -60,7 +65,7 @@ use mass::MassRules;
 use schema_table::MJCF_SCHEMA;
 
 /// Sections of an MJCF file that do not describe the tree.
-const IGNORED_SECTIONS: [&str; 3] = ["sensor", "visual", "statistic"];
+const IGNORED_SECTIONS: [&str; 4] = ["sensor", "visual", "statistic", "deformable"];
 
 /// Loads an MJCF file and the files it includes.
 pub fn load_mjcf_file(path: &Path) -> Result<Model> {
@@ -169,6 +174,8 @@ fn load_sources(sources: &Sources) -> Result<Model> {
         materials: HashMap::new(),
         mesh_directory: None,
         fit_aabb: false,
+        auto_limits: true,
+        align_free: false,
         mesh_cache: RefCell::new(HashMap::new()),
         mesh_triangles: RefCell::new(HashMap::new()),
         hull_cache: RefCell::new(HashMap::new()),
@@ -186,9 +193,11 @@ fn load_sources(sources: &Sources) -> Result<Model> {
             mass: 0.0,
             com: crate::spatial::Vec3::zeros(),
             simple: false,
+            gravcomp: 0.0,
         }]),
         site_bodies: RefCell::new(HashMap::new()),
         site_points: RefCell::new(HashMap::new()),
+        spring_dampers: RefCell::new(Vec::new()),
     };
     if !root.has_tag_name("mujoco") {
         return Err(reader.error(root, "expected the root element <mujoco>"));
@@ -252,7 +261,23 @@ fn load_sources(sources: &Sources) -> Result<Model> {
     reader.read_keyframes(&sections, &mut model)?;
     reader.read_options(&sections, &mut model)?;
     model.source_bodies = reader.source_bodies.take();
+    let compensated: Vec<&str> = model
+        .source_bodies
+        .iter()
+        .filter(|s| s.gravcomp != 0.0)
+        .map(|s| s.name.as_str())
+        .collect();
+    if !compensated.is_empty() {
+        model.warnings.push(format!(
+            "{}: the gravity compensation (gravcomp) of {} holds them up in the scene's own \
+             dynamics (m.contact_forward_dynamics, simulate with integrator='mujoco'); robodyn's \
+             other integrators and algorithms feel their full weight",
+            reader.location(root),
+            compensated.join(", ")
+        ));
+    }
     reader.tendon_inertias(root, &mut model);
+    reader.apply_spring_dampers(&mut model)?;
     reader.read_contacts(&sections, &mut model)?;
     for message in reader.warnings.take() {
         model.warnings.push(message);
@@ -317,6 +342,12 @@ struct Reader<'a> {
     mesh_directory: Option<String>,
     /// `<compiler fitaabb>`: primitives fitted to a mesh's bounding box rather than its inertia
     fit_aabb: bool,
+    /// `<compiler autolimits>`: a range without its `limited` limits (true, MuJoCo's default)
+    /// or is refused (false).
+    auto_limits: bool,
+    /// `<compiler alignfree>`: whether a free body without children has its frame moved to its
+    /// inertial frame where its `<freejoint align>` is "auto" (MuJoCo's default: false).
+    align_free: bool,
     mesh_cache: RefCell<HashMap<String, meshes::CompiledMesh>>,
     /// each mesh's triangles in its geoms' frame, read once
     mesh_triangles: RefCell<HashMap<String, std::rc::Rc<crate::io::mesh::TriangleMesh>>>,
@@ -341,6 +372,9 @@ struct Reader<'a> {
     site_bodies: RefCell<HashMap<String, usize>>,
     /// each site's body in the model and its position in that body's frame
     site_points: RefCell<HashMap<String, (usize, Vec3)>>,
+    /// Each joint with a `springdamper`: its body, (time constant, damping ratio) and the
+    /// joint's own linear damping ([`Reader::apply_spring_dampers`]).
+    spring_dampers: RefCell<Vec<(usize, [f64; 2], f64)>>,
 }
 
 impl<'a> Reader<'a> {
@@ -437,6 +471,19 @@ impl<'a> Reader<'a> {
         }
         if let Some(value) = compiler.attribute("fitaabb") {
             self.fit_aabb = value == "true";
+        }
+        if let Some(value) = compiler.attribute("alignfree") {
+            self.align_free = value == "true";
+        }
+        if let Some(value) = compiler.attribute("autolimits") {
+            self.auto_limits = value != "false";
+        }
+        if compiler.attribute("coordinate") == Some("global") {
+            return Err(self.error(
+                compiler,
+                "attribute 'coordinate': global coordinates are refused, as MuJoCo (since 2.3.4) \
+                 refuses them",
+            ));
         }
         // the options that rewrite masses and inertias (mjcf/mass.rs)
         let number = |name: &str| self.own_number(compiler, name);

@@ -15,7 +15,7 @@ use crate::soft::wrap::Surface;
 const TAG: &[u8; 8] = b"robodyn\0";
 
 /// The snapshot format: bumped whenever `Model` (or a type inside it) changes its fields.
-pub const MODEL_FORMAT: u32 = 4;
+pub const MODEL_FORMAT: u32 = 5;
 
 /// The model as bytes.
 pub fn model_to_bytes(model: &Model) -> Vec<u8> {
@@ -126,6 +126,8 @@ fn check_structure(model: &Model) -> Result<()> {
         ("damping", model.damping.len(), nv),
         ("friction", model.friction.len(), nv),
         ("stiffness", model.stiffness.len(), nv),
+        ("stiffness_poly", model.stiffness_poly.len(), nv),
+        ("damping_poly", model.damping_poly.len(), nv),
     ];
     if let Some((name, length, expected)) = by_coordinate.iter().find(|(_, l, e)| l != e) {
         return damaged(format!("{name} has {length} entries, expected {expected}"));

@@ -64,6 +64,8 @@ impl ModelBuilder {
                 damping: DVector::zeros(0),
                 friction: DVector::zeros(0),
                 stiffness: DVector::zeros(0),
+                stiffness_poly: Vec::new(),
+                damping_poly: Vec::new(),
                 spring_reference: DVector::zeros(0),
                 neutral_configuration: DVector::zeros(0),
                 frames: Vec::new(),
@@ -160,6 +162,10 @@ impl ModelBuilder {
         extend(&mut m.damping, nv, properties.damping);
         extend(&mut m.friction, nv, properties.friction);
         extend(&mut m.stiffness, nv, properties.stiffness);
+        m.stiffness_poly
+            .extend(std::iter::repeat_n(properties.stiffness_poly, nv));
+        m.damping_poly
+            .extend(std::iter::repeat_n(properties.damping_poly, nv));
         extend(&mut m.spring_reference, nq, properties.spring_reference);
         extend(&mut m.neutral_configuration, nq, 0.0);
         joint.neutral(&mut m.neutral_configuration.as_mut_slice()[m.nq - nq..]);

@@ -96,6 +96,10 @@ pub struct SourceBody {
     /// world or a jointless child of it. Its weights are then 1/m.
     #[serde(default)]
     pub simple: bool,
+    /// The fraction of its weight held up by a force at its centre of mass (MJCF `gravcomp`,
+    /// MuJoCo's gravity compensation; 0: none).
+    #[serde(default)]
+    pub gravcomp: f64,
 }
 
 /// Two of the file's bodies whose geoms never touch (`<contact><exclude>`), as

@@ -10,6 +10,7 @@
 //! constraint rows, equalities coupling two lengths, actuators pulling on it, and an inertia
 //! moving with it (`armature`).
 
+use super::springs::{polynomial_coefficient, polynomial_slope};
 use super::{Model, SolverParameters};
 use crate::spatial::Vec3;
 
@@ -175,15 +176,8 @@ impl Tendon {
 
     /// ∂f/∂L̇ of the damper at L̇: `−(b + 2 b₁ |L̇| + 3 b₂ L̇²)` (MuJoCo's `mjd_xPolyForce`).
     pub fn damping_slope(&self, rate: f64) -> f64 {
-        let [b1, b2] = self.damping_poly;
-        let speed = rate.abs();
-        -(self.damping + 2.0 * b1 * speed + 3.0 * b2 * speed * speed)
+        -polynomial_slope(self.damping, &self.damping_poly, rate.abs())
     }
-}
-
-/// c + c₁ x + c₂ x²: a spring's or damper's coefficient at x (MuJoCo's `mju_polyForce`).
-fn polynomial_coefficient(linear: f64, [c1, c2]: &[f64; 2], x: f64) -> f64 {
-    linear + x * (c1 + c2 * x)
 }
 
 /// A tendon equality (MJCF `<equality><tendon>`): one tendon's length a polynomial of another's

@@ -20,7 +20,7 @@ use super::inertia::{add_tendon_inertia, add_tendon_inertia_bias, has_tendon_ine
 use super::rows::{constraint_rows, Rows};
 use super::solver::{dot, Solution, Solver};
 use super::tendons::TendonKinematics;
-use super::weights::{inverse_weights, InverseWeights};
+use super::weights::{inverse_weights, point_columns, world_point, InverseWeights};
 use crate::algo::kinematics::update_velocity_products;
 use crate::algo::{aba, crba, forward_kinematics};
 use crate::collision::{checked_pairs, collide, CheckedPair, CollisionScratch, Contact};
@@ -47,7 +47,8 @@ pub struct ContactForward {
     pub activation_rate: DVector<f64>,
     /// The constraints' generalised forces `Jᵀ f` (MuJoCo's `qfrc_constraint`).
     pub constraint: DVector<f64>,
-    /// The joints' and tendons' springs and dampers (MuJoCo's `qfrc_passive`).
+    /// The joints' and tendons' springs and dampers and the gravity compensation (MuJoCo's
+    /// `qfrc_passive`).
     pub passive: DVector<f64>,
     /// The mass matrix M at q, with the tendons' inertia ([`super::inertia`]).
     pub mass: DMatrix<f64>,
@@ -135,6 +136,7 @@ impl ContactDynamics {
         model.activation_rates(ctrl, act, out.activation_rate.as_mut_slice())?;
         sized(&mut out.passive, nv);
         passive_forces(model, q, v, &out.tendons, out.passive.as_mut_slice());
+        add_gravity_compensation(model, &self.x_world, out.passive.as_mut_slice());
         self.total.copy_from_slice(tau);
         self.total += &out.actuator;
         self.total += &out.passive;
@@ -220,9 +222,10 @@ impl ContactDynamics {
     }
 }
 
-/// τ_passive = −K (q ⊖ q_ref) − D q̇ + Σ Jᵀ f_tendon: the joints' and the tendons' springs and
-/// dampers (MuJoCo's `qfrc_passive` without gravity compensation and fluid forces; dry friction
-/// is a constraint row), into `tau` (nv).
+/// τ_passive = −K (q ⊖ q_ref) − D q̇ + Σ Jᵀ f_tendon (K and D with their polynomial terms,
+/// [`Model::spring_forces`]): the joints' and the tendons' springs and dampers (MuJoCo's
+/// `qfrc_passive` without the gravity compensation, [`add_gravity_compensation`], and fluid
+/// forces; dry friction is a constraint row), into `tau` (nv).
 fn passive_forces(
     model: &Model,
     q: &[f64],
@@ -233,22 +236,59 @@ fn passive_forces(
     let options = &model.options;
     let (spring, damper) = (options.flag("spring"), options.flag("damper"));
     tau.fill(0.0);
-    if spring && model.stiffness.iter().any(|k| *k != 0.0) {
+    if spring && model.has_springs() {
         mujoco_spring_displacement(model, q, tau);
-        for (t, k) in tau.iter_mut().zip(model.stiffness.iter()) {
-            *t *= -k;
-        }
+        model.spring_forces(tau);
     }
     if damper {
-        for ((t, d), v) in tau.iter_mut().zip(model.damping.iter()).zip(v) {
-            *t -= d * v;
-        }
+        add_damper_forces(model, q, v, tau);
     }
     // each tendon's spring and damper along its length: τ += Jᵀ f
     for (t, tendon) in model.tendons.iter().enumerate() {
         let (length, rate) = (tendons.lengths[t], tendons.rate(t, v));
         let force = tendon.passive_force(length, rate, spring, damper);
         tendons.add_to_row(t, force, tau);
+    }
+}
+
+/// τ += Σ_b J_b(c_b)ᵀ (−γ_b m_b g): MuJoCo's gravity compensation (`gravcomp` γ), a force at
+/// each file body's centre of mass c_b holding up the fraction γ of its weight, J_b(c) the
+/// Jacobian of that point (MuJoCo's `mj_gravcomp`; none without gravity).
+fn add_gravity_compensation(model: &Model, x_world: &[Transform], tau: &mut [f64]) {
+    let held = model
+        .source_bodies
+        .iter()
+        .filter(|s| s.gravcomp != 0.0 && s.body != 0);
+    for source in held {
+        let force = -source.gravcomp * source.mass * model.gravity;
+        let centre = world_point(&x_world[source.body], &source.com);
+        point_columns(model, x_world, source.body, &centre, |c, linear, _| {
+            tau[c] += linear.dot(&force);
+        });
+    }
+}
+
+/// τ += each joint damper's force (MuJoCo's per-dof `−(b + b₁ |ν| + b₂ ν²) ν`), on MuJoCo's
+/// velocities ν: a free joint's translation dampers act along the world's axes, f = Rᵀ f(R v)
+/// (the same as f(v) when they are linear).
+fn add_damper_forces(model: &Model, q: &[f64], v: &[f64], tau: &mut [f64]) {
+    let polynomial = |s: usize| model.damping_poly[s..s + 3].iter().any(|t| *t != [0.0; 2]);
+    for i in 1..model.nbodies() {
+        let (s, nv) = (model.idx_v[i], model.joints[i].nv());
+        let mut along_own_axes = s..s + nv;
+        if matches!(model.joints[i], Joint::Free) && polynomial(s) {
+            let rotation = quaternion_of(&q[model.idx_q[i] + 3..model.idx_q[i] + 7]);
+            let world = rotation * Vec3::new(v[s], v[s + 1], v[s + 2]);
+            let force = Vec3::from_fn(|r, _| model.damper_force(s + r, world[r]));
+            let local = rotation.inverse_transform_vector(&force);
+            for r in 0..3 {
+                tau[s + r] += local[r];
+            }
+            along_own_axes = s + 3..s + nv;
+        }
+        for k in along_own_axes {
+            tau[k] += model.damper_force(k, v[k]);
+        }
     }
 }
 

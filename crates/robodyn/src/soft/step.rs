@@ -136,10 +136,10 @@ impl SceneStep {
             Integrator::Euler => {
                 let damped = model.options.flag("eulerdamp")
                     && model.options.flag("damper")
-                    && model.damping.iter().any(|d| *d > 0.0);
+                    && model.has_dampers();
                 Some(match damped {
                     true => {
-                        let k = -DMatrix::from_diagonal(&model.damping);
+                        let k = DMatrix::from_diagonal(&damper_slopes(model, q, v));
                         implicit_solve(model, q, &self.forward.mass, &k, None, h, &acceleration)
                     }
                     false => Some(acceleration.clone()),
@@ -294,7 +294,7 @@ fn lone_free_bodies(model: &Model) -> Vec<usize> {
         .collect()
 }
 
-/// K = ∂f/∂ν of the dampers (−D, and (∂f/∂L̇) JᵀJ of each tendon's) and of the actuators
+/// K = ∂f/∂ν of the dampers (−D with its polynomial terms, and (∂f/∂L̇) JᵀJ of each tendon's) and of the actuators
 /// whose force is not saturated ([`crate::model::ActuatorForce::saturated`]): (b₂ + a₂ u) m mᵀ,
 /// m the moment arms (gear on a joint, gear J on a tendon; the activation w, or with `actearly`
 /// the next one, in place of u where the actuator has one), MuJoCo's `qDeriv` without the bias
@@ -309,9 +309,7 @@ fn velocity_derivative(
     let nv = model.nv;
     let mut k = DMatrix::zeros(nv, nv);
     if model.options.flag("damper") {
-        for c in 0..nv {
-            k[(c, c)] -= model.damping[c];
-        }
+        k.set_diagonal(&damper_slopes(model, q, v));
         // (∂f/∂L̇) JᵀJ, ∂f/∂L̇ = −(b + 2 b₁ |L̇| + 3 b₂ L̇²), with J in MuJoCo's velocities:
         // J_ν = J T⁻¹, its transpose T Jᵀ
         for (t, tendon) in model.tendons.iter().enumerate() {
@@ -343,6 +341,13 @@ fn velocity_derivative(
     }
     keep_tree_pattern(model, &mut k);
     Ok(k)
+}
+
+/// ∂f/∂ν of each joint's damper on MuJoCo's velocities ν, −(b + 2 b₁ |ν| + 3 b₂ ν²)
+/// ([`Model::damper_slope`]; −b without polynomial terms).
+fn damper_slopes(model: &Model, q: &[f64], v: &[f64]) -> DVector<f64> {
+    let nu = to_mujoco(model, q, v);
+    DVector::from_fn(model.nv, |c, _| model.damper_slope(c, nu[c]))
 }
 
 /// K keeps only the entries MuJoCo's `qDeriv` holds, those of M's sparsity: two degrees of

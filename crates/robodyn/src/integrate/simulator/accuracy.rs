@@ -209,7 +209,7 @@ impl Accuracy {
 /// Whether the passive forces keep the energy E = T + V + V_springs: no damping or friction on
 /// any joint and no limit penalty (springs are part of E).
 fn conserves_energy(model: &Model, passive: &PassiveForces) -> bool {
-    model.damping.iter().all(|d| *d == 0.0)
+    !model.has_dampers()
         && model.friction.iter().all(|f| *f == 0.0)
         && passive.limits == LimitModel::Report
 }

@@ -144,7 +144,7 @@ impl<'a> Reader<'a> {
         let own = |name: &str| self.numbers::<1>(element, "main", name);
         match tag {
             "general" | "motor" | "position" | "intvelocity" | "velocity" | "damper"
-            | "cylinder" => {}
+            | "cylinder" => self.warn_unmodelled(element, class),
             "muscle" => {
                 actuator.dynamics = ActivationDynamics::Held { states: 1 };
                 return unmodelled(actuator, "<muscle>".into());
@@ -326,8 +326,8 @@ impl<'a> Reader<'a> {
     /// The actuator's own `damping` and `armature` (MuJoCo ≥ 3.5), which MuJoCo adds to its
     /// joint's (or its tendon's), scaled by gear²: a passive damper −g² b q̇ and a rotor
     /// inertia g² I_a (on a tendon: its inertia, [`crate::soft::inertia`]). A polynomial
-    /// damping's terms past the linear one (MuJoCo's `actuator_dampingpoly`) join a tendon's,
-    /// times g²; on a joint they are not modelled (a warning).
+    /// damping's terms past the linear one (MuJoCo's `actuator_dampingpoly`) join the tendon's
+    /// or the joint's, times g² (as MuJoCo 4.0 applies them).
     fn add_transmission_terms(
         &self,
         element: Node<'a, 'a>,
@@ -367,13 +367,10 @@ impl<'a> Reader<'a> {
         let Some(c) = actuator.coordinate else {
             return Ok(());
         };
-        if higher != [0.0; 2] {
-            model.warnings.push(format!(
-                "{}: a polynomial 'damping' on a joint not modelled (its linear term is: −g² b q̇)",
-                self.location(element)
-            ));
-        }
         model.damping[c] += scale * damping;
+        for (term, value) in model.damping_poly[c].iter_mut().zip(higher) {
+            *term += scale * value;
+        }
         model.armature[c] += scale * self.non_negative_term(element, "armature")?;
         Ok(())
     }
@@ -402,7 +399,9 @@ impl<'a> Reader<'a> {
     fn range(&self, element: Node<'a, 'a>, name: &str) -> Result<Option<(f64, f64)>> {
         let (range, limited) = (format!("{name}range"), format!("{name}limited"));
         let values = self.numbers::<2>(element, "main", &range)?;
-        let limited = match self.attribute(element, "main", &limited).as_deref() {
+        let flag = self.attribute(element, "main", &limited);
+        self.check_auto_limits(element, values.is_some(), flag.as_deref(), &limited)?;
+        let limited = match flag.as_deref() {
             None | Some("auto") => values.is_some(),
             Some("true") => true,
             Some("false") => false,

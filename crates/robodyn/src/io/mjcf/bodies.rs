@@ -5,9 +5,7 @@ use super::inertia::InertiaAxes;
 use super::Reader;
 use crate::error::Result;
 use crate::joint::Joint;
-use crate::model::{
-    JointProperties, JointSoftness, ModelBuilder, NewBody, SolverParameters, SourceBody,
-};
+use crate::model::{JointProperties, ModelBuilder, NewBody, SourceBody};
 use crate::spatial::{Inertia, Mat3, Transform, Vec3};
 use nalgebra::{Rotation3, Unit, UnitQuaternion};
 use roxmltree::Node;
@@ -115,8 +113,13 @@ impl<'a> Reader<'a> {
                 tag @ ("replicate" | "attach" | "composite" | "flexcomp") => {
                     return Err(self.error(child, format!("<{tag}> is not supported")));
                 }
-                // joints, inertials and geoms are read with their body; cameras, lights and
-                // plugins are not part of the tree
+                "plugin" => self.warnings.borrow_mut().push(format!(
+                    "{}: not read (robodyn runs no MuJoCo plugins: the forces it would add are \
+                     left out)",
+                    self.location(child)
+                )),
+                // joints, inertials and geoms are read with their body; cameras and lights are
+                // not part of the tree
                 _ => {}
             }
         }
@@ -137,6 +140,7 @@ impl<'a> Reader<'a> {
             .attribute("name")
             .map_or_else(|| format!("body{}", node.range().start), str::to_string);
         let child_class = self.declared_class(node, "childclass", class)?;
+        self.warn_unmodelled(node, class);
         // MuJoCo numbers the file's bodies in document order, the world 0
         let source_body = {
             let mut bodies = self.source_bodies.borrow_mut();
@@ -149,6 +153,7 @@ impl<'a> Reader<'a> {
                 mass: 0.0,
                 com: Vec3::zeros(),
                 simple: false,
+                gravcomp: self.own_number(node, "gravcomp")?.unwrap_or(0.0),
             });
             bodies.len() - 1
         };
@@ -189,6 +194,7 @@ impl<'a> Reader<'a> {
         let mut only_aligned_slides = true;
         for (k, (joint_node, to_frame, frame_class)) in joints.iter().enumerate() {
             let joint_class = self.declared_class(*joint_node, "class", frame_class)?;
+            self.warn_unmodelled(*joint_node, joint_class);
             // a joint in a <frame> has its pos and axis in the frame's axes
             let in_body = to_frame.rotation.transpose();
             let kind = if joint_node.has_tag_name("freejoint") {
@@ -250,22 +256,28 @@ impl<'a> Reader<'a> {
                     x
                 }
             };
+            // "c c₁ c₂": a linear coefficient and up to two higher ones
+            let polynomial = |key: &str| {
+                let text = self.attribute(*joint_node, joint_class, key);
+                self.spring_polynomial(*joint_node, key, text.as_deref())
+            };
+            let (stiffness, stiffness_poly) = polynomial("stiffness")?;
+            let (damping, damping_poly) = polynomial("damping")?;
             let mut properties = JointProperties {
                 armature: scalar("armature", 0.0)?,
-                damping: scalar("damping", 0.0)?,
+                damping,
+                damping_poly,
                 friction: scalar("frictionloss", 0.0)?,
-                stiffness: scalar("stiffness", 0.0)?,
+                stiffness,
+                stiffness_poly,
                 spring_reference: position_unit(scalar("springref", 0.0)?),
                 softness: self.joint_softness(*joint_node, joint_class)?,
                 ..JointProperties::default()
             };
-            let limited = self
-                .attribute(*joint_node, joint_class, "limited")
-                .is_none_or(|l| l != "false");
-            if let (true, Some([lower, upper])) = (
-                limited,
-                self.numbers::<2>(*joint_node, joint_class, "range")?,
-            ) {
+            let limited = self.attribute(*joint_node, joint_class, "limited");
+            let range = self.numbers::<2>(*joint_node, joint_class, "range")?;
+            self.check_auto_limits(*joint_node, range.is_some(), limited.as_deref(), "limited")?;
+            if let (true, Some([lower, upper])) = (limited.is_none_or(|l| l != "false"), range) {
                 properties.lower = position_unit(lower);
                 properties.upper = position_unit(upper);
                 // a ball's limit is a cone: its largest angle
@@ -275,6 +287,7 @@ impl<'a> Reader<'a> {
             }
             properties.actuator_force_range =
                 self.actuator_force_range(*joint_node, joint_class)?;
+            let spring_damper = self.spring_damper(*joint_node, joint_class)?;
             // `ref`: the joint position at which the body has its XML pose, so the joint moves
             // by q − ref: X_J(q − ref) X_tree = X_J(q) X_J(−ref) X_tree
             let reference = position_unit(scalar("ref", 0.0)?);
@@ -301,6 +314,7 @@ impl<'a> Reader<'a> {
                         "a free joint must be the only joint of a child of the worldbody",
                     ));
                 }
+                self.warn_aligned_free_body(node, *joint_node);
                 Transform::IDENTITY
             } else if k == 0 {
                 // the joint frame sits at `pos` in the body's frame
@@ -337,6 +351,12 @@ impl<'a> Reader<'a> {
                     Inertia::ZERO
                 },
             })?;
+            if let Some(spring_damper) = spring_damper {
+                let own_damping = properties.damping;
+                self.spring_dampers
+                    .borrow_mut()
+                    .push((body, spring_damper, own_damping));
+            }
             // MuJoCo's qpos0: a hinge or slide at its ref, a free joint at the body's XML pose
             if joint == Joint::Free {
                 builder.set_neutral(body, &free_joint_coordinates(&to_body))?;
@@ -391,69 +411,6 @@ impl<'a> Reader<'a> {
         let mut bodies = self.source_bodies.borrow_mut();
         let source = &mut bodies[source_body];
         (source.body, source.mass, source.com) = (body, inertia.mass, com);
-    }
-
-    /// A joint's limit and dry friction in MuJoCo's soft constraint model: `solreflimit`,
-    /// `solimplimit`, `margin` (in radians for a hinge whatever the compiler's angle unit, as
-    /// MuJoCo reads it), `solreffriction`, `solimpfriction`.
-    fn joint_softness(&self, joint: Node<'a, 'a>, class: &str) -> Result<JointSoftness> {
-        // a <freejoint> takes no joint defaults
-        let tag = joint.tag_name().name();
-        let parameters = |solref: &str, solimp: &str| -> Result<SolverParameters> {
-            let defaults = SolverParameters::default();
-            Ok(SolverParameters {
-                solref: self.leading_numbers(joint, class, tag, solref, defaults.solref)?,
-                solimp: self.leading_numbers(joint, class, tag, solimp, defaults.solimp)?,
-            })
-        };
-        Ok(JointSoftness {
-            limit: parameters("solreflimit", "solimplimit")?,
-            margin: self
-                .numbers::<1>(joint, class, "margin")?
-                .map_or(0.0, |[m]| m),
-            friction: parameters("solreffriction", "solimpfriction")?,
-            cone_limit: None,
-        })
-    }
-
-    /// The range a joint's total actuator force is clamped to, as MuJoCo reads it:
-    /// `actuatorfrcrange` where `actuatorfrclimited` is true (a range with low < high needed), or
-    /// "auto" (the default) and a range with low < high is given.
-    fn actuator_force_range(&self, joint: Node<'a, 'a>, class: &str) -> Result<Option<(f64, f64)>> {
-        let range = self.numbers::<2>(joint, class, "actuatorfrcrange")?;
-        let limited = self.attribute(joint, class, "actuatorfrclimited");
-        let message = "attribute 'actuatorfrclimited' is true: expected an 'actuatorfrcrange' \
-                       with low < high";
-        self.limited_range(
-            joint,
-            (range, limited.as_deref()),
-            "actuatorfrclimited",
-            message,
-        )
-    }
-
-    /// A range where limited, MuJoCo's way: its `limited` attribute (named `limited_name`)
-    /// true, false, or auto (absent: limited where the range is given with low < high); a
-    /// limited one without low < high refused with `message`.
-    pub(super) fn limited_range(
-        &self,
-        element: Node<'a, 'a>,
-        (range, limited): (Option<[f64; 2]>, Option<&str>),
-        limited_name: &str,
-        message: &str,
-    ) -> Result<Option<(f64, f64)>> {
-        let valid = range
-            .filter(|[low, high]| low < high)
-            .map(|[low, high]| (low, high));
-        match limited {
-            None | Some("auto") => Ok(valid),
-            Some("false") => Ok(None),
-            Some("true") => valid.map(Some).ok_or_else(|| self.error(element, message)),
-            Some(other) => Err(self.error(
-                element,
-                format!("attribute '{limited_name}': expected true, false or auto, got '{other}'"),
-            )),
-        }
     }
 }
 

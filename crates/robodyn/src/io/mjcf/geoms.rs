@@ -31,6 +31,7 @@ impl<'a> Reader<'a> {
         self.framed_elements(elements, class, &["geom"], Transform::IDENTITY, &mut geoms)?;
         for (geom, to_frame, frame_class) in geoms {
             let class = self.declared_class(geom, "class", frame_class)?;
+            self.warn_unmodelled(geom, class);
             let kind = self.geom_type(geom, class);
             let contype = self.integer(geom, class, "contype", 1)?;
             let conaffinity = self.integer(geom, class, "conaffinity", 1)?;
