@@ -255,7 +255,13 @@ def test_disabled_gravity_and_equalities_are_followed_and_the_rest_named():
     assert model.constraints == []
     assert not model.options.flag("gravity") and not model.options.flag("limit")
     messages = " ".join(model.warnings)
-    assert "<flag> 'limit' not followed" in messages
+    # the scene's own dynamics follows 'limit'; robodyn's other integrators have no soft limits
+    assert "'limit'" not in messages
+    springless = held.replace('<flag warmstart="disable" energy="enable"/>',
+                              '<flag spring="disable" clampctrl="disable"/>')
+    messages = " ".join(robodyn.load_mjcf_string(springless).warnings)
+    assert "<flag> 'clampctrl' not followed" in messages
+    assert "<flag> 'spring' followed by the scene's own dynamics" in messages
     assert "robodyn.simulate feels them only with integrator='mujoco'" in messages
 
 
@@ -504,9 +510,15 @@ def test_a_deformable_section_is_named():
          r"<joint name='hip'> \(line \d+\): attribute 'range' without 'limited': with <compiler autolimits=\"false\">"),
         (('angle="degree"', 'angle="degree" coordinate="global"'),
          r"<compiler> \(line \d+\): attribute 'coordinate': global coordinates are refused"),
+        (('<body name="toe" pos="0.05 0 -0.25">', '<body name="toe" pos="0.05 0 -0.25" mocap="true">'),
+         r"<body name='toe'> \(line \d+\): a mocap body must be a child of the worldbody without joints"),
+        (('<body name="base" pos="0 0 0.5">', '<body name="base" pos="0 0 0.5" mocap="true">'),
+         r"<body name='base'> \(line \d+\): a mocap body must be a child of the worldbody without joints"),
+        (("</contact>", '</contact><actuator><motor name="m" joint="hip" delay="0.01"/></actuator>'),
+         r"<motor name='m'> \(line \d+\): attribute 'delay': 0.01 s needs a history buffer \('nsample' > 0\)"),
     ],
 )
-def test_compiler_settings_mujoco_refuses_are_refused(change, message):
+def test_settings_mujoco_refuses_are_refused(change, message):
     assert_refused_as_in_mujoco(SCENE.replace(*change), message)
 
 

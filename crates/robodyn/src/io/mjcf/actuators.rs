@@ -144,7 +144,23 @@ impl<'a> Reader<'a> {
         let own = |name: &str| self.numbers::<1>(element, "main", name);
         match tag {
             "general" | "motor" | "position" | "intvelocity" | "velocity" | "damper"
-            | "cylinder" => self.warn_unmodelled(element, class),
+            | "cylinder" => {
+                // a delay reads the control from a history of `nsample` samples
+                let delay = self
+                    .numbers::<1>(element, class, "delay")?
+                    .map_or(0.0, |[d]| d);
+                let samples = self
+                    .numbers::<1>(element, class, "nsample")?
+                    .map_or(0.0, |[n]| n);
+                if delay > 0.0 && samples <= 0.0 {
+                    let message = format!(
+                        "attribute 'delay': {delay} s needs a history buffer ('nsample' > 0), as \
+                         MuJoCo requires"
+                    );
+                    return Err(self.error(element, message));
+                }
+                self.warn_unmodelled(element, class);
+            }
             "muscle" => {
                 actuator.dynamics = ActivationDynamics::Held { states: 1 };
                 return unmodelled(actuator, "<muscle>".into());

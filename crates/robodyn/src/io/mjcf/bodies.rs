@@ -20,6 +20,15 @@ fn in_world_frame(element: Node) -> bool {
             .is_some_and(|a| a.has_tag_name("worldbody"))
 }
 
+/// Whether a body's parent, through any `<frame>`s, is the worldbody.
+fn under_world(body: Node) -> bool {
+    let mut parent = body.parent_element();
+    while parent.is_some_and(|p| p.has_tag_name("frame")) {
+        parent = parent.and_then(|p| p.parent_element());
+    }
+    parent.is_some_and(|p| p.has_tag_name("worldbody"))
+}
+
 /// A free joint's `[x, y, z, qx, qy, qz, qw]` that places its body at `to_body`
 /// (`X_{B←world}`).
 fn free_joint_coordinates(to_body: &Transform) -> [f64; 7] {
@@ -175,6 +184,12 @@ impl<'a> Reader<'a> {
             Transform::IDENTITY,
             &mut joints,
         )?;
+        if node.attribute("mocap") == Some("true") && !(joints.is_empty() && under_world(node)) {
+            return Err(self.error(
+                node,
+                "a mocap body must be a child of the worldbody without joints, as MuJoCo requires",
+            ));
+        }
         if joints.is_empty() {
             // no joint: merged into the parent, kept as a frame
             self.record_source_mass(source_body, parent, &inertia, &to_body);
@@ -303,12 +318,7 @@ impl<'a> Reader<'a> {
             };
             // a free joint places the body in the world: its XML pose is only MuJoCo's qpos0
             let x_tree = if joint == Joint::Free {
-                // the body's parent, through any <frame>s, is the world
-                let mut parent = node.parent_element();
-                while parent.is_some_and(|p| p.has_tag_name("frame")) {
-                    parent = parent.and_then(|p| p.parent_element());
-                }
-                if k > 0 || !parent.is_some_and(|p| p.has_tag_name("worldbody")) {
+                if k > 0 || !under_world(node) {
                     return Err(self.error(
                         *joint_node,
                         "a free joint must be the only joint of a child of the worldbody",

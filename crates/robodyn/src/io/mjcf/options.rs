@@ -36,8 +36,27 @@ const FLAGS_WITHOUT_EFFECT: [&str; 10] = [
     "invdiscrete",
 ];
 
-/// Flags robodyn follows by changing the model (`gravity`, `equality`, `constraint`).
-const FLAGS_FOLLOWED: [&str; 3] = ["gravity", "equality", "constraint"];
+/// Flags robodyn follows by changing the model (`gravity`, `equality`, `constraint`), or that
+/// the scene's own dynamics (`m.contact_forward_dynamics`, `simulate` with
+/// `integrator="mujoco"`) follows as MuJoCo does; robodyn's other integrators have no contacts,
+/// soft limits or dry-friction rows to switch off.
+const FLAGS_FOLLOWED: [&str; 11] = [
+    "gravity",
+    "equality",
+    "constraint",
+    "contact",
+    "limit",
+    "frictionloss",
+    "filterparent",
+    "refsafe",
+    "eulerdamp",
+    "override",
+    "midphase",
+];
+
+/// Flags the scene's own dynamics follows and robodyn's other integrators do not: they apply
+/// the joints' springs and dampers whatever the file says.
+const FLAGS_FOLLOWED_BY_THE_SCENE: [&str; 2] = ["spring", "damper"];
 
 impl<'a> Reader<'a> {
     /// The `<option>` sections among `sections`, in order, into `model.options` and
@@ -57,23 +76,39 @@ impl<'a> Reader<'a> {
         if !options.flag("equality") || !options.flag("constraint") {
             model.constraints.iter_mut().for_each(|c| c.active = false);
         }
-        let unfollowed: Vec<String> = options
-            .disabled
-            .iter()
-            .chain(&options.enabled)
-            .filter(|f| !FLAGS_WITHOUT_EFFECT.contains(&f.as_str()))
-            .filter(|f| !FLAGS_FOLLOWED.contains(&f.as_str()))
-            .map(|f| format!("'{f}'"))
-            .collect();
-        if let (false, Some(option)) = (
-            unfollowed.is_empty(),
-            sections.iter().find(|c| c.has_tag_name("option")),
-        ) {
-            model.warnings.push(format!(
-                "{}: <flag> {} not followed (robodyn's simulation does not change with it)",
-                self.location(*option),
-                unfollowed.join(", ")
-            ));
+        let set = || options.disabled.iter().chain(&options.enabled);
+        let named = |flags: Vec<&String>| -> Vec<String> {
+            flags.iter().map(|f| format!("'{f}'")).collect()
+        };
+        let unfollowed = named(
+            set()
+                .filter(|f| !FLAGS_WITHOUT_EFFECT.contains(&f.as_str()))
+                .filter(|f| !FLAGS_FOLLOWED.contains(&f.as_str()))
+                .filter(|f| !FLAGS_FOLLOWED_BY_THE_SCENE.contains(&f.as_str()))
+                .collect(),
+        );
+        let scene_only = named(
+            set()
+                .filter(|f| FLAGS_FOLLOWED_BY_THE_SCENE.contains(&f.as_str()))
+                .collect(),
+        );
+        if let Some(option) = sections.iter().find(|c| c.has_tag_name("option")) {
+            if !unfollowed.is_empty() {
+                model.warnings.push(format!(
+                    "{}: <flag> {} not followed (robodyn's simulation does not change with it)",
+                    self.location(*option),
+                    unfollowed.join(", ")
+                ));
+            }
+            if !scene_only.is_empty() {
+                model.warnings.push(format!(
+                    "{}: <flag> {} followed by the scene's own dynamics (integrator='mujoco', \
+                     m.contact_forward_dynamics) only: robodyn's other integrators apply the \
+                     joints' springs and dampers",
+                    self.location(*option),
+                    scene_only.join(", ")
+                ));
+            }
         }
         model.options = options;
         self.warn_disabled_actuator_groups(sections, model)
