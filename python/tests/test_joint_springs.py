@@ -180,3 +180,12 @@ def test_spring_dampers_mujoco_refuses_are_refused():
         text = SPRING_DAMPERS.replace('springdamper="0.05 0.3"', f'springdamper="{value}"')
         assert_refused_as_in_mujoco(text, rf"<joint name='reach'>.*attribute 'springdamper': expected a positive "
                                           rf"time constant and damping ratio, got {value}")
+
+
+@pytest.mark.parametrize("damping", ["-0.5", "0 0.3", "-0.5 0.3", "0 -0.3"])
+def test_euler_takes_the_dampers_implicit_as_mujoco_decides(damping):
+    """MuJoCo 4.0's Euler takes the joint dampers implicitly when one has a positive linear term or
+    any higher term (measured): a negative linear damping alone stays explicit."""
+    text = ('<mujoco><option gravity="0 0 -9.81"/><worldbody><body><joint name="swing" axis="0 1 0" '
+            f'damping="{damping}"/><geom name="bob" size=".1" pos="0 0 -1"/></body></worldbody></mujoco>')
+    assert_steps_from_a_turned_state(text, "Euler", 8)

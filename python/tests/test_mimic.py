@@ -455,3 +455,37 @@ def test_symbolic_equations_in_reduced_coordinates(tmp_path, ratio):
         assert equations.skew_residual() == sp.zeros(2)
         assert sym.newton_euler(chain).difference(equations) == sp.zeros(2, 1)
 
+
+
+def test_polynomial_springs_and_dampers_through_the_transmission(gripper):
+    """A reduced coordinate's dampers are its group's, each −(b + b₁ |r q̇| + b₂ r² q̇²) r q̇ pulled
+    through r: Gᵀ τ_full equals the reduced polynomial with (Σ r² b, Σ |r|³ b₁, Σ r⁴ b₂), exactly; so
+    do the springs of groups with one spring each, (r² k, r³ k₁, r⁴ k₂) about the reduced reference.
+    Two springs with higher terms in one group have no such polynomial: refused by name."""
+    full, rng = gripper.full, np.random.default_rng(4)
+    full.damping = rng.uniform(0.1, 0.6, full.nv)
+    full.damping_poly = rng.uniform(0.1, 1.0, (full.nv, 2))
+    v = rng.normal(size=gripper.nv)
+    rate = gripper.coupling @ v
+    tau = gripper.coupling.T @ (-(full.damping + full.damping_poly[:, 0] * np.abs(rate) + full.damping_poly[:, 1] * rate**2) * rate)
+    b, (b1, b2) = gripper.damping, gripper.damping_poly.T
+    assert_close(tau, -(b + b1 * np.abs(v) + b2 * v**2) * v, IDENTITY_TOLERANCE, "dampers")
+    # one spring per group: the shoulder, the thumb (the wrist's group), the right finger (the left's)
+    springs = np.zeros(full.nv)
+    terms = np.zeros((full.nv, 2))
+    for name, k, k1, k2 in [("shoulder", 2.0, 0.5, 3.0), ("thumb", 1.5, -0.4, 2.0), ("right", 30.0, 4.0, 80.0)]:
+        dof = full.joint_idx_v[full.joint_names.index(name)]
+        springs[dof], terms[dof] = k, (k1, k2)
+    full.stiffness, full.stiffness_poly = springs, terms
+    full.spring_reference = full.neutral() + 0.05
+    q = gripper.neutral() + rng.uniform(-0.3, 0.3, gripper.nq)
+    x = gripper.expand(q) - full.spring_reference
+    tau = gripper.coupling.T @ (-(springs + terms[:, 0] * x + terms[:, 1] * x**2) * x)
+    s = q - gripper.spring_reference
+    k, (k1, k2) = gripper.stiffness, gripper.stiffness_poly.T
+    assert_close(tau, -(k + k1 * s + k2 * s**2) * s, IDENTITY_TOLERANCE, "springs")
+    both = terms.copy()
+    both[full.joint_idx_v[full.joint_names.index("wrist")]] = (0.1, 0.0)
+    full.stiffness_poly = both
+    with pytest.raises(ValueError, match=r"stiffness_poly.*reduced coordinate \d moves 2 springs .*(wrist|thumb).*m.full"):
+        gripper.stiffness_poly

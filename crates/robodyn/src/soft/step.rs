@@ -134,9 +134,11 @@ impl SceneStep {
         let u = match model.options.integrator {
             Integrator::Rk4 => None,
             Integrator::Euler => {
+                // as MuJoCo 4.0 decides (measured): a positive linear or any higher term
                 let damped = model.options.flag("eulerdamp")
                     && model.options.flag("damper")
-                    && model.has_dampers();
+                    && (model.damping.iter().any(|d| *d > 0.0)
+                        || model.damping_poly.iter().any(|t| *t != [0.0; 2]));
                 Some(match damped {
                     true => {
                         let k = DMatrix::from_diagonal(&damper_slopes(model, q, v));
@@ -294,11 +296,11 @@ fn lone_free_bodies(model: &Model) -> Vec<usize> {
         .collect()
 }
 
-/// K = ∂f/∂ν of the dampers (−D with its polynomial terms, and (∂f/∂L̇) JᵀJ of each tendon's) and of the actuators
-/// whose force is not saturated ([`crate::model::ActuatorForce::saturated`]): (b₂ + a₂ u) m mᵀ,
-/// m the moment arms (gear on a joint, gear J on a tendon; the activation w, or with `actearly`
-/// the next one, in place of u where the actuator has one), MuJoCo's `qDeriv` without the bias
-/// forces' terms, in MuJoCo's velocities ν (a joint actuator's hinge or slide has ν = v; a
+/// K = ∂f/∂ν of the dampers (−D with its polynomial terms, and (∂f/∂L̇) JᵀJ of each
+/// tendon's) and of the actuators whose force is not saturated
+/// ([`crate::model::ActuatorForce::saturated`]): (b₂ + a₂ u) m mᵀ, m the moment arms (gear on a
+/// joint, gear J on a tendon; the activation w, or with `actearly` the next one, in place of u
+/// where the actuator has one), MuJoCo's `qDeriv` without the bias forces' terms, in MuJoCo's velocities ν (a joint actuator's hinge or slide has ν = v; a
 /// tendon's J, on a free body's sites, is turned into ν's).
 fn velocity_derivative(
     model: &Model,
