@@ -16,7 +16,7 @@ STEP_MULTIPLE_TOLERANCE = 1e-9
 
 
 def simulate_scene(model: Any, q0: Any, v0: Any, t_end: float, dt: float | None, controller: Any, wrenches: Any,
-                    progress: Any, constraints: Any, ctrl: Any, act0: Any) -> Any:
+                    progress: Any, constraints: Any, ctrl: Any, act0: Any, plastic0: Any) -> Any:
     """:func:`simulate` with ``integrator="mujoco"``: the scene stepped as ``mj_step`` steps it."""
     from robodyn.simulation import Trajectory, _controller_argument
 
@@ -28,7 +28,7 @@ def simulate_scene(model: Any, q0: Any, v0: Any, t_end: float, dt: float | None,
         raise bad("constraints", "'model' with integrator='mujoco' (the scene's own equality constraints)",
                   repr(constraints))
     start = keyframe(model, q0).time if isinstance(q0, str) else 0.0
-    q0, v0, ctrl, act0 = scene_start(model, q0, v0, ctrl, act0)
+    q0, v0, ctrl, act0, plastic0 = scene_start(model, q0, v0, ctrl, act0, plastic0)
     h = model.options.timestep
     dt = h if dt is None else real("dt", dt)
     record_every = round(dt / h)
@@ -39,8 +39,8 @@ def simulate_scene(model: Any, q0: Any, v0: Any, t_end: float, dt: float | None,
         raise bad("t_end", f"a time (s) not before the start, {start}", repr(t_end))
     result = _core.simulate_scene(model, q0, v0, steps, record_every, start=start, ctrl=ctrl,
                                   controller=_controller_argument(model, controller),
-                                  progress=callback("progress", progress), act0=act0)
-    series = ("q", "v", "a", "tau", "tau_passive", "ctrl", "tau_constraint", "act")
+                                  progress=callback("progress", progress), act0=act0, plastic0=plastic0)
+    series = ("q", "v", "a", "tau", "tau_passive", "ctrl", "tau_constraint", "act", "plastic")
     batch = result["q"].ndim == 3
     runs = [
         Trajectory(model, result["t"], integrator="mujoco",
@@ -62,18 +62,21 @@ def scene_model(model: Any) -> _core.Model:
     return model
 
 
-def scene_start(model: _core.Model, q0: Any, v0: Any, ctrl: Any, act0: Any) -> tuple[Any, Any, Any, Any]:
-    """(q0, v0, ctrl, act0) of a scene's run: a keyframe's name gives its q, v, ctrl and act (those
-    given win)."""
+def scene_start(model: _core.Model, q0: Any, v0: Any, ctrl: Any, act0: Any,
+                plastic0: Any) -> tuple[Any, Any, Any, Any, Any]:
+    """(q0, v0, ctrl, act0, plastic0) of a scene's run: a keyframe's name gives its q, v, ctrl, act
+    and plastic (those given win)."""
     if isinstance(q0, str):
         key = keyframe(model, q0)
         q0, v0 = key.q, key.v if v0 is None else v0
         ctrl, act0 = key.ctrl if ctrl is None else ctrl, key.act if act0 is None else act0
+        plastic0 = key.plastic if plastic0 is None else plastic0
     q0 = numbers("q0", q0)
     v0 = np.zeros(q0.shape[:-1] + (model.nv,)) if v0 is None else numbers("v0", v0)
     if ctrl is not None and not callable(ctrl):
         ctrl = numbers("ctrl", ctrl)
-    return q0, v0, ctrl, None if act0 is None else numbers("act0", act0)
+    act0 = None if act0 is None else numbers("act0", act0)
+    return q0, v0, ctrl, act0, None if plastic0 is None else numbers("plastic0", plastic0)
 
 
 def keyframe(model: _core.Model, name: str) -> Any:
@@ -86,7 +89,7 @@ def keyframe(model: _core.Model, name: str) -> Any:
 
 
 def step_scene(model: Any, q: Any, v: Any, tau: Any, dt: float, derivatives: bool, constraints: Any,
-                ctrl: Any, act: Any) -> Any:
+                ctrl: Any, act: Any, plastic: Any) -> Any:
     """:func:`step` with ``integrator="mujoco"``: one ``mj_step`` of the scene."""
     model = scene_model(model)
     if flag("derivatives", derivatives):
@@ -100,4 +103,5 @@ def step_scene(model: Any, q: Any, v: Any, tau: Any, dt: float, derivatives: boo
         raise bad("dt", f"the scene's time step ({h} s) with integrator='mujoco'", repr(dt))
     ctrl = np.zeros(model.nu) if ctrl is None else ctrl
     act = np.zeros(model.na) if act is None else act
-    return _core.step_scene(model, q, v, tau, ctrl, act)
+    plastic = model.plastic0 if plastic is None else plastic
+    return _core.step_scene(model, q, v, tau, ctrl, act, plastic)

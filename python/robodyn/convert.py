@@ -185,6 +185,36 @@ class MujocoLayout:
                 out[iq] = q[mj_iq]
         return out
 
+    def _plastic_entries(self) -> list[tuple[int, int, int]]:
+        """(robodyn's index, MuJoCo's, size) of each plastic spring's references: the joints with a
+        yield (a ball's quaternion: size 4), then the tendons (their dead band: size 2), by name."""
+        mj, entries, start = self.mj_model, [], 0
+        for k, (kind, y) in enumerate(zip(self.model.joint_types, self.model.spring_yield)):
+            if y > 0:
+                size = 4 if kind == "spherical" else 1
+                entries.append((start, int(mj.jnt_plasticadr[self.mujoco_joints[k]]), size))
+                start += size
+        for name, y in zip(self.model.tendon_names, self.model.tendon_spring_yield):
+            if y > 0:
+                entries.append((start, int(mj.tendon_plasticadr[mj.tendon(name).id]), 2))
+                start += 2
+        return entries
+
+    def plastic_to_mujoco(self, plastic) -> np.ndarray:
+        """The plastic springs' references (robodyn's ``plastic``) as MuJoCo's ``plastic``: a ball's
+        quaternion scalar first."""
+        plastic, out = np.asarray(plastic, dtype=float), np.zeros(self.mj_model.nplastic)
+        for ours, theirs, size in self._plastic_entries():
+            out[theirs : theirs + size] = np.roll(plastic[ours : ours + size], 1 if size == 4 else 0)
+        return out
+
+    def plastic_from_mujoco(self, plastic) -> np.ndarray:
+        """MuJoCo's ``plastic`` in robodyn's layout: a ball's quaternion scalar last."""
+        plastic, out = np.asarray(plastic, dtype=float), np.zeros(self.model.nplastic)
+        for ours, theirs, size in self._plastic_entries():
+            out[ours : ours + size] = np.roll(plastic[theirs : theirs + size], -1 if size == 4 else 0)
+        return out
+
     def v_to_mujoco(self, q, v) -> np.ndarray:
         """Velocities: v_mj = T v."""
         return self._to_mujoco_order(self._transform(q) @ np.asarray(v, dtype=float))

@@ -234,7 +234,8 @@ class MimicModel(ConstrainedMethods):
         return self._reduced_keyframe(self.full.keyframe(key))
 
     def _reduced_keyframe(self, key: _core.Keyframe) -> _core.Keyframe:
-        return _core.Keyframe(key.name, key.time, self.reduce(key.q), key.v[self.independent_v], key.ctrl, key.act)
+        return _core.Keyframe(key.name, key.time, self.reduce(key.q), key.v[self.independent_v], key.ctrl, key.act,
+                              key.plastic)
 
     def actuator_forces(self, q: Any, v: Any, ctrl: Any, act: Any = None) -> np.ndarray:
         """Gᵀ of the full model's actuator forces at the expanded state."""
@@ -517,14 +518,14 @@ class MimicModel(ConstrainedMethods):
         return self.full.collide(self.expand(q))
 
     def contact_forward_dynamics(
-        self, q: Any, v: Any, tau: Any = None, ctrl: Any = None, act: Any = None
+        self, q: Any, v: Any, tau: Any = None, ctrl: Any = None, act: Any = None, plastic: Any = None
     ) -> dict[str, Any]:
         """The full model's, where no joint mimics another; MuJoCo's soft model of a coupled
         joint (an equality row) is not made yet."""
         if self.mimic_joints:
             raise bad("model", "a model without mimic joints (MuJoCo's soft couplings are not made yet)",
                       f"mimic joints {[name for name, *_ in self.mimic_joints]}")
-        return self.full.contact_forward_dynamics(q, v, tau, ctrl, act)
+        return self.full.contact_forward_dynamics(q, v, tau, ctrl, act, plastic)
 
     def jacobian(self, q: Any, frame: Any, reference: str = "world", out: Any = None) -> np.ndarray:
         """J_red = J G."""
@@ -633,7 +634,7 @@ _SHARED = frozenset({
     "name", "body_names", "body_parents", "body_masses", "frame_names", "frame_bodies", "joint_names",
     "joint_types", "mimic_joints", "total_mass", "visuals", "skybox", "nu", "na", "activation_rates", "actuator_names", "ctrl_range",
     "tendon_names", "options", "geoms", "contact_pairs", "contact_excludes", "contact_candidates", "joint_softness",
-    "contact_parameters", "collide_placed",
+    "contact_parameters", "collide_placed", "spring_yield", "nplastic", "plastic0", "tendon_spring_yield",
 })
 
 

@@ -207,7 +207,8 @@ class Trajectory:
     Arrays: ``t`` (T,), ``q`` (T, nq), ``v``, ``a``, ``tau`` and ``tau_passive`` (T, nv). ``tau`` is
     the controller's torque, ``tau_passive`` the joints' own (springs, damping, friction, limit
     penalty). A scene stepped with ``integrator="mujoco"`` also records ``ctrl`` (T, nu), ``act``
-    (T, na: the actuators' activations, MuJoCo's ``act``),
+    (T, na: the actuators' activations, MuJoCo's ``act``), ``plastic`` (T, nplastic: the references
+    of the springs with a ``springyield``, MuJoCo's ``plastic``),
     ``tau_constraint`` (T, nv: Jᵀ f of its contacts, limits and dry friction) and ``contacts`` (per
     sample, its contacts as :meth:`Model.collide` lists them, each with ``force``: normal, tangents,
     spin and rolls in its frame; :meth:`contact_force` sums them per geom), and its ``tau`` holds the
@@ -241,6 +242,7 @@ class Trajectory:
     ctrl: np.ndarray = field(default_factory=lambda: np.empty((0, 0)), repr=False)
     tau_constraint: np.ndarray = field(default_factory=lambda: np.empty((0, 0)), repr=False)
     act: np.ndarray = field(default_factory=lambda: np.empty((0, 0)), repr=False)
+    plastic: np.ndarray = field(default_factory=lambda: np.empty((0, 0)), repr=False)
     contacts: list[list[dict[str, Any]]] = field(default_factory=list, repr=False)
     kinetic_energy: np.ndarray = field(init=False, repr=False)
     potential_energy: np.ndarray = field(init=False, repr=False)
@@ -255,6 +257,8 @@ class Trajectory:
             self.tau_constraint = np.empty((len(self.t), 0))
         if self.act.size == 0:
             self.act = np.empty((len(self.t), 0))
+        if self.plastic.size == 0:
+            self.plastic = np.empty((len(self.t), 0))
         self.kinetic_energy = np.asarray(m.kinetic_energy(self.q, self.v))
         self.potential_energy = np.asarray(m.potential_energy(self.q))
         reference = np.broadcast_to(m.spring_reference, self.q.shape)
@@ -389,7 +393,8 @@ def simulate(model: _core.Model | MimicModel, q0: Configuration | str, v0: Array
              friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
              limit_damping: float = 1e2, progress: Callable[[float], Any] | None = None,
              accuracy: str = "warn", constraints: Any | None = "model", baumgarte: tuple[float, float] | None = None,
-             damping: float = 0.0, ctrl: Any = None, act0: ArrayLike | None = None) -> Trajectory: ...
+             damping: float = 0.0, ctrl: Any = None, act0: ArrayLike | None = None,
+             plastic0: ArrayLike | None = None) -> Trajectory: ...
 
 
 @overload
@@ -399,7 +404,8 @@ def simulate(model: _core.Model | MimicModel, q0: Configurations, v0: ArrayLike 
              friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
              limit_damping: float = 1e2, progress: Callable[[float], Any] | None = None,
              accuracy: str = "warn", constraints: Any | None = "model", baumgarte: tuple[float, float] | None = None,
-             damping: float = 0.0, ctrl: Any = None, act0: ArrayLike | None = None) -> list[Trajectory]: ...
+             damping: float = 0.0, ctrl: Any = None, act0: ArrayLike | None = None,
+             plastic0: ArrayLike | None = None) -> list[Trajectory]: ...
 
 
 @overload
@@ -409,7 +415,8 @@ def simulate(model: _core.Model | MimicModel, q0: ArrayLike, v0: ArrayLike | Non
              friction_velocity: float = 1e-2, limits: str = "report", limit_stiffness: float = 1e4,
              limit_damping: float = 1e2, progress: Callable[[float], Any] | None = None,
              accuracy: str = "warn", constraints: Any | None = "model", baumgarte: tuple[float, float] | None = None,
-             damping: float = 0.0, ctrl: Any = None, act0: ArrayLike | None = None) -> Trajectory | list[Trajectory]: ...
+             damping: float = 0.0, ctrl: Any = None, act0: ArrayLike | None = None,
+             plastic0: ArrayLike | None = None) -> Trajectory | list[Trajectory]: ...
 
 
 def simulate(
@@ -436,6 +443,7 @@ def simulate(
     damping: float = 0.0,
     ctrl: Any = None,
     act0: ArrayLike | None = None,
+    plastic0: ArrayLike | None = None,
 ) -> Trajectory | list[Trajectory]:
     """Simulate ``model`` from (``q0``, ``v0``) at t = 0 to ``t_end``, recording every ``dt``.
 
@@ -449,11 +457,13 @@ def simulate(
 
     ``integrator="mujoco"`` steps a scene as MuJoCo's ``mj_step`` does (the file's ``<option>``
     integrator and time step, its soft contacts, limits, dry friction and actuators; see the guide's
-    "Scenes stepped as MuJoCo"): ``q0`` may name a keyframe (its q, v, ctrl and act; the run starts at
-    its time, from which ``t_end`` counts), ``ctrl`` gives the
+    "Scenes stepped as MuJoCo"): ``q0`` may name a keyframe (its q, v, ctrl, act and plastic; the run
+    starts at its time, from which ``t_end`` counts), ``ctrl`` gives the
     actuators' controls (nu values, one row per rollout, or a callable ``(t, q, v) -> ctrl``),
     ``act0`` the activations of the actuators with activation dynamics at the start (na values, one
-    row per rollout; default zeros, or the keyframe's),
+    row per rollout; default zeros, or the keyframe's), ``plastic0`` the references of the springs
+    with a ``springyield`` (``m.nplastic`` values, one row per rollout; default ``m.plastic0``, or the
+    keyframe's),
     ``controller`` forces on the joints, ``dt`` (default: the time step) a whole number of steps
     between samples; the accuracy, passive-force and limit options below are the other integrators'.
 
@@ -499,11 +509,14 @@ def simulate(
     propagates unchanged.
     """
     if integrator == "mujoco":
-        return simulate_scene(model, q0, v0, t_end, dt, controller, wrenches, progress, constraints, ctrl, act0)
+        return simulate_scene(model, q0, v0, t_end, dt, controller, wrenches, progress, constraints, ctrl, act0,
+                              plastic0)
     if ctrl is not None:
         raise bad("ctrl", "None: controls drive a scene's actuators with integrator='mujoco'", "controls")
     if act0 is not None:
         raise bad("act0", "None: activations are a scene's state with integrator='mujoco'", "activations")
+    if plastic0 is not None:
+        raise bad("plastic0", "None: plastic springs are a scene's state with integrator='mujoco'", "references")
     if isinstance(model, MimicModel):
         return simulate_reduced(dict(locals()))
     robot_model("model", model)
@@ -590,6 +603,7 @@ def step(
     damping: float = 0.0,
     ctrl: Any = None,
     act: ArrayLike | None = None,
+    plastic: ArrayLike | None = None,
 ) -> Any:
     """One step of size ``dt`` from (``q``, ``v``) with the torque ``tau`` held over it (with
     ``integrator="mujoco"``: one ``mj_step`` of the scene, ``dt`` its time step, ``ctrl`` the controls): the step
@@ -597,9 +611,10 @@ def step(
     joints' Lie groups, with the model's passive forces and the same ``friction_velocity`` and
     ``limits`` options).
 
-    Returns ``x1`` = [q1, v1] (nq + nv values; with ``integrator="mujoco"`` and actuators with
-    activation dynamics [q1, v1, act1], ``act`` the activations at the start, na values, default
-    zeros), and with ``derivatives=True`` the tuple
+    Returns ``x1`` = [q1, v1] (nq + nv values; with ``integrator="mujoco"`` [q1, v1, act1, plastic1],
+    ``act`` the activations of the actuators with activation dynamics at the start, na values,
+    default zeros, and ``plastic`` the references of the springs with a ``springyield``,
+    ``m.nplastic`` values, default ``m.plastic0``), and with ``derivatives=True`` the tuple
     ``(x1, A, B)``: A = ∂x1/∂x0 (2nv × 2nv) and B = ∂x1/∂tau (2nv × nv), the exact Jacobians of this
     discrete step (chain rule through its stages, from the analytical derivatives of forward
     dynamics and of the passive forces). Rows and columns are [q; v] with q in the tangent space:
@@ -613,11 +628,13 @@ def step(
     equations, so ``derivatives=True`` takes ``baumgarte=None``).
     """
     if integrator == "mujoco":
-        return step_scene(model, q, v, tau, dt, derivatives, constraints, ctrl, act)
+        return step_scene(model, q, v, tau, dt, derivatives, constraints, ctrl, act, plastic)
     if ctrl is not None:
         raise bad("ctrl", "None: controls drive a scene's actuators with integrator='mujoco'", "controls")
     if act is not None:
         raise bad("act", "None: activations are a scene's state with integrator='mujoco'", "activations")
+    if plastic is not None:
+        raise bad("plastic", "None: plastic springs are a scene's state with integrator='mujoco'", "references")
     if isinstance(model, MimicModel):
         return step_reduced(dict(locals()))
     robot_model("model", model)

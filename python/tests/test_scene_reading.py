@@ -406,7 +406,8 @@ def test_a_tendon_mujoco_refuses_is_refused_by_name_and_line(change, message):
 
 
 def test_what_tendons_robodyn_does_not_model_are_named():
-    """A tendon's springyield: a warning; an invalid range under limited="auto" leaves the tendon
+    """A tendon's springyield makes its spring plastic, a warning says in the scene's dynamics
+    only; an invalid range under limited="auto" leaves the tendon
     unlimited, as in MuJoCo; the actuator on the fixed tendon pulls with gear times its
     coefficients, the one on the spatial tendon wrapping a cylinder with gear times its J."""
     text = TENDON_ARM.replace('range="0 1"', 'range="1 0" springyield="0.1"').replace(
@@ -418,7 +419,8 @@ def test_what_tendons_robodyn_does_not_model_are_named():
     mj_model = mujoco.MjModel.from_xml_string(text)
     model = robodyn.load_mjcf_string(text)
     messages = " ".join(model.warnings)
-    assert "'springyield' not modelled" in messages and "wrapped" not in messages
+    assert "tendon 'pull' yield (springyield) in the scene's own dynamics" in messages
+    assert "wrapped" not in messages and model.tendon_spring_yield == [0.1, 0.0, 0.0]
     assert model.tendon_names == ["pull", "string", "wrapped"]
     q = model.neutral()
     q[model.joint_idx_q[model.joint_names.index("hinge")]] = 0.3
@@ -439,8 +441,6 @@ def test_what_tendons_robodyn_does_not_model_are_named():
 @pytest.mark.parametrize(
     ("original", "change", "neutral", "warning"),
     [
-        ('margin="0.05"/>', 'margin="0.05" springyield="5"/>', 'springyield="0"',
-         r"<joint name='knee'> \(line \d+\): attribute 'springyield' not modelled \(the spring stays elastic"),
         ('margin="0.05"/>', 'margin="0.05" actuatorgravcomp="true"/>', 'actuatorgravcomp="false"',
          r"<joint name='knee'> \(line \d+\): attribute 'actuatorgravcomp' not modelled"),
         ('<geom name="ankle" size="0.03"/>', '<geom name="ankle" size="0.03" adhesion="2"/>', 'adhesion="0"',

@@ -13,7 +13,8 @@ use robodyn::soft::dynamics::{ContactDynamics, ContactForward};
 #[pymethods]
 impl PyModel {
     /// The accelerations and constraint forces of MuJoCo's soft constraint model at (q, v) and
-    /// the actuators' activations `act` (na; None: zero) under the applied generalised forces
+    /// the actuators' activations `act` (na; None: zero) and the plastic springs' references
+    /// `plastic` (nplastic; None: `plastic0`) under the applied generalised forces
     /// `tau` (nv, MuJoCo's `qfrc_applied`; None: zero) and the controls `ctrl` (nu; None:
     /// zero), as MuJoCo's `mj_forward` computes them with its solver
     /// run to convergence: the contacts (`collide`), the rows of every active constraint (the
@@ -29,7 +30,8 @@ impl PyModel {
     /// tangent, spin and roll forces in its frame, MuJoCo's `mj_contactForce`), `tau_actuator` and
     /// `tau_constraint` (nv,: MuJoCo's `qfrc_actuator` and `qfrc_constraint`), `act_dot` (na,:
     /// the activations' rates).
-    #[pyo3(signature = (q, v, tau=None, ctrl=None, act=None))]
+    #[pyo3(signature = (q, v, tau=None, ctrl=None, act=None, plastic=None))]
+    #[allow(clippy::too_many_arguments)]
     fn contact_forward_dynamics<'py>(
         &self,
         py: Python<'py>,
@@ -38,6 +40,7 @@ impl PyModel {
         tau: Option<&Bound<'py, PyAny>>,
         ctrl: Option<&Bound<'py, PyAny>>,
         act: Option<&Bound<'py, PyAny>>,
+        plastic: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let model = &self.model;
         let (nv, nu, na) = (model.nv, model.nu(), model.na());
@@ -55,9 +58,14 @@ impl PyModel {
             Some(act) => read_sample("act", act, SampleShape::vector(na))?,
             None => vec![0.0; na],
         };
+        let plastic = match plastic {
+            Some(p) => read_sample("plastic", p, SampleShape::vector(model.nplastic()))?,
+            None => model.initial_plastic(),
+        };
         let mut out = ContactForward::default();
         py.detach(|| {
-            ContactDynamics::new(model)?.forward(model, (&q, &v, &act), &tau, &ctrl, &mut out)
+            let state = (&q[..], &v[..], &act[..], &plastic[..]);
+            ContactDynamics::new(model)?.forward(model, state, &tau, &ctrl, &mut out)
         })
         .map_err(to_py_err)?;
         let rows = &out.rows;

@@ -12,7 +12,9 @@ use robodyn::Keyframe;
 /// A state the model file names (MuJoCo's `<key>`), in robodyn's coordinates: `q` (nq,),
 /// quaternions scalar last; `v` (nv,), a free joint's linear velocity in its body's axes (MuJoCo's
 /// `qvel` has world axes); `ctrl`, one control per actuator of the file, in its order; `act`, one
-/// activation per actuator with activation dynamics (MuJoCo's `act`); `time` (s).
+/// activation per actuator with activation dynamics (MuJoCo's `act`); `plastic`, the plastic
+/// springs' references (MuJoCo's `plastic`, nplastic, a ball's quaternion scalar last); `time`
+/// (s).
 /// Start a simulation from it with `robodyn.simulate(m, key.q, v0=key.v, ...)`.
 #[pyclass(name = "Keyframe", module = "robodyn", frozen)]
 pub(crate) struct PyKeyframe {
@@ -26,6 +28,7 @@ pub(crate) struct PyKeyframe {
     v: Vec<f64>,
     ctrl: Vec<f64>,
     act: Vec<f64>,
+    plastic: Vec<f64>,
 }
 
 impl From<&Keyframe> for PyKeyframe {
@@ -37,6 +40,7 @@ impl From<&Keyframe> for PyKeyframe {
             v: key.v.as_slice().to_vec(),
             ctrl: key.ctrl.as_slice().to_vec(),
             act: key.act.as_slice().to_vec(),
+            plastic: key.plastic.as_slice().to_vec(),
         }
     }
 }
@@ -44,7 +48,8 @@ impl From<&Keyframe> for PyKeyframe {
 #[pymethods]
 impl PyKeyframe {
     #[new]
-    #[pyo3(signature = (name, time, q, v, ctrl, act=None))]
+    #[pyo3(signature = (name, time, q, v, ctrl, act=None, plastic=None))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         name: &Bound<PyAny>,
         time: &Bound<PyAny>,
@@ -52,6 +57,7 @@ impl PyKeyframe {
         v: &Bound<PyAny>,
         ctrl: &Bound<PyAny>,
         act: Option<&Bound<PyAny>>,
+        plastic: Option<&Bound<PyAny>>,
     ) -> PyResult<Self> {
         Ok(PyKeyframe {
             name: text("name", name)?,
@@ -60,6 +66,7 @@ impl PyKeyframe {
             v: finite_numbers("v", v)?,
             ctrl: finite_numbers("ctrl", ctrl)?,
             act: act.map_or(Ok(Vec::new()), |act| finite_numbers("act", act))?,
+            plastic: plastic.map_or(Ok(Vec::new()), |p| finite_numbers("plastic", p))?,
         })
     }
 
@@ -88,10 +95,16 @@ impl PyKeyframe {
         PyArray1::from_slice(py, &self.act)
     }
 
+    /// The plastic springs' references (nplastic,): a new array each time.
+    #[getter]
+    fn plastic<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.plastic)
+    }
+
     fn __repr__(&self) -> String {
         format!(
-            "Keyframe({:?}, time={}, q={:?}, v={:?}, ctrl={:?}, act={:?})",
-            self.name, self.time, self.q, self.v, self.ctrl, self.act
+            "Keyframe({:?}, time={}, q={:?}, v={:?}, ctrl={:?}, act={:?}, plastic={:?})",
+            self.name, self.time, self.q, self.v, self.ctrl, self.act, self.plastic
         )
     }
 
@@ -104,6 +117,7 @@ impl PyKeyframe {
             this.v.clone(),
             this.ctrl.clone(),
             this.act.clone(),
+            this.plastic.clone(),
         );
         (slf.get_type(), args).into_pyobject(slf.py())
     }

@@ -236,6 +236,28 @@ impl PyModel {
         Ok(())
     }
 
+    /// Each joint's spring yield (MJCF `springyield`, rad or m; 0: elastic), one per joint in
+    /// `joint_names`' order: a spring stretched past it moves its reference (the plastic state,
+    /// `plastic0`), in the scene's own dynamics.
+    #[getter]
+    fn spring_yield(&self) -> Vec<f64> {
+        self.model.spring_yield[1..].to_vec()
+    }
+
+    /// The length of the plastic state (MuJoCo's `nplastic`): one reference per plastic hinge or
+    /// slide, a quaternion (scalar last) per plastic ball, then a dead band [low, high] per
+    /// plastic tendon.
+    #[getter]
+    fn nplastic(&self) -> usize {
+        self.model.nplastic()
+    }
+
+    /// The plastic state before anything yields (nplastic,): the springs' own references.
+    #[getter]
+    fn plastic0<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector_array(py, &self.model.initial_plastic())
+    }
+
     /// URDF mimic relations as (joint, mimicked joint, multiplier, offset):
     /// q[joint] = multiplier * q[mimicked] + offset. Those between two revolute or prismatic
     /// joints are also in `constraints` (as `JointCoupling`s), which `simulate` holds.

@@ -13,6 +13,12 @@ impl PyModel {
         self.model.tendons.iter().map(|t| t.name.clone()).collect()
     }
 
+    /// Each tendon's spring yield (MJCF `springyield`; 0: elastic), in the file's order.
+    #[getter]
+    fn tendon_spring_yield(&self) -> Vec<f64> {
+        self.model.tendons.iter().map(|t| t.spring_yield).collect()
+    }
+
     /// The tendons' lengths (ntendon,) at q (MuJoCo's `ten_length`): `L = Σ coef q_j` over a
     /// fixed tendon's joints, the length of its path through its sites for a spatial one (each
     /// branch after a pulley divided by its divisor). A batch gives (N, ntendon).

@@ -41,7 +41,7 @@ fn scenes(c: &mut Criterion) {
                     stepper
                         .forward_only(
                             &model,
-                            (home.q.as_slice(), home.v.as_slice(), &[]),
+                            (home.q.as_slice(), home.v.as_slice(), &[], &[]),
                             &tau,
                             ctrl,
                         )
@@ -55,7 +55,7 @@ fn scenes(c: &mut Criterion) {
                 let (mut q, mut v) = (home.q.as_slice().to_vec(), home.v.as_slice().to_vec());
                 stepper.forget_warm_start();
                 stepper
-                    .step(&model, 0.0, (&mut q, &mut v, &mut []), &tau, ctrl)
+                    .step(&model, 0.0, (&mut q, &mut v, &mut [], &mut []), &tau, ctrl)
                     .expect("step");
                 black_box(&q);
             })
@@ -67,7 +67,7 @@ fn scenes(c: &mut Criterion) {
                 for k in 0..RUN_STEPS {
                     let time = k as f64 * model.options.timestep;
                     stepper
-                        .step(&model, time, (&mut q, &mut v, &mut []), &tau, ctrl)
+                        .step(&model, time, (&mut q, &mut v, &mut [], &mut []), &tau, ctrl)
                         .expect("step");
                 }
                 black_box(&q);

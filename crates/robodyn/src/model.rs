@@ -8,6 +8,7 @@ mod geom;
 mod keyframe;
 mod options;
 mod physical;
+pub mod plastic;
 mod springs;
 mod tendon;
 
@@ -28,6 +29,7 @@ pub use options::{
 pub use physical::{
     check_mass_and_inertia, check_physical_parameters, check_positive_semidefinite, Unphysical,
 };
+pub use plastic::{PlasticSlot, SpringReferences};
 pub use tendon::{PathPoint, PathSite, Tendon, TendonEquality, UnreadElements};
 
 use crate::error::{check_length, check_vector, Error, Result};
@@ -104,6 +106,9 @@ pub struct JointProperties {
     pub damping_poly: [f64; 2],
     /// The position at which the spring is relaxed (MJCF `springref`); one-coordinate joints only.
     pub spring_reference: f64,
+    /// The spring's yield (MJCF `springyield`, rad or m; 0: elastic): past it the reference
+    /// moves ([`Model::yield_springs`]). Hinges, slides and balls only.
+    pub spring_yield: f64,
     /// How its limit and dry friction act in MuJoCo's soft constraint model.
     pub softness: JointSoftness,
     /// The range the total actuator force on it is clamped to (MJCF `actuatorfrcrange`);
@@ -125,6 +130,7 @@ impl Default for JointProperties {
             stiffness_poly: [0.0; 2],
             damping_poly: [0.0; 2],
             spring_reference: 0.0,
+            spring_yield: 0.0,
             softness: JointSoftness::default(),
             actuator_force_range: None,
         }
@@ -253,6 +259,9 @@ pub struct Model {
     /// world's unused).
     #[serde(default)]
     pub joint_softness: Vec<JointSoftness>,
+    /// Each body's joint spring yield (MJCF `springyield`; 0: elastic), nbodies (the world's
+    /// 0): its plastic state [`Model::plastic_slots`].
+    pub spring_yield: Vec<f64>,
     /// The collision shapes (MJCF geoms), in the file's order.
     #[serde(default)]
     pub geoms: Vec<Geom>,

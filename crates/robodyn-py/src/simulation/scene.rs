@@ -22,12 +22,13 @@ use robodyn::soft::simulate::{
 use robodyn::soft::step::SceneStep;
 use robodyn::{Error, Model};
 
-/// Simulates `model`'s scene from `q0`, `v0` (one state, or N: shape (N, nq), (N, nv)) and the
-/// activations `act0` (None: zeros; na, or (N, na)) at time `start` over `steps` of its time
+/// Simulates `model`'s scene from `q0`, `v0` (one state, or N: shape (N, nq), (N, nv)), the
+/// activations `act0` (None: zeros; na, or (N, na)) and the plastic springs' references
+/// `plastic0` (None: the model's; nplastic, or (N, nplastic)) at time `start` over `steps` of its time
 /// step, recording every `record_every`-th. `ctrl`: None (zeros), the controls (nu, or (N, nu))
 /// or a callable `(t, q, v) -> ctrl`; `controller` as in `simulate`.
 #[pyfunction]
-#[pyo3(signature = (model, q0, v0, steps, record_every, start=0.0, ctrl=None, controller=None, progress=None, act0=None))]
+#[pyo3(signature = (model, q0, v0, steps, record_every, start=0.0, ctrl=None, controller=None, progress=None, act0=None, plastic0=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_scene<'py>(
     py: Python<'py>,
@@ -41,12 +42,17 @@ pub fn simulate_scene<'py>(
     controller: Option<&Bound<'py, PyAny>>,
     progress: Option<&Bound<'py, PyAny>>,
     act0: Option<&Bound<'py, PyAny>>,
+    plastic0: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &model.model;
     let (q0, v0, batch) = initial_states(model, q0, v0)?;
     let count = batch.unwrap_or(1);
     let controls = read_controls(m, ctrl, count)?;
     let act0 = per_rollout("act0", act0, m.na(), count)?;
+    let plastic0 = match plastic0 {
+        Some(_) => per_rollout("plastic0", plastic0, m.nplastic(), count)?,
+        None => vec![m.initial_plastic(); count],
+    };
     let t_end = start + steps as f64 * m.options.timestep;
     let control = read_controller(m, controller, PassiveForces::default(), t_end)?;
     let (q0, v0) = (q0.values().into_owned(), v0.values().into_owned());
@@ -55,6 +61,7 @@ pub fn simulate_scene<'py>(
             &q0[k * m.nq..(k + 1) * m.nq],
             &v0[k * m.nv..(k + 1) * m.nv],
             act0[k].as_slice(),
+            plastic0[k].as_slice(),
         )
     };
     let scene = SceneRun {
@@ -135,6 +142,7 @@ pub fn simulate_scene<'py>(
         ),
         ("tau_constraint", m.nv, |r| &r.tau_constraint),
         ("act", m.na(), |r| &r.act),
+        ("plastic", m.nplastic(), |r| &r.plastic),
     ] {
         let flat: Vec<f64> = runs.iter().flat_map(|r| field(r).iter().copied()).collect();
         let shape = match batch {
@@ -161,9 +169,11 @@ pub fn simulate_scene<'py>(
     Ok(out)
 }
 
-/// One step of each state (q, v, act) under applied forces `tau` and controls `ctrl`: per
-/// sample the flat [q₁, v₁, act₁] (act: the activations, na).
+/// One step of each state (q, v, act, plastic) under applied forces `tau` and controls `ctrl`:
+/// per sample the flat [q₁, v₁, act₁, plastic₁] (act: the activations, na; plastic: the plastic
+/// springs' references, nplastic).
 #[pyfunction]
+#[allow(clippy::too_many_arguments)]
 pub fn step_scene<'py>(
     py: Python<'py>,
     model: &PyModel,
@@ -172,6 +182,7 @@ pub fn step_scene<'py>(
     tau: &Bound<'py, PyAny>,
     ctrl: &Bound<'py, PyAny>,
     act: &Bound<'py, PyAny>,
+    plastic: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let m = &model.model;
     let arguments = [
@@ -180,6 +191,7 @@ pub fn step_scene<'py>(
         model.v_arg("tau", tau)?,
         Argument::new("ctrl", ctrl, SampleShape::vector(m.nu()))?,
         Argument::new("act", act, SampleShape::vector(m.na()))?,
+        Argument::new("plastic", plastic, SampleShape::vector(m.nplastic()))?,
     ];
     let batch = arguments[0].batch()?;
     for argument in &arguments[1..] {
@@ -193,7 +205,7 @@ pub fn step_scene<'py>(
     }
     let count = batch.unwrap_or(1);
     let values: Vec<Vec<f64>> = arguments.iter().map(|a| a.values().into_owned()).collect();
-    let sizes = [m.nq, m.nv, m.nv, m.nu(), m.na()];
+    let sizes = [m.nq, m.nv, m.nv, m.nu(), m.na(), m.nplastic()];
     let row = |i: usize, k: usize| -> &[f64] {
         let n = sizes[i];
         match values[i].len() == n {
@@ -205,11 +217,13 @@ pub fn step_scene<'py>(
         .detach(|| {
             let step = |stepper: &mut SceneStep, k: usize| {
                 stepper.forget_warm_start();
-                let (mut q, mut v, mut act) =
-                    (row(0, k).to_vec(), row(1, k).to_vec(), row(4, k).to_vec());
-                stepper.step(m, 0.0, (&mut q, &mut v, &mut act), row(2, k), row(3, k))?;
+                let (mut q, mut v) = (row(0, k).to_vec(), row(1, k).to_vec());
+                let (mut act, mut plastic) = (row(4, k).to_vec(), row(5, k).to_vec());
+                let state = (&mut q[..], &mut v[..], &mut act[..], &mut plastic[..]);
+                stepper.step(m, 0.0, state, row(2, k), row(3, k))?;
                 q.extend_from_slice(&v);
                 q.extend_from_slice(&act);
+                q.extend_from_slice(&plastic);
                 Ok(q)
             };
             // one state with the model's own step; a batch with a copy per task
@@ -225,7 +239,9 @@ pub fn step_scene<'py>(
     let flat: Vec<f64> = states.concat();
     let array = PyArray1::from_vec(py, flat);
     Ok(match batch {
-        Some(n) => array.reshape([n, m.nq + m.nv + m.na()])?.into_any(),
+        Some(n) => array
+            .reshape([n, m.nq + m.nv + m.na() + m.nplastic()])?
+            .into_any(),
         None => array.into_any(),
     })
 }

@@ -86,7 +86,7 @@ impl PassiveForces {
         // springs: −(k + k₁ s + k₂ s²)(q ⊖ q_ref), with q ⊖ q_ref written into tau first (none
         // without springs: the Lie-group differences are the costly part)
         if model.has_springs() {
-            spring_displacement(model, q, tau);
+            spring_displacement(model, model.spring_reference.as_slice(), q, tau);
             model.spring_forces(tau);
         } else {
             tau.fill(0.0);
@@ -190,16 +190,16 @@ fn limit_penalties<'a>(
 /// The energy stored in the joint springs, Σ (k s²/2 + k₁ s³/3 + k₂ s⁴/4) over their stretches
 /// s ([`Model::spring_energy_at`]); `scratch` (nv) holds q ⊖ q_ref.
 pub fn spring_energy(model: &Model, q: &[f64], scratch: &mut [f64]) -> f64 {
-    spring_displacement(model, q, scratch);
+    spring_displacement(model, model.spring_reference.as_slice(), q, scratch);
     model.spring_energy_at(scratch)
 }
 
-/// q ⊖ q_ref, joint by joint on its group, into `out` (nv).
-pub(crate) fn spring_displacement(model: &Model, q: &[f64], out: &mut [f64]) {
+/// q ⊖ q_ref, joint by joint on its group, into `out` (nv): `reference` is q_ref (nq).
+pub(crate) fn spring_displacement(model: &Model, reference: &[f64], q: &[f64], out: &mut [f64]) {
     for i in 1..model.nbodies() {
         let (configuration, dofs) = (model.q_range(i), model.v_range(i));
         model.joints[i].difference(
-            &model.spring_reference.as_slice()[configuration.clone()],
+            &reference[configuration.clone()],
             &q[configuration],
             &mut out[dofs],
         );

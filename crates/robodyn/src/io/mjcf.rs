@@ -31,7 +31,7 @@ use crate::error::{Error, Result};
 use crate::io::read_model_file;
 use crate::io::schema;
 use crate::io::xml::{check_nesting, location, parse_numbers};
-use crate::model::{Model, ModelBuilder, SourceBody};
+use crate::model::{Model, ModelBuilder, PlasticSlot, SourceBody};
 use crate::spatial::{Mat3, Transform, Vec3};
 use nalgebra::{Rotation3, Unit, UnitQuaternion};
 use roxmltree::{Document, Node};
@@ -261,21 +261,24 @@ fn load_sources(sources: &Sources) -> Result<Model> {
     reader.read_keyframes(&sections, &mut model)?;
     reader.read_options(&sections, &mut model)?;
     model.source_bodies = reader.source_bodies.take();
-    let compensated: Vec<&str> = model
-        .source_bodies
-        .iter()
+    let compensated: Vec<String> = (model.source_bodies.iter())
         .filter(|s| s.gravcomp != 0.0)
-        .map(|s| s.name.as_str())
+        .map(|s| s.name.clone())
         .collect();
-    if !compensated.is_empty() {
-        model.warnings.push(format!(
-            "{}: the gravity compensation (gravcomp) of {} holds them up in the scene's own \
-             dynamics (m.contact_forward_dynamics, simulate with integrator='mujoco'); robodyn's \
-             other integrators and algorithms feel their full weight",
-            reader.location(root),
-            compensated.join(", ")
-        ));
-    }
+    let what = "the gravity compensation (gravcomp) of {} holds them up";
+    let elsewhere = "feel their full weight";
+    let warning = scene_only(&reader.location(root), what, &compensated, elsewhere);
+    model.warnings.extend(warning);
+    let plastic: Vec<String> = (model.plastic_slots())
+        .map(|(slot, _)| match slot {
+            PlasticSlot::Joint(i) => format!("joint '{}'", model.joint_names[i]),
+            PlasticSlot::Tendon(t) => format!("tendon '{}'", model.tendons[t].name),
+        })
+        .collect();
+    let what = "the springs of {} yield (springyield)";
+    let elsewhere = "keep them elastic";
+    let warning = scene_only(&reader.location(root), what, &plastic, elsewhere);
+    model.warnings.extend(warning);
     reader.tendon_inertias(root, &mut model);
     reader.apply_spring_dampers(&mut model)?;
     reader.read_contacts(&sections, &mut model)?;
@@ -590,4 +593,16 @@ impl<'a> Reader<'a> {
             &Vec3::from(position),
         ))
     }
+}
+
+/// A warning that what `what` says of `names` (its `{}`) holds in the scene's own dynamics only,
+/// while robodyn's other integrators and algorithms do what `elsewhere` says; none without names.
+fn scene_only(location: &str, what: &str, names: &[String], elsewhere: &str) -> Option<String> {
+    (!names.is_empty()).then(|| {
+        format!(
+            "{location}: {} in the scene's own dynamics (m.contact_forward_dynamics, simulate \
+             with integrator='mujoco'); robodyn's other integrators and algorithms {elsewhere}",
+            what.replace("{}", &names.join(", "))
+        )
+    })
 }

@@ -15,7 +15,7 @@ use crate::soft::wrap::Surface;
 const TAG: &[u8; 8] = b"robodyn\0";
 
 /// The snapshot format: bumped whenever `Model` (or a type inside it) changes its fields.
-pub const MODEL_FORMAT: u32 = 5;
+pub const MODEL_FORMAT: u32 = 6;
 
 /// The model as bytes.
 pub fn model_to_bytes(model: &Model) -> Vec<u8> {
@@ -84,6 +84,7 @@ fn check_structure(model: &Model) -> Result<()> {
         ("inertias", model.inertias.len()),
         ("idx_q", model.idx_q.len()),
         ("idx_v", model.idx_v.len()),
+        ("spring_yield", model.spring_yield.len()),
     ];
     if bodies == 0 || model.parent[0] != 0 {
         return damaged("body 0 must be the world".into());
@@ -144,17 +145,19 @@ fn check_structure(model: &Model) -> Result<()> {
             key.v.len()
         ));
     }
-    let (nu, na) = (model.nu(), model.na());
+    let (nu, na, np) = (model.nu(), model.na(), model.nplastic());
     if let Some(key) = model
         .keyframes
         .iter()
-        .find(|k| (k.ctrl.len(), k.act.len()) != (nu, na))
+        .find(|k| (k.ctrl.len(), k.act.len(), k.plastic.len()) != (nu, na, np))
     {
         return damaged(format!(
-            "keyframe '{}' has {} controls and {} activations, expected {nu} and {na}",
+            "keyframe '{}' has {} controls, {} activations and {} plastic references, expected \
+             {nu}, {na} and {np}",
             key.name,
             key.ctrl.len(),
-            key.act.len()
+            key.act.len(),
+            key.plastic.len()
         ));
     }
     let bodies_named = model
@@ -267,6 +270,7 @@ mod tests {
             v: nalgebra::DVector::zeros(1),
             ctrl: nalgebra::DVector::zeros(0),
             act: nalgebra::DVector::zeros(0),
+            plastic: nalgebra::DVector::zeros(0),
         });
         assert!(message(&model_to_bytes(&model)).contains("keyframe 'home' has 5 + 1"));
         let mut model = crate::io::load_mjcf_str(

@@ -79,6 +79,7 @@ impl ModelBuilder {
                 unread: Default::default(),
                 actuator_force_range: vec![None],
                 joint_softness: vec![JointSoftness::default()],
+                spring_yield: vec![0.0],
                 geoms: Vec::new(),
                 source_bodies: Vec::new(),
                 contact_pairs: Vec::new(),
@@ -123,6 +124,7 @@ impl ModelBuilder {
         m.x_tree.push(tree_transform(x_tree));
         m.inertias.push(inertia);
         m.joint_softness.push(properties.softness);
+        m.spring_yield.push(properties.spring_yield);
         m.actuator_force_range.push(properties.actuator_force_range);
         m.idx_q.push(m.nq);
         m.idx_v.push(m.nv);

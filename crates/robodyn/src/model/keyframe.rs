@@ -23,6 +23,9 @@ pub struct Keyframe {
     /// The actuators' activations, one per actuator with activation dynamics (MuJoCo's `act`).
     #[serde(default)]
     pub act: DVector<f64>,
+    /// The plastic springs' references (MuJoCo's `plastic`, [`crate::model::plastic`]).
+    #[serde(default)]
+    pub plastic: DVector<f64>,
 }
 
 impl Model {

@@ -104,6 +104,10 @@ pub struct Tendon {
     /// ([`crate::soft::inertia`]).
     #[serde(default)]
     pub armature: f64,
+    /// The spring's yield (`springyield`; 0: elastic): past it the dead band moves
+    /// ([`Model::yield_springs`]).
+    #[serde(default)]
+    pub spring_yield: f64,
 }
 
 impl Tendon {
@@ -149,11 +153,18 @@ impl Tendon {
             .map(|&(body, c)| (model.idx_v[body], model.idx_q[body], c))
     }
 
-    /// The spring's and the damper's force along the tendon at (L, L̇): with x = L − high above
+    /// The spring's and the damper's force along the tendon at (L, L̇) with the dead band
+    /// `[low, high]` (its `spring_length`, or where it yielded to): with x = L − high above
     /// the dead band, L − low below it, 0 within, `−x (k + k₁ x + k₂ x²)` and
     /// `− L̇ (b + b₁ |L̇| + b₂ L̇²)` (MuJoCo's `mju_polyForce`).
-    pub fn passive_force(&self, length: f64, rate: f64, spring: bool, damper: bool) -> f64 {
-        let [low, high] = self.spring_length;
+    pub fn passive_force(
+        &self,
+        [low, high]: [f64; 2],
+        length: f64,
+        rate: f64,
+        spring: bool,
+        damper: bool,
+    ) -> f64 {
         let x = if length < low {
             length - low
         } else if length > high {
@@ -241,17 +252,30 @@ mod tests {
             damping: 2.0,
             actuator_force_range: None,
             armature: 0.0,
+            spring_yield: 0.0,
             stiffness_poly: [0.0; 2],
             damping_poly: [0.0; 2],
         };
-        assert_eq!(tendon.passive_force(0.1, 0.0, true, true), 10.0 * 0.1);
-        assert_eq!(tendon.passive_force(0.3, 0.0, true, true), 0.0);
         assert_eq!(
-            tendon.passive_force(0.5, 0.0, true, true),
+            tendon.passive_force(tendon.spring_length, 0.1, 0.0, true, true),
+            10.0 * 0.1
+        );
+        assert_eq!(
+            tendon.passive_force(tendon.spring_length, 0.3, 0.0, true, true),
+            0.0
+        );
+        assert_eq!(
+            tendon.passive_force(tendon.spring_length, 0.5, 0.0, true, true),
             -10.0 * (0.5 - 0.4)
         );
-        assert_eq!(tendon.passive_force(0.3, 1.5, true, true), -3.0);
-        assert_eq!(tendon.passive_force(0.5, 1.5, false, false), 0.0);
+        assert_eq!(
+            tendon.passive_force(tendon.spring_length, 0.3, 1.5, true, true),
+            -3.0
+        );
+        assert_eq!(
+            tendon.passive_force(tendon.spring_length, 0.5, 1.5, false, false),
+            0.0
+        );
         // the polynomial terms: −x (k + k₁ x + k₂ x²), −L̇ (b + b₁ |L̇| + b₂ L̇²)
         let tendon = Tendon {
             stiffness_poly: [2.0, 0.5],
@@ -259,12 +283,18 @@ mod tests {
             ..tendon
         };
         let spring = -0.1 * (10.0 + 2.0 * 0.1 + 0.5 * 0.01);
-        assert!((tendon.passive_force(0.5, 0.0, true, true) - spring).abs() < 1e-15);
+        assert!(
+            (tendon.passive_force(tendon.spring_length, 0.5, 0.0, true, true) - spring).abs()
+                < 1e-15
+        );
         let damper = 1.5 * (2.0 - 0.5 * 1.5 + 0.3 * 2.25);
-        assert!((tendon.passive_force(0.3, -1.5, true, true) - damper).abs() < 1e-15);
+        assert!(
+            (tendon.passive_force(tendon.spring_length, 0.3, -1.5, true, true) - damper).abs()
+                < 1e-15
+        );
         // the damper's slope: its force's derivative in L̇
         for rate in [-1.5, 0.7] {
-            let force = |r: f64| tendon.passive_force(0.3, r, false, true);
+            let force = |r: f64| tendon.passive_force(tendon.spring_length, 0.3, r, false, true);
             let slope = (force(rate + 1e-6) - force(rate - 1e-6)) / 2e-6;
             assert!((tendon.damping_slope(rate) - slope).abs() < 1e-8, "{rate}");
         }

@@ -27,7 +27,7 @@ use crate::collision::{checked_pairs, collide, CheckedPair, CollisionScratch, Co
 use crate::error::{check_vector, Error, Result};
 use crate::integrate::forces::spring_displacement;
 use crate::joint::{quaternion_of, Joint};
-use crate::model::Model;
+use crate::model::{Model, SpringReferences};
 use crate::spatial::{Transform, Vec3};
 use crate::Data;
 use nalgebra::{DMatrix, DVector};
@@ -75,6 +75,8 @@ pub struct ContactDynamics {
     reference: Vec<f64>,
     /// The Cholesky factor of M with the tendons' inertia, where some tendon has one.
     factor: DMatrix<f64>,
+    /// The springs' references with the state's plastic part in place.
+    springs: SpringReferences,
 }
 
 impl ContactDynamics {
@@ -95,6 +97,7 @@ impl ContactDynamics {
             w: DVector::zeros(model.nv),
             reference: Vec::new(),
             factor: DMatrix::zeros(0, 0),
+            springs: SpringReferences::default(),
         })
     }
 
@@ -103,18 +106,20 @@ impl ContactDynamics {
         self.solver.forget_warm_start();
     }
 
-    /// The soft model's q̈ at (q, q̇) and activations `act` (na) under applied forces `tau`
+    /// The soft model's q̈ at (q, q̇), the activations `act` (na) and the plastic springs'
+    /// references `plastic` (nplastic, [`crate::model::plastic`]) under applied forces `tau`
     /// (nv) and controls `ctrl` (nu), into `out` (see the module's header).
     pub fn forward(
         &mut self,
         model: &Model,
-        (q, v, act): (&[f64], &[f64], &[f64]),
+        (q, v, act, plastic): (&[f64], &[f64], &[f64], &[f64]),
         tau: &[f64],
         ctrl: &[f64],
         out: &mut ContactForward,
     ) -> Result<()> {
         check_vector("v", v, model.nv)?;
         check_vector("tau", tau, model.nv)?;
+        model.check_plastic("plastic", plastic)?;
         let nv = model.nv;
         // 1. the contacts
         let placements = forward_kinematics(model, &mut self.data, q)?;
@@ -135,7 +140,9 @@ impl ContactDynamics {
         sized(&mut out.activation_rate, act.len());
         model.activation_rates(ctrl, act, out.activation_rate.as_mut_slice())?;
         sized(&mut out.passive, nv);
-        passive_forces(model, q, v, &out.tendons, out.passive.as_mut_slice());
+        self.springs.update(model, plastic);
+        let state = (q, v, &self.springs);
+        passive_forces(model, state, &out.tendons, out.passive.as_mut_slice());
         add_gravity_compensation(model, &self.x_world, out.passive.as_mut_slice());
         self.total.copy_from_slice(tau);
         self.total += &out.actuator;
@@ -223,13 +230,13 @@ impl ContactDynamics {
 }
 
 /// τ_passive = −K (q ⊖ q_ref) − D q̇ + Σ Jᵀ f_tendon (K and D with their polynomial terms,
-/// [`Model::spring_forces`]): the joints' and the tendons' springs and dampers (MuJoCo's
-/// `qfrc_passive` without the gravity compensation, [`add_gravity_compensation`], and fluid
-/// forces; dry friction is a constraint row), into `tau` (nv).
+/// [`Model::spring_forces`]; q_ref and the tendons' dead bands from `springs`): the joints' and
+/// the tendons' springs and dampers (MuJoCo's `qfrc_passive` without the gravity compensation,
+/// [`add_gravity_compensation`], and fluid forces; dry friction is a constraint row), into `tau`
+/// (nv).
 fn passive_forces(
     model: &Model,
-    q: &[f64],
-    v: &[f64],
+    (q, v, springs): (&[f64], &[f64], &SpringReferences),
     tendons: &TendonKinematics,
     tau: &mut [f64],
 ) {
@@ -237,7 +244,7 @@ fn passive_forces(
     let (spring, damper) = (options.flag("spring"), options.flag("damper"));
     tau.fill(0.0);
     if spring && model.has_springs() {
-        mujoco_spring_displacement(model, q, tau);
+        mujoco_spring_displacement(model, &springs.configuration, q, tau);
         model.spring_forces(tau);
     }
     if damper {
@@ -246,7 +253,7 @@ fn passive_forces(
     // each tendon's spring and damper along its length: τ += Jᵀ f
     for (t, tendon) in model.tendons.iter().enumerate() {
         let (length, rate) = (tendons.lengths[t], tendons.rate(t, v));
-        let force = tendon.passive_force(length, rate, spring, damper);
+        let force = tendon.passive_force(springs.bands[t], length, rate, spring, damper);
         tendons.add_to_row(t, force, tau);
     }
 }
@@ -305,12 +312,12 @@ fn sized(vector: &mut DVector<f64>, n: usize) {
 /// (MuJoCo's `mj_passive`): a free joint's translation and rotation apart, Rᵀ (p − p_ref) (the
 /// world-axes displacement MuJoCo pulls back, turned into the body's axes of robodyn's linear
 /// velocity) and log(q_ref⁻¹ ⊗ q); every other joint as [`spring_displacement`] (a ball's is the
-/// same log).
-fn mujoco_spring_displacement(model: &Model, q: &[f64], out: &mut [f64]) {
-    spring_displacement(model, q, out);
+/// same log). `reference` is q_ref (nq).
+fn mujoco_spring_displacement(model: &Model, reference: &[f64], q: &[f64], out: &mut [f64]) {
+    spring_displacement(model, reference, q, out);
     for i in (1..model.nbodies()).filter(|&i| matches!(model.joints[i], Joint::Free)) {
         let (s, v) = (model.idx_q[i], model.idx_v[i]);
-        let reference = &model.spring_reference.as_slice()[s..s + 7];
+        let reference = &reference[s..s + 7];
         let rotation = quaternion_of(&q[s + 3..s + 7]);
         let moved = Vec3::new(q[s], q[s + 1], q[s + 2])
             - Vec3::new(reference[0], reference[1], reference[2]);

@@ -53,6 +53,8 @@ pub struct SceneTrajectory {
     pub ctrl: Vec<f64>,
     /// The actuators' activations (MuJoCo's `act`), row by row (T × na).
     pub act: Vec<f64>,
+    /// The plastic springs' references (MuJoCo's `plastic`), row by row (T × nplastic).
+    pub plastic: Vec<f64>,
     /// The constraints' generalised forces (MuJoCo's `qfrc_constraint`), row by row (T × nv).
     pub tau_constraint: Vec<f64>,
     /// Per sample, its contacts and each one's force in its frame
@@ -71,13 +73,13 @@ pub struct SceneRun {
     pub start: f64,
 }
 
-/// Simulates `model`'s scene from (q₀, v₀) and the activations w₀ (na) at `run.start` over
-/// `run.steps` steps under `controls`
+/// Simulates `model`'s scene from (q₀, v₀), the activations w₀ (na) and the plastic state p₀
+/// (nplastic, [`crate::model::plastic`]) at `run.start` over `run.steps` steps under `controls`
 /// and the applied forces of `controller`. `progress`, if given, is called with the fraction
 /// done about a hundred times; an error it returns stops the simulation with that error.
 pub fn simulate_scene(
     model: &Model,
-    (q0, v0, act0): (&[f64], &[f64], &[f64]),
+    (q0, v0, act0, plastic0): (&[f64], &[f64], &[f64], &[f64]),
     run: SceneRun,
     controller: &mut dyn Controller,
     controls: &mut dyn Controls,
@@ -86,6 +88,7 @@ pub fn simulate_scene(
     model.check_configuration(q0)?;
     check_vector("v0", v0, model.nv)?;
     check_vector("act0", act0, model.na())?;
+    model.check_plastic("plastic0", plastic0)?;
     if run.record_every == 0 {
         return Err(Error::InvalidValue {
             argument: "record_every".into(),
@@ -94,7 +97,8 @@ pub fn simulate_scene(
     }
     let h = model.options.timestep;
     let mut stepper = SceneStep::new(model)?;
-    let (mut q, mut v, mut act) = (q0.to_vec(), v0.to_vec(), act0.to_vec());
+    let (mut q, mut v) = (q0.to_vec(), v0.to_vec());
+    let (mut act, mut plastic) = (act0.to_vec(), plastic0.to_vec());
     let (mut tau, mut ctrl) = (vec![0.0; model.nv], vec![0.0; model.nu()]);
     let mut out = SceneTrajectory::default();
     let report_every = (run.steps / 100).max(1);
@@ -108,11 +112,13 @@ pub fn simulate_scene(
             out.trajectory.q.extend_from_slice(&q);
             out.trajectory.v.extend_from_slice(&v);
             out.act.extend_from_slice(&act);
+            out.plastic.extend_from_slice(&plastic);
         }
         if k == run.steps {
-            stepper.forward_only(model, (&q, &v, &act), &tau, &ctrl)?;
+            stepper.forward_only(model, (&q, &v, &act, &plastic), &tau, &ctrl)?;
         } else {
-            stepper.step(model, t, (&mut q, &mut v, &mut act), &tau, &ctrl)?;
+            let state = (&mut q[..], &mut v[..], &mut act[..], &mut plastic[..]);
+            stepper.step(model, t, state, &tau, &ctrl)?;
         }
         if recorded {
             record(&mut out, &stepper, &tau, &ctrl);

@@ -16,6 +16,9 @@
 //!                  exp(h ω) on balls, p + h v_world and quat ⊗ exp(h ω) on free joints,
 //!                  and the activations w₁ = w₀ ⊞ h ẇ (crate::model::Actuator::next_activation;
 //!                  RK4: its stages take w₀ + h a_i ẇ_{i−1}, its step the weighted ẇ)
+//!   last           the plastic springs yield at q₁ (crate::model::plastic; its stages keep
+//!                  the references of the step's start), a tendon's at the length MuJoCo
+//!                  takes there, L₁ = L₀ + J₀ (q₁ ⊖ q₀) (measured: not L(q₁))
 //! ```
 //! Written in robodyn's basis an implicit solve reads `(M − h Tᵀ K T) u = M (q̈ + w)` with
 //! ν₁ = T₀ (v₀ + h u), and v₁ = T₁ᵀ ν₁ at the new orientation. A free body's gyroscopic
@@ -28,7 +31,7 @@ use super::TINY;
 use crate::algo::rnea_derivatives;
 use crate::algo::DerivativesInto;
 use crate::error::{check_vector, Error, Result};
-use crate::joint::{rotation_of, Joint};
+use crate::joint::{quaternion_of, rotation_of, Joint};
 use crate::model::{Integrator, Model};
 use crate::spatial::{skew, Mat3, Vec3};
 use crate::Data;
@@ -54,6 +57,10 @@ pub struct SceneStep {
     evaluations: usize,
     /// The free bodies alone in their trees ([`lone_free_bodies`]).
     lone_free_bodies: Vec<usize>,
+    /// For the plastic tendons: q₀, q₁ ⊖ q₀ and the lengths L₁.
+    start: Vec<f64>,
+    change: Vec<f64>,
+    lengths: Vec<f64>,
 }
 
 impl SceneStep {
@@ -85,15 +92,18 @@ impl SceneStep {
             data: Data::new(model),
             evaluations: 0,
             lone_free_bodies: lone_free_bodies(model),
+            start: Vec::new(),
+            change: Vec::new(),
+            lengths: Vec::new(),
         })
     }
 
-    /// The forward dynamics at (q, v) and the activations `act` into [`Self::forward`],
-    /// without a step.
+    /// The forward dynamics at (q, v), the activations `act` and the plastic state `plastic`
+    /// into [`Self::forward`], without a step.
     pub fn forward_only(
         &mut self,
         model: &Model,
-        state: (&[f64], &[f64], &[f64]),
+        state: (&[f64], &[f64], &[f64], &[f64]),
         tau: &[f64],
         ctrl: &[f64],
     ) -> Result<()> {
@@ -113,15 +123,15 @@ impl SceneStep {
         self.evaluations
     }
 
-    /// Advances (q, v) and the activations `act` (na) at time `time` (s; for its errors) by the
-    /// scene's time step under the applied forces `tau` (nv) and the controls `ctrl` (nu), both
-    /// held over the step. A state that is not finite or beyond [`MAX_STATE`] afterwards stops
-    /// it (MuJoCo resets there).
+    /// Advances (q, v), the activations `act` (na) and the plastic state `plastic` (nplastic)
+    /// at time `time` (s; for its errors) by the scene's time step under the applied forces
+    /// `tau` (nv) and the controls `ctrl` (nu), both held over the step. A state that is not
+    /// finite or beyond [`MAX_STATE`] afterwards stops it (MuJoCo resets there).
     pub fn step(
         &mut self,
         model: &Model,
         time: f64,
-        (q, v, act): (&mut [f64], &mut [f64], &mut [f64]),
+        (q, v, act, plastic): (&mut [f64], &mut [f64], &mut [f64], &mut [f64]),
         tau: &[f64],
         ctrl: &[f64],
     ) -> Result<()> {
@@ -129,7 +139,9 @@ impl SceneStep {
         check_vector("v", v, model.nv)?;
         check_vector("act", act, model.na())?;
         let h = model.options.timestep;
-        self.forward_only(model, (q, v, act), tau, ctrl)?;
+        self.forward_only(model, (q, v, act, plastic), tau, ctrl)?;
+        self.start.clear();
+        self.start.extend_from_slice(q);
         let acceleration = mujoco_acceleration(model, v, &self.forward.solution.acceleration);
         let u = match model.options.integrator {
             Integrator::Rk4 => None,
@@ -165,7 +177,10 @@ impl SceneStep {
             Integrator::Implicit | Integrator::Discrete => unreachable!("refused by new"),
         };
         match u {
-            None => self.runge_kutta(model, (q, v, act), &acceleration, tau, ctrl)?,
+            None => {
+                let state = (&mut *q, &mut *v, &mut *act, &*plastic);
+                self.runge_kutta(model, state, &acceleration, tau, ctrl)?
+            }
             Some(Some(u)) => {
                 advance(model, q, v, &u, h);
                 model.advance_activations(act, self.forward.activation_rate.as_slice(), h);
@@ -184,6 +199,25 @@ impl SceneStep {
                 message: format!("the state diverged (beyond {MAX_STATE:e} or not finite)"),
             });
         }
+        self.yield_springs(model, q, plastic)
+    }
+
+    /// The plastic springs yield at the step's new configuration q, the tendons at
+    /// L₁ = L₀ + J₀ (q ⊖ q₀) (from the step's start), while springs are enabled.
+    fn yield_springs(&mut self, model: &Model, q: &[f64], plastic: &mut [f64]) -> Result<()> {
+        if plastic.is_empty() || !model.options.flag("spring") {
+            return Ok(());
+        }
+        self.lengths.clear();
+        if model.has_plastic_tendons() {
+            self.change.resize(model.nv, 0.0);
+            mujoco_change(model, &self.start, q, &mut self.change);
+            let tendons = &self.forward.tendons;
+            let lengths = tendons.lengths.iter().enumerate();
+            self.lengths
+                .extend(lengths.map(|(t, length)| length + tendons.rate(t, &self.change)));
+        }
+        model.yield_springs(q, &self.lengths, plastic);
         Ok(())
     }
 
@@ -196,7 +230,7 @@ impl SceneStep {
     fn runge_kutta(
         &mut self,
         model: &Model,
-        (q, v, act): (&mut [f64], &mut [f64], &mut [f64]),
+        (q, v, act, plastic): (&mut [f64], &mut [f64], &mut [f64], &[f64]),
         start: &DVector<f64>,
         tau: &[f64],
         ctrl: &[f64],
@@ -222,7 +256,7 @@ impl SceneStep {
             self.evaluations += 1;
             self.dynamics.forward(
                 model,
-                (&stage_q, stage_v.as_slice(), stage_w.as_slice()),
+                (&stage_q, stage_v.as_slice(), stage_w.as_slice(), plastic),
                 tau,
                 ctrl,
                 &mut self.stage,
@@ -279,6 +313,26 @@ impl SceneStep {
             k.view_mut((s, s), (6, 6)).copy_from(&(-block));
         }
         Ok(Some(k))
+    }
+}
+
+/// q₁ ⊖ q₀ as MuJoCo's `mj_differentiatePos` measures it, in robodyn's basis at q₀: a free
+/// joint's translation p₁ − p₀ in world axes turned into its body's at q₀, R₀ᵀ (p₁ − p₀), and its
+/// rotation log(R₀ᵀ R₁); every other joint on its group.
+fn mujoco_change(model: &Model, q0: &[f64], q1: &[f64], out: &mut [f64]) {
+    for i in 1..model.nbodies() {
+        let (configuration, dofs) = (model.q_range(i), model.v_range(i));
+        let (a, b) = (&q0[configuration.clone()], &q1[configuration]);
+        let out = &mut out[dofs];
+        match model.joints[i] {
+            Joint::Free => {
+                let (r0, r1) = (quaternion_of(&a[3..7]), quaternion_of(&b[3..7]));
+                let moved = vec3(&b[0..3]) - vec3(&a[0..3]);
+                out[0..3].copy_from_slice(r0.inverse_transform_vector(&moved).as_slice());
+                out[3..6].copy_from_slice((r0.inverse() * r1).scaled_axis().as_slice());
+            }
+            ref joint => joint.difference(a, b, out),
+        }
     }
 }
 

@@ -278,6 +278,8 @@ impl<'a> Reader<'a> {
             };
             let (stiffness, stiffness_poly) = polynomial("stiffness")?;
             let (damping, damping_poly) = polynomial("damping")?;
+            let spring_yield =
+                self.spring_yield(*joint_node, joint, scalar("springyield", 0.0)?)?;
             let mut properties = JointProperties {
                 armature: scalar("armature", 0.0)?,
                 damping,
@@ -286,6 +288,7 @@ impl<'a> Reader<'a> {
                 stiffness,
                 stiffness_poly,
                 spring_reference: position_unit(scalar("springref", 0.0)?),
+                spring_yield,
                 softness: self.joint_softness(*joint_node, joint_class)?,
                 ..JointProperties::default()
             };

@@ -1,9 +1,10 @@
 //! A joint's properties beyond its kind and frame, as MuJoCo's compiler reads them: its soft
-//! limit and dry friction, the range its actuator forces are clamped to, `springdamper`, and
-//! MuJoCo's rules for ranges (`limited`, `<compiler autolimits>`) and for aligned free bodies.
+//! limit and dry friction, the range its actuator forces are clamped to, `springdamper`,
+//! `springyield`, and MuJoCo's rules for ranges (`limited`, `<compiler autolimits>`) and for aligned free bodies.
 
 use super::Reader;
 use crate::error::Result;
+use crate::joint::Joint;
 use crate::model::{JointSoftness, Model, SolverParameters};
 use roxmltree::Node;
 
@@ -26,6 +27,22 @@ impl<'a> Reader<'a> {
                 Err(self.error(joint, message))
             }
         }
+    }
+
+    /// A joint's `springyield` `value` (the compiler's angle unit on hinges and balls): not
+    /// negative, and none on a free joint, as MuJoCo requires.
+    pub(super) fn spring_yield(&self, node: Node<'a, 'a>, joint: Joint, value: f64) -> Result<f64> {
+        if value < 0.0 || (value > 0.0 && joint == Joint::Free) {
+            let message = format!(
+                "attribute 'springyield': expected a yield ≥ 0 on a hinge, slide or ball (none on \
+                 a free joint), got {value}"
+            );
+            return Err(self.error(node, message));
+        }
+        Ok(match joint {
+            Joint::Revolute { .. } | Joint::Spherical => self.angle(value),
+            _ => value,
+        })
     }
 
     /// The stiffness and damping of each joint with a `springdamper`, set as MuJoCo's compiler

@@ -5,13 +5,14 @@
 //! use; its `qvel` gives a free joint's linear velocity in world axes (robodyn's: in the body's).
 //! As in MuJoCo (4.0), a list may be shorter than the model's: it gives the first entries, and
 //! the rest are those of `qpos0` (the neutral configuration) for `qpos`, zeros for `qvel`, `act`
-//! and `ctrl`; a longer list is an error. A key without `time` is at 0.
+//! and `ctrl`, the springs' own references for `plastic` (its ball references quaternions as in
+//! `qpos`); a longer list is an error. A key without `time` is at 0.
 //! `mpos`/`mquat` (mocap bodies) are not read: a warning each.
 
 use super::Reader;
 use crate::error::Result;
 use crate::io::xml::{parse_number_list, parse_numbers};
-use crate::model::{Keyframe, Model};
+use crate::model::{Keyframe, Model, PlasticSlot};
 use nalgebra::{DVector, Quaternion, UnitQuaternion, Vector3};
 use roxmltree::Node;
 
@@ -68,6 +69,8 @@ impl<'a> Reader<'a> {
         let v = velocity_from_mujoco(model, &q, &qvel);
         let ctrl = list("ctrl", vec![0.0; actuators])?;
         let act = list("act", vec![0.0; model.na()])?;
+        let initial = plastic_to_mujoco(model, model.initial_plastic());
+        let plastic = plastic_from_mujoco(model, list("plastic", initial)?);
         for name in ["mpos", "mquat"] {
             if key.attribute(name).is_some() {
                 model.warnings.push(format!(
@@ -83,6 +86,7 @@ impl<'a> Reader<'a> {
             v,
             ctrl: DVector::from_vec(ctrl),
             act: DVector::from_vec(act),
+            plastic: DVector::from_vec(plastic),
         })
     }
 
@@ -128,6 +132,39 @@ fn configuration_to_mujoco(model: &Model, q: &DVector<f64>) -> Vec<f64> {
         }
     }
     qpos
+}
+
+/// A plastic state in MuJoCo's layout: each ball's reference quaternion turned to
+/// `[w, x, y, z]`.
+fn plastic_to_mujoco(model: &Model, mut plastic: Vec<f64>) -> Vec<f64> {
+    for start in ball_references(model) {
+        plastic[start..start + 4].rotate_right(1);
+    }
+    plastic
+}
+
+/// MuJoCo's plastic state in robodyn's layout: each ball's reference quaternion normalised
+/// (where not zero) and turned to `[x, y, z, w]`.
+fn plastic_from_mujoco(model: &Model, mut plastic: Vec<f64>) -> Vec<f64> {
+    for start in ball_references(model) {
+        let quaternion = &mut plastic[start..start + 4];
+        let norm = quaternion.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if norm > 0.0 {
+            quaternion.iter_mut().for_each(|x| *x /= norm);
+        }
+        quaternion.rotate_left(1);
+    }
+    plastic
+}
+
+/// Where each plastic ball's reference quaternion starts in the plastic state.
+fn ball_references(model: &Model) -> Vec<usize> {
+    let ball = |slot| matches!(slot, PlasticSlot::Joint(i) if model.joints()[i].nq() == 4);
+    model
+        .plastic_slots()
+        .filter(|(slot, _)| ball(*slot))
+        .map(|(_, start)| start)
+        .collect()
 }
 
 /// MuJoCo's qvel in robodyn's layout at configuration `q`: a free joint's linear velocity

@@ -13,8 +13,8 @@
 //! not given) come from the element or its class's `<tendon>` default; L at qpos0 and the
 //! default dead band are measured once the model's tendons are all read; `actuatorfrclimited`
 //! and `actuatorfrcrange` bound its actuators' forces together; its `armature` (with its
-//! actuators' g² `armature`, [`tendon_inertias`]) is an inertia moving with L. A tendon's
-//! `springyield` is not modelled (a warning).
+//! actuators' g² `armature`, [`tendon_inertias`]) is an inertia moving with L; its
+//! `springyield` makes its spring plastic ([`crate::model::plastic`]).
 
 use super::Reader;
 use crate::error::Result;
@@ -31,10 +31,6 @@ type TendonShape = (Vec<(usize, f64)>, Vec<PathPoint>);
 
 /// MuJoCo's `springlength` that asks for the length at the joints' `springref`.
 const UNGIVEN_SPRING_LENGTH: [f64; 2] = [-1.0, -1.0];
-
-/// What robodyn models, for the warnings about the rest.
-const MODELLED: &str = "robodyn models fixed tendons and spatial ones (sites, pulleys, spheres \
-                        and cylinders), with a polynomial spring and damper and an armature";
 
 impl<'a> Reader<'a> {
     /// The `<fixed>` and `<spatial>` elements of the `<tendon>` sections among `sections`, in
@@ -304,12 +300,11 @@ impl<'a> Reader<'a> {
         };
         let ((stiffness, stiffness_poly), (damping, damping_poly)) =
             (polynomial("stiffness")?, polynomial("damping")?);
-        // what is not modelled: warned
-        if first("springyield", 0.0)? != 0.0 {
-            model.warnings.push(format!(
-                "{}: 'springyield' not modelled ({MODELLED})",
-                self.location(element),
-            ));
+        let spring_yield = first("springyield", 0.0)?;
+        if spring_yield < 0.0 {
+            let message =
+                format!("attribute 'springyield': expected a yield ≥ 0, got {spring_yield}");
+            return Err(self.error(element, message));
         }
         let mut tendon = Tendon {
             name: element
@@ -330,6 +325,7 @@ impl<'a> Reader<'a> {
             armature,
             stiffness_poly,
             damping_poly,
+            spring_yield,
         };
         // the dead band: given, or (MuJoCo's (−1, −1)) the length at the joints' springref
         tendon.spring_length = match values("springlength")?.as_deref() {

@@ -35,12 +35,6 @@ const UNMODELLED: &[Unmodelled] = &[
     },
     Unmodelled {
         tags: &["joint"],
-        name: "springyield",
-        neutral: Neutral::Zero,
-        instead: "the spring stays elastic: robodyn models no plasticity",
-    },
-    Unmodelled {
-        tags: &["joint"],
         name: "actuatorgravcomp",
         neutral: Neutral::NotTrue,
         instead: "its gravity compensation stays a passive force, not clamped by \
