@@ -496,6 +496,9 @@ class MimicModel(ConstrainedMethods):
     def potential_energy(self, q: Any) -> Any:
         return self.full.potential_energy(self.expand(q))
 
+    def spring_energy(self, q: Any) -> Any:
+        return self.full.spring_energy(self.expand(q))
+
     def lagrangian(self, q: Any, v: Any) -> Any:
         return self.full.lagrangian(self.expand(q), self.expand_velocity(v))
 

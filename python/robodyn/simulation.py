@@ -115,25 +115,6 @@ def _gains(model, name: str, value: Any) -> np.ndarray:
     return gains
 
 
-def _spring_energy(m: Any, displacement: np.ndarray) -> np.ndarray:
-    """Σ (k d²/2 + k₁ s³/3 + k₂ s⁴/4) per sample of the displacements q ⊖ q_ref (T, nv): s the
-    signed displacement of a hinge or slide, the length of a ball's or of either half of a free
-    joint's (the springs' potential, as ``Model.spring_energy_at`` in the core)."""
-    energy = 0.5 * np.sum(m.stiffness * displacement**2, axis=1)
-    terms = np.asarray(m.stiffness_poly)
-    if not np.any(terms):
-        return energy
-    halves = {"revolute": [(0, 1)], "prismatic": [(0, 1)], "spherical": [(0, 3)],
-              "free": [(0, 3), (3, 3)]}
-    for kind, first in zip(m.joint_types, m.joint_idx_v):
-        for offset, size in halves.get(kind, []):
-            block = displacement[:, first + offset:first + offset + size]
-            s = block[:, 0] if size == 1 else np.linalg.norm(block, axis=1)
-            k1, k2 = terms[first + offset]
-            energy = energy + k1 * s**3 / 3 + k2 * s**4 / 4
-    return energy
-
-
 @dataclass(frozen=True)
 class PD:
     """τ = K_p (q_ref ⊖ q) + K_d (v_ref − v), plus g(q) with ``gravity_compensation=True``.
@@ -261,9 +242,7 @@ class Trajectory:
             self.plastic = np.empty((len(self.t), 0))
         self.kinetic_energy = np.asarray(m.kinetic_energy(self.q, self.v))
         self.potential_energy = np.asarray(m.potential_energy(self.q))
-        reference = np.broadcast_to(m.spring_reference, self.q.shape)
-        displacement = np.asarray(m.difference(reference, self.q)).reshape(len(self.t), m.nv)
-        self.spring_energy = _spring_energy(m, displacement)
+        self.spring_energy = np.asarray(m.spring_energy(self.q))
 
     def contact_force(self, geom: str) -> np.ndarray:
         """The contact force on the geom named ``geom`` per sample, (T, 3) in world axes (N): the sum

@@ -1,5 +1,6 @@
 """MuJoCo's gravity compensation (`<body gravcomp="γ">`): a force −γ m g at each body's centre of
-mass, in the scene's dynamics (`qfrc_passive`), against MuJoCo 4.0's `mj_forward` and `mj_step`;
+mass, in the scene's dynamics (`qfrc_passive`, or `qfrc_actuator` on an `actuatorgravcomp` joint),
+against MuJoCo 4.0's `mj_forward` and `mj_step`;
 an arm fully compensated holds still; gravity disabled takes it away, as in MuJoCo."""
 
 import mujoco
@@ -73,6 +74,38 @@ def test_an_arm_held_up_entirely_stays_still_and_without_gravity_nothing_is_held
     mujoco.mj_forward(mj_model, mj_data)
     assert_close(mj_data.qfrc_passive, np.zeros(mj_model.nv), 0.0, "MuJoCo without gravity")
     assert_matches_mujoco(model, mj_model, layout, mj_model.qpos0, np.zeros(mj_model.nv), label="no gravity")
+
+
+# The shoulder's and the elbow's compensation counted as actuator forces (actuatorgravcomp), the
+# shoulder's clamped with its motor's force to ±3 N·m.
+ACTUATED = HELD.replace('<joint name="shoulder" axis="0 1 0" damping="0.1"/>',
+                        '<joint name="shoulder" axis="0 1 0" damping="0.1" actuatorgravcomp="true" actuatorfrcrange="-3 3"/>').replace(
+    '<joint name="elbow" axis="0 1 0" damping="0.1"/>', '<joint name="elbow" axis="0 1 0" damping="0.1" actuatorgravcomp="true"/>').replace(
+    "</worldbody>", '</worldbody><actuator><motor joint="shoulder" gear="2"/></actuator>')
+
+
+@pytest.mark.parametrize("cone", ["pyramidal", "elliptic"])
+def test_actuator_gravity_compensation_as_in_mujoco(cone):
+    """actuatorgravcomp: the joint's compensation is in MuJoCo's qfrc_actuator, clamped with the
+    actuators' forces by the joint's actuatorfrcrange (so a clamped shoulder holds less), and not in
+    qfrc_passive: tau_actuator and q̈ at random states against mj_forward; no warning."""
+    model, mj_model, layout = load_both(ACTUATED.replace("{cone}", cone))
+    assert not [w for w in model.warnings if "actuatorgravcomp" in w], model.warnings
+    rng = np.random.default_rng(7)
+    clamped = 0
+    for case in range(10):
+        qpos = mj_model.qpos0.copy()
+        mujoco.mj_integratePos(mj_model, qpos, rng.normal(size=mj_model.nv) * 0.5, 1.0)
+        qvel, ctrl = rng.normal(size=mj_model.nv), rng.uniform(-2, 2, 1)
+        ours, _ = assert_matches_mujoco(model, mj_model, layout, qpos, qvel, ctrl=ctrl, label=f"{cone} case {case}")
+        shoulder = model.joint_idx_v[model.joint_names.index("shoulder")]
+        clamped += abs(ours["tau_actuator"][shoulder]) == 3.0
+    assert 0 < clamped < 10
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+def test_actuator_gravity_compensation_steps_as_in_mujoco(integrator):
+    assert_steps_from_a_turned_state(ACTUATED, integrator, 4, ctrl=[0.7])
 
 
 #: q̈ of an arm held up entirely: the weights and their compensation cancel to round-off.

@@ -135,6 +135,26 @@ def test_own_integrators_feel_the_terms_and_their_derivatives():
     assert np.ptp(run.spring_energy) > 0.5 * np.max(run.spring_energy)
 
 
+def test_the_spring_energy_is_the_potential_of_the_springs():
+    """m.spring_energy(q): Σ (k d²/2 + k₁ s³/3 + k₂ s⁴/4) written out joint by joint here (s the
+    signed displacement of the hinge and the slide, the length of the ball's and of either half of
+    the free joint's), one state and a batch."""
+    model = load_quietly(None, SPRINGS.replace("{cone}", "pyramidal"))
+    q = model.random_configuration(8, seed=3)
+    displacement = np.asarray(model.difference(np.broadcast_to(model.spring_reference, q.shape), q))
+    expected = 0.5 * np.sum(model.stiffness * displacement**2, axis=1)
+    blocks = {"revolute": [(0, 1)], "prismatic": [(0, 1)], "spherical": [(0, 3)], "free": [(0, 3), (3, 3)]}
+    for kind, first in zip(model.joint_types, model.joint_idx_v):
+        for offset, size in blocks[kind]:
+            block = displacement[:, first + offset : first + offset + size]
+            s = block[:, 0] if size == 1 else np.linalg.norm(block, axis=1)
+            k1, k2 = model.stiffness_poly[first + offset]
+            expected += k1 * s**3 / 3 + k2 * s**4 / 4
+    assert_close(model.spring_energy(q), expected, 1e-13, "a batch")
+    assert_close(model.spring_energy(q[3]), expected[3], 1e-13, "one state")
+    assert model.spring_energy(model.spring_reference) == 0.0
+
+
 #: RK4's energy drift over 0.2 s at 1e-4 s, relative to the energy that moves between the springs
 #: and the bodies (measured 6e-10; leaving the polynomial terms out of the energy: 0.35).
 ENERGY_DRIFT = 1e-7

@@ -441,8 +441,6 @@ def test_what_tendons_robodyn_does_not_model_are_named():
 @pytest.mark.parametrize(
     ("original", "change", "neutral", "warning"),
     [
-        ('margin="0.05"/>', 'margin="0.05" actuatorgravcomp="true"/>', 'actuatorgravcomp="false"',
-         r"<joint name='knee'> \(line \d+\): attribute 'actuatorgravcomp' not modelled"),
         ('<geom name="ankle" size="0.03"/>', '<geom name="ankle" size="0.03" adhesion="2"/>', 'adhesion="0"',
          r"<geom name='ankle'> \(line \d+\): attribute 'adhesion' not modelled \(robodyn models no adhesion\)"),
         ('<geom name="ankle" size="0.03"/>', '<geom name="ankle" size="0.03" surfacevel="0 0 1"/>', 'surfacevel="0 0 0"',

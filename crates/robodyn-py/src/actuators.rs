@@ -57,7 +57,10 @@ impl PyModel {
     /// clamped to its range, its actuator's force `(a₀ + a₁ l + a₂ l̇) u + (b₀ + b₁ l + b₂ l̇)`
     /// (l = gear q_j, or gear L on a tendon; its activation w, or with `actearly` the next one,
     /// in place of u where it has one) clamped to its force range, times its moment arms: the
-    /// gear on its joint, gear J on a tendon (J = ∂L̇/∂v, fixed or spatial). A batch gives (N, nv).
+    /// gear on its joint, gear J on a tendon (J = ∂L̇/∂v, fixed or spatial), a joint's total
+    /// clamped to its `actuatorfrcrange`. An `actuatorgravcomp` joint's gravity compensation,
+    /// which MuJoCo adds there, is in `contact_forward_dynamics`' `tau_actuator`, not here. A
+    /// batch gives (N, nv).
     #[pyo3(signature = (q, v, ctrl, act=None))]
     fn actuator_forces<'py>(
         &self,

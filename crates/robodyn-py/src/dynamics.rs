@@ -446,6 +446,22 @@ impl PyModel {
         })
     }
 
+    /// The joint springs' energy (J) at q: Σ (k d²/2 + k₁ s³/3 + k₂ s⁴/4) over d = q ⊖
+    /// `spring_reference`, s the signed displacement of a hinge or slide, the length of a ball's
+    /// or of either half of a free joint's (the potential of the springs `simulate` applies);
+    /// zero where every spring is relaxed. A batch (N, nq) gives (N,).
+    fn spring_energy<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.evaluate(py, &[self.q_arg("q", q)?], &[], &|m, w, i, out| {
+            let scratch = w.data.tau.as_mut_slice();
+            out[0] = robodyn::integrate::forces::spring_energy(m, i[0], scratch);
+            Ok(())
+        })
+    }
+
     /// Centroidal momentum matrix A_G(q), (6, nv): h_G = A_G v, rows [linear momentum; angular
     /// momentum about the centre of mass], world axes (Orin, Goswami & Lee 2013).
     fn centroidal_momentum_matrix<'py>(

@@ -109,6 +109,10 @@ pub struct JointProperties {
     /// The spring's yield (MJCF `springyield`, rad or m; 0: elastic): past it the reference
     /// moves ([`Model::yield_springs`]). Hinges, slides and balls only.
     pub spring_yield: f64,
+    /// Whether its bodies' gravity compensation (`gravcomp`) is an actuator force on it (MJCF
+    /// `actuatorgravcomp`: counted in `qfrc_actuator` and clamped with the actuators' by
+    /// `actuator_force_range`) rather than a passive one.
+    pub actuator_gravcomp: bool,
     /// How its limit and dry friction act in MuJoCo's soft constraint model.
     pub softness: JointSoftness,
     /// The range the total actuator force on it is clamped to (MJCF `actuatorfrcrange`);
@@ -131,6 +135,7 @@ impl Default for JointProperties {
             damping_poly: [0.0; 2],
             spring_reference: 0.0,
             spring_yield: 0.0,
+            actuator_gravcomp: false,
             softness: JointSoftness::default(),
             actuator_force_range: None,
         }
@@ -262,6 +267,8 @@ pub struct Model {
     /// Each body's joint spring yield (MJCF `springyield`; 0: elastic), nbodies (the world's
     /// 0): its plastic state [`Model::plastic_slots`].
     pub spring_yield: Vec<f64>,
+    /// Each body's joint's `actuatorgravcomp` ([`JointProperties::actuator_gravcomp`]), nbodies.
+    pub actuator_gravcomp: Vec<bool>,
     /// The collision shapes (MJCF geoms), in the file's order.
     #[serde(default)]
     pub geoms: Vec<Geom>,

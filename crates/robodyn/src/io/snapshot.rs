@@ -85,6 +85,7 @@ fn check_structure(model: &Model) -> Result<()> {
         ("idx_q", model.idx_q.len()),
         ("idx_v", model.idx_v.len()),
         ("spring_yield", model.spring_yield.len()),
+        ("actuator_gravcomp", model.actuator_gravcomp.len()),
     ];
     if bodies == 0 || model.parent[0] != 0 {
         return damaged("body 0 must be the world".into());

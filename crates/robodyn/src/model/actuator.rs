@@ -294,8 +294,23 @@ impl Model {
 
     /// The generalised forces (nv) the actuators exert under controls `ctrl` (nu, in the
     /// order of [`Model::actuators`]) and activations `act` (na) at (q, q̇), the tendons at q
-    /// `tendons` ([`TendonKinematics::update`]), into `tau`: MuJoCo's `qfrc_actuator`.
+    /// `tendons` ([`TendonKinematics::update`]), into `tau`: MuJoCo's `qfrc_actuator` (without
+    /// the gravity compensation of `actuatorgravcomp` joints, which the scene's dynamics adds
+    /// before [`Model::clamp_joint_actuator_forces`]).
     pub fn actuator_forces(
+        &self,
+        state: (&[f64], &[f64]),
+        inputs: (&[f64], &[f64]),
+        tendons: &TendonKinematics,
+        tau: &mut [f64],
+    ) -> Result<()> {
+        self.unclamped_actuator_forces(state, inputs, tendons, tau)?;
+        self.clamp_joint_actuator_forces(tau);
+        Ok(())
+    }
+
+    /// [`Model::actuator_forces`] before each joint's total is clamped to its range.
+    pub fn unclamped_actuator_forces(
         &self,
         (q, v): (&[f64], &[f64]),
         (ctrl, act): (&[f64], &[f64]),
@@ -314,14 +329,18 @@ impl Model {
                 tau[k] += arm * out.force;
             }
         }
-        // a hinge's or slide's total actuator force is clamped to its range
+        Ok(())
+    }
+
+    /// Clamps a hinge's or slide's total actuator force in `tau` (nv) to its range
+    /// (`actuatorfrcrange`).
+    pub fn clamp_joint_actuator_forces(&self, tau: &mut [f64]) {
         for (body, range) in self.actuator_force_range.iter().enumerate() {
             if let (Some((low, high)), 1) = (range, self.joints[body].nv()) {
                 let c = self.idx_v[body];
                 tau[c] = tau[c].clamp(*low, *high);
             }
         }
-        Ok(())
     }
 
     /// Each actuator with its force at (q, q̇) under `ctrl` (nu) and `act` (na), the tendons at

@@ -80,6 +80,7 @@ impl ModelBuilder {
                 actuator_force_range: vec![None],
                 joint_softness: vec![JointSoftness::default()],
                 spring_yield: vec![0.0],
+                actuator_gravcomp: vec![false],
                 geoms: Vec::new(),
                 source_bodies: Vec::new(),
                 contact_pairs: Vec::new(),
@@ -125,6 +126,7 @@ impl ModelBuilder {
         m.inertias.push(inertia);
         m.joint_softness.push(properties.softness);
         m.spring_yield.push(properties.spring_yield);
+        m.actuator_gravcomp.push(properties.actuator_gravcomp);
         m.actuator_force_range.push(properties.actuator_force_range);
         m.idx_q.push(m.nq);
         m.idx_v.push(m.nv);

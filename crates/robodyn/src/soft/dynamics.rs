@@ -77,6 +77,8 @@ pub struct ContactDynamics {
     factor: DMatrix<f64>,
     /// The springs' references with the state's plastic part in place.
     springs: SpringReferences,
+    /// The bodies' gravity compensation (nv).
+    gravcomp: DVector<f64>,
 }
 
 impl ContactDynamics {
@@ -98,6 +100,7 @@ impl ContactDynamics {
             reference: Vec::new(),
             factor: DMatrix::zeros(0, 0),
             springs: SpringReferences::default(),
+            gravcomp: DVector::zeros(model.nv),
         })
     }
 
@@ -134,16 +137,26 @@ impl ContactDynamics {
         );
         out.tendons.update(model, q, &self.x_world);
         // 2. q̈₀ = M⁻¹ (τ + τ_actuator + τ_passive − C q̇ − g), by the articulated-body algorithm
+        // τ_actuator: the actuators' forces and an actuatorgravcomp joint's gravity
+        // compensation, clamped to the joint's range; the rest of the compensation is passive
         sized(&mut out.actuator, nv);
         let actuator = out.actuator.as_mut_slice();
-        model.actuator_forces((q, v), (ctrl, act), &out.tendons, actuator)?;
+        model.unclamped_actuator_forces((q, v), (ctrl, act), &out.tendons, actuator)?;
+        sized(&mut self.gravcomp, nv);
+        add_gravity_compensation(model, &self.x_world, self.gravcomp.as_mut_slice());
+        for i in (1..model.nbodies()).filter(|&i| model.actuator_gravcomp[i]) {
+            for c in model.v_range(i) {
+                actuator[c] += std::mem::take(&mut self.gravcomp[c]);
+            }
+        }
+        model.clamp_joint_actuator_forces(actuator);
         sized(&mut out.activation_rate, act.len());
         model.activation_rates(ctrl, act, out.activation_rate.as_mut_slice())?;
         sized(&mut out.passive, nv);
         self.springs.update(model, plastic);
         let state = (q, v, &self.springs);
         passive_forces(model, state, &out.tendons, out.passive.as_mut_slice());
-        add_gravity_compensation(model, &self.x_world, out.passive.as_mut_slice());
+        out.passive += &self.gravcomp;
         self.total.copy_from_slice(tau);
         self.total += &out.actuator;
         self.total += &out.passive;

@@ -289,6 +289,7 @@ impl<'a> Reader<'a> {
                 stiffness_poly,
                 spring_reference: position_unit(scalar("springref", 0.0)?),
                 spring_yield,
+                actuator_gravcomp: self.flag(*joint_node, joint_class, "actuatorgravcomp")?,
                 softness: self.joint_softness(*joint_node, joint_class)?,
                 ..JointProperties::default()
             };

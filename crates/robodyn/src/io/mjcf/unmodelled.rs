@@ -34,13 +34,6 @@ const UNMODELLED: &[Unmodelled] = &[
         instead: "a mocap body stays where the file places it, welded to its parent",
     },
     Unmodelled {
-        tags: &["joint"],
-        name: "actuatorgravcomp",
-        neutral: Neutral::NotTrue,
-        instead: "its gravity compensation stays a passive force, not clamped by \
-                  actuatorfrcrange",
-    },
-    Unmodelled {
         tags: &["geom"],
         name: "adhesion",
         neutral: Neutral::Zero,
