@@ -10,7 +10,7 @@ import mujoco
 import numpy as np
 import pytest
 import robodyn
-from conftest import load_quietly
+from conftest import assert_close, load_quietly
 from test_contact_dynamics import load_both
 from test_scene_stepping import INTEGRATORS, STEP_AGREEMENT, STEPS, with_integrator
 
@@ -69,6 +69,19 @@ def mujoco_forward(mj_model, qpos, qvel, ctrl, act):
     return d
 
 
+def random_forwards(model, mj_model, layout, seed, cases=5):
+    """At `cases` random states, activations and controls (some outside their ranges, the
+    activations too): (q, v, ctrl, act, MuJoCo's mj_forward, robodyn's contact_forward_dynamics)."""
+    rng = np.random.default_rng(seed)
+    for _ in range(cases):
+        qpos = rng.uniform(-0.15, 0.15, size=4)
+        qvel, act, ctrl = rng.normal(size=4), rng.uniform(-1.2, 1.2, size=6), rng.uniform(-2.5, 2.5, size=8)
+        d = mujoco_forward(mj_model, qpos, qvel, ctrl, act)
+        q = layout.q_from_mujoco(qpos)
+        v = layout.v_from_mujoco(q, qvel)
+        yield q, v, ctrl, act, d, model.contact_forward_dynamics(q, v, ctrl=ctrl, act=act)
+
+
 def test_activation_dynamics_are_read_as_mujoco_compiles_them():
     model, mj_model, _ = load_both(ACTIVATED)
     assert model.warnings == []
@@ -81,14 +94,7 @@ def test_activations_drive_the_forces_as_in_mujoco():
     """At random states, activations and controls (some outside their ranges, the activations too:
     MuJoCo clamps w only as it integrates): act_dot, qfrc_actuator and qacc as mj_forward's."""
     model, mj_model, layout = load_both(ACTIVATED)
-    rng = np.random.default_rng(11)
-    for case in range(5):
-        qpos = rng.uniform(-0.15, 0.15, size=4)
-        qvel, act, ctrl = rng.normal(size=4), rng.uniform(-1.2, 1.2, size=6), rng.uniform(-2.5, 2.5, size=8)
-        d = mujoco_forward(mj_model, qpos, qvel, ctrl, act)
-        q = layout.q_from_mujoco(qpos)
-        v = layout.v_from_mujoco(q, qvel)
-        ours = model.contact_forward_dynamics(q, v, ctrl=ctrl, act=act)
+    for case, (q, v, ctrl, act, d, ours) in enumerate(random_forwards(model, mj_model, layout, 11)):
         scale = max(1.0, np.max(np.abs(d.act_dot)))
         assert np.max(np.abs(ours["act_dot"] - d.act_dot)) <= FORWARD_AGREEMENT * scale, f"case {case}"
         assert np.allclose(model.activation_rates(ctrl, act), d.act_dot, rtol=0, atol=FORWARD_AGREEMENT * scale)
@@ -173,3 +179,32 @@ def test_bad_activations_are_refused():
         robodyn.simulate(model, key.q, t_end=0.01, act0=np.zeros(6))
     with pytest.raises(ValueError, match="'act'"):
         model.actuator_forces(key.q, key.v, key.ctrl, np.zeros(3))
+
+
+@pytest.mark.parametrize("flag", ['actuation="disable"', 'clampctrl="disable"'])
+def test_the_actuation_and_clampctrl_flags_as_in_mujoco(flag):
+    """actuation disabled: the actuators exert nothing, every ẇ is 0 and an actuatorgravcomp joint's
+    gravity compensation is lost; clampctrl disabled: controls past their ranges act as given. At
+    random states against mj_forward, and 100 steps of each integrator from the keyframe."""
+    text = ACTIVATED.replace('<option timestep="0.005"/>', f'<option timestep="0.005"><flag {flag}/></option>').replace(
+        '<body name="fore" pos="0.4 0 0">', '<body name="fore" pos="0.4 0 0" gravcomp="1">').replace(
+        '<joint name="elbow" axis="0 1 0" damping="0.2"/>', '<joint name="elbow" axis="0 1 0" damping="0.2" actuatorgravcomp="true"/>')
+    model, mj_model, layout = load_both(text)
+    assert not [w for w in model.warnings if "not followed" in w], model.warnings
+    for case, (q, v, ctrl, act, d, ours) in enumerate(random_forwards(model, mj_model, layout, 13)):
+        assert_close(ours["act_dot"], d.act_dot, FORWARD_AGREEMENT, f"{flag} case {case} act_dot")
+        assert_close(model.activation_rates(ctrl, act), d.act_dot, FORWARD_AGREEMENT, "m.activation_rates")
+        assert_close(ours["tau_actuator"], layout.force_from_mujoco(q, d.qfrc_actuator), FORWARD_AGREEMENT, "tau_actuator")
+        assert_close(ours["qdd"], layout.a_from_mujoco(q, v, d.qacc), FORWARD_AGREEMENT, f"{flag} case {case} qdd")
+    for integrator in INTEGRATORS:
+        model, mj_model, layout = load_both(with_integrator(text, integrator))
+        h = model.options.timestep
+        run = robodyn.simulate(model, "primed", t_end=STEPS * h, integrator="mujoco")
+        d = mujoco.MjData(mj_model)
+        mujoco.mj_resetDataKeyframe(mj_model, d, 0)
+        for k in range(1, STEPS + 1):
+            mujoco.mj_step(mj_model, d)
+            q, v = run.q[k], run.v[k]
+            assert_close(layout.q_to_mujoco(q), d.qpos, STEP_AGREEMENT, f"{flag} {integrator} step {k} qpos")
+            assert_close(layout.v_to_mujoco(q, v), d.qvel, STEP_AGREEMENT, f"{flag} {integrator} step {k} qvel")
+            assert_close(run.act[k], d.act, STEP_AGREEMENT, f"{flag} {integrator} step {k} act")

@@ -258,9 +258,9 @@ def test_disabled_gravity_and_equalities_are_followed_and_the_rest_named():
     # the scene's own dynamics follows 'limit'; robodyn's other integrators have no soft limits
     assert "'limit'" not in messages
     springless = held.replace('<flag warmstart="disable" energy="enable"/>',
-                              '<flag spring="disable" clampctrl="disable"/>')
+                              '<flag spring="disable" clampctrl="disable" multiccd="disable"/>')
     messages = " ".join(robodyn.load_mjcf_string(springless).warnings)
-    assert "<flag> 'clampctrl' not followed" in messages
+    assert "<flag> 'multiccd' not followed" in messages and "clampctrl" not in messages
     assert "<flag> 'spring' followed by the scene's own dynamics" in messages
     assert "robodyn.simulate feels them only with integrator='mujoco'" in messages
 

@@ -54,7 +54,8 @@ impl PyModel {
 
     /// The generalised forces (nv,) the actuators exert under the controls `ctrl` (nu,) and the
     /// activations `act` (na,; None: zero) at (q, v): MuJoCo's `qfrc_actuator` — each control
-    /// clamped to its range, its actuator's force `(a₀ + a₁ l + a₂ l̇) u + (b₀ + b₁ l + b₂ l̇)`
+    /// clamped to its range (unless the `clampctrl` flag is disabled; with `actuation` disabled
+    /// every force is zero), its actuator's force `(a₀ + a₁ l + a₂ l̇) u + (b₀ + b₁ l + b₂ l̇)`
     /// (l = gear q_j, or gear L on a tendon; its activation w, or with `actearly` the next one,
     /// in place of u where it has one) clamped to its force range, times its moment arms: the
     /// gear on its joint, gear J on a tendon (J = ∂L̇/∂v, fixed or spatial), a joint's total
@@ -89,8 +90,9 @@ impl PyModel {
     }
 
     /// ẇ (na,): the rates of the actuators' activations under the controls `ctrl` (nu,) at the
-    /// activations `act` (na,), MuJoCo's `act_dot`: u (clamped) for an integrator, (u − w)/τ for
-    /// a filter. A batch gives (N, na).
+    /// activations `act` (na,), MuJoCo's `act_dot`: u (clamped, unless the `clampctrl` flag is
+    /// disabled) for an integrator, (u − w)/τ for a filter; all zero with the `actuation` flag
+    /// disabled. A batch gives (N, na).
     fn activation_rates<'py>(
         &self,
         py: Python<'py>,

@@ -2,7 +2,8 @@
 //!
 //! Reference: MuJoCo's documentation, "Computation", §Actuation model. An actuator with a joint
 //! transmission of gear g on a hinge or slide has length `l = g q_j` and velocity `l̇ = g q̇_j`;
-//! with control u (clamped to `ctrlrange` when limited) its scalar force is
+//! with control u (clamped to `ctrlrange` when limited, unless the `clampctrl` flag is
+//! disabled) its scalar force is
 //! ```text
 //!   f = (a₀ + a₁ l + a₂ l̇) u + (b₀ + b₁ l + b₂ l̇)        (gain a, bias b: MuJoCo's
 //!                                                             gainprm and biasprm, affine)
@@ -28,7 +29,8 @@
 //!                  w₁ = w + ẇ τ (1 − e^(−h/τ))              (else w₁ = w + h ẇ)
 //! ```
 //! w₁ clamped to `actrange` when limited. With `actearly` the force takes w₁ instead of w (the
-//! force answers the control within the same step).
+//! force answers the control within the same step). With the `actuation` flag disabled the
+//! actuators exert nothing and every ẇ is 0.
 
 use super::Model;
 use crate::error::{check_length, check_vector, Result};
@@ -173,10 +175,10 @@ impl Actuator {
             .map_or(next, |(low, high)| next.clamp(low, high))
     }
 
-    /// What the force's gain multiplies: the clamped control without activation, else the
-    /// activation `w` (or, with `actearly`, the next one, after a step `h`).
+    /// What the force's gain multiplies: the control `u` (as the model takes it,
+    /// [`Model::control`]) without activation, else the activation `w` (or, with `actearly`,
+    /// the next one, after a step `h`).
     pub fn input(&self, u: f64, w: f64, h: f64) -> f64 {
-        let u = self.clamp_control(u);
         match (self.has_activation(), self.act_early) {
             (false, _) => u,
             (true, false) => w,
@@ -250,8 +252,17 @@ impl Model {
         })
     }
 
-    /// Each actuator with its control u and its activation w (its last; 0 for one without):
-    /// the actuators zipped with `ctrl` (nu) and `act` (na) in order.
+    /// The control `u` as `actuator` takes it: clamped to its range, unless the `clampctrl`
+    /// flag is disabled.
+    pub fn control(&self, actuator: &Actuator, u: f64) -> f64 {
+        match self.options.flag("clampctrl") {
+            true => actuator.clamp_control(u),
+            false => u,
+        }
+    }
+
+    /// Each actuator with its control u ([`Model::control`]) and its activation w (its last; 0
+    /// for one without): the actuators zipped with `ctrl` (nu) and `act` (na) in order.
     pub fn actuator_states<'a>(
         &'a self,
         ctrl: &'a [f64],
@@ -264,19 +275,23 @@ impl Model {
                     0 => 0.0,
                     count => act[slot + count - 1],
                 };
-                (actuator, u, w)
+                (actuator, self.control(actuator, u), w)
             })
     }
 
     /// ẇ (na) at the controls `ctrl` (nu) and activations `act` (na), into `rates`: MuJoCo's
-    /// `act_dot` (0 for the activations robodyn holds).
+    /// `act_dot` (0 for the activations robodyn holds, and all 0 with the `actuation` flag
+    /// disabled).
     pub fn activation_rates(&self, ctrl: &[f64], act: &[f64], rates: &mut [f64]) -> Result<()> {
         check_vector("ctrl", ctrl, self.nu())?;
         check_vector("act", act, self.na())?;
         rates.fill(0.0);
+        if !self.options.flag("actuation") {
+            return Ok(());
+        }
         for ((actuator, slot), &u) in self.activation_slots().zip(ctrl) {
             if actuator.activation_count() == 1 {
-                rates[slot] = actuator.activation_rate(actuator.clamp_control(u), act[slot]);
+                rates[slot] = actuator.activation_rate(self.control(actuator, u), act[slot]);
             }
         }
         Ok(())
@@ -309,7 +324,8 @@ impl Model {
         Ok(())
     }
 
-    /// [`Model::actuator_forces`] before each joint's total is clamped to its range.
+    /// [`Model::actuator_forces`] before each joint's total is clamped to its range (zero with
+    /// the `actuation` flag disabled).
     pub fn unclamped_actuator_forces(
         &self,
         (q, v): (&[f64], &[f64]),
@@ -323,6 +339,9 @@ impl Model {
         check_vector("act", act, self.na())?;
         check_length("tendons", tendons.lengths.len(), self.tendons.len())?;
         tau.fill(0.0);
+        if !self.options.flag("actuation") {
+            return Ok(());
+        }
         for (actuator, out) in self.actuator_scalar_forces((q, v), (ctrl, act), tendons) {
             // τ += arm f
             for (k, arm) in self.actuator_arms(actuator, tendons) {

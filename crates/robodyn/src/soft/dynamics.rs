@@ -144,9 +144,12 @@ impl ContactDynamics {
         model.unclamped_actuator_forces((q, v), (ctrl, act), &out.tendons, actuator)?;
         sized(&mut self.gravcomp, nv);
         add_gravity_compensation(model, &self.x_world, self.gravcomp.as_mut_slice());
+        // (with the actuation flag disabled it is lost, as in MuJoCo)
+        let actuation = model.options.flag("actuation");
         for i in (1..model.nbodies()).filter(|&i| model.actuator_gravcomp[i]) {
             for c in model.v_range(i) {
-                actuator[c] += std::mem::take(&mut self.gravcomp[c]);
+                let compensation = std::mem::take(&mut self.gravcomp[c]);
+                actuator[c] += if actuation { compensation } else { 0.0 };
             }
         }
         model.clamp_joint_actuator_forces(actuator);

@@ -40,8 +40,10 @@ const FLAGS_WITHOUT_EFFECT: [&str; 10] = [
 /// the scene's own dynamics (`m.contact_forward_dynamics`, `simulate` with
 /// `integrator="mujoco"`) follows as MuJoCo does; robodyn's other integrators have no contacts,
 /// soft limits or dry-friction rows to switch off.
-const FLAGS_FOLLOWED: [&str; 11] = [
+const FLAGS_FOLLOWED: [&str; 13] = [
     "gravity",
+    "actuation",
+    "clampctrl",
     "equality",
     "constraint",
     "contact",
