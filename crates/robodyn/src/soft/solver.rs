@@ -16,7 +16,9 @@
 //! from the last solution when it costs less than q̈₀ (MuJoCo's warm start), until a step is
 //! below tolerance. Where no row has changed zone since the last factorisation, H differs from
 //! that factor's only by the cones' curvature: its step −H⁻¹ g, below tolerance, ends the solve
-//! (and is taken) without another Hessian, the last of Newton's iterations. J is sparse (a
+//! (and is taken) without another Hessian, the last of Newton's iterations; small enough that
+//! its error will be, it is taken in place of a new factorisation. A warm start's first step is
+//! the last solve's factor's (the Hessian at the last optimum). J is sparse (a
 //! friction row has one column, a foot's contact the columns of its leg and base): its rows are
 //! used through their nonzero columns only.
 
@@ -33,6 +35,13 @@ const MAX_ITERATIONS: usize = 100;
 /// tolerances only chase round-off: steps of 1e-14 relative, measured on a Go2 falling onto its
 /// floor; warm and cold starts then end within 2e-13 of each other).
 const STEP_TOLERANCE: f64 = 1e-10;
+/// Near the optimum H moves with q̈ only through the cones' curvature, by about the size of the
+/// last step: a step r by a factor taken with a step s leaves an error of about |r| |s|
+/// (relative to the accelerations). Where that is below this the step is taken without a new
+/// factorisation, once. Measured on the Go2 standing, 1000 Euler steps from `home`: 6.75
+/// factorisations a solve without it or the warm start's kept factor, 6.19 with it, 5.81 with
+/// the kept factor, 5.24 with both; the states within 1.3e-14 of each other at the end.
+const CHORD_REACH: f64 = STEP_TOLERANCE;
 /// The line search's iterations at most (Newton's method on the slope, kept in a bracket).
 const LINE_ITERATIONS: usize = 50;
 /// The line search ends where the slope is this small against its value at the start: the
@@ -62,6 +71,10 @@ pub struct Solver {
     warm_start: DVector<f64>,
     /// Whether `warm_start` holds a solution (false: the next solve starts from q̈₀).
     warm: bool,
+    /// Whether `hessian` holds a factor (of the last solve's last Hessian, between solves).
+    factored: bool,
+    /// The last factor's step, taken, against the accelerations.
+    factored_step: f64,
     pattern: Pattern,
     curvature: Curvature,
     /// x = J q̈ − a_ref and the rows' forces there.
@@ -100,58 +113,52 @@ impl Solver {
         let (nv, count) = (mass.nrows(), rows.len());
         self.size(nv, count);
         self.pattern.find(rows);
-        // from the last solution when it costs less than q̈₀
-        if out.acceleration.len() == nv {
-            out.acceleration.copy_from(free);
-        } else {
-            out.acceleration = free.clone();
-        }
-        let warm_start = std::mem::take(&mut self.warm_start);
-        if self.warm
-            && warm_start.len() == nv
-            && self.cost(rows, mass, free, reference, &warm_start)
-                < self.cost(rows, mass, free, reference, free)
-        {
-            out.acceleration.copy_from(&warm_start);
-        }
-        self.warm_start = warm_start;
+        let warmed = self.start(rows, mass, free, reference, &mut out.acceleration);
         out.iterations = 0;
         self.residual(reference, &out.acceleration);
         self.curvature.clear();
         forces_at(rows, &self.x, &mut self.forces, &mut self.curvature);
+        // from a warm start, first the last solve's step: its factor is the Hessian at the
+        // last optimum, Newton's own where no row has changed zone since
+        if warmed && self.factored {
+            self.gradient(mass, free, &out.acceleration);
+            self.solve_factored();
+            self.descend(rows, mass, reference, &mut out.acceleration);
+        }
+        let mut chord_taken = false;
         while out.iterations < MAX_ITERATIONS {
-            // g = M (q̈ − q̈₀) − Jᵀ f (f and H_s: the line search's last)
-            self.difference.copy_from(&out.acceleration);
-            self.difference -= free;
-            self.m_difference.gemv(1.0, mass, &self.difference, 0.0);
-            self.gradient.copy_from(&self.m_difference);
-            self.pattern
-                .subtract_transposed(&self.forces, self.gradient.as_mut_slice());
-            // the last factor's step, where no row has changed zone since, and below tolerance
+            // g (f and H_s: the line search's last)
+            self.gradient(mass, free, &out.acceleration);
+            // the last factor's step, where no row has changed zone since: below tolerance it
+            // ends the solve; taken once where it will (see CHORD_REACH)
             if out.iterations > 0
                 && self
                     .curvature
                     .zones()
                     .eq(self.factored_zones.iter().copied())
             {
-                self.step.copy_from(&self.gradient);
                 self.solve_factored();
                 if self.converged(1.0, &out.acceleration) {
                     out.acceleration -= &self.step;
                     break;
                 }
+                let reach = self.relative_step(1.0, &out.acceleration) * self.factored_step;
+                if !chord_taken && reach <= CHORD_REACH {
+                    chord_taken = true;
+                    self.descend(rows, mass, reference, &mut out.acceleration);
+                    continue;
+                }
             }
             out.iterations += 1;
+            chord_taken = false;
             // δ = −H⁻¹ g,  H = M + Jᵀ H_s J
             self.assemble_hessian(mass);
             self.factor()?;
-            self.step.copy_from(&self.gradient);
             self.solve_factored();
-            self.step.neg_mut();
             // q̈ += α δ
-            let length = self.line_search(rows, mass, reference);
-            out.acceleration.axpy(length, &self.step, 1.0);
-            if self.converged(length, &out.acceleration) {
+            let length = self.descend(rows, mass, reference, &mut out.acceleration);
+            self.factored_step = self.relative_step(length, &out.acceleration);
+            if self.factored_step <= STEP_TOLERANCE {
                 break;
             }
         }
@@ -167,9 +174,38 @@ impl Solver {
         Ok(())
     }
 
+    /// Sets `acceleration` to where the solve starts: the last solution when it costs less
+    /// than q̈₀ (MuJoCo's warm start; returns true), else q̈₀.
+    fn start(
+        &mut self,
+        rows: &Rows,
+        mass: &DMatrix<f64>,
+        free: &DVector<f64>,
+        reference: &[f64],
+        acceleration: &mut DVector<f64>,
+    ) -> bool {
+        let nv = mass.nrows();
+        if acceleration.len() == nv {
+            acceleration.copy_from(free);
+        } else {
+            *acceleration = free.clone();
+        }
+        let warm_start = std::mem::take(&mut self.warm_start);
+        let warmed = self.warm
+            && warm_start.len() == nv
+            && self.cost(rows, mass, free, reference, &warm_start)
+                < self.cost(rows, mass, free, reference, free);
+        if warmed {
+            acceleration.copy_from(&warm_start);
+        }
+        self.warm_start = warm_start;
+        warmed
+    }
+
     /// The next solve starts from q̈₀: its result no longer depends on the solves before.
     pub fn forget_warm_start(&mut self) {
         self.warm = false;
+        self.factored = false;
     }
 
     fn size(&mut self, nv: usize, count: usize) {
@@ -182,6 +218,7 @@ impl Solver {
             v.resize(count, 0.0);
         }
         if self.hessian.nrows() != nv {
+            self.factored = false;
             self.hessian = DMatrix::zeros(nv, nv);
             for v in [
                 &mut self.difference,
@@ -238,6 +275,7 @@ impl Solver {
 
     /// H = L Lᵀ in place (Cholesky).
     fn factor(&mut self) -> Result<()> {
+        self.factored = false;
         let factor = Cholesky::new(std::mem::take(&mut self.hessian)).ok_or_else(|| {
             Error::InvalidValue {
                 argument: "model".into(),
@@ -245,20 +283,52 @@ impl Solver {
             }
         })?;
         self.hessian = factor.unpack_dirty();
+        self.factored = true;
         Ok(())
     }
 
-    /// `step` ← H⁻¹ `step` by the kept factor: L⁻ᵀ L⁻¹.
+    /// `step` ← H⁻¹ g by the kept factor: L⁻ᵀ L⁻¹ g.
     fn solve_factored(&mut self) {
+        self.step.copy_from(&self.gradient);
         self.hessian
             .solve_lower_triangular_unchecked_mut(&mut self.step);
         self.hessian
             .tr_solve_lower_triangular_unchecked_mut(&mut self.step);
     }
 
+    /// g = M (q̈ − q̈₀) − Jᵀ f, with f at q̈ (the last [`forces_at`]'s); M (q̈ − q̈₀) kept.
+    fn gradient(&mut self, mass: &DMatrix<f64>, free: &DVector<f64>, acceleration: &DVector<f64>) {
+        self.difference.copy_from(acceleration);
+        self.difference -= free;
+        self.m_difference.gemv(1.0, mass, &self.difference, 0.0);
+        self.gradient.copy_from(&self.m_difference);
+        self.pattern
+            .subtract_transposed(&self.forces, self.gradient.as_mut_slice());
+    }
+
+    /// q̈ += α δ along δ = −`step` (`step` a positive definite matrix's inverse times g, a
+    /// direction of descent) by the line search; returns α.
+    fn descend(
+        &mut self,
+        rows: &Rows,
+        mass: &DMatrix<f64>,
+        reference: &[f64],
+        acceleration: &mut DVector<f64>,
+    ) -> f64 {
+        self.step.neg_mut();
+        let length = self.line_search(rows, mass, reference);
+        acceleration.axpy(length, &self.step, 1.0);
+        length
+    }
+
+    /// A step of `length` × `step` against the accelerations.
+    fn relative_step(&self, length: f64, acceleration: &DVector<f64>) -> f64 {
+        length * self.step.amax() / (1.0 + acceleration.amax())
+    }
+
     /// Whether a step of `length` × `step` is below tolerance against the accelerations.
     fn converged(&self, length: f64, acceleration: &DVector<f64>) -> bool {
-        length * self.step.amax() <= STEP_TOLERANCE * (1.0 + acceleration.amax())
+        self.relative_step(length, acceleration) <= STEP_TOLERANCE
     }
 
     /// The step length α minimising the cost along δ from q̈: where its slope
@@ -493,8 +563,10 @@ mod tests {
         let mass = mixed_mass();
         let mut warm = Solver::default();
         let mut solution = Solution::default();
-        for shift in [0.0, 0.3, -2.0] {
+        // M changes between the solves too: the first step of each is by the last one's factor
+        for (shift, scale) in [(0.0, 1.0), (0.3, 1.1), (-2.0, 0.8), (-2.1, 0.8)] {
             let free = DVector::from_fn(4, |i, _| (i as f64 - 1.5) * 4.0 + shift);
+            let mass = &mass * scale;
             warm.solve(&rows, &mass, &free, &rows.reference, &mut solution)
                 .expect("solvable");
             let cold = solve(&rows, &mass, &free, &rows.reference);

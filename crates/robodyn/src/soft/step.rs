@@ -57,6 +57,9 @@ pub struct SceneStep {
     evaluations: usize,
     /// The free bodies alone in their trees ([`lone_free_bodies`]).
     lone_free_bodies: Vec<usize>,
+    /// Euler's implicit matrix (then its factor) and its K, kept between steps.
+    implicit: DMatrix<f64>,
+    damping: DMatrix<f64>,
     /// For the plastic tendons: q₀, q₁ ⊖ q₀ and the lengths L₁.
     start: Vec<f64>,
     change: Vec<f64>,
@@ -92,6 +95,8 @@ impl SceneStep {
             data: Data::new(model),
             evaluations: 0,
             lone_free_bodies: lone_free_bodies(model),
+            implicit: DMatrix::zeros(0, 0),
+            damping: DMatrix::zeros(0, 0),
             start: Vec::new(),
             change: Vec::new(),
             lengths: Vec::new(),
@@ -152,10 +157,7 @@ impl SceneStep {
                     && (model.damping.iter().any(|d| *d > 0.0)
                         || model.damping_poly.iter().any(|t| *t != [0.0; 2]));
                 Some(match damped {
-                    true => {
-                        let k = DMatrix::from_diagonal(&damper_slopes(model, q, v));
-                        implicit_solve(model, q, &self.forward.mass, &k, None, h, &acceleration)
-                    }
+                    true => self.damped_euler(model, q, v, &acceleration),
                     false => Some(acceleration.clone()),
                 })
             }
@@ -164,15 +166,9 @@ impl SceneStep {
                 let k = velocity_derivative(model, (q, v, act), ctrl, tendons)?;
                 let gyroscopic = self.free_body_gyroscopic(model, q, v)?;
                 let mass = &self.forward.mass;
-                Some(implicit_solve(
-                    model,
-                    q,
-                    mass,
-                    &k,
-                    gyroscopic,
-                    h,
-                    &acceleration,
-                ))
+                let mut matrix = DMatrix::zeros(0, 0);
+                implicit_matrix(model, q, mass, &k, gyroscopic, &mut matrix);
+                Some(matrix.lu().solve(&(mass * &acceleration)))
             }
             Integrator::Implicit | Integrator::Discrete => unreachable!("refused by new"),
         };
@@ -200,6 +196,40 @@ impl SceneStep {
             });
         }
         self.yield_springs(model, q, plastic)
+    }
+
+    /// Euler's step with its joints' damping implicit: u with (M − h Tᵀ K T) u = M a, K the
+    /// dampers' ∂f/∂ν (diagonal, ≤ 0: the matrix is M plus a positive semi-definite term,
+    /// factored by Cholesky); `None` when singular.
+    fn damped_euler(
+        &mut self,
+        model: &Model,
+        q: &[f64],
+        v: &[f64],
+        acceleration: &DVector<f64>,
+    ) -> Option<DVector<f64>> {
+        let nv = model.nv;
+        if self.damping.shape() != (nv, nv) {
+            self.damping = DMatrix::zeros(nv, nv);
+        }
+        self.damping.set_diagonal(&damper_slopes(model, q, v));
+        let mass = &self.forward.mass;
+        let mut matrix = std::mem::take(&mut self.implicit);
+        implicit_matrix(model, q, mass, &self.damping, None, &mut matrix);
+        let mut u = mass * acceleration;
+        match matrix.cholesky() {
+            Some(factor) => {
+                factor.solve_mut(&mut u);
+                self.implicit = factor.unpack_dirty();
+                Some(u)
+            }
+            // a damper's negative terms may leave it indefinite: the general solve
+            None => {
+                let mut matrix = DMatrix::zeros(0, 0);
+                implicit_matrix(model, q, mass, &self.damping, None, &mut matrix);
+                matrix.lu().solve(&u)
+            }
+        }
     }
 
     /// The plastic springs yield at the step's new configuration q, the tendons at
@@ -420,20 +450,23 @@ fn keep_tree_pattern(model: &Model, k: &mut DMatrix<f64>) {
     }
 }
 
-/// u with (M − h Tᵀ K T − h G) u = M a: the implicit step's acceleration in robodyn's basis
-/// (G: the free bodies' gyroscopic Tᵀ(∂f/∂ν)T, already in that basis); `None` when singular.
-fn implicit_solve(
+/// M − h Tᵀ K T − h G into `matrix`: the implicit step's matrix in robodyn's basis (G: the
+/// free bodies' gyroscopic Tᵀ(∂f/∂ν)T, already in that basis; h the scene's time step).
+fn implicit_matrix(
     model: &Model,
     q: &[f64],
     mass: &DMatrix<f64>,
     k: &DMatrix<f64>,
     gyroscopic: Option<DMatrix<f64>>,
-    h: f64,
-    acceleration: &DVector<f64>,
-) -> Option<DVector<f64>> {
+    matrix: &mut DMatrix<f64>,
+) {
     // Tᵀ K T, T the identity but for each free joint's linear block R: Rᵀ on those rows, R on
     // those columns
-    let mut matrix = k.clone();
+    if matrix.shape() == k.shape() {
+        matrix.copy_from(k);
+    } else {
+        *matrix = k.clone();
+    }
     for (s, rotation) in free_rotations(model, q) {
         let turned = rotation.transpose() * matrix.fixed_rows::<3>(s);
         matrix.fixed_rows_mut::<3>(s).copy_from(&turned);
@@ -441,11 +474,10 @@ fn implicit_solve(
         matrix.fixed_columns_mut::<3>(s).copy_from(&turned);
     }
     if let Some(g) = gyroscopic {
-        matrix += g;
+        *matrix += g;
     }
-    matrix *= -h;
-    matrix += mass;
-    matrix.lu().solve(&(mass * acceleration))
+    *matrix *= -model.options.timestep;
+    *matrix += mass;
 }
 
 /// ν₁ = T₀ (v₀ + h u), q₁ = q₀ ⊞ h ν₁, v₁ = T₁ᵀ ν₁ (the module's header).
