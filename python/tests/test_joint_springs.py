@@ -209,3 +209,21 @@ def test_euler_takes_the_dampers_implicit_as_mujoco_decides(damping):
     text = ('<mujoco><option gravity="0 0 -9.81"/><worldbody><body><joint name="swing" axis="0 1 0" '
             f'damping="{damping}"/><geom name="bob" size=".1" pos="0 0 -1"/></body></worldbody></mujoco>')
     assert_steps_from_a_turned_state(text, "Euler", 8)
+
+
+def test_euler_solves_dampers_that_leave_its_matrix_indefinite():
+    """A damper whose slope outweighs the inertia (b₁ < 0 at speed) leaves M − h ∂f/∂ν
+    indefinite: Cholesky fails there (MuJoCo 4.0's factorisation too: it warns and its step
+    diverges, measured 4e15 rad/s) and robodyn solves the implicit step by LU; v₁ by hand."""
+    b, b1, h, v = 1.0, -50.0, 0.01, 3.0
+    text = (f'<mujoco><option timestep="{h}" gravity="0 0 0"/><worldbody><body><joint name="j" axis="0 1 0" '
+            f'damping="{b} {b1}"/><geom name="bob" size="0.01" pos="0.1 0 0" mass="0.01" contype="0" '
+            'conaffinity="0"/></body></worldbody></mujoco>')
+    model = load_quietly(None, text)
+    inertia = model.mass_matrix(np.zeros(1))[0, 0]
+    force, slope = -(b + b1 * v) * v, -(b + 2 * b1 * v)
+    assert inertia - h * slope < 0, "the case must leave the matrix indefinite"
+    # (M − h K) u = M a with M a the damper's force, v₁ = v + h u
+    expected = v + h * force / (inertia - h * slope)
+    stepped = robodyn.step(model, np.zeros(1), np.array([v]), np.zeros(1), h, integrator="mujoco")
+    assert_close(stepped[model.nq:], [expected], 1e-12, "v₁")
